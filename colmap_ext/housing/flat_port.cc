@@ -1,0 +1,84 @@
+#include "colmap_ext/housing/flat_port.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace portcal {
+
+std::optional<std::string> FlatPort::Invalidity(const double* port) {
+  for (int i = 0; i < kNumParams; ++i) {
+    if (!std::isfinite(port[i])) {
+      return "FLATPORT parameter " + std::to_string(i) + " is not finite";
+    }
+  }
+  const double norm = Eigen::Vector3d(port[0], port[1], port[2]).norm();
+  if (std::abs(norm - 1.0) > 1e-6) {
+    return "FLATPORT normal (Nx, Ny, Nz) must be a unit vector, its norm is " +
+           std::to_string(norm);
+  }
+  if (port[2] <= 0) {
+    return "FLATPORT normal must point forward, into the water (Nz > 0)";
+  }
+  if (!(InterfaceDistance(port) > 0)) {
+    return "FLATPORT int_dist must be positive";
+  }
+  if (!(Thickness(port) > 0)) return "FLATPORT int_thick must be positive";
+  if (!(AirIndex(port) > 0 && GlassIndex(port) > 0 && WaterIndex(port) > 0)) {
+    return "FLATPORT refractive indices must be positive";
+  }
+  return std::nullopt;
+}
+
+bool FlatPort::AirRayToPointValue(const double* port,
+                                  const Eigen::Vector3d& point,
+                                  Eigen::Vector3d* dir_in_air) {
+  const Eigen::Vector3d n = Normal(port);
+  const double d = InterfaceDistance(port);
+  const double t = Thickness(port);
+  const double z = n.dot(point);
+  const double w = z - d - t;  // depth of the point beyond the outer surface
+  if (!(w > 0)) return false;
+  const Eigen::Vector3d radial = point - z * n;
+  const double r = radial.norm();
+  if (r <= 1e-15 * z) {  // on the axis: the ray is not bent
+    *dir_in_air = n;
+    return true;
+  }
+  const double ra = AirIndex(port) / GlassIndex(port);
+  const double rw = AirIndex(port) / WaterIndex(port);
+  // The air sine s is limited to where every layer still transmits.
+  double s_max = 1.0;
+  if (ra > 1.0) s_max = std::min(s_max, 1.0 / ra);
+  if (rw > 1.0) s_max = std::min(s_max, 1.0 / rw);
+
+  // Radial distance reached at depth z by the ray of air sine s, minus r, and
+  // its derivative: d/ds [k s / sqrt(1 - k^2 s^2)] = k / (1 - k^2 s^2)^1.5.
+  const auto residual = [&](double s, double* derivative) {
+    const double ca2 = 1.0 - s * s;
+    const double cg2 = 1.0 - ra * ra * s * s;
+    const double cw2 = 1.0 - rw * rw * s * s;
+    const double ca = std::sqrt(ca2), cg = std::sqrt(cg2), cw = std::sqrt(cw2);
+    *derivative = d / (ca2 * ca) + t * ra / (cg2 * cg) + w * rw / (cw2 * cw);
+    return d * s / ca + t * ra * s / cg + w * rw * s / cw - r;
+  };
+
+  double lo = 0.0, hi = s_max;
+  double s = std::clamp(r / point.norm(), 0.0, s_max);
+  if (s <= lo || s >= hi) s = 0.5 * (lo + hi);
+  for (int iter = 0; iter < 200; ++iter) {
+    double derivative;
+    const double value = residual(s, &derivative);
+    if (value == 0.0) break;
+    (value < 0 ? lo : hi) = s;
+    double next = s - value / derivative;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);  // safeguard
+    const bool converged = std::abs(next - s) <= 4e-16 * std::max(s, 1e-300);
+    s = next;
+    if (converged || hi - lo <= 4e-16 * hi) break;
+  }
+  if (!std::isfinite(s)) return false;
+  *dir_in_air = std::sqrt(1.0 - s * s) * n + (s / r) * radial;
+  return true;
+}
+
+}  // namespace portcal

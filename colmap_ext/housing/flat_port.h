@@ -1,0 +1,91 @@
+// FLATPORT (refractive COLMAP fork id 0): a glass plate of thickness int_thick
+// in front of the camera. Parameters, in this order:
+//   Nx, Ny, Nz   unit normal of the interface in the camera frame, pointing
+//                into the water
+//   int_dist     distance (m) of the inner, air-glass surface from the camera
+//                centre: the surface is the plane n . X = int_dist
+//   int_thick    glass thickness (m): the outer surface is n . X = int_dist +
+//                int_thick
+//   na, ng, nw   refractive indices of air, glass and water
+// Treibitz et al., PAMI 2012; Agrawal et al., "A theory of multi-layer flat
+// refractive geometry", CVPR 2012.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+
+#include "colmap_ext/housing/refraction.h"
+#include "colmap_ext/util/jet_utils.h"
+
+namespace portcal {
+
+struct FlatPort {
+  static constexpr int kId = 0;
+  static constexpr const char* kName = "FLATPORT";
+  static constexpr int kNumParams = 8;
+  static constexpr const char* kParamsInfo =
+      "Nx, Ny, Nz, int_dist, int_thick, na, ng, nw";
+
+  // Normalized, so that derivatives w.r.t. (Nx, Ny, Nz) are those of the
+  // direction (the stored vector is unit up to rounding; Invalidity checks).
+  template <typename T>
+  static VectorT<T, 3> Normal(const T* port) {
+    return VectorT<T, 3>(port[0], port[1], port[2]).normalized();
+  }
+  template <typename T>
+  static const T& InterfaceDistance(const T* port) { return port[3]; }
+  template <typename T>
+  static const T& Thickness(const T* port) { return port[4]; }
+  template <typename T>
+  static const T& AirIndex(const T* port) { return port[5]; }
+  template <typename T>
+  static const T& GlassIndex(const T* port) { return port[6]; }
+  template <typename T>
+  static const T& WaterIndex(const T* port) { return port[7]; }
+
+  // The axis every plane of refraction contains, through the camera centre.
+  template <typename T>
+  static VectorT<T, 3> RefractionAxis(const T* port) {
+    return Normal(port);
+  }
+
+  // Why these parameters describe no flat port, or nullopt if they do.
+  static std::optional<std::string> Invalidity(const double* port);
+
+  // Back-projection: a ray leaving the camera centre along `dir_in_air` (any
+  // length) -> ray in water, origin on the outer surface, unit direction.
+  // False if the ray misses the port (n . d <= 0) or is totally reflected.
+  template <typename T>
+  [[nodiscard]] static bool RayInWater(const T* port,
+                                       const VectorT<T, 3>& dir_in_air,
+                                       VectorT<T, 3>* origin,
+                                       VectorT<T, 3>* dir) {
+    const VectorT<T, 3> n = Normal(port);
+    const VectorT<T, 3> d0 = dir_in_air.normalized();
+    const T cos0 = n.dot(d0);
+    if (!(cos0 > T(0))) return false;
+    const VectorT<T, 3> p1 = (InterfaceDistance(port) / cos0) * d0;
+    VectorT<T, 3> d1;
+    if (!Refract<T, 3>(d0, n, AirIndex(port) / GlassIndex(port), &d1)) {
+      return false;
+    }
+    *origin = p1 + (Thickness(port) / n.dot(d1)) * d1;
+    return Refract<T, 3>(d1, n, GlassIndex(port) / WaterIndex(port), dir);
+  }
+
+  // Forward projection, exact: the unit direction in air, from the camera
+  // centre, of the ray that reaches `point` (camera frame, in water). The ray
+  // stays in the plane spanned by n and the point; there the sine s of the
+  // air angle solves the 1-D equation (radial distance as a sum over layers)
+  //   d s / ca + t ra s / cg + w rw s / cw = r,
+  //   ra = na/ng, rw = na/nw, cg = sqrt(1 - ra^2 s^2), ...
+  // whose left side is convex and increasing in s, so a safeguarded Newton
+  // iteration with the analytic derivative converges from any start.
+  // False if the point is not beyond the outer surface.
+  static bool AirRayToPointValue(const double* port,
+                                 const Eigen::Vector3d& point,
+                                 Eigen::Vector3d* dir_in_air);
+};
+
+}  // namespace portcal

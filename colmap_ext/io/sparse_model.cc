@@ -1,0 +1,149 @@
+#include "colmap_ext/io/sparse_model.h"
+
+#include <fstream>
+#include <set>
+
+#include "colmap_ext/util/error.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+
+void SparseModel::Validate(const std::string& context) const {
+  for (const auto& [camera_id, camera] : cameras) {
+    camera.Validate(context + ": camera " + std::to_string(camera_id));
+  }
+  for (const auto& [image_id, image] : images) {
+    if (cameras.count(image.camera_id) == 0) {
+      throw InputError(context + ": image " + std::to_string(image_id) + " (" +
+                       image.name + ") refers to unknown camera " +
+                       std::to_string(image.camera_id));
+    }
+    if (!image.cam_from_world.rotation.coeffs().allFinite() ||
+        !image.cam_from_world.translation.allFinite()) {
+      throw InputError(context + ": image " + image.name +
+                       " has a non-finite pose");
+    }
+    for (const Point2D& point2D : image.points2D) {
+      if (!point2D.xy.allFinite()) {
+        throw InputError(context + ": image " + image.name +
+                         " has a non-finite 2D point");
+      }
+      if (point2D.point3D_id != kInvalidPoint3DId &&
+          points3D.count(point2D.point3D_id) == 0) {
+        throw InputError(context + ": image " + image.name +
+                         " refers to unknown 3D point " +
+                         std::to_string(point2D.point3D_id));
+      }
+    }
+  }
+  for (const auto& [point3D_id, point3D] : points3D) {
+    if (!point3D.xyz.allFinite() || !std::isfinite(point3D.error)) {
+      throw InputError(context + ": 3D point " + std::to_string(point3D_id) +
+                       " is not finite");
+    }
+    for (const TrackElement& element : point3D.track) {
+      const auto image = images.find(element.image_id);
+      if (image == images.end() ||
+          element.point2D_idx >= image->second.points2D.size()) {
+        throw InputError(context + ": 3D point " + std::to_string(point3D_id) +
+                         " observes unknown image " +
+                         std::to_string(element.image_id) + " / point " +
+                         std::to_string(element.point2D_idx));
+      }
+    }
+  }
+  for (const auto& [camera_id, housing] : housings) {
+    if (cameras.count(camera_id) == 0) {
+      throw InputError(context + ": housing of unknown camera " +
+                       std::to_string(camera_id));
+    }
+    housing.Validate(context + ": housing of camera " +
+                     std::to_string(camera_id));
+  }
+}
+
+SparseModel ReadSparseModel(const fs::path& dir) {
+  if (!fs::is_directory(dir)) {
+    throw InputError(dir.string() + ": not a directory with a sparse model");
+  }
+  SparseModel model;
+  if (fs::exists(dir / "cameras.bin") && fs::exists(dir / "images.bin") &&
+      fs::exists(dir / "points3D.bin")) {
+    model.cameras = ReadCamerasBinary(dir / "cameras.bin");
+    model.images = ReadImagesBinary(dir / "images.bin");
+    model.points3D = ReadPoints3DBinary(dir / "points3D.bin");
+  } else if (fs::exists(dir / "cameras.txt") && fs::exists(dir / "images.txt") &&
+             fs::exists(dir / "points3D.txt")) {
+    // Accepts the refractive fork's cameras.txt too (port after the camera).
+    ImportRefractiveCamerasText(dir / "cameras.txt", &model.cameras,
+                                &model.housings);
+    model.images = ReadImagesText(dir / "images.txt");
+    model.points3D = ReadPoints3DText(dir / "points3D.txt");
+  } else {
+    throw InputError(dir.string() +
+                     ": no cameras/images/points3D .bin or .txt files");
+  }
+  if (fs::exists(dir / "housings.txt")) {
+    if (!model.housings.empty()) {
+      throw InputError(dir.string() +
+                       ": housings given both in cameras.txt (refractive fork "
+                       "format) and in housings.txt; keep one");
+    }
+    model.housings = ReadHousingsText(dir / "housings.txt");
+  }
+  model.Validate(dir.string());
+  return model;
+}
+
+void WriteFileAtomically(const fs::path& path, bool binary,
+                         const std::function<void(std::ostream&)>& write) {
+  const fs::path tmp = path.string() + ".tmp";
+  try {
+    {
+      std::ofstream out(tmp, binary ? std::ios::binary | std::ios::trunc
+                                    : std::ios::trunc);
+      if (!out) throw InputError(tmp.string() + ": cannot open for writing");
+      write(out);
+      out.flush();
+      if (!out) throw InputError(tmp.string() + ": write failed");
+    }
+    fs::rename(tmp, path);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw;
+  }
+}
+
+void WriteSparseModel(const SparseModel& model, const fs::path& dir,
+                      ModelFormat format) {
+  model.Validate("model to write to " + dir.string());
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!fs::is_directory(dir)) {
+    throw InputError(dir.string() + ": cannot create output directory");
+  }
+  const bool binary = format == ModelFormat::kBinary;
+  const std::string ext = binary ? ".bin" : ".txt";
+  WriteFileAtomically(dir / ("cameras" + ext), binary, [&](std::ostream& out) {
+    binary ? WriteCamerasBinary(model, out) : WriteCamerasText(model, out);
+  });
+  WriteFileAtomically(dir / ("images" + ext), binary, [&](std::ostream& out) {
+    binary ? WriteImagesBinary(model, out) : WriteImagesText(model, out);
+  });
+  WriteFileAtomically(dir / ("points3D" + ext), binary, [&](std::ostream& out) {
+    binary ? WritePoints3DBinary(model, out) : WritePoints3DText(model, out);
+  });
+  const fs::path housings_path = dir / "housings.txt";
+  if (!model.housings.empty()) {
+    WriteFileAtomically(housings_path, false, [&](std::ostream& out) {
+      WriteHousingsText(model.housings, out);
+    });
+  } else if (fs::exists(housings_path)) {
+    // A stale sidecar would attach housings to cameras that have none.
+    fs::remove(housings_path);
+  }
+}
+
+}  // namespace portcal

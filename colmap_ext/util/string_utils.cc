@@ -1,0 +1,74 @@
+#include "colmap_ext/util/string_utils.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+
+#include "colmap_ext/util/error.h"
+
+namespace portcal {
+
+std::string Trim(const std::string& s) {
+  const size_t begin = s.find_first_not_of(" \t\r\n");
+  if (begin == std::string::npos) return "";
+  const size_t end = s.find_last_not_of(" \t\r\n");
+  return s.substr(begin, end - begin + 1);
+}
+
+std::vector<std::string> SplitTokens(const std::string& s,
+                                     const std::string& delimiters) {
+  std::vector<std::string> tokens;
+  size_t pos = 0;
+  while (pos < s.size()) {
+    const size_t begin = s.find_first_not_of(delimiters, pos);
+    if (begin == std::string::npos) break;
+    size_t end = s.find_first_of(delimiters, begin);
+    if (end == std::string::npos) end = s.size();
+    tokens.push_back(s.substr(begin, end - begin));
+    pos = end;
+  }
+  return tokens;
+}
+
+double ParseDouble(const std::string& token, const std::string& context) {
+  const std::string trimmed = Trim(token);
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(trimmed.c_str(), &end);
+  if (trimmed.empty() || end != trimmed.c_str() + trimmed.size()) {
+    throw InputError(context + ": '" + token + "' is not a number");
+  }
+  if (!std::isfinite(value)) {
+    throw InputError(context + ": '" + token + "' is not finite");
+  }
+  return value;
+}
+
+long long ParseInteger(const std::string& token, const std::string& context,
+                       long long min_value, long long max_value) {
+  const std::string trimmed = Trim(token);
+  char* end = nullptr;
+  errno = 0;
+  const long long value = std::strtoll(trimmed.c_str(), &end, 10);
+  if (trimmed.empty() || end != trimmed.c_str() + trimmed.size() ||
+      errno == ERANGE) {
+    throw InputError(context + ": '" + token + "' is not an integer");
+  }
+  if (value < min_value || value > max_value) {
+    throw InputError(context + ": " + token + " is outside [" +
+                     std::to_string(min_value) + ", " +
+                     std::to_string(max_value) + "]");
+  }
+  return value;
+}
+
+std::vector<double> ParseDoubleList(const std::string& s,
+                                    const std::string& context) {
+  std::vector<double> values;
+  for (const std::string& token : SplitTokens(s)) {
+    values.push_back(ParseDouble(token, context));
+  }
+  return values;
+}
+
+}  // namespace portcal

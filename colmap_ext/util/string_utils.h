@@ -1,0 +1,22 @@
+// Small string helpers for the text formats.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace portcal {
+
+std::string Trim(const std::string& s);
+// Splits on any run of the delimiter characters; no empty tokens.
+std::vector<std::string> SplitTokens(const std::string& s,
+                                     const std::string& delimiters = " \t,");
+// Parses a finite double; throws InputError("<context>: ...") otherwise.
+double ParseDouble(const std::string& token, const std::string& context);
+// Parses an integer within [min, max]; throws InputError otherwise.
+long long ParseInteger(const std::string& token, const std::string& context,
+                       long long min_value, long long max_value);
+// "1.0, 2 3" -> {1, 2, 3}; throws InputError naming `context`.
+std::vector<double> ParseDoubleList(const std::string& s,
+                                    const std::string& context);
+
+}  // namespace portcal

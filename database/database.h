@@ -1,0 +1,120 @@
+// A COLMAP 3.8 database (the six tables, byte-compatible, PRAGMA
+// user_version = 3800) plus portcal's own tables, all prefixed portcal_.
+//
+// Stages write inside one Transaction: it rolls back unless committed, so a
+// failed or interrupted stage leaves the file as it was.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "colmap_ext/housing/housing.h"
+#include "database/feature_types.h"
+#include "database/statement.h"
+
+struct sqlite3;
+
+namespace portcal {
+
+class Database {
+ public:
+  static constexpr int kColmapSchemaVersion = 3800;
+  static constexpr int kPortcalSchemaVersion = 1;
+
+  enum class OpenMode {
+    kReadOnly,   // must exist
+    kReadWrite,  // must exist
+    kCreate,     // created with the full schema if missing
+  };
+
+  // Throws DatabaseError naming `path` for: a missing file (unless kCreate),
+  // a file that is no SQLite database, a database of another COLMAP or
+  // portcal schema version, or one locked by another process.
+  explicit Database(const std::filesystem::path& path,
+                    OpenMode mode = OpenMode::kReadWrite);
+  ~Database();
+  Database(const Database&) = delete;
+  Database& operator=(const Database&) = delete;
+
+  const std::string& path() const { return path_; }
+  // BEGIN IMMEDIATE; ROLLBACK unless Commit() is called.
+  Transaction BeginTransaction();
+
+  // --- COLMAP tables -------------------------------------------------------
+  // Inserts; assigns a new id unless `use_camera_id`.
+  camera_t WriteCamera(const Camera& camera, bool use_camera_id = false);
+  void UpdateCamera(const Camera& camera);
+  std::optional<Camera> ReadCamera(camera_t camera_id);
+  std::vector<Camera> ReadAllCameras();
+
+  image_t WriteImage(const DatabaseImage& image, bool use_image_id = false);
+  std::optional<DatabaseImage> ReadImage(image_t image_id);
+  std::optional<DatabaseImage> ReadImageWithName(const std::string& name);
+  std::vector<DatabaseImage> ReadAllImages();
+
+  // Replaces the image's keypoints / descriptors.
+  void WriteKeypoints(image_t image_id, const FeatureKeypoints& keypoints);
+  // Reads 6-, 4- (x, y, scale, orientation) and 2-column blobs.
+  FeatureKeypoints ReadKeypoints(image_t image_id);
+  void WriteDescriptors(image_t image_id,
+                        const FeatureDescriptors& descriptors);
+  FeatureDescriptors ReadDescriptors(image_t image_id);
+  bool ExistsKeypoints(image_t image_id);
+  bool ExistsDescriptors(image_t image_id);
+
+  // Matches are stored for (min id, max id); reading swaps back as needed.
+  void WriteMatches(image_t image_id1, image_t image_id2,
+                    const FeatureMatches& matches);
+  FeatureMatches ReadMatches(image_t image_id1, image_t image_id2);
+  std::vector<std::pair<image_pair_t, FeatureMatches>> ReadAllMatches();
+  void WriteTwoViewGeometry(image_t image_id1, image_t image_id2,
+                            const TwoViewGeometry& geometry);
+  std::optional<TwoViewGeometry> ReadTwoViewGeometry(image_t image_id1,
+                                                     image_t image_id2);
+  std::vector<std::pair<image_pair_t, TwoViewGeometry>> ReadTwoViewGeometries();
+  // Deletes matches and geometries of every pair involving the image.
+  void DeleteMatchesOfImage(image_t image_id);
+
+  int64_t NumCameras();
+  int64_t NumImages();
+  int64_t NumKeypoints();   // summed over images
+  int64_t NumDescriptors();
+  int64_t NumMatches();     // summed over pairs
+  int64_t NumInlierMatches();
+  int64_t NumMatchedImagePairs();
+  int64_t NumVerifiedImagePairs();
+
+  // --- portcal tables ------------------------------------------------------
+  void WriteHousing(camera_t camera_id, const Housing& housing);
+  std::optional<Housing> ReadHousing(camera_t camera_id);
+  std::map<camera_t, Housing> ReadAllHousings();
+
+  // Replace the image's rows.
+  void WriteTargetObservations(image_t image_id,
+                               const std::vector<TargetObservation>& rows);
+  std::vector<TargetObservation> ReadTargetObservations(image_t image_id);
+  void WriteMarkerDetections(image_t image_id,
+                             const std::vector<MarkerDetection>& rows);
+  std::vector<MarkerDetection> ReadMarkerDetections(image_t image_id);
+
+  // Appends a completed run (write it inside the stage's transaction, so a
+  // failed stage leaves no log row either).
+  int64_t WriteStageLog(const StageLogEntry& entry);
+  std::vector<StageLogEntry> ReadStageLog();
+
+ private:
+  void CreateSchema();
+  void CheckSchema();
+  Statement& Prepare(const std::string& key, const std::string& sql);
+  int64_t QueryInt(const std::string& sql);
+
+  std::string path_;
+  sqlite3* db_ = nullptr;
+  std::map<std::string, std::unique_ptr<Statement>> statements_;
+};
+
+}  // namespace portcal

@@ -1,0 +1,36 @@
+// `portcal project_points`: 3-D points (camera frame, metres) to pixels
+// through a camera and an optional housing, or pixels to rays with
+// `unproject`.
+#pragma once
+
+#include <iosfwd>
+#include <string>
+
+namespace portcal {
+
+struct ProjectPointsOptions {
+  // The camera: either from a sparse model (input_path + camera_id, with its
+  // housings.txt) or from the Camera.* / Housing.* options.
+  std::string input_path;
+  int camera_id = -1;
+  std::string camera_model;   // COLMAP name, e.g. RADIAL
+  std::string camera_params;  // comma/space separated, COLMAP order
+  int width = 0;              // pixels, > 0
+  int height = 0;
+  std::string housing_model;  // "" | NONE | FLATPORT | DOMEPORT
+  std::string housing_params;
+
+  std::string points_path;  // input text file: "X Y Z" or "x y" per line
+  bool unproject = false;   // pixels -> rays instead of points -> pixels
+
+  void Check() const;  // throws OptionError naming the option
+};
+
+// Writes one line per input line to `out`: "x y" for a projected point,
+// "ox oy oz dx dy dz" for an unprojected pixel (origin on the port's outer
+// surface, unit direction), or "invalid <reason>" where there is no answer.
+// Returns the number of invalid lines. Throws InputError naming the file and
+// line for malformed input.
+int ProjectPoints(const ProjectPointsOptions& options, std::ostream& out);
+
+}  // namespace portcal

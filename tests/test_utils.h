@@ -1,0 +1,57 @@
+// Shared helpers of the test suite: temporary directories, the shared data
+// folder (skipped cleanly when absent), and running executables.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <optional>
+#include <random>
+#include <string>
+
+namespace portcal {
+namespace testing {
+
+// A fresh directory removed at scope exit.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& name) const {
+    return path_ / name;
+  }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// ../shared beside the project root (PORTCAL_SHARED_DIR overrides), or
+// nullopt when absent.
+std::optional<std::filesystem::path> SharedDir();
+
+// The built portcal executable and the colmap binary ("" when not found).
+std::string PortcalBinary();
+std::string ColmapBinary();
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr
+};
+// Runs a shell command, capturing its output.
+CommandResult RunCommand(const std::string& command);
+
+std::string ReadFileToString(const std::filesystem::path& path);
+
+}  // namespace testing
+}  // namespace portcal
+
+// Skips the test with a message when the shared data folder is absent.
+#define PORTCAL_REQUIRE_SHARED(var)                                        \
+  const auto var##_opt = ::portcal::testing::SharedDir();                  \
+  if (!var##_opt) GTEST_SKIP() << "../shared is absent: shared-data test skipped"; \
+  const std::filesystem::path var = *var##_opt
+
+#define PORTCAL_REQUIRE_COLMAP(var)                                         \
+  const std::string var = ::portcal::testing::ColmapBinary();              \
+  if (var.empty()) GTEST_SKIP() << "the colmap binary was not found: interop test skipped"

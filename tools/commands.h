@@ -1,0 +1,10 @@
+// The subcommands; each parses its options and calls one pipeline.
+#pragma once
+
+namespace portcal {
+
+int RunDatabaseCreator(int argc, char** argv);
+int RunModelConverter(int argc, char** argv);
+int RunProjectPoints(int argc, char** argv);
+
+}  // namespace portcal

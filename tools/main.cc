@@ -1,0 +1,78 @@
+// The portcal executable: a table of colmap-style subcommands.
+#include <csignal>
+#include <cstring>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/progress.h"
+#include "tools/command_line.h"
+#include "tools/commands.h"
+
+namespace {
+
+struct Command {
+  const char* name;
+  int (*run)(int argc, char** argv);
+  const char* summary;
+};
+
+const std::vector<Command>& Commands() {
+  static const std::vector<Command> kCommands = {
+      {"database_creator", portcal::RunDatabaseCreator,
+       "create a COLMAP 3.8 database with portcal's tables"},
+      {"model_converter", portcal::RunModelConverter,
+       "convert sparse models between BIN and TXT (and import the refractive "
+       "fork's cameras.txt)"},
+      {"project_points", portcal::RunProjectPoints,
+       "project 3-D points through a camera and housing (or unproject pixels "
+       "to rays)"},
+  };
+  return kCommands;
+}
+
+void PrintHelp() {
+  std::cout << "portcal " << PORTCAL_VERSION
+            << " -- camera, stereo and housing calibration for underwater "
+               "photogrammetry\n\nUsage:\n  portcal <command> [options]\n  "
+               "portcal <command> -h\n\nCommands:\n";
+  std::cout << "  help                  list the commands\n";
+  for (const Command& command : Commands()) {
+    std::string name = command.name;
+    name.resize(22, ' ');
+    std::cout << "  " << name << command.summary << "\n";
+  }
+}
+
+void HandleSignal(int signal) {
+  // First signal: ask the running stage to stop (it rolls back); second:
+  // default action.
+  portcal::CancelFlag::Request();
+  std::signal(signal, SIG_DFL);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  portcal::InitializeLogging(argv[0]);
+  std::signal(SIGINT, HandleSignal);
+  std::signal(SIGTERM, HandleSignal);
+  if (argc < 2 || std::strcmp(argv[1], "help") == 0 ||
+      std::strcmp(argv[1], "-h") == 0 || std::strcmp(argv[1], "--help") == 0) {
+    PrintHelp();
+    return argc < 2 ? portcal::kExitUsage : portcal::kExitSuccess;
+  }
+  if (std::strcmp(argv[1], "--version") == 0 || std::strcmp(argv[1], "version") == 0) {
+    std::cout << "portcal " << PORTCAL_VERSION << "\n";
+    return portcal::kExitSuccess;
+  }
+  for (const Command& command : Commands()) {
+    if (command.name == std::string(argv[1])) {
+      return command.run(argc - 1, argv + 1);
+    }
+  }
+  std::cerr << "error: unknown command '" << argv[1]
+            << "' (portcal help lists the commands)\n";
+  return portcal::kExitUsage;
+}

@@ -1,0 +1,55 @@
+#include <iostream>
+
+#include "pipelines/model_converter.h"
+#include "pipelines/project_points.h"
+#include "tools/command_line.h"
+#include "tools/commands.h"
+
+namespace portcal {
+
+int RunModelConverter(int argc, char** argv) {
+  ModelConverterOptions options;
+  CommandLine cli("model_converter",
+                  "Converts a COLMAP sparse model (cameras, images, points3D "
+                  "and portcal's housings.txt) between BIN and TXT. A "
+                  "cameras.txt of the refractive COLMAP fork (housing after "
+                  "the camera parameters) is imported into housings.txt.");
+  cli.AddRequired("input_path", &options.input_path, "model directory to read");
+  cli.AddRequired("output_path", &options.output_path,
+                  "model directory to write (created if missing)");
+  cli.Add("output_type", &options.output_type, "BIN | TXT");
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    ConvertModel(options);
+  });
+}
+
+int RunProjectPoints(int argc, char** argv) {
+  ProjectPointsOptions options;
+  CommandLine cli("project_points",
+                  "Projects 3-D points (camera frame, metres; one 'X Y Z' per "
+                  "line) through a camera and optional housing and prints one "
+                  "'x y' pixel per line (COLMAP convention: top-left pixel "
+                  "centre at 0.5, 0.5). With --unproject, reads 'x y' pixels "
+                  "and prints rays 'ox oy oz dx dy dz' (in water behind a "
+                  "housing). Points without an answer print 'invalid ...'.");
+  cli.AddRequired("points_path", &options.points_path, "input text file");
+  cli.Add("unproject", &options.unproject, "pixels -> rays (0 | 1)");
+  cli.Add("input_path", &options.input_path,
+          "sparse model to take the camera (and housings.txt) from");
+  cli.Add("camera_id", &options.camera_id, "camera id in --input_path");
+  cli.Add("Camera.model", &options.camera_model, "COLMAP camera model name");
+  cli.Add("Camera.params", &options.camera_params, "parameters in COLMAP's order");
+  cli.Add("Camera.width", &options.width, "image width, pixels");
+  cli.Add("Camera.height", &options.height, "image height, pixels");
+  cli.Add("Housing.model", &options.housing_model, "NONE | FLATPORT | DOMEPORT");
+  cli.Add("Housing.params", &options.housing_params,
+          "FLATPORT: Nx,Ny,Nz,int_dist,int_thick,na,ng,nw; DOMEPORT: "
+          "Cx,Cy,Cz,int_radius,int_thick,na,ng,nw (metres)");
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    ProjectPoints(options, std::cout);
+  });
+}
+
+}  // namespace portcal
