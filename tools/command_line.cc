@@ -48,7 +48,11 @@ bool CommandLine::Parse(int argc, char** argv) {
   } catch (const po::error& e) {
     throw UsageError(std::string(e.what()) + " (see portcal " + command_ + " -h)");
   }
-  SetLogLevel(log_level_);
+  try {
+    SetLogLevel(log_level_);
+  } catch (const OptionError& e) {
+    throw UsageError(e.what());
+  }
   return true;
 }
 

@@ -88,10 +88,11 @@ struct DomePort {
 
   // Forward projection, exact: unit air direction of the ray that reaches
   // `point` (camera frame, outside the outer sphere). The ray lies in the
-  // plane through the camera centre, C and the point; there the air angle phi
-  // solves g(phi) = cross(water_dir, point - water_origin) = 0, a 1-D root
-  // found by bracketed Newton (derivative by forward-mode autodiff of the 2-D
-  // trace, not finite differences). False if no ray reaches the point.
+  // plane through the camera centre, C and the point. There, because both
+  // surfaces are spheres about C, Bouguer's invariant n * (signed distance of
+  // the ray from C) gives the water ray of the air angle phi in closed form,
+  // and phi solves a 1-D equation by safeguarded Newton with its analytic
+  // derivative (see dome_port.cc). False if no ray reaches the point.
   static bool AirRayToPointValue(const double* port,
                                  const Eigen::Vector3d& point,
                                  Eigen::Vector3d* dir_in_air);

@@ -1,0 +1,170 @@
+// The portcal executable as a user runs it: help, exit codes, one-line
+// errors naming the culprit, ini files, and the commands of the foundation.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "colmap_ext/housing/housing.h"
+#include "colmap_ext/io/sparse_model.h"
+#include "tests/test_utils.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+namespace {
+
+using testing::RunCommand;
+
+std::string Portcal(const std::string& args) { return testing::PortcalBinary() + " " + args; }
+
+TEST(Cli, HelpListsTheCommands) {
+  const auto result = RunCommand(Portcal("help"));
+  EXPECT_EQ(result.exit_code, 0);
+  for (const char* command : {"database_creator", "model_converter", "project_points"}) {
+    EXPECT_NE(result.output.find(command), std::string::npos) << command;
+  }
+  EXPECT_EQ(RunCommand(Portcal("")).exit_code, 2);
+  const auto unknown = RunCommand(Portcal("frobnicate"));
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.output.find("frobnicate"), std::string::npos);
+}
+
+TEST(Cli, CommandHelpShowsOptionsWithDefaults) {
+  const auto result = RunCommand(Portcal("project_points -h"));
+  EXPECT_EQ(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--Housing.model"), std::string::npos);
+  EXPECT_NE(result.output.find("--log_level"), std::string::npos);
+  EXPECT_NE(result.output.find("(=info)"), std::string::npos) << result.output;
+}
+
+TEST(Cli, BadOptionsAreUsageErrorsNamingTheOption) {
+  auto result = RunCommand(Portcal("model_converter --input_path a --output_path b --bogus 1"));
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.output.find("--bogus"), std::string::npos) << result.output;
+  result = RunCommand(Portcal("model_converter --input_path a"));
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.output.find("output_path"), std::string::npos) << result.output;
+  result = RunCommand(Portcal("database_creator --database_path x.db --log_level loud"));
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.output.find("log_level"), std::string::npos) << result.output;
+}
+
+TEST(Cli, ProjectPointsMatchesTheLibraryAndReportsInvalidPoints) {
+  testing::TempDir dir;
+  std::ofstream(dir / "points.txt") << "# X Y Z\n0.1 -0.05 1.2\n0 0 0.01\n0.3 0.2 2.5\n";
+  const std::string camera =
+      "--Camera.model RADIAL --Camera.params 1297.3655,960,540,-0.1,0.01 "
+      "--Camera.width 1920 --Camera.height 1080";
+  const std::string housing =
+      "--Housing.model DOMEPORT --Housing.params '0.01 0.006 0.002 0.05 0.006 1 1.473 1.334'";
+  const auto result = RunCommand(Portcal("project_points --log_level error --points_path " +
+                                         (dir / "points.txt").string() + " " + camera + " " +
+                                         housing));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  std::istringstream lines(result.output);
+  std::string first, second, third;
+  std::getline(lines, first);
+  std::getline(lines, second);
+  std::getline(lines, third);
+  Camera cam = Camera::FromModelName("RADIAL", 1297.3655, 1920, 1080);
+  cam.params = {1297.3655, 960, 540, -0.1, 0.01};
+  const Housing dome = Housing::FromName(
+      "DOMEPORT", {0.01, 0.006, 0.002, 0.05, 0.006, 1, 1.473, 1.334}, "test");
+  const Eigen::Vector2d expected = *ProjectPoint(cam, &dome, Eigen::Vector3d(0.1, -0.05, 1.2));
+  double x, y;
+  std::istringstream(first) >> x >> y;
+  EXPECT_EQ(x, expected.x());  // 17 digits: exact
+  EXPECT_EQ(y, expected.y());
+  EXPECT_EQ(second.rfind("invalid", 0), 0u) << second;  // inside the dome
+  EXPECT_NE(third.rfind("invalid", 0), 0u) << third;
+
+  // Unproject: the pixel's ray passes through the point.
+  std::ofstream(dir / "pixels.txt") << first << "\n";
+  const auto rays = RunCommand(Portcal("project_points --log_level error --unproject 1 "
+                                       "--points_path " + (dir / "pixels.txt").string() +
+                                       " " + camera + " " + housing));
+  ASSERT_EQ(rays.exit_code, 0) << rays.output;
+  Eigen::Vector3d origin, direction;
+  std::istringstream(rays.output) >> origin.x() >> origin.y() >> origin.z() >> direction.x() >>
+      direction.y() >> direction.z();
+  const Eigen::Vector3d to_point = Eigen::Vector3d(0.1, -0.05, 1.2) - origin;
+  EXPECT_LT((to_point - to_point.dot(direction) * direction).norm(), 1e-9);
+}
+
+TEST(Cli, ErrorsNameTheFileAndLine) {
+  testing::TempDir dir;
+  std::ofstream(dir / "bad.txt") << "0.1 0.2 1\n0.1 oops 1\n";
+  const std::string camera =
+      "--Camera.model PINHOLE --Camera.params 800,800,320,240 --Camera.width 640 "
+      "--Camera.height 480";
+  auto result = RunCommand(Portcal("project_points --points_path " + (dir / "bad.txt").string() +
+                                   " " + camera));
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("bad.txt:2"), std::string::npos) << result.output;
+  result = RunCommand(Portcal("project_points --points_path " + (dir / "none.txt").string() +
+                              " " + camera));
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("none.txt"), std::string::npos) << result.output;
+  result = RunCommand(Portcal("project_points --points_path " + (dir / "bad.txt").string() +
+                              " --Camera.model PINHOLE --Camera.params 800,800 "
+                              "--Camera.width 640 --Camera.height 480"));
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("--Camera.params"), std::string::npos) << result.output;
+  // The error is one line.
+  EXPECT_EQ(std::count(result.output.begin(), result.output.end(), '\n'), 1) << result.output;
+}
+
+TEST(Cli, ProjectPathReadsOptionsFromAnIniFile) {
+  testing::TempDir dir;
+  std::ofstream(dir / "points.txt") << "0 0 2\n";
+  std::ofstream(dir / "project.ini")
+      << "log_level = error\npoints_path = " << (dir / "points.txt").string() << "\n"
+      << "[Camera]\nmodel = PINHOLE\nparams = 800,800,320.5,240.5\nwidth = 640\nheight = 480\n";
+  const auto result =
+      RunCommand(Portcal("project_points --project_path " + (dir / "project.ini").string()));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(result.output, "320.5 240.5\n");
+}
+
+TEST(Cli, DatabaseCreatorRefusesAFileThatIsNoDatabaseAndLeavesItAlone) {
+  testing::TempDir dir;
+  const std::string text(2000, 'x');
+  std::ofstream(dir / "notes.db") << text;
+  const auto result = RunCommand(Portcal("database_creator --database_path " +
+                                         (dir / "notes.db").string()));
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("notes.db"), std::string::npos) << result.output;
+  EXPECT_EQ(testing::ReadFileToString(dir / "notes.db"), text);
+  EXPECT_EQ(RunCommand(Portcal("database_creator --log_level error --database_path " +
+                               (dir / "new.db").string())).exit_code, 0);
+  EXPECT_TRUE(fs::exists(dir / "new.db"));
+}
+
+TEST(Cli, ModelConverterImportsTheForksCameras) {
+  testing::TempDir dir;
+  fs::create_directories(dir / "fork");
+  std::ofstream(dir / "fork" / "cameras.txt")
+      << "1 SIMPLE_RADIAL 1920 1080 1300 960 540 0.01 FLATPORT 0 0 1 0.02 0.014 1 1.473 1.334\n";
+  std::ofstream(dir / "fork" / "images.txt") << "";
+  std::ofstream(dir / "fork" / "points3D.txt") << "";
+  auto result = RunCommand(Portcal("model_converter --log_level error --input_path " +
+                                   (dir / "fork").string() + " --output_path " +
+                                   (dir / "out").string() + " --output_type BIN"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const SparseModel model = ReadSparseModel(dir / "out");
+  ASSERT_EQ(model.housings.count(1), 1u);
+  EXPECT_EQ(model.housings.at(1).ModelName(), "FLATPORT");
+  result = RunCommand(Portcal("model_converter --input_path " + (dir / "missing").string() +
+                              " --output_path " + (dir / "out2").string()));
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("missing"), std::string::npos);
+  result = RunCommand(Portcal("model_converter --input_path " + (dir / "fork").string() +
+                              " --output_path " + (dir / "out3").string() +
+                              " --output_type PLY"));
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("--output_type"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace portcal
