@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Set-up, then portcal's main job on a built-in default. For now (the
+# foundation): a camera behind a decentred dome port, imported from the
+# refractive COLMAP fork's cameras.txt format, converted to a COLMAP model
+# with portcal's housings.txt, and a chessboard projected through it and
+# back. Later stages replace this with a full calibration of a rendered set.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash workflows/setup.sh >/dev/null
+
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+portcal=build/portcal
+
+echo "== A RADIAL camera behind a dome port decentred by (10, 6, 2) mm"
+mkdir -p "$work/fork"
+cat > "$work/fork/cameras.txt" <<'CAMERAS'
+# CAMERA_ID MODEL WIDTH HEIGHT PARAMS[] HOUSING HOUSING_PARAMS[]
+1 RADIAL 1920 1080 1297.3655 960 540 0 0 DOMEPORT 0.01 0.006 0.002 0.05 0.006 1.0 1.473 1.334
+CAMERAS
+: > "$work/fork/images.txt"
+: > "$work/fork/points3D.txt"
+"$portcal" model_converter --log_level warn --input_path "$work/fork" \
+  --output_path "$work/model" --output_type TXT
+echo "-- housings.txt written beside the COLMAP model:"
+grep -v '^#' "$work/model/housings.txt"
+
+echo
+echo "== Chessboard corners 0.8 m in front of the camera, projected in air and through the dome"
+awk 'BEGIN { for (r = 0; r < 3; ++r) for (c = 0; c < 4; ++c)
+               printf "%g %g 0.8\n", -0.03 + 0.02 * c, -0.02 + 0.02 * r }' > "$work/corners.txt"
+"$portcal" project_points --log_level warn --points_path "$work/corners.txt" \
+  --Camera.model RADIAL --Camera.params 1297.3655,960,540,0,0 \
+  --Camera.width 1920 --Camera.height 1080 > "$work/air.txt"
+"$portcal" project_points --log_level warn --points_path "$work/corners.txt" \
+  --input_path "$work/model" --camera_id 1 > "$work/dome.txt"
+paste "$work/corners.txt" "$work/air.txt" "$work/dome.txt" | \
+  awk '{printf "X=(%6.3f %6.3f %4.2f)  in air (%8.3f, %8.3f)  behind the dome (%8.3f, %8.3f)  shift %.2f px\n",
+        $1, $2, $3, $4, $5, $6, $7, sqrt(($6-$4)^2 + ($7-$5)^2)}'
+
+echo
+echo "== Back-projection of the dome pixels: rays in water (origin on the outer glass surface)"
+"$portcal" project_points --log_level warn --unproject 1 --points_path "$work/dome.txt" \
+  --input_path "$work/model" --camera_id 1 | head -3
