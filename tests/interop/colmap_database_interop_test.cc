@@ -23,6 +23,7 @@ namespace fs = std::filesystem;
 namespace portcal {
 namespace {
 
+using testing::CommandResult;
 using testing::RunCommand;
 
 constexpr int kWidth = 640, kHeight = 480;
@@ -124,14 +125,20 @@ TEST(ColmapDatabaseInterop, SchemaIsCharacterForCharacterCOLMAPs) {
             "3800\n");
 }
 
-// portcal creates, colmap fills and reconstructs, portcal reads it all.
-TEST(ColmapDatabaseInterop, ColmapFillsAPortcalDatabaseAndPortcalReadsIt) {
+// The database is created by portcal (true) or by colmap itself (false);
+// colmap fills and reconstructs it; portcal reads it all.
+class ColmapFillsDatabase : public ::testing::TestWithParam<bool> {};
+
+TEST_P(ColmapFillsDatabase, PortcalReadsEverythingColmapWrote) {
   PORTCAL_REQUIRE_COLMAP(colmap);
   testing::TempDir dir;
   RenderImages(dir / "images", 6);
   const std::string db_path = (dir / "db.db").string();
-  auto result = RunCommand(testing::PortcalBinary() + " database_creator --database_path " + db_path);
-  ASSERT_EQ(result.exit_code, 0) << result.output;
+  CommandResult result;
+  if (GetParam()) {
+    result = RunCommand(testing::PortcalBinary() + " database_creator --database_path " + db_path);
+    ASSERT_EQ(result.exit_code, 0) << result.output;
+  }
   result = RunCommand(colmap + " feature_extractor --database_path " + db_path +
                       " --image_path " + (dir / "images").string() +
                       " --ImageReader.camera_model SIMPLE_RADIAL --ImageReader.single_camera 1"
@@ -200,10 +207,17 @@ TEST(ColmapDatabaseInterop, ColmapFillsAPortcalDatabaseAndPortcalReadsIt) {
   const SparseModel model = ReadSparseModel(dir / "sparse" / "0");
   EXPECT_GE(model.images.size(), 5u);
   EXPECT_GT(model.points3D.size(), 200u);
-  // colmap left portcal's tables alone.
-  Database db(db_path, Database::OpenMode::kReadOnly);
+  // Written by portcal into colmap's database, read back by colmap's mapper
+  // run above without complaint; portcal's tables are portcal's.
+  Database db(db_path, Database::OpenMode::kReadWrite);
   EXPECT_TRUE(db.ReadStageLog().empty());
+  EXPECT_TRUE(db.ReadAllHousings().empty());
 }
+
+INSTANTIATE_TEST_SUITE_P(CreatedBy, ColmapFillsDatabase, ::testing::Values(true, false),
+                         [](const ::testing::TestParamInfo<bool>& info) {
+                           return info.param ? "Portcal" : "Colmap";
+                         });
 
 // A synthetic scene written through portcal's layer, reconstructed by colmap.
 TEST(ColmapDatabaseInterop, ColmapMapperReconstructsRowsPortcalWrote) {
