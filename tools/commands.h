@@ -6,5 +6,6 @@ namespace portcal {
 int RunDatabaseCreator(int argc, char** argv);
 int RunModelConverter(int argc, char** argv);
 int RunProjectPoints(int argc, char** argv);
+int RunSynthesize(int argc, char** argv);
 
 }  // namespace portcal
