@@ -1,0 +1,50 @@
+// Sub-pixel chessboard corners by fitting the ideal corner pattern.
+//
+// Around an inner corner a chessboard image is two straight edges crossing,
+// dark and light quadrants alternating, blurred by optics and pixel area.
+// The model
+//   I(p) = m + a * erf(s1 / (sqrt(2) sigma)) * erf(s2 / (sqrt(2) sigma)),
+//   s_k = n_k . (p - c),  n_k = (cos theta_k, sin theta_k)
+// integrated over each pixel's area (4 x 4 sub-samples), is point-symmetric
+// about the corner c, as the pattern is, so a mismatch in the edge profile
+// does not bias c. It is fitted to the pixels of a window
+// by Levenberg-Marquardt (Ceres, autodiff): c, both edge angles (any
+// perspective), the levels m, a and the blur sigma. Compared with the
+// gradient-orthogonality of cv::cornerSubPix it uses the whole edge profile
+// and does not assume orthogonal edges.
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
+namespace portcal {
+
+struct CornerRefinementOptions {
+  // Window half size as a fraction of the distance to the nearest
+  // neighbouring corner, clamped to [min, max] pixels.
+  double window_fraction = 0.4;
+  double min_window_px = 3;
+  double max_window_px = 15;
+  // A refined corner further than this from its start is rejected.
+  double max_shift_px = 2.0;
+  int max_num_iterations = 50;
+  void Check() const;  // throws OptionError
+};
+
+struct RefinedCorner {
+  Eigen::Vector2d xy;        // COLMAP pixels
+  double rms_gray = 0;       // fit residual, gray levels
+  double contrast = 0;       // |a| * 2, gray levels
+  double blur_sigma_px = 0;
+};
+
+// Refines corners (COLMAP pixel convention) of a grid of rows x cols inner
+// corners, index r * cols + c, in an 8-bit gray image. nullopt for corners
+// whose fit failed (no contrast, diverged, moved too far).
+std::vector<std::optional<RefinedCorner>> RefineChessboardCorners(
+    const cv::Mat& gray, const std::vector<Eigen::Vector2d>& corners, int cols, int rows,
+    const CornerRefinementOptions& options = {});
+
+}  // namespace portcal
