@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# Set-up, then portcal's main job on a built-in default. For now (the
-# foundation): a camera behind a decentred dome port, imported from the
-# refractive COLMAP fork's cameras.txt format, converted to a COLMAP model
-# with portcal's housings.txt, and a chessboard projected through it and
-# back. Later stages replace this with a full calibration of a rendered set.
+# Set-up, then portcal's main job on a built-in default: render a small
+# dome-port chessboard set with exact ground truth (portcal synthesize), then
+# what exists so far of the calibration: the camera + dome model, imported
+# from the refractive COLMAP fork's cameras.txt, converted to a COLMAP model
+# with housings.txt, and used to project and back-project through the dome.
+# The calibration stages (target_extractor, housing_calibrator) will take the
+# rendered set from here.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash workflows/setup.sh >/dev/null
@@ -11,6 +13,24 @@ bash workflows/setup.sh >/dev/null
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 portcal=build/portcal
+
+echo "== Rendering a small dome-port chessboard set (8 views, 960 x 540, 4 x 4 supersampling)"
+cat > "$work/dome_set.yaml" <<'CONFIG'
+name: demo_domeport
+description: Decentred dome port (10, 6, 2) mm, RADIAL camera, 10x7 inner-corner chessboard.
+seed: 3
+num_images: 8
+camera: {model: RADIAL, width: 960, height: 540, params: [648.68, 480.0, 270.0, 0.0, 0.0]}
+housing: {model: DOMEPORT, params: [0.01, 0.006, 0.002, 0.05, 0.006, 1.0, 1.473, 1.334]}
+target: {type: chessboard, cols: 10, rows: 7, square_size: 0.02, margin: 0.015}
+poses: {distance: [0.35, 0.9], tilt_max_deg: 40, roll_max_deg: 30}
+render: {spp: 4, noise_sigma: 1.0}
+CONFIG
+"$portcal" synthesize --log_level warn --config "$work/dome_set.yaml" --output_path "$work/dome_set"
+echo "-- $(ls "$work/dome_set/images" | wc -l) images and ground_truth.yaml in the set:"
+sed -n '/^camera:/,/^stereo:/p' "$work/dome_set/ground_truth.yaml"
+echo
+
 
 echo "== A RADIAL camera behind a dome port decentred by (10, 6, 2) mm"
 mkdir -p "$work/fork"

@@ -251,7 +251,9 @@ poses:
       EXPECT_EQ(truth.target.faces.size(), 2u);
       EXPECT_GT(truth.target.faces[0].num_dots, 100);
     }
-    if (name == "charuco") EXPECT_EQ(truth.target.corners_3d.size(), 20u);
+    if (name == "charuco") {
+      EXPECT_EQ(truth.target.corners_3d.size(), 20u);
+    }
   }
 }
 
