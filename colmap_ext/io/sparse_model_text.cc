@@ -32,33 +32,14 @@ std::string Where(const fs::path& path, int line_number) {
 }  // namespace
 
 std::map<camera_t, Camera> ReadCamerasText(const fs::path& path) {
-  std::ifstream file = OpenText(path);
+  // The refractive fork's format is a superset; a stock file has no housing.
   std::map<camera_t, Camera> cameras;
-  std::string line;
-  for (int line_number = 1; std::getline(file, line); ++line_number) {
-    if (!IsDataLine(line)) continue;
-    const std::string where = Where(path, line_number);
-    const std::vector<std::string> tokens = SplitTokens(line, " \t\r");
-    if (tokens.size() < 4) {
-      throw InputError(where + ": expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS");
-    }
-    Camera camera;
-    camera.camera_id = static_cast<camera_t>(
-        ParseInteger(tokens[0], where + " camera id", 0, 0xFFFFFFFELL));
-    try {
-      camera.model_id = CameraModelNameToId(tokens[1]);
-    } catch (const InputError& e) {
-      throw InputError(where + ": " + e.what());
-    }
-    camera.width = ParseInteger(tokens[2], where + " width", 0, 1LL << 40);
-    camera.height = ParseInteger(tokens[3], where + " height", 0, 1LL << 40);
-    for (size_t i = 4; i < tokens.size(); ++i) {
-      camera.params.push_back(ParseDouble(tokens[i], where));
-    }
-    camera.Validate(where);
-    if (!cameras.emplace(camera.camera_id, camera).second) {
-      throw InputError(where + ": duplicate camera id " + tokens[0]);
-    }
+  std::map<camera_t, Housing> housings;
+  ImportRefractiveCamerasText(path, &cameras, &housings);
+  if (!housings.empty()) {
+    throw InputError(path.string() + ": camera " + std::to_string(housings.begin()->first) +
+                     " carries a housing (refractive fork format); read the model with "
+                     "ReadSparseModel or convert it with portcal model_converter");
   }
   return cameras;
 }
