@@ -97,6 +97,8 @@ class Database {
   void WriteTargetObservations(image_t image_id,
                                const std::vector<TargetObservation>& rows);
   std::vector<TargetObservation> ReadTargetObservations(image_t image_id);
+  void WriteTargetDetectionStatus(image_t image_id, const TargetDetectionStatus& status);
+  std::optional<TargetDetectionStatus> ReadTargetDetectionStatus(image_t image_id);
   void WriteMarkerDetections(image_t image_id,
                              const std::vector<MarkerDetection>& rows);
   std::vector<MarkerDetection> ReadMarkerDetections(image_t image_id);

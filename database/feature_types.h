@@ -80,6 +80,14 @@ struct TargetObservation {
   Eigen::Vector3d point_in_target = Eigen::Vector3d::Zero();  // metres
 };
 
+// portcal_target_detections: the outcome of target detection in an image.
+struct TargetDetectionStatus {
+  std::string target;  // e.g. "chessboard 10x7"
+  bool found = false;
+  int num_points = 0;
+  std::string reason;  // why not, when not found
+};
+
 // portcal_marker_detections: one ArUco marker in an image.
 struct MarkerDetection {
   std::string dictionary;  // e.g. DICT_4X4_50

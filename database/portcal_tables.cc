@@ -93,6 +93,34 @@ std::vector<TargetObservation> Database::ReadTargetObservations(image_t image_id
   return rows;
 }
 
+void Database::WriteTargetDetectionStatus(image_t image_id,
+                                          const TargetDetectionStatus& status) {
+  Statement& stmt = Prepare(
+      "write_detection_status",
+      "INSERT OR REPLACE INTO portcal_target_detections(image_id, target, found, "
+      "num_points, reason) VALUES(?, ?, ?, ?, ?);");
+  stmt.Bind(1, static_cast<int64_t>(image_id))
+      .Bind(2, status.target)
+      .Bind(3, static_cast<int64_t>(status.found))
+      .Bind(4, static_cast<int64_t>(status.num_points))
+      .Bind(5, status.reason);
+  stmt.Execute();
+}
+
+std::optional<TargetDetectionStatus> Database::ReadTargetDetectionStatus(image_t image_id) {
+  Statement& stmt = Prepare(
+      "read_detection_status",
+      "SELECT target, found, num_points, reason FROM portcal_target_detections WHERE image_id=?;");
+  stmt.Bind(1, static_cast<int64_t>(image_id));
+  if (!stmt.Step()) return std::nullopt;
+  TargetDetectionStatus status;
+  status.target = stmt.ColumnText(0);
+  status.found = stmt.ColumnInt64(1) != 0;
+  status.num_points = static_cast<int>(stmt.ColumnInt64(2));
+  status.reason = stmt.ColumnText(3);
+  return status;
+}
+
 void Database::WriteMarkerDetections(image_t image_id,
                                      const std::vector<MarkerDetection>& rows) {
   Statement& remove = Prepare(

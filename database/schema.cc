@@ -49,6 +49,15 @@ const std::vector<std::string>& PortcalSchemaSql() {
   target_z  REAL NOT NULL,
   PRIMARY KEY(image_id, point_id),
   FOREIGN KEY(image_id) REFERENCES images(image_id) ON DELETE CASCADE))sql",
+      // Per image and target stage: whether the target was found, how many
+      // points were kept, and why not.
+      R"sql(CREATE TABLE IF NOT EXISTS portcal_target_detections (
+  image_id    INTEGER PRIMARY KEY NOT NULL,
+  target      TEXT NOT NULL,
+  found       INTEGER NOT NULL,
+  num_points  INTEGER NOT NULL,
+  reason      TEXT NOT NULL,
+  FOREIGN KEY(image_id) REFERENCES images(image_id) ON DELETE CASCADE))sql",
       // ArUco detections: dictionary name, marker id, 4 corners in OpenCV's
       // order (COLMAP pixels).
       R"sql(CREATE TABLE IF NOT EXISTS portcal_marker_detections (

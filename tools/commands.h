@@ -7,5 +7,6 @@ int RunDatabaseCreator(int argc, char** argv);
 int RunModelConverter(int argc, char** argv);
 int RunProjectPoints(int argc, char** argv);
 int RunSynthesize(int argc, char** argv);
+int RunTargetExtractor(int argc, char** argv);
 
 }  // namespace portcal

@@ -28,6 +28,8 @@ const std::vector<Command>& Commands() {
       {"project_points", portcal::RunProjectPoints,
        "project 3-D points through a camera and housing (or unproject pixels "
        "to rays)"},
+      {"target_extractor", portcal::RunTargetExtractor,
+       "import images and store the calibration target's corners seen in each"},
       {"synthesize", portcal::RunSynthesize,
        "render a calibration image set (targets, stereo, surveys, underwater "
        "effects) with exact ground truth"},

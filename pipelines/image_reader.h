@@ -1,0 +1,35 @@
+// Importing images into the database the way COLMAP's ImageReader does: one
+// `images` row per file (name relative to the image directory), cameras per
+// --ImageReader.camera_model / single_camera / camera_params.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "database/database.h"
+
+namespace portcal {
+
+struct ImageReaderOptions {
+  std::string camera_model = "SIMPLE_RADIAL";  // COLMAP model name
+  bool single_camera = false;                  // one camera for all images
+  std::string camera_params;                   // "" = default from the image size
+  // Default focal length = factor * max(width, height) (COLMAP's 1.2).
+  double default_focal_length_factor = 1.2;
+  void Check() const;  // throws OptionError naming --ImageReader.*
+};
+
+// Image files (.png .jpg .jpeg .tif .tiff .bmp, any case) below `dir`,
+// sorted, as paths relative to `dir`. Throws InputError if there are none.
+std::vector<std::string> ListImages(const std::filesystem::path& dir);
+
+// Adds (or finds, on a rerun) the image and its camera. Call inside the
+// stage's transaction. `cameras_by_size` carries the single camera between
+// calls. Throws InputError naming the image when its size does not match
+// its existing camera.
+image_t ImportImage(Database* database, const ImageReaderOptions& options,
+                    const std::string& name, int width, int height,
+                    camera_t* single_camera_id);
+
+}  // namespace portcal

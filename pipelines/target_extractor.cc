@@ -1,0 +1,148 @@
+#include "pipelines/target_extractor.h"
+
+#include <atomic>
+#include <mutex>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <thread>
+
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
+#include "database/database.h"
+#include "pipelines/stage_log.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+
+void TargetExtractorOptions::Check() const {
+  if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
+  if (image_path.empty()) throw OptionError("--image_path", "''", "a directory of images");
+  if (target_type != "chessboard") {
+    throw OptionError("--Target.type", target_type,
+                      "chessboard (aruco_grid and charuco detection are not available yet)");
+  }
+  if (!(square_size_m > 0)) throw OptionError("--Target.square_size", std::to_string(square_size_m), "> 0 m");
+  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+  reader.Check();
+  chessboard.Check();
+}
+
+namespace {
+
+struct ImageResult {
+  std::string name;
+  int width = 0, height = 0;
+  bool readable = false;
+  ChessboardDetection detection;
+};
+
+std::string OptionsText(const TargetExtractorOptions& o) {
+  std::ostringstream out;
+  out << "image_path=" << o.image_path << "\nImageReader.camera_model=" << o.reader.camera_model
+      << "\nImageReader.single_camera=" << o.reader.single_camera
+      << "\nImageReader.camera_params=" << o.reader.camera_params << "\nTarget.type=" << o.target_type
+      << "\nTarget.cols=" << o.chessboard.cols << "\nTarget.rows=" << o.chessboard.rows
+      << "\nTarget.square_size=" << o.square_size_m << "\n";
+  return out.str();
+}
+
+}  // namespace
+
+TargetExtractionSummary ExtractTargets(const TargetExtractorOptions& options,
+                                       ProgressSink& progress) {
+  options.Check();
+  StageRun run("target_extractor", OptionsText(options));
+  const std::vector<std::string> names = ListImages(options.image_path);
+  LOG(INFO) << "target_extractor: " << names.size() << " images, chessboard "
+            << options.chessboard.cols << "x" << options.chessboard.rows << " inner corners";
+
+  // Detection in parallel, outside the database transaction.
+  std::vector<ImageResult> results(names.size());
+  std::atomic<size_t> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  progress.Begin("target_extractor: images", names.size());
+  const auto worker = [&] {
+    for (size_t i = next++; i < names.size(); i = next++) {
+      try {
+        CancelFlag::ThrowIfRequested();
+        ImageResult& result = results[i];
+        result.name = names[i];
+        const cv::Mat gray = cv::imread((fs::path(options.image_path) / names[i]).string(),
+                                        cv::IMREAD_GRAYSCALE);
+        if (!gray.empty()) {
+          result.readable = true;
+          result.width = gray.cols;
+          result.height = gray.rows;
+          result.detection = DetectChessboard(gray, options.chessboard);
+        }
+        progress.Advance(1);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+        next = names.size();
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 1; t < options.num_threads; ++t) threads.emplace_back(worker);
+  worker();
+  for (std::thread& t : threads) t.join();
+  if (error) std::rethrow_exception(error);
+  progress.End();
+
+  // One transaction: images, cameras, observations, status, log.
+  Database database(options.database_path, Database::OpenMode::kCreate);
+  Transaction transaction = database.BeginTransaction();
+  TargetExtractionSummary summary;
+  camera_t single_camera_id = kInvalidCameraId;
+  const std::string target = "chessboard " + std::to_string(options.chessboard.cols) + "x" +
+                             std::to_string(options.chessboard.rows);
+  for (const ImageResult& result : results) {
+    if (!result.readable) {
+      LOG(WARNING) << result.name << ": cannot read the image; skipped";
+      continue;
+    }
+    const image_t image_id = ImportImage(&database, options.reader, result.name, result.width,
+                                         result.height, &single_camera_id);
+    std::vector<TargetObservation> observations;
+    const ChessboardDetection& d = result.detection;
+    if (d.found) {
+      for (size_t i = 0; i < d.corners.size(); ++i) {
+        if (!d.corners[i]) continue;
+        TargetObservation observation;
+        observation.point_id = static_cast<int64_t>(i);
+        observation.xy = *d.corners[i];
+        observation.point_in_target = Eigen::Vector3d(
+            (i % options.chessboard.cols) * options.square_size_m,
+            (i / options.chessboard.cols) * options.square_size_m, 0.0);
+        observations.push_back(observation);
+      }
+    } else {
+      LOG(WARNING) << result.name << ": " << d.reason;
+    }
+    database.WriteTargetObservations(image_id, observations);
+    TargetDetectionStatus status;
+    status.target = target;
+    status.found = d.found;
+    status.num_points = static_cast<int>(observations.size());
+    status.reason = d.found ? (d.symmetric ? "found (symmetric board: order may be rotated by 180 deg)"
+                                           : "found")
+                            : d.reason;
+    database.WriteTargetDetectionStatus(image_id, status);
+    ++summary.num_images;
+    summary.num_found += d.found;
+    summary.num_points += static_cast<int64_t>(observations.size());
+  }
+  run.Finish(&database, {{"images", summary.num_images},
+                         {"found", summary.num_found},
+                         {"points", summary.num_points}});
+  CancelFlag::ThrowIfRequested();
+  transaction.Commit();
+  LOG(INFO) << "target_extractor: target found in " << summary.num_found << " of "
+            << summary.num_images << " images, " << summary.num_points << " corners";
+  return summary;
+}
+
+}  // namespace portcal

@@ -1,0 +1,137 @@
+// target_extractor: chessboard corners in the database where the ground
+// truth says they are (portcal's detector: median <= 0.02 px, max <= 0.1 px
+// on the shared renders in air and behind both ports), per-image outcome,
+// reruns, and a failed run that leaves the database as it was.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+
+#include "colmap_ext/io/ground_truth.h"
+#include "colmap_ext/util/error.h"
+#include "database/database.h"
+#include "pipelines/synthesize/synthesize.h"
+#include "pipelines/target_extractor.h"
+#include "tests/test_utils.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+namespace {
+
+TargetExtractorOptions Options(const fs::path& database, const fs::path& images) {
+  TargetExtractorOptions options;
+  options.database_path = database.string();
+  options.image_path = images.string();
+  options.reader.camera_model = "RADIAL";
+  options.reader.single_camera = true;
+  return options;
+}
+
+// Errors (px) of the stored observations against the ground truth.
+std::vector<double> ObservationErrors(const fs::path& database, const GroundTruth& truth) {
+  Database db(database, Database::OpenMode::kReadOnly);
+  std::vector<double> errors;
+  for (const FrameTruth& frame : truth.images) {
+    const std::string name = fs::path(frame.cam1.file).filename().string();
+    const auto image = db.ReadImageWithName(name);
+    EXPECT_TRUE(image.has_value()) << name;
+    if (!image) continue;
+    const auto status = db.ReadTargetDetectionStatus(image->image_id);
+    EXPECT_TRUE(status && status->found) << name << ": " << (status ? status->reason : "no status");
+    for (const TargetObservation& o : db.ReadTargetObservations(image->image_id)) {
+      EXPECT_LT((o.point_in_target - truth.target.corners_3d[o.point_id]).norm(), 1e-12);
+      errors.push_back((o.xy - *frame.cam1.corners_px[o.point_id]).norm());
+    }
+  }
+  std::sort(errors.begin(), errors.end());
+  return errors;
+}
+
+class SharedSets : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SharedSets, CornersWithinHundredthsOfAPixel) {
+  PORTCAL_REQUIRE_SHARED(shared);
+  const fs::path set = shared / "datasets/rendered" / GetParam();
+  if (!fs::exists(set / "ground_truth.yaml")) GTEST_SKIP() << set << " absent";
+  const GroundTruth truth = ReadGroundTruth(set / "ground_truth.yaml");
+  testing::TempDir dir;
+  NullProgress progress;
+  const TargetExtractionSummary summary = ExtractTargets(Options(dir / "db.db", set / "images"), progress);
+  EXPECT_EQ(summary.num_found, 25);
+  const std::vector<double> errors = ObservationErrors(dir / "db.db", truth);
+  ASSERT_EQ(errors.size(), 25u * 70u);
+  EXPECT_LE(errors[errors.size() / 2], 0.02) << GetParam();
+  EXPECT_LE(errors.back(), 0.1) << GetParam();
+}
+
+INSTANTIATE_TEST_SUITE_P(Rendered, SharedSets,
+                         ::testing::Values("chess_air_distorted", "chess_domeport", "chess_flatport"));
+
+TEST(TargetExtractor, ReportsImagesWithoutTheBoardAndRerunsCleanly) {
+  testing::TempDir dir;
+  std::ofstream(dir / "set.yaml") << R"(name: small
+seed: 4
+num_images: 3
+camera: {model: RADIAL, width: 800, height: 600, params: [700.0, 400.0, 300.0, -0.05, 0.0]}
+housing: null
+target: {type: chessboard, cols: 8, rows: 6, square_size: 0.025, margin: 0.015}
+poses: {distance: [0.4, 0.8], tilt_max_deg: 35}
+)";
+  SynthesizeOptions synthesize;
+  synthesize.config_path = (dir / "set.yaml").string();
+  synthesize.output_path = (dir / "set").string();
+  NullProgress progress;
+  Synthesize(synthesize, progress);
+  cv::imwrite((dir / "set/images/zz_empty.png").string(), cv::Mat(600, 800, CV_8UC1, cv::Scalar(120)));
+
+  TargetExtractorOptions options = Options(dir / "db.db", dir / "set/images");
+  options.chessboard.cols = 8;
+  options.chessboard.rows = 6;
+  options.square_size_m = 0.025;
+  const TargetExtractionSummary first = ExtractTargets(options, progress);
+  EXPECT_EQ(first.num_images, 4);
+  EXPECT_EQ(first.num_found, 3);
+  const TargetExtractionSummary second = ExtractTargets(options, progress);
+  EXPECT_EQ(second.num_points, first.num_points);
+  Database db(dir / "db.db", Database::OpenMode::kReadOnly);
+  EXPECT_EQ(db.NumImages(), 4);
+  EXPECT_EQ(db.NumCameras(), 1);  // single_camera
+  const auto empty = db.ReadImageWithName("zz_empty.png");
+  ASSERT_TRUE(empty.has_value());
+  const auto status = db.ReadTargetDetectionStatus(empty->image_id);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_FALSE(status->found);
+  EXPECT_NE(status->reason.find("no 8x6"), std::string::npos) << status->reason;
+  EXPECT_EQ(db.ReadStageLog().size(), 2u);
+}
+
+TEST(TargetExtractor, AFailedRunLeavesTheDatabaseAsItWas) {
+  testing::TempDir dir;
+  fs::create_directories(dir / "images");
+  cv::imwrite((dir / "images/a.png").string(), cv::Mat(100, 200, CV_8UC1, cv::Scalar(0)));
+  cv::imwrite((dir / "images/b.png").string(), cv::Mat(120, 200, CV_8UC1, cv::Scalar(0)));
+  { Database db(dir / "db.db", Database::OpenMode::kCreate); }
+  const std::string before = testing::ReadFileToString(dir / "db.db");
+  NullProgress progress;
+  // Two image sizes with one shared camera: b.png is at fault.
+  try {
+    ExtractTargets(Options(dir / "db.db", dir / "images"), progress);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("b.png"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(testing::ReadFileToString(dir / "db.db"), before);
+  TargetExtractorOptions bad = Options(dir / "db.db", dir / "images");
+  bad.reader.camera_params = "1, 2";
+  try {
+    ExtractTargets(bad, progress);
+    FAIL() << "expected OptionError";
+  } catch (const OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("--ImageReader.camera_params"), std::string::npos);
+  }
+  EXPECT_EQ(testing::ReadFileToString(dir / "db.db"), before);
+}
+
+}  // namespace
+}  // namespace portcal
