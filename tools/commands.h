@@ -8,5 +8,6 @@ int RunModelConverter(int argc, char** argv);
 int RunProjectPoints(int argc, char** argv);
 int RunSynthesize(int argc, char** argv);
 int RunTargetExtractor(int argc, char** argv);
+int RunCameraCalibrator(int argc, char** argv);
 
 }  // namespace portcal

@@ -30,6 +30,8 @@ const std::vector<Command>& Commands() {
        "to rays)"},
       {"target_extractor", portcal::RunTargetExtractor,
        "import images and store the calibration target's corners seen in each"},
+      {"camera_calibrator", portcal::RunCameraCalibrator,
+       "calibrate camera intrinsics from the stored target observations"},
       {"synthesize", portcal::RunSynthesize,
        "render a calibration image set (targets, stereo, surveys, underwater "
        "effects) with exact ground truth"},

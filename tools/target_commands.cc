@@ -1,3 +1,5 @@
+#include "colmap_ext/util/string_utils.h"
+#include "pipelines/camera_calibrator.h"
 #include "pipelines/target_extractor.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
@@ -28,6 +30,34 @@ int RunTargetExtractor(int argc, char** argv) {
     if (!cli.Parse(argc, argv)) return;
     StderrProgress progress;
     ExtractTargets(options, progress);
+  });
+}
+
+int RunCameraCalibrator(int argc, char** argv) {
+  CameraCalibratorOptions options;
+  std::string fixed;
+  CommandLine cli("camera_calibrator",
+                  "Calibrates a camera's intrinsics (any COLMAP model) from the target "
+                  "observations in the database: Zhang's closed form, then bundle adjustment "
+                  "of intrinsics and poses; standard deviations from the covariance scaled by "
+                  "the residual variance. Writes calibration.yaml and calibration.txt.");
+  cli.AddRequired("database_path", &options.database_path, "database with target observations");
+  cli.AddRequired("output_path", &options.output_path, "directory for the reports");
+  cli.Add("camera_id", &options.camera_id, "camera to calibrate (-1: the only one)");
+  cli.Add("Calibration.camera_model", &options.camera_model, "model to fit (default: the database's)");
+  cli.Add("Calibration.fixed_params", &fixed,
+          "parameters to hold, comma separated: names (k2, p1, ...), focal, principal_point, extra");
+  cli.Add("Calibration.estimate_board_warp", &options.calibration.estimate_board_warp,
+          "fit mrcal's two-parameter board sag (0 | 1)");
+  cli.Add("Calibration.drop_outlier_views", &options.calibration.drop_outlier_views,
+          "remove views whose RMS exceeds outlier_view_factor x median, and re-solve (0 | 1)");
+  cli.Add("Calibration.outlier_view_factor", &options.calibration.outlier_view_factor,
+          "outlier threshold on a view's RMS, times the median");
+  cli.Add("num_threads", &options.calibration.num_threads, "threads");
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    options.calibration.fixed_params = SplitTokens(fixed, ", ");
+    CalibrateCameraStage(options);
   });
 }
 

@@ -1,0 +1,137 @@
+#include "pipelines/calibration/calibration_report.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstdio>
+#include <iomanip>
+#include <sstream>
+
+#include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/io/sparse_model.h"
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/string_utils.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+namespace {
+
+std::string Num(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
+  return buffer;
+}
+
+std::string List(const std::vector<double>& values) {
+  std::string text = "[";
+  for (size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + Num(values[i]);
+  return text + "]";
+}
+
+std::string Yaml(const CalibrationReport& r) {
+  std::ostringstream out;
+  out << "# portcal calibration report (calibmar-compatible keys first)\n"
+      << "model: " << r.camera.ModelName() << "\n"
+      << "parameters: " << List(r.camera.params) << "\n"
+      << "non_svp_model: " << (r.housing ? r.housing->ModelName() : "NONE") << "\n"
+      << "non_svp_parameters: " << List(r.housing ? r.housing->params : std::vector<double>{}) << "\n"
+      << "width: " << r.camera.width << "\n"
+      << "height: " << r.camera.height << "\n"
+      << "parameter_names: [" << r.camera.ParamsInfo() << "]\n"
+      << "parameters_std_dev: " << List(r.parameters_std_dev) << "\n"
+      << "non_svp_parameters_std_dev: " << List(r.housing_std_dev) << "\n"
+      << "overall_rms: " << Num(r.overall_rms_px) << "\n"
+      << "residual_sigma_px: " << Num(r.residual_sigma_px) << "\n"
+      << "num_views: " << std::count_if(r.views.begin(), r.views.end(), [](const CalibratedView& v) { return !v.dropped; })
+      << "\nnum_points: " << r.num_points << "\n"
+      << "target: '" << r.target_description << "'\n";
+  if (r.board_warp) {
+    out << "board_warp: " << List({r.board_warp->x(), r.board_warp->y()}) << "\n"
+        << "board_warp_std_dev: " << List({r.board_warp_std_dev->x(), r.board_warp_std_dev->y()}) << "\n";
+  }
+  out << "per_view:\n";
+  for (const CalibratedView& v : r.views) {
+    const Eigen::Vector4d q = QuaternionToWxyz(v.cam_from_target.rotation);
+    out << "- image: '" << v.image_name << "'\n  rms: " << Num(v.rms_px) << "\n  points: " << v.num_points
+        << "\n  outlier: " << (v.outlier ? "true" : "false") << "\n  dropped: " << (v.dropped ? "true" : "false")
+        << "\n  cam_from_target:\n    rotation_wxyz: " << List({q[0], q[1], q[2], q[3]})
+        << "\n    translation: "
+        << List({v.cam_from_target.translation.x(), v.cam_from_target.translation.y(),
+                 v.cam_from_target.translation.z()})
+        << "\n";
+  }
+  return out.str();
+}
+
+std::string Text(const CalibrationReport& r) {
+  std::ostringstream out;
+  out << std::fixed;
+  out << "portcal calibration\n===================\n\n"
+      << "Camera model " << r.camera.ModelName() << ", " << r.camera.width << " x " << r.camera.height
+      << " px\nTarget: " << r.target_description << "\n\n";
+  const std::vector<std::string> names = SplitTokens(r.camera.ParamsInfo(), ", ");
+  out << "  parameter          value          std dev\n";
+  for (size_t i = 0; i < r.camera.params.size(); ++i) {
+    out << "  " << std::left << std::setw(10) << names[i] << std::right << std::setw(17)
+        << std::setprecision(6) << r.camera.params[i] << std::setw(17)
+        << (i < r.parameters_std_dev.size() && r.parameters_std_dev[i] > 0 ? r.parameters_std_dev[i] : 0.0)
+        << (i < r.parameters_std_dev.size() && r.parameters_std_dev[i] > 0 ? "" : "  (fixed)") << "\n";
+  }
+  if (r.housing) {
+    out << "\nHousing " << r.housing->ModelName() << ": " << r.housing->ParamsInfo() << "\n  ";
+    for (double p : r.housing->params) out << std::setprecision(6) << p << " ";
+    out << "\n";
+  }
+  if (r.board_warp) {
+    out << std::setprecision(3) << "\nBoard warp (parabolic sag): x " << r.board_warp->x() * 1000 << " +- "
+        << r.board_warp_std_dev->x() * 1000 << " mm, y " << r.board_warp->y() * 1000 << " +- "
+        << r.board_warp_std_dev->y() * 1000 << " mm\n";
+  }
+  out << std::setprecision(4) << "\nRMS reprojection error " << r.overall_rms_px << " px over "
+      << r.num_points << " points (residual sigma " << r.residual_sigma_px << " px)\n\n"
+      << "  view                                  rms (px)  points\n";
+  for (const CalibratedView& v : r.views) {
+    out << "  " << std::left << std::setw(36) << v.image_name << std::right << std::setw(10)
+        << v.rms_px << std::setw(8) << v.num_points
+        << (v.dropped ? "  dropped (outlier)" : v.outlier ? "  outlier" : "") << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace
+
+void WriteCalibrationReport(const CalibrationReport& report, const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!fs::is_directory(dir)) throw InputError(dir.string() + ": cannot create output directory");
+  const std::string yaml = Yaml(report), text = Text(report);
+  WriteFileAtomically(dir / "calibration.yaml", false, [&](std::ostream& out) { out << yaml; });
+  WriteFileAtomically(dir / "calibration.txt", false, [&](std::ostream& out) { out << text; });
+}
+
+CalibrationReport ReadCalibrationReport(const fs::path& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path.string());
+  } catch (const YAML::Exception& e) {
+    throw InputError(path.string() + ": " + e.what());
+  }
+  CalibrationReport report;
+  try {
+    report.camera.model_id = CameraModelNameToId(root["model"].as<std::string>());
+    report.camera.width = root["width"].as<uint64_t>();
+    report.camera.height = root["height"].as<uint64_t>();
+    report.camera.params = root["parameters"].as<std::vector<double>>();
+    if (root["non_svp_model"] && root["non_svp_model"].as<std::string>() != "NONE") {
+      report.housing = Housing::FromName(root["non_svp_model"].as<std::string>(),
+                                         root["non_svp_parameters"].as<std::vector<double>>(),
+                                         path.string() + ": non_svp_parameters");
+    }
+  } catch (const YAML::Exception& e) {
+    throw InputError(path.string() + ": " + e.what());
+  }
+  report.camera.Validate(path.string());
+  return report;
+}
+
+}  // namespace portcal

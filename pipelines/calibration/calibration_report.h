@@ -1,0 +1,38 @@
+// calibration.yaml (calibmar's keys, so calibmar imports it, plus portcal's
+// own: standard deviations, RMS, per-view table, target) and calibration.txt
+// for people.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "colmap_ext/camera/camera.h"
+#include "colmap_ext/housing/housing.h"
+#include "pipelines/calibration/camera_calibration.h"
+
+namespace portcal {
+
+struct CalibrationReport {
+  Camera camera;
+  std::vector<double> parameters_std_dev;
+  std::optional<Housing> housing;
+  std::vector<double> housing_std_dev;
+  double overall_rms_px = 0;
+  double residual_sigma_px = 0;
+  int num_points = 0;
+  std::vector<CalibratedView> views;
+  std::string target_description;  // e.g. "chessboard 10x7, square 0.02 m"
+  std::optional<Eigen::Vector2d> board_warp, board_warp_std_dev;
+};
+
+// Writes calibration.yaml and calibration.txt into `dir` (created),
+// atomically.
+void WriteCalibrationReport(const CalibrationReport& report, const std::filesystem::path& dir);
+
+// Reads the camera (and housing) of a calibration.yaml written by portcal or
+// calibmar. Throws InputError naming the file and key.
+CalibrationReport ReadCalibrationReport(const std::filesystem::path& path);
+
+}  // namespace portcal

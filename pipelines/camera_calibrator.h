@@ -1,0 +1,24 @@
+// `portcal camera_calibrator`: intrinsics of one camera of the database from
+// the target observations target_extractor stored; writes the reports.
+#pragma once
+
+#include <string>
+
+#include "pipelines/calibration/camera_calibration.h"
+
+namespace portcal {
+
+struct CameraCalibratorOptions {
+  std::string database_path;
+  std::string output_path;   // directory for calibration.yaml / .txt
+  int camera_id = -1;        // -1: the only camera with observations
+  std::string camera_model;  // "" = the database camera's model
+  CameraCalibrationSettings calibration;
+  void Check() const;  // throws OptionError naming the option
+};
+
+// Throws InputError / NumericalError / DatabaseError. Reads the database
+// only.
+CameraCalibrationResult CalibrateCameraStage(const CameraCalibratorOptions& options);
+
+}  // namespace portcal
