@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Set-up, then portcal's main job on a built-in default: render a small
 # dome-port chessboard set with exact ground truth (portcal synthesize), then
-# what exists so far of the calibration: the camera + dome model, imported
-# from the refractive COLMAP fork's cameras.txt, converted to a COLMAP model
-# with housings.txt, and used to project and back-project through the dome.
-# The calibration stages (target_extractor, housing_calibrator) will take the
-# rendered set from here.
+# the calibration that exists so far: target_extractor (sub-pixel corners
+# into the database) and camera_calibrator (an OPENCV model fitted to the
+# underwater views, refraction absorbed), printed next to the truth; then
+# the camera + dome model itself, imported from the refractive COLMAP fork's
+# cameras.txt, projecting and back-projecting through the dome.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash workflows/setup.sh >/dev/null
@@ -29,6 +29,19 @@ CONFIG
 "$portcal" synthesize --log_level warn --config "$work/dome_set.yaml" --output_path "$work/dome_set"
 echo "-- $(ls "$work/dome_set/images" | wc -l) images and ground_truth.yaml in the set:"
 sed -n '/^camera:/,/^stereo:/p' "$work/dome_set/ground_truth.yaml"
+echo
+
+echo "== target_extractor: chessboard corners of every view into a COLMAP database"
+"$portcal" target_extractor --log_level warn --database_path "$work/demo.db" \
+  --image_path "$work/dome_set/images" --ImageReader.camera_model OPENCV \
+  --ImageReader.single_camera 1 --Target.cols 10 --Target.rows 7 --Target.square_size 0.02
+echo "-- views with the board found: $(sqlite3 "$work/demo.db" 'SELECT count(*) FROM portcal_target_detections WHERE found = 1') of 8"
+echo
+echo "== camera_calibrator: OPENCV fitted to the underwater views (refraction absorbed by the lens model)"
+"$portcal" camera_calibrator --log_level warn --database_path "$work/demo.db" --output_path "$work/calibration"
+sed -n '/parameter/,/^RMS/p' "$work/calibration/calibration.txt"
+echo "-- truth: f = 648.68 px, (cx, cy) = (480, 270) px behind a dome decentred by (10, 6, 2) mm;"
+echo "   the housing calibrator (next) models the dome instead of absorbing it."
 echo
 
 
