@@ -9,5 +9,6 @@ int RunProjectPoints(int argc, char** argv);
 int RunSynthesize(int argc, char** argv);
 int RunTargetExtractor(int argc, char** argv);
 int RunCameraCalibrator(int argc, char** argv);
+int RunHousingCalibrator(int argc, char** argv);
 
 }  // namespace portcal

@@ -32,6 +32,8 @@ const std::vector<Command>& Commands() {
        "import images and store the calibration target's corners seen in each"},
       {"camera_calibrator", portcal::RunCameraCalibrator,
        "calibrate camera intrinsics from the stored target observations"},
+      {"housing_calibrator", portcal::RunHousingCalibrator,
+       "calibrate a flat or dome port, the in-air intrinsics given"},
       {"synthesize", portcal::RunSynthesize,
        "render a calibration image set (targets, stereo, surveys, underwater "
        "effects) with exact ground truth"},

@@ -1,5 +1,6 @@
 #include "colmap_ext/util/string_utils.h"
 #include "pipelines/camera_calibrator.h"
+#include "pipelines/housing_calibrator.h"
 #include "pipelines/target_extractor.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
@@ -58,6 +59,33 @@ int RunCameraCalibrator(int argc, char** argv) {
     if (!cli.Parse(argc, argv)) return;
     options.calibration.fixed_params = SplitTokens(fixed, ", ");
     CalibrateCameraStage(options);
+  });
+}
+
+int RunHousingCalibrator(int argc, char** argv) {
+  HousingCalibratorOptions options;
+  CommandLine cli("housing_calibrator",
+                  "Calibrates a flat or dome port from the target observations of underwater "
+                  "views, the camera's in-air intrinsics given (--input_calibration, portcal's "
+                  "or calibmar's calibration.yaml) and fixed unless refined. The port's axis "
+                  "and magnitude are initialised from the data; thickness, radius and indices "
+                  "are the constants of --Housing.params. Writes calibration.yaml/.txt.");
+  cli.AddRequired("database_path", &options.database_path, "database with target observations");
+  cli.AddRequired("input_calibration", &options.input_calibration, "in-air calibration.yaml");
+  cli.AddRequired("output_path", &options.output_path, "directory for the reports");
+  cli.AddRequired("Housing.model", &options.housing_model, "FLATPORT | DOMEPORT");
+  cli.AddRequired("Housing.params", &options.housing_params,
+                  "FLATPORT: Nx,Ny,Nz,int_dist,int_thick,na,ng,nw; DOMEPORT: "
+                  "Cx,Cy,Cz,int_radius,int_thick,na,ng,nw (metres; a guess for what is estimated)");
+  cli.Add("camera_id", &options.camera_id, "camera (-1: the only one)");
+  cli.Add("Calibration.refine_intrinsics", &options.calibration.refine_intrinsics,
+          "refine the intrinsics jointly (0 | 1)");
+  cli.Add("Calibration.initialize_from_data", &options.calibration.initialize_from_data,
+          "initialise the port from the views (0: from --Housing.params)");
+  cli.Add("num_threads", &options.calibration.num_threads, "threads");
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    CalibrateHousingStage(options);
   });
 }
 

@@ -36,6 +36,36 @@ bool RefractionAxisOf(const T* port, VectorT<T, 3>* axis) {
   }
 }
 
+// The virtual-camera residual (pixels, before division by sigma) of an
+// observed pixel and a point in the camera frame. False where the pixel has
+// no ray in water or the point is behind the virtual camera.
+template <typename CameraModel, typename Port, typename T>
+bool VirtualCameraResidual(const T* intrinsics, const T* housing, const Eigen::Vector2d& observed_px,
+                           const VectorT<T, 3>& point_in_cam, T* residual) {
+  VectorT<T, 3> origin, dir;
+  if (!WaterFromImg<CameraModel, Port, T>(intrinsics, housing, T(observed_px.x()),
+                                          T(observed_px.y()), &origin, &dir)) {
+    return false;
+  }
+  // Virtual centre: the point of the axis closest to the water ray (they
+  // intersect up to rounding). A ray along the axis is not bent: centre 0.
+  VectorT<T, 3> center = VectorT<T, 3>::Zero();
+  VectorT<T, 3> axis;
+  if (RefractionAxisOf<Port, T>(housing, &axis)) {
+    const T cos_axis = axis.dot(dir);
+    const T sin2 = T(1) - cos_axis * cos_axis;
+    if (sin2 > T(1e-12)) {
+      center = ((axis.dot(origin) - cos_axis * dir.dot(origin)) / sin2) * axis;
+    }
+  }
+  const VectorT<T, 3> point_in_virtual = point_in_cam - center;
+  if (!(point_in_virtual.z() > T(0)) || !(dir.z() > T(1e-9))) return false;
+  const T focal = T(0.5) * (CameraModel::Fx(intrinsics) + CameraModel::Fy(intrinsics));
+  residual[0] = focal * (point_in_virtual.x() / point_in_virtual.z() - dir.x() / dir.z());
+  residual[1] = focal * (point_in_virtual.y() / point_in_virtual.z() - dir.y() / dir.z());
+  return true;
+}
+
 template <typename CameraModel, typename Port>
 struct VirtualCameraError
     : AutoDiffFunctor<VirtualCameraError<CameraModel, Port>, 2, 7, 3,
@@ -46,37 +76,16 @@ struct VirtualCameraError
   template <typename T>
   bool operator()(const T* cam_from_world, const T* point_in_world,
                   const T* intrinsics, const T* housing, T* residual) const {
-    VectorT<T, 3> origin, dir;
-    if (!WaterFromImg<CameraModel, Port, T>(intrinsics, housing,
-                                            T(observed_px_.x()),
-                                            T(observed_px_.y()), &origin,
-                                            &dir)) {
-      return false;
-    }
-    // Virtual centre: the point of the axis closest to the water ray (they
-    // intersect up to rounding). A ray along the axis is not bent: centre 0.
-    VectorT<T, 3> center = VectorT<T, 3>::Zero();
-    VectorT<T, 3> axis;
-    if (RefractionAxisOf<Port, T>(housing, &axis)) {
-      const T cos_axis = axis.dot(dir);
-      const T sin2 = T(1) - cos_axis * cos_axis;
-      if (sin2 > T(1e-12)) {
-        center = ((axis.dot(origin) - cos_axis * dir.dot(origin)) / sin2) * axis;
-      }
-    }
     const Eigen::Map<const Eigen::Quaternion<T>> rotation(cam_from_world);
     const Eigen::Map<const VectorT<T, 3>> translation(cam_from_world + 4);
     const Eigen::Map<const VectorT<T, 3>> point(point_in_world);
-    const VectorT<T, 3> point_in_virtual =
-        rotation * point + translation - center;
-    if (!(point_in_virtual.z() > T(0)) || !(dir.z() > T(1e-9))) return false;
-
-    const T focal =
-        T(0.5) * (CameraModel::Fx(intrinsics) + CameraModel::Fy(intrinsics));
-    residual[0] = focal * (point_in_virtual.x() / point_in_virtual.z() -
-                           dir.x() / dir.z()) * inv_sigma_;
-    residual[1] = focal * (point_in_virtual.y() / point_in_virtual.z() -
-                           dir.y() / dir.z()) * inv_sigma_;
+    const VectorT<T, 3> point_in_cam = rotation * point + translation;
+    if (!VirtualCameraResidual<CameraModel, Port, T>(intrinsics, housing, observed_px_,
+                                                     point_in_cam, residual)) {
+      return false;
+    }
+    residual[0] *= inv_sigma_;
+    residual[1] *= inv_sigma_;
     return true;
   }
 

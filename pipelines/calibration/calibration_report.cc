@@ -28,6 +28,23 @@ std::string List(const std::vector<double>& values) {
   return text + "]";
 }
 
+// Standard deviations: negative means undetermined, written as null.
+std::string StdDevList(const std::vector<double>& values) {
+  std::string text = "[";
+  for (size_t i = 0; i < values.size(); ++i) {
+    text += (i ? ", " : "") + (values[i] < 0 ? std::string("null") : Num(values[i]));
+  }
+  return text + "]";
+}
+
+std::string StdDevText(const std::vector<double>& values, size_t i) {
+  if (i >= values.size() || values[i] == 0) return "          (fixed)";
+  if (values[i] < 0) return "   (undetermined)";
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(6) << std::setw(17) << values[i];
+  return out.str();
+}
+
 std::string Yaml(const CalibrationReport& r) {
   std::ostringstream out;
   out << "# portcal calibration report (calibmar-compatible keys first)\n"
@@ -38,8 +55,8 @@ std::string Yaml(const CalibrationReport& r) {
       << "width: " << r.camera.width << "\n"
       << "height: " << r.camera.height << "\n"
       << "parameter_names: [" << r.camera.ParamsInfo() << "]\n"
-      << "parameters_std_dev: " << List(r.parameters_std_dev) << "\n"
-      << "non_svp_parameters_std_dev: " << List(r.housing_std_dev) << "\n"
+      << "parameters_std_dev: " << StdDevList(r.parameters_std_dev) << "\n"
+      << "non_svp_parameters_std_dev: " << StdDevList(r.housing_std_dev) << "\n"
       << "overall_rms: " << Num(r.overall_rms_px) << "\n"
       << "residual_sigma_px: " << Num(r.residual_sigma_px) << "\n"
       << "num_views: " << std::count_if(r.views.begin(), r.views.end(), [](const CalibratedView& v) { return !v.dropped; })
@@ -73,14 +90,19 @@ std::string Text(const CalibrationReport& r) {
   out << "  parameter          value          std dev\n";
   for (size_t i = 0; i < r.camera.params.size(); ++i) {
     out << "  " << std::left << std::setw(10) << names[i] << std::right << std::setw(17)
-        << std::setprecision(6) << r.camera.params[i] << std::setw(17)
-        << (i < r.parameters_std_dev.size() && r.parameters_std_dev[i] > 0 ? r.parameters_std_dev[i] : 0.0)
-        << (i < r.parameters_std_dev.size() && r.parameters_std_dev[i] > 0 ? "" : "  (fixed)") << "\n";
+        << std::setprecision(6) << r.camera.params[i] << StdDevText(r.parameters_std_dev, i) << "\n";
   }
   if (r.housing) {
-    out << "\nHousing " << r.housing->ModelName() << ": " << r.housing->ParamsInfo() << "\n  ";
-    for (double p : r.housing->params) out << std::setprecision(6) << p << " ";
-    out << "\n";
+    const std::vector<std::string> housing_names = SplitTokens(r.housing->ParamsInfo(), ", ");
+    out << "\nHousing " << r.housing->ModelName() << " (metres)\n";
+    for (size_t i = 0; i < r.housing->params.size(); ++i) {
+      out << "  " << std::left << std::setw(10) << housing_names[i] << std::right << std::setw(17)
+          << std::setprecision(6) << r.housing->params[i]
+          << (i < r.housing_std_dev.size() && r.housing_std_dev[i] == 0 && i >= 3
+                  ? std::string("       (constant)")
+                  : StdDevText(r.housing_std_dev, i))
+          << "\n";
+    }
   }
   if (r.board_warp) {
     out << std::setprecision(3) << "\nBoard warp (parabolic sag): x " << r.board_warp->x() * 1000 << " +- "

@@ -1,0 +1,55 @@
+// Housing calibration from views of a planar target through a flat or dome
+// port, with the camera's in-air intrinsics known (and by default fixed).
+//
+// Initialisation from the data: every ray of an axial camera (both ports
+// are) meets the refraction axis, so the ray direction d of a pixel, the
+// axis a and the target point X are coplanar: d^T [a]x [r1 r2 t] (x, y, 1)^T
+// = 0, a "fundamental matrix" F = [a]x H between the target plane and the
+// rays whose left null vector is the axis (She et al., "Refractive geometry
+// for underwater domes", ISPRS J. 2022). One F per view, the axis as the
+// common null vector of all of them; then the magnitude (flat: interface
+// distance, dome: decentering along the axis) by a coarse 1-D search scored
+// by pose-only residuals. Then Ceres over the poses and the housing (flat:
+// normal on the unit sphere + distance; dome: centre), first with the
+// virtual-camera error, then with the exact reprojection error, which gives
+// the reported RMS and, through the covariance scaled by the residual
+// variance, the standard deviations.
+#pragma once
+
+#include <vector>
+
+#include "colmap_ext/camera/camera.h"
+#include "colmap_ext/housing/housing.h"
+#include "pipelines/calibration/camera_calibration.h"
+
+namespace portcal {
+
+struct HousingCalibrationSettings {
+  bool refine_intrinsics = false;  // jointly with the housing
+  bool initialize_from_data = true;  // else start from the given parameters
+  int max_num_iterations = 200;
+  int num_threads = 2;
+  void Check() const;  // throws OptionError
+};
+
+struct HousingCalibrationResult {
+  Housing housing;
+  // Per parameter; 0 for constants and fixed values, -1 where the
+  // covariance is rank deficient (undetermined).
+  std::vector<double> housing_std_dev;
+  Camera camera;
+  std::vector<double> camera_std_dev;
+  Eigen::Vector3d initial_axis = Eigen::Vector3d::Zero();  // from the F matrices
+  double overall_rms_px = 0;
+  double residual_sigma_px = 0;
+  int num_points = 0;
+  std::vector<CalibratedView> views;
+};
+
+// `housing` gives the model, the constants (thickness, radius, indices) and
+// the starting guess. Throws NumericalError when the solve fails.
+HousingCalibrationResult CalibrateHousing(const std::vector<CalibrationView>& views,
+                                          const Camera& camera, const Housing& housing,
+                                          const HousingCalibrationSettings& settings);
+
+}  // namespace portcal

@@ -1,0 +1,87 @@
+#include "pipelines/housing_calibrator.h"
+
+#include <map>
+
+#include "colmap_ext/housing/housing_models.h"
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/string_utils.h"
+#include "database/database.h"
+#include "pipelines/calibration/calibration_report.h"
+
+namespace portcal {
+
+void HousingCalibratorOptions::Check() const {
+  if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
+  if (input_calibration.empty()) {
+    throw OptionError("--input_calibration", "''", "the in-air calibration.yaml");
+  }
+  if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
+  if (!ExistsHousingModelWithName(housing_model)) {
+    throw OptionError("--Housing.model", housing_model, "FLATPORT or DOMEPORT");
+  }
+  calibration.Check();
+}
+
+HousingCalibrationResult CalibrateHousingStage(const HousingCalibratorOptions& options) {
+  options.Check();
+  const Housing housing = Housing::FromName(
+      options.housing_model, ParseDoubleList(options.housing_params, "--Housing.params"),
+      "--Housing.params");
+  const CalibrationReport in_air = ReadCalibrationReport(options.input_calibration);
+  Database database(options.database_path, Database::OpenMode::kReadOnly);
+  std::map<camera_t, std::vector<CalibrationView>> views_by_camera;
+  std::string target;
+  for (const DatabaseImage& image : database.ReadAllImages()) {
+    const auto status = database.ReadTargetDetectionStatus(image.image_id);
+    if (!status || !status->found) continue;
+    target = status->target;
+    CalibrationView view;
+    view.image_name = image.name;
+    for (const TargetObservation& o : database.ReadTargetObservations(image.image_id)) {
+      view.points_in_target.push_back(o.point_in_target);
+      view.pixels.push_back(o.xy);
+    }
+    views_by_camera[image.camera_id].push_back(view);
+  }
+  if (views_by_camera.empty()) {
+    throw InputError(options.database_path + ": no target observations; run target_extractor first");
+  }
+  camera_t camera_id = static_cast<camera_t>(options.camera_id);
+  if (options.camera_id < 0) {
+    if (views_by_camera.size() > 1) {
+      throw InputError(options.database_path + ": several cameras have observations; choose one with --camera_id");
+    }
+    camera_id = views_by_camera.begin()->first;
+  }
+  const auto views = views_by_camera.find(camera_id);
+  if (views == views_by_camera.end()) {
+    throw InputError(options.database_path + ": camera " + std::to_string(camera_id) + " has no observations");
+  }
+  const std::optional<Camera> database_camera = database.ReadCamera(camera_id);
+  if (database_camera->width != in_air.camera.width || database_camera->height != in_air.camera.height) {
+    throw InputError(options.input_calibration + ": calibrated for " + std::to_string(in_air.camera.width) +
+                     "x" + std::to_string(in_air.camera.height) + " images, the database's are " +
+                     std::to_string(database_camera->width) + "x" + std::to_string(database_camera->height));
+  }
+  LOG(INFO) << "housing_calibrator: " << housing.ModelName() << ", camera " << in_air.camera.ModelName()
+            << " from " << options.input_calibration << ", " << views->second.size() << " views";
+  const HousingCalibrationResult result =
+      CalibrateHousing(views->second, in_air.camera, housing, options.calibration);
+
+  CalibrationReport report;
+  report.camera = result.camera;
+  report.parameters_std_dev = result.camera_std_dev;
+  report.housing = result.housing;
+  report.housing_std_dev = result.housing_std_dev;
+  report.overall_rms_px = result.overall_rms_px;
+  report.residual_sigma_px = result.residual_sigma_px;
+  report.num_points = result.num_points;
+  report.views = result.views;
+  report.target_description = target;
+  WriteCalibrationReport(report, options.output_path);
+  LOG(INFO) << "housing_calibrator: RMS " << result.overall_rms_px << " px -> " << options.output_path;
+  return result;
+}
+
+}  // namespace portcal

@@ -1,0 +1,25 @@
+// `portcal housing_calibrator`: the flat or dome port of a camera whose
+// in-air intrinsics are known (--input_calibration), from the target
+// observations of its underwater views; writes the reports.
+#pragma once
+
+#include <string>
+
+#include "pipelines/calibration/housing_calibration.h"
+
+namespace portcal {
+
+struct HousingCalibratorOptions {
+  std::string database_path;
+  std::string input_calibration;  // calibration.yaml (portcal or calibmar)
+  std::string output_path;
+  std::string housing_model;      // FLATPORT | DOMEPORT
+  std::string housing_params;     // 8 numbers: the constants and a guess
+  int camera_id = -1;
+  HousingCalibrationSettings calibration;
+  void Check() const;  // throws OptionError naming the option
+};
+
+HousingCalibrationResult CalibrateHousingStage(const HousingCalibratorOptions& options);
+
+}  // namespace portcal
