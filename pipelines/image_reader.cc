@@ -62,8 +62,10 @@ Camera NewCamera(const ImageReaderOptions& options, int width, int height) {
 }  // namespace
 
 image_t ImportImage(Database* database, const ImageReaderOptions& options,
-                    const std::string& name, int width, int height,
-                    camera_t* single_camera_id) {
+                    const std::string& name, int width, int height, SharedCameras* shared) {
+  const bool sharing = options.single_camera || options.single_camera_per_folder;
+  const std::string key =
+      options.single_camera ? std::string() : fs::path(name).parent_path().generic_string();
   if (const std::optional<DatabaseImage> existing = database->ReadImageWithName(name)) {
     const std::optional<Camera> camera = database->ReadCamera(existing->camera_id);
     if (camera && (camera->width != static_cast<uint64_t>(width) ||
@@ -72,22 +74,23 @@ image_t ImportImage(Database* database, const ImageReaderOptions& options,
                        " pixels, but its camera in the database is " +
                        std::to_string(camera->width) + "x" + std::to_string(camera->height));
     }
-    if (options.single_camera) *single_camera_id = existing->camera_id;
+    if (sharing) shared->emplace(key, existing->camera_id);
     return existing->image_id;
   }
-  camera_t camera_id = *single_camera_id;
-  if (!options.single_camera || camera_id == kInvalidCameraId) {
-    camera_id = database->WriteCamera(NewCamera(options, width, height));
-    if (options.single_camera) *single_camera_id = camera_id;
-  } else {
+  camera_t camera_id = kInvalidCameraId;
+  if (sharing && shared->count(key)) {
+    camera_id = shared->at(key);
     const std::optional<Camera> camera = database->ReadCamera(camera_id);
     if (camera && (camera->width != static_cast<uint64_t>(width) ||
                    camera->height != static_cast<uint64_t>(height))) {
       throw InputError(name + ": " + std::to_string(width) + "x" + std::to_string(height) +
-                       " pixels, but --ImageReader.single_camera shares a " +
-                       std::to_string(camera->width) + "x" + std::to_string(camera->height) +
-                       " camera");
+                       " pixels, but it shares a " + std::to_string(camera->width) + "x" +
+                       std::to_string(camera->height) + " camera (--ImageReader.single_camera" +
+                       (options.single_camera ? "" : "_per_folder") + ")");
     }
+  } else {
+    camera_id = database->WriteCamera(NewCamera(options, width, height));
+    if (sharing) shared->emplace(key, camera_id);
   }
   DatabaseImage image;
   image.name = name;

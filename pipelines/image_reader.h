@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@ namespace portcal {
 struct ImageReaderOptions {
   std::string camera_model = "SIMPLE_RADIAL";  // COLMAP model name
   bool single_camera = false;                  // one camera for all images
+  bool single_camera_per_folder = false;       // one camera per sub-folder (stereo: cam1/, cam2/)
   std::string camera_params;                   // "" = default from the image size
   // Default focal length = factor * max(width, height) (COLMAP's 1.2).
   double default_focal_length_factor = 1.2;
@@ -24,12 +26,14 @@ struct ImageReaderOptions {
 // sorted, as paths relative to `dir`. Throws InputError if there are none.
 std::vector<std::string> ListImages(const std::filesystem::path& dir);
 
+// Cameras shared between images of one import (single_camera, or per
+// folder).
+using SharedCameras = std::map<std::string, camera_t>;
+
 // Adds (or finds, on a rerun) the image and its camera. Call inside the
-// stage's transaction. `cameras_by_size` carries the single camera between
-// calls. Throws InputError naming the image when its size does not match
-// its existing camera.
+// stage's transaction. Throws InputError naming the image when its size does
+// not match its shared or existing camera.
 image_t ImportImage(Database* database, const ImageReaderOptions& options,
-                    const std::string& name, int width, int height,
-                    camera_t* single_camera_id);
+                    const std::string& name, int width, int height, SharedCameras* shared);
 
 }  // namespace portcal

@@ -41,6 +41,7 @@ std::string OptionsText(const TargetExtractorOptions& o) {
   std::ostringstream out;
   out << "image_path=" << o.image_path << "\nImageReader.camera_model=" << o.reader.camera_model
       << "\nImageReader.single_camera=" << o.reader.single_camera
+      << "\nImageReader.single_camera_per_folder=" << o.reader.single_camera_per_folder
       << "\nImageReader.camera_params=" << o.reader.camera_params << "\nTarget.type=" << o.target_type
       << "\nTarget.cols=" << o.chessboard.cols << "\nTarget.rows=" << o.chessboard.rows
       << "\nTarget.square_size=" << o.square_size_m << "\n";
@@ -96,7 +97,7 @@ TargetExtractionSummary ExtractTargets(const TargetExtractorOptions& options,
   Database database(options.database_path, Database::OpenMode::kCreate);
   Transaction transaction = database.BeginTransaction();
   TargetExtractionSummary summary;
-  camera_t single_camera_id = kInvalidCameraId;
+  SharedCameras shared_cameras;
   const std::string target = "chessboard " + std::to_string(options.chessboard.cols) + "x" +
                              std::to_string(options.chessboard.rows);
   for (const ImageResult& result : results) {
@@ -105,7 +106,7 @@ TargetExtractionSummary ExtractTargets(const TargetExtractorOptions& options,
       continue;
     }
     const image_t image_id = ImportImage(&database, options.reader, result.name, result.width,
-                                         result.height, &single_camera_id);
+                                         result.height, &shared_cameras);
     std::vector<TargetObservation> observations;
     const ChessboardDetection& d = result.detection;
     if (d.found) {

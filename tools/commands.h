@@ -10,5 +10,6 @@ int RunSynthesize(int argc, char** argv);
 int RunTargetExtractor(int argc, char** argv);
 int RunCameraCalibrator(int argc, char** argv);
 int RunHousingCalibrator(int argc, char** argv);
+int RunStereoCalibrator(int argc, char** argv);
 
 }  // namespace portcal

@@ -34,6 +34,8 @@ const std::vector<Command>& Commands() {
        "calibrate camera intrinsics from the stored target observations"},
       {"housing_calibrator", portcal::RunHousingCalibrator,
        "calibrate a flat or dome port, the in-air intrinsics given"},
+      {"stereo_calibrator", portcal::RunStereoCalibrator,
+       "calibrate a stereo rig's relative pose, in air or behind housings"},
       {"synthesize", portcal::RunSynthesize,
        "render a calibration image set (targets, stereo, surveys, underwater "
        "effects) with exact ground truth"},

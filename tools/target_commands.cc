@@ -1,6 +1,7 @@
 #include "colmap_ext/util/string_utils.h"
 #include "pipelines/camera_calibrator.h"
 #include "pipelines/housing_calibrator.h"
+#include "pipelines/stereo_calibrator.h"
 #include "pipelines/target_extractor.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
@@ -18,6 +19,8 @@ int RunTargetExtractor(int argc, char** argv) {
   cli.AddRequired("image_path", &options.image_path, "directory of images");
   cli.Add("ImageReader.camera_model", &options.reader.camera_model, "COLMAP camera model");
   cli.Add("ImageReader.single_camera", &options.reader.single_camera, "one camera for all images (0 | 1)");
+  cli.Add("ImageReader.single_camera_per_folder", &options.reader.single_camera_per_folder,
+          "one camera per sub-folder, e.g. a stereo rig's cam1/ and cam2/ (0 | 1)");
   cli.Add("ImageReader.camera_params", &options.reader.camera_params,
           "initial parameters in COLMAP's order (default: from the image size)");
   cli.Add("Target.type", &options.target_type, "chessboard");
@@ -86,6 +89,29 @@ int RunHousingCalibrator(int argc, char** argv) {
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
     CalibrateHousingStage(options);
+  });
+}
+
+int RunStereoCalibrator(int argc, char** argv) {
+  StereoCalibratorOptions options;
+  CommandLine cli("stereo_calibrator",
+                  "Calibrates the relative pose of two cameras from frames in which both see the "
+                  "target (robust median of the frames' relative poses, then a joint adjustment), "
+                  "each camera optionally behind its own housing (from its "
+                  "--input_calibration). Without input calibrations each camera is first "
+                  "calibrated in air from its own views. Writes calibration.yaml/.txt.");
+  cli.AddRequired("database_path", &options.database_path, "database with both cameras' observations");
+  cli.AddRequired("output_path", &options.output_path, "directory for the reports");
+  cli.Add("Stereo.camera1_id", &options.camera1_id, "camera 1 (-1: the lower id of the two)");
+  cli.Add("Stereo.camera2_id", &options.camera2_id, "camera 2 (-1: the higher id)");
+  cli.Add("Stereo.pairing", &options.pairing, "name (same file name in both folders) | order");
+  cli.Add("input_calibration1", &options.input_calibration1, "calibration.yaml of camera 1");
+  cli.Add("input_calibration2", &options.input_calibration2, "calibration.yaml of camera 2");
+  cli.Add("Stereo.refine_intrinsics", &options.stereo.refine_intrinsics, "refine both cameras' intrinsics (0 | 1)");
+  cli.Add("num_threads", &options.stereo.num_threads, "threads");
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    CalibrateStereoStage(options);
   });
 }
 

@@ -120,7 +120,75 @@ std::string Text(const CalibrationReport& r) {
   return out.str();
 }
 
+std::string CameraBlock(const std::string& key, const Camera& camera, const std::vector<double>& std_dev,
+                        const std::optional<Housing>& housing) {
+  std::ostringstream out;
+  out << key << ":\n  model: " << camera.ModelName() << "\n  parameters: " << List(camera.params)
+      << "\n  parameters_std_dev: " << StdDevList(std_dev)
+      << "\n  non_svp_model: " << (housing ? housing->ModelName() : "NONE")
+      << "\n  non_svp_parameters: " << List(housing ? housing->params : std::vector<double>{})
+      << "\n  width: " << camera.width << "\n  height: " << camera.height << "\n";
+  return out.str();
+}
+
 }  // namespace
+
+void WriteStereoCalibrationReport(const StereoCalibrationResult& r, const RigCamera& camera1,
+                                  const RigCamera& camera2, const std::string& target_description,
+                                  const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!fs::is_directory(dir)) throw InputError(dir.string() + ": cannot create output directory");
+  const Rigid3d cam1_from_cam2 = r.cam2_from_cam1.Inverse();
+  const Eigen::Matrix3d rotation = cam1_from_cam2.rotation.toRotationMatrix();
+  const Eigen::Vector4d q = QuaternionToWxyz(r.cam2_from_cam1.rotation.normalized());
+  std::ostringstream yaml;
+  yaml << "# portcal stereo calibration report (calibmar-compatible keys first)\n"
+       << "cam_to_world_rotation_rowmajor: "
+       << List({rotation(0, 0), rotation(0, 1), rotation(0, 2), rotation(1, 0), rotation(1, 1),
+                rotation(1, 2), rotation(2, 0), rotation(2, 1), rotation(2, 2)})
+       << "\ncam_to_world_translation: "
+       << List({cam1_from_cam2.translation.x(), cam1_from_cam2.translation.y(), cam1_from_cam2.translation.z()})
+       << "\ncam2_from_cam1:\n  rotation_wxyz: " << List({q[0], q[1], q[2], q[3]}) << "\n  translation: "
+       << List({r.cam2_from_cam1.translation.x(), r.cam2_from_cam1.translation.y(), r.cam2_from_cam1.translation.z()})
+       << "\ncam2_from_cam1_std_dev:\n  rotation_deg: "
+       << StdDevList({r.rotation_std_dev_deg.x(), r.rotation_std_dev_deg.y(), r.rotation_std_dev_deg.z()})
+       << "\n  translation: "
+       << StdDevList({r.translation_std_dev.x(), r.translation_std_dev.y(), r.translation_std_dev.z()})
+       << "\nbaseline: " << Num(r.cam2_from_cam1.translation.norm()) << "\n"
+       << CameraBlock("camera1", r.camera1, r.camera1_std_dev, camera1.housing)
+       << CameraBlock("camera2", r.camera2, r.camera2_std_dev, camera2.housing)
+       << "overall_rms: " << Num(r.overall_rms_px) << "\nresidual_sigma_px: " << Num(r.residual_sigma_px)
+       << "\nnum_views: " << r.views1.size() << "\nnum_points: " << r.num_points << "\ntarget: '"
+       << target_description << "'\nper_view:\n";
+  for (size_t f = 0; f < r.views1.size(); ++f) {
+    yaml << "- image1: '" << r.views1[f].image_name << "'\n  rms1: " << Num(r.views1[f].rms_px)
+         << "\n  image2: '" << r.views2[f].image_name << "'\n  rms2: " << Num(r.views2[f].rms_px) << "\n";
+  }
+  std::ostringstream text;
+  text << std::fixed << "portcal stereo calibration\n==========================\n\nTarget: "
+       << target_description << "\n\ncam2_from_cam1 (camera 2 from camera 1)\n" << std::setprecision(6)
+       << "  rotation (w, x, y, z)   " << q[0] << " " << q[1] << " " << q[2] << " " << q[3]
+       << "\n  translation (m)         " << r.cam2_from_cam1.translation.transpose()
+       << "\n  baseline (m)            " << r.cam2_from_cam1.translation.norm() << std::scientific
+       << std::setprecision(2) << "\n  rotation std dev (deg)  " << r.rotation_std_dev_deg.transpose()
+       << "\n  translation std dev (m) " << r.translation_std_dev.transpose() << std::fixed << "\n\n";
+  for (const auto& [name, camera, std_dev] :
+       {std::tuple{"camera 1", &r.camera1, &r.camera1_std_dev}, std::tuple{"camera 2", &r.camera2, &r.camera2_std_dev}}) {
+    text << name << " " << camera->ModelName() << ": ";
+    for (double p : camera->params) text << std::setprecision(6) << p << " ";
+    text << (std_dev->empty() || (*std_dev)[0] == 0 ? "(fixed)" : "(refined)") << "\n";
+  }
+  text << std::setprecision(4) << "\nRMS reprojection error " << r.overall_rms_px << " px over " << r.num_points
+       << " points\n\n  frame  image 1 rms  image 2 rms\n";
+  for (size_t f = 0; f < r.views1.size(); ++f) {
+    text << "  " << std::left << std::setw(24) << r.views1[f].image_name << std::right << std::setw(8)
+         << r.views1[f].rms_px << std::setw(10) << r.views2[f].rms_px << "\n";
+  }
+  const std::string yaml_text = yaml.str(), text_text = text.str();
+  WriteFileAtomically(dir / "calibration.yaml", false, [&](std::ostream& out) { out << yaml_text; });
+  WriteFileAtomically(dir / "calibration.txt", false, [&](std::ostream& out) { out << text_text; });
+}
 
 void WriteCalibrationReport(const CalibrationReport& report, const fs::path& dir) {
   std::error_code ec;

@@ -11,6 +11,7 @@
 #include "colmap_ext/camera/camera.h"
 #include "colmap_ext/housing/housing.h"
 #include "pipelines/calibration/camera_calibration.h"
+#include "pipelines/calibration/stereo_calibration.h"
 
 namespace portcal {
 
@@ -30,6 +31,13 @@ struct CalibrationReport {
 // Writes calibration.yaml and calibration.txt into `dir` (created),
 // atomically.
 void WriteCalibrationReport(const CalibrationReport& report, const std::filesystem::path& dir);
+
+// Stereo: calibmar's cam_to_world_rotation_rowmajor / cam_to_world_translation
+// (camera 2 in the camera-1 frame), cam2_from_cam1 (rotation_wxyz,
+// translation) with standard deviations, and a block per camera.
+void WriteStereoCalibrationReport(const StereoCalibrationResult& result, const RigCamera& camera1,
+                                  const RigCamera& camera2, const std::string& target_description,
+                                  const std::filesystem::path& dir);
 
 // Reads the camera (and housing) of a calibration.yaml written by portcal or
 // calibmar. Throws InputError naming the file and key.

@@ -95,19 +95,9 @@ std::vector<Pose> InitialPoses(const std::vector<CalibrationView>& views, const 
       plane.push_back(view.points_in_target[i].head<2>());
       rays.push_back(ray->head<2>());
     }
-    const auto h = EstimateHomography(plane, rays);
-    if (!h) throw NumericalError(view.image_name + ": no homography from the target to the image");
-    Eigen::Matrix3d m = *h;
-    double scale = 1.0 / m.col(0).norm();
-    if (m(2, 2) * scale < 0) scale = -scale;
-    Eigen::Matrix3d r;
-    r.col(0) = scale * m.col(0);
-    r.col(1) = scale * m.col(1);
-    r.col(2) = r.col(0).cross(r.col(1));
-    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(r, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Eigen::Matrix3d rotation = svd.matrixU() * svd.matrixV().transpose();
-    if (rotation.determinant() < 0) rotation = -rotation;
-    poses.push_back(ToPose(Rigid3d(Eigen::Quaterniond(rotation), scale * m.col(2))));
+    const std::optional<Rigid3d> pose = PoseFromNormalizedPlanarView({plane, rays});
+    if (!pose) throw NumericalError(view.image_name + ": no homography from the target to the image");
+    poses.push_back(ToPose(*pose));
   }
   return poses;
 }

@@ -51,6 +51,23 @@ std::optional<Eigen::Matrix3d> EstimateHomography(const std::vector<Eigen::Vecto
   return result / result(2, 2);
 }
 
+std::optional<Rigid3d> PoseFromNormalizedPlanarView(const PlanarView& view) {
+  const auto h = EstimateHomography(view.target_xy, view.pixels);
+  if (!h) return std::nullopt;
+  // [r1 r2 t] = s H with |r1| = 1 and the target in front (t_z > 0).
+  const Eigen::Matrix3d& m = *h;
+  double scale = 1.0 / m.col(0).norm();
+  if (m(2, 2) * scale < 0) scale = -scale;
+  Eigen::Matrix3d r;
+  r.col(0) = scale * m.col(0);
+  r.col(1) = scale * m.col(1);
+  r.col(2) = r.col(0).cross(r.col(1));
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(r, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d rotation = svd.matrixU() * svd.matrixV().transpose();
+  if (rotation.determinant() < 0) rotation = -rotation;
+  return Rigid3d(Eigen::Quaterniond(rotation), scale * m.col(2));
+}
+
 std::optional<PinholeEstimate> InitializePinholeFromPlanarViews(const std::vector<PlanarView>& views,
                                                                 int width, int height) {
   std::vector<Eigen::Matrix3d> homographies;
@@ -99,26 +116,12 @@ std::optional<PinholeEstimate> InitializePinholeFromPlanarViews(const std::vecto
   estimate.cx = u0 - centre(0, 2);
   estimate.cy = v0 - centre(1, 2);
   if (!std::isfinite(estimate.fx) || !std::isfinite(estimate.fy)) return std::nullopt;
-  Eigen::Matrix3d k;
-  k << estimate.fx, 0, estimate.cx, 0, estimate.fy, estimate.cy, 0, 0, 1;
-  const Eigen::Matrix3d k_inv = k.inverse();
   for (const PlanarView& view : views) {
-    const auto h = EstimateHomography(view.target_xy, view.pixels);
-    if (!h) {
-      estimate.cam_from_target.emplace_back();
-      continue;
+    PlanarView normalized = view;
+    for (Eigen::Vector2d& p : normalized.pixels) {
+      p = Eigen::Vector2d((p.x() - estimate.cx) / estimate.fx, (p.y() - estimate.cy) / estimate.fy);
     }
-    Eigen::Matrix3d m = k_inv * *h;
-    double scale = 1.0 / m.col(0).norm();
-    if (m(2, 2) * scale < 0) scale = -scale;  // target in front of the camera
-    Eigen::Matrix3d r;
-    r.col(0) = scale * m.col(0);
-    r.col(1) = scale * m.col(1);
-    r.col(2) = r.col(0).cross(r.col(1));
-    const Eigen::JacobiSVD<Eigen::Matrix3d> rsvd(r, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Eigen::Matrix3d rotation = rsvd.matrixU() * rsvd.matrixV().transpose();
-    if (rotation.determinant() < 0) rotation = -rotation;
-    estimate.cam_from_target.emplace_back(Eigen::Quaterniond(rotation), scale * m.col(2));
+    estimate.cam_from_target.push_back(PoseFromNormalizedPlanarView(normalized).value_or(Rigid3d()));
   }
   return estimate;
 }

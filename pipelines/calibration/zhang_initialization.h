@@ -22,6 +22,11 @@ struct PlanarView {
 std::optional<Eigen::Matrix3d> EstimateHomography(const std::vector<Eigen::Vector2d>& from,
                                                   const std::vector<Eigen::Vector2d>& to);
 
+// Pose of a planar view whose `pixels` are normalized ray coordinates
+// (x / z, y / z): the homography's decomposition with K = I, the target in
+// front of the camera. nullopt without a homography.
+std::optional<Rigid3d> PoseFromNormalizedPlanarView(const PlanarView& view);
+
 struct PinholeEstimate {
   double fx = 0, fy = 0, cx = 0, cy = 0;
   std::vector<Rigid3d> cam_from_target;  // one per view

@@ -1,0 +1,181 @@
+// Stereo calibration: the shared in-air stereo render against its ground
+// truth, OpenCV's stereo sample against cv::stereoCalibrate on the same
+// corners, the robust median, and a rig behind two housings.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <opencv2/calib3d.hpp>
+
+#include "colmap_ext/io/ground_truth.h"
+#include "database/database.h"
+#include "pipelines/calibration/calibration_report.h"
+#include "pipelines/stereo_calibrator.h"
+#include "pipelines/synthesize/synthesize.h"
+#include "pipelines/target_extractor.h"
+#include "tests/test_utils.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+namespace {
+
+void Extract(const fs::path& images, const fs::path& database, const std::string& model, int cols, int rows,
+             double square) {
+  TargetExtractorOptions options;
+  options.database_path = database.string();
+  options.image_path = images.string();
+  options.reader.camera_model = model;
+  options.reader.single_camera_per_folder = true;
+  options.chessboard.cols = cols;
+  options.chessboard.rows = rows;
+  options.square_size_m = square;
+  NullProgress progress;
+  ExtractTargets(options, progress);
+}
+
+double AngleDeg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
+  return a.angularDistance(b) * 180 / M_PI;
+}
+
+TEST(StereoCalibration, SharedInAirRigWithinItsStandardDeviations) {
+  PORTCAL_REQUIRE_SHARED(shared);
+  const fs::path set = shared / "datasets/rendered/chess_stereo_air";
+  const GroundTruth truth = ReadGroundTruth(set / "ground_truth.yaml");
+  testing::TempDir dir;
+  Extract(set / "images", dir / "db.db", "RADIAL", 10, 7, 0.02);
+  StereoCalibratorOptions options;
+  options.database_path = (dir / "db.db").string();
+  options.output_path = (dir / "out").string();
+  options.stereo.refine_intrinsics = true;
+  const StereoCalibrationResult result = CalibrateStereoStage(options);
+  const Rigid3d& t = truth.stereo->cam2_from_cam1;
+  const Eigen::Vector3d dt = result.cam2_from_cam1.translation - t.translation;
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_GT(result.translation_std_dev[i], 0);
+    EXPECT_LT(std::abs(dt[i]), 4 * result.translation_std_dev[i] + 1e-6) << "axis " << i;
+  }
+  EXPECT_LT(AngleDeg(result.cam2_from_cam1.rotation, t.rotation), 4 * result.rotation_std_dev_deg.norm() + 1e-4);
+  // The median start is already close.
+  EXPECT_LT((result.median_cam2_from_cam1.translation - t.translation).norm(), 1e-3);
+  EXPECT_TRUE(fs::exists(dir / "out/calibration.yaml"));
+  EXPECT_NE(testing::ReadFileToString(dir / "out/calibration.yaml").find("cam_to_world_rotation_rowmajor"),
+            std::string::npos);
+}
+
+TEST(StereoCalibration, OpenCVStereoSampleAgreesWithStereoCalibrate) {
+  PORTCAL_REQUIRE_SHARED(shared);
+  const fs::path sample = shared / "datasets/opencv-stereo";
+  testing::TempDir dir;
+  fs::create_directories(dir / "images/left");
+  fs::create_directories(dir / "images/right");
+  for (const auto& entry : fs::directory_iterator(sample)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("left", 0) == 0) fs::copy(entry.path(), dir / "images/left" / name.substr(4));
+    if (name.rfind("right", 0) == 0) fs::copy(entry.path(), dir / "images/right" / name.substr(5));
+  }
+  Extract(dir / "images", dir / "db.db", "OPENCV", 9, 6, 0.025);
+  StereoCalibratorOptions options;
+  options.database_path = (dir / "db.db").string();
+  options.output_path = (dir / "out").string();
+  options.stereo.refine_intrinsics = true;
+  const StereoCalibrationResult ours = CalibrateStereoStage(options);
+
+  // OpenCV on exactly the same corners and frames.
+  Database db(dir / "db.db", Database::OpenMode::kReadOnly);
+  std::map<std::string, std::vector<TargetObservation>> left, right;
+  for (const DatabaseImage& image : db.ReadAllImages()) {
+    const auto status = db.ReadTargetDetectionStatus(image.image_id);
+    if (!status || !status->found) continue;
+    const std::string frame = fs::path(image.name).filename().string();
+    (image.name.rfind("left", 0) == 0 ? left : right)[frame] = db.ReadTargetObservations(image.image_id);
+  }
+  std::vector<std::vector<cv::Point3f>> object;
+  std::vector<std::vector<cv::Point2f>> points1, points2;
+  for (const auto& [frame, observations] : left) {
+    if (!right.count(frame)) continue;
+    std::map<int64_t, Eigen::Vector2d> in_right;
+    for (const auto& o : right[frame]) in_right[o.point_id] = o.xy;
+    object.emplace_back();
+    points1.emplace_back();
+    points2.emplace_back();
+    for (const auto& o : observations) {
+      if (!in_right.count(o.point_id)) continue;
+      object.back().emplace_back(o.point_in_target.x(), o.point_in_target.y(), 0);
+      points1.back().emplace_back(o.xy.x() - 0.5, o.xy.y() - 0.5);
+      points2.back().emplace_back(in_right[o.point_id].x() - 0.5, in_right[o.point_id].y() - 0.5);
+    }
+  }
+  ASSERT_GE(object.size(), 10u);
+  cv::Mat k1, d1, k2, d2, r, t, e, f;
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 300, 1e-14);
+  const double rms = cv::stereoCalibrate(object, points1, points2, k1, d1, k2, d2, cv::Size(640, 480), r, t, e, f,
+                                         cv::CALIB_FIX_K3, criteria);
+  cv::Matx33d rotation;
+  r.copyTo(rotation);
+  const Eigen::Matrix3d opencv_rotation = (Eigen::Matrix3d() << rotation(0, 0), rotation(0, 1), rotation(0, 2),
+                                           rotation(1, 0), rotation(1, 1), rotation(1, 2), rotation(2, 0),
+                                           rotation(2, 1), rotation(2, 2)).finished();
+  const Eigen::Vector3d opencv_translation(t.at<double>(0), t.at<double>(1), t.at<double>(2));
+  // OpenCV's R, T map camera 1 to camera 2, as cam2_from_cam1 does.
+  EXPECT_LT(AngleDeg(ours.cam2_from_cam1.rotation, Eigen::Quaterniond(opencv_rotation)),
+            ours.rotation_std_dev_deg.norm());
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LT(std::abs(ours.cam2_from_cam1.translation[i] - opencv_translation[i]), ours.translation_std_dev[i])
+        << "axis " << i;
+  }
+  EXPECT_NEAR(ours.overall_rms_px, rms, 0.02);
+}
+
+TEST(StereoCalibration, MedianIgnoresAFlippedFrame) {
+  std::vector<Rigid3d> poses;
+  for (int i = 0; i < 9; ++i) {
+    poses.emplace_back(Eigen::Quaterniond(Eigen::AngleAxisd(0.05 + 1e-4 * i, Eigen::Vector3d::UnitY())),
+                       Eigen::Vector3d(-0.1 + 1e-5 * i, 0, 0.005));
+  }
+  poses.emplace_back(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ())),
+                     Eigen::Vector3d(0.3, 0.2, 0.1));  // a view detected rotated by 180 deg
+  const Rigid3d median = MedianPose(poses);
+  EXPECT_LT(median.rotation.angularDistance(poses[4].rotation), 1e-3);
+  EXPECT_LT((median.translation - poses[4].translation).norm(), 1e-4);
+}
+
+TEST(StereoCalibration, RigBehindTwoDomes) {
+  testing::TempDir dir;
+  std::ofstream(dir / "rig.yaml") << R"(name: rig
+seed: 8
+num_images: 10
+camera: {model: SIMPLE_RADIAL, width: 800, height: 600, params: [650.0, 400.0, 300.0, -0.03]}
+housing: {model: DOMEPORT, params: [0.003, -0.002, 0.004, 0.05, 0.006, 1.0, 1.473, 1.334]}
+stereo:
+  cam2_from_cam1: {rotation_axis_angle_deg: [0.0, 1.0, 0.0, -4.0], translation: [-0.12, 0.0, 0.004]}
+  housing2: {model: DOMEPORT, params: [-0.002, 0.001, 0.005, 0.05, 0.006, 1.0, 1.473, 1.334]}
+target: {type: chessboard, cols: 8, rows: 6, square_size: 0.025, margin: 0.015}
+poses: {distance: [0.5, 1.0], tilt_max_deg: 35, roll_max_deg: 20}
+)";
+  SynthesizeOptions synthesize;
+  synthesize.config_path = (dir / "rig.yaml").string();
+  synthesize.output_path = (dir / "set").string();
+  NullProgress progress;
+  Synthesize(synthesize, progress);
+  const GroundTruth truth = ReadGroundTruth(dir / "set/ground_truth.yaml");
+  Extract(dir / "set/images", dir / "db.db", "SIMPLE_RADIAL", 8, 6, 0.025);
+  for (int k = 0; k < 2; ++k) {  // each camera's housing calibration, known here
+    CalibrationReport report;
+    report.camera = k == 0 ? truth.camera : truth.stereo->camera2;
+    report.housing = k == 0 ? truth.housing : truth.stereo->housing2;
+    WriteCalibrationReport(report, dir / ("cam" + std::to_string(k + 1)));
+  }
+  StereoCalibratorOptions options;
+  options.database_path = (dir / "db.db").string();
+  options.output_path = (dir / "out").string();
+  options.input_calibration1 = (dir / "cam1/calibration.yaml").string();
+  options.input_calibration2 = (dir / "cam2/calibration.yaml").string();
+  const StereoCalibrationResult result = CalibrateStereoStage(options);
+  const Rigid3d& t = truth.stereo->cam2_from_cam1;
+  EXPECT_LT((result.cam2_from_cam1.translation - t.translation).norm(), 1e-4);
+  EXPECT_LT(AngleDeg(result.cam2_from_cam1.rotation, t.rotation), 0.005);
+  EXPECT_LT(result.overall_rms_px, 0.05);
+}
+
+}  // namespace
+}  // namespace portcal
