@@ -11,6 +11,7 @@
 #include "colmap_ext/housing/port_projection.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "pipelines/calibration/view_pose.h"
 #include "pipelines/calibration/zhang_initialization.h"
 
 namespace portcal {
@@ -21,123 +22,6 @@ void StereoCalibrationSettings::Check() const {
   }
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
 }
-
-namespace {
-
-using Pose = std::array<double, 7>;
-
-Pose ToPose(const Rigid3d& rigid) {
-  const Eigen::Quaterniond q = rigid.rotation.normalized();
-  return {q.x(), q.y(), q.z(), q.w(), rigid.translation.x(), rigid.translation.y(), rigid.translation.z()};
-}
-
-Rigid3d FromPose(const Pose& p) {
-  return Rigid3d(Eigen::Quaterniond(p[3], p[0], p[1], p[2]).normalized(), Eigen::Vector3d(p[4], p[5], p[6]));
-}
-
-// A target point of frame f seen by camera k of the rig: X_k = camk_from_cam1
-// * cam1_from_target * X, through the lens and, if Port is not void, the
-// port (fixed parameters).
-template <typename CameraModel, typename Port>
-struct RigBoardError
-    : AutoDiffFunctor<RigBoardError<CameraModel, Port>, 2, 7, 7, CameraModel::kNumParams> {
-  RigBoardError(const Eigen::Vector3d& point, const Eigen::Vector2d& observed, const std::vector<double>& port)
-      : point_(point), observed_(observed), port_(port) {}
-
-  template <typename T>
-  bool operator()(const T* cam1_from_target, const T* camk_from_cam1, const T* intrinsics, T* residual) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q1(cam1_from_target), qk(camk_from_cam1);
-    const Eigen::Map<const VectorT<T, 3>> t1(cam1_from_target + 4), tk(camk_from_cam1 + 4);
-    const VectorT<T, 3> in_cam = qk * (q1 * point_.cast<T>() + t1) + tk;
-    T x, y;
-    if constexpr (std::is_void_v<Port>) {
-      if (!CameraModel::ImgFromCam(intrinsics, in_cam.x(), in_cam.y(), in_cam.z(), &x, &y)) return false;
-    } else {
-      T port[Port::kNumParams];
-      for (int i = 0; i < Port::kNumParams; ++i) port[i] = T(port_[i]);
-      if (!ImgFromWater<CameraModel, Port, T>(intrinsics, port, in_cam, &x, &y)) return false;
-    }
-    residual[0] = x - observed_.x();
-    residual[1] = y - observed_.y();
-    return true;
-  }
-
- private:
-  Eigen::Vector3d point_;
-  Eigen::Vector2d observed_;
-  std::vector<double> port_;
-};
-
-void AddView(const CalibrationView& view, const RigCamera& rig_camera, double* cam1_from_target,
-             double* camk_from_cam1, double* intrinsics, ceres::Problem* problem) {
-  VisitCameraModel(rig_camera.camera.model_id, [&](auto camera_tag) {
-    using CameraModel = decltype(camera_tag);
-    const auto add = [&](auto make) {
-      for (size_t i = 0; i < view.pixels.size(); ++i) {
-        problem->AddResidualBlock(make(view.points_in_target[i], view.pixels[i]), nullptr,
-                                  cam1_from_target, camk_from_cam1, intrinsics);
-      }
-    };
-    if (!rig_camera.housing) {
-      add([&](const Eigen::Vector3d& p, const Eigen::Vector2d& o) {
-        return RigBoardError<CameraModel, void>::Create(p, o, std::vector<double>{});
-      });
-      return;
-    }
-    VisitHousingModel(rig_camera.housing->model_id, [&](auto port_tag) {
-      using Port = decltype(port_tag);
-      add([&](const Eigen::Vector3d& p, const Eigen::Vector2d& o) {
-        return RigBoardError<CameraModel, Port>::Create(p, o, rig_camera.housing->params);
-      });
-    });
-  });
-}
-
-ceres::Manifold* PoseManifold() {
-  return new ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>();
-}
-
-// cam_from_target of one camera and view: homography on the undistorted
-// rays, then a pose-only solve through lens and port.
-Pose InitialPose(const CalibrationView& view, const RigCamera& rig_camera, int num_threads) {
-  PlanarView planar;
-  for (size_t i = 0; i < view.pixels.size(); ++i) {
-    const auto ray = rig_camera.camera.CamFromImg(view.pixels[i]);
-    if (!ray) continue;
-    planar.target_xy.push_back(view.points_in_target[i].head<2>());
-    planar.pixels.push_back(ray->head<2>());
-  }
-  const std::optional<Rigid3d> pose = PoseFromNormalizedPlanarView(planar);
-  if (!pose) throw NumericalError(view.image_name + ": no initial pose from the target");
-  Pose p = ToPose(*pose);
-  Pose identity = {0, 0, 0, 1, 0, 0, 0};
-  std::vector<double> intrinsics = rig_camera.camera.params;
-  ceres::Problem problem;
-  AddView(view, rig_camera, p.data(), identity.data(), intrinsics.data(), &problem);
-  problem.SetManifold(p.data(), PoseManifold());
-  problem.SetParameterBlockConstant(identity.data());
-  problem.SetParameterBlockConstant(intrinsics.data());
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
-  options.logging_type = ceres::SILENT;
-  options.num_threads = num_threads;
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
-  if (!summary.IsSolutionUsable()) throw NumericalError(view.image_name + ": pose solve failed");
-  return p;
-}
-
-double ViewRms(const CalibrationView& view, const RigCamera& rig_camera, const Rigid3d& cam_from_target) {
-  double sum = 0;
-  for (size_t i = 0; i < view.pixels.size(); ++i) {
-    const auto pixel = ProjectPoint(rig_camera.camera, rig_camera.housing ? &*rig_camera.housing : nullptr,
-                                    cam_from_target * view.points_in_target[i]);
-    sum += pixel ? (*pixel - view.pixels[i]).squaredNorm() : 1e6;
-  }
-  return std::sqrt(sum / std::max<size_t>(1, view.pixels.size()));
-}
-
-}  // namespace
 
 Rigid3d MedianPose(const std::vector<Rigid3d>& poses) {
   PORTCAL_CHECK(!poses.empty());
@@ -203,16 +87,16 @@ StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames, 
   }
   const Eigen::Vector2d centre = 0.5 * (lo + hi);
   std::vector<StereoFrame> used = frames;
-  std::vector<Pose> poses1;
+  std::vector<PoseBlock> poses1;
   std::vector<Rigid3d> relative, relative_flipped;
   std::vector<CalibrationView> flipped;
   for (const StereoFrame& frame : frames) {
-    poses1.push_back(InitialPose(frame.cam1, camera1, settings.num_threads));
-    relative.push_back(FromPose(InitialPose(frame.cam2, camera2, settings.num_threads)) *
+    poses1.push_back(ToPose(EstimateViewPose(frame.cam1, camera1, settings.num_threads)));
+    relative.push_back(EstimateViewPose(frame.cam2, camera2, settings.num_threads) *
                        FromPose(poses1.back()).Inverse());
     CalibrationView view = frame.cam2;
     for (auto& p : view.points_in_target) p.head<2>() = 2 * centre - p.head<2>();
-    relative_flipped.push_back(FromPose(InitialPose(view, camera2, settings.num_threads)) *
+    relative_flipped.push_back(EstimateViewPose(view, camera2, settings.num_threads) *
                                FromPose(poses1.back()).Inverse());
     flipped.push_back(std::move(view));
   }
@@ -229,15 +113,15 @@ StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames, 
     chosen.push_back(turned < as_is ? relative_flipped[f] : relative[f]);
   }
   result.median_cam2_from_cam1 = MedianPose(chosen);
-  Pose cam2_from_cam1 = ToPose(result.median_cam2_from_cam1);
-  Pose identity = {0, 0, 0, 1, 0, 0, 0};
+  PoseBlock cam2_from_cam1 = ToPose(result.median_cam2_from_cam1);
+  PoseBlock identity = {0, 0, 0, 1, 0, 0, 0};
   std::vector<double> intrinsics1 = camera1.camera.params, intrinsics2 = camera2.camera.params;
 
   ceres::Problem problem;
   int num_points = 0;
   for (size_t f = 0; f < frames.size(); ++f) {
-    AddView(used[f].cam1, camera1, poses1[f].data(), identity.data(), intrinsics1.data(), &problem);
-    AddView(used[f].cam2, camera2, poses1[f].data(), cam2_from_cam1.data(), intrinsics2.data(), &problem);
+    AddRigView(used[f].cam1, camera1, poses1[f].data(), identity.data(), intrinsics1.data(), &problem);
+    AddRigView(used[f].cam2, camera2, poses1[f].data(), cam2_from_cam1.data(), intrinsics2.data(), &problem);
     problem.SetManifold(poses1[f].data(), PoseManifold());
     num_points += static_cast<int>(used[f].cam1.pixels.size() + used[f].cam2.pixels.size());
   }

@@ -14,16 +14,12 @@
 #include "colmap_ext/camera/camera.h"
 #include "colmap_ext/housing/housing.h"
 #include "pipelines/calibration/camera_calibration.h"
+#include "pipelines/calibration/view_pose.h"
 
 namespace portcal {
 
 struct StereoFrame {
   CalibrationView cam1, cam2;  // the same target frame seen by both cameras
-};
-
-struct RigCamera {
-  Camera camera;
-  std::optional<Housing> housing;
 };
 
 struct StereoCalibrationSettings {

@@ -1,0 +1,141 @@
+#include "pipelines/calibration/view_pose.h"
+
+#include <cmath>
+
+#include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/cost/autodiff_functor.h"
+#include "colmap_ext/housing/housing_models.h"
+#include "colmap_ext/housing/port_projection.h"
+#include "colmap_ext/util/error.h"
+#include "pipelines/calibration/zhang_initialization.h"
+
+namespace portcal {
+namespace {
+
+// A target point of frame f seen by camera k of the rig: X_k = camk_from_cam1
+// * cam1_from_target * X, through the lens and, if Port is not void, the
+// port (fixed parameters).
+template <typename CameraModel, typename Port>
+struct RigBoardError
+    : AutoDiffFunctor<RigBoardError<CameraModel, Port>, 2, 7, 7, CameraModel::kNumParams> {
+  RigBoardError(const Eigen::Vector3d& point, const Eigen::Vector2d& observed, const std::vector<double>& port)
+      : point_(point), observed_(observed), port_(port) {}
+
+  template <typename T>
+  bool operator()(const T* cam1_from_target, const T* camk_from_cam1, const T* intrinsics, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q1(cam1_from_target), qk(camk_from_cam1);
+    const Eigen::Map<const VectorT<T, 3>> t1(cam1_from_target + 4), tk(camk_from_cam1 + 4);
+    const VectorT<T, 3> in_cam = qk * (q1 * point_.cast<T>() + t1) + tk;
+    T x, y;
+    if constexpr (std::is_void_v<Port>) {
+      if (!CameraModel::ImgFromCam(intrinsics, in_cam.x(), in_cam.y(), in_cam.z(), &x, &y)) return false;
+    } else {
+      T port[Port::kNumParams];
+      for (int i = 0; i < Port::kNumParams; ++i) port[i] = T(port_[i]);
+      if (!ImgFromWater<CameraModel, Port, T>(intrinsics, port, in_cam, &x, &y)) return false;
+    }
+    residual[0] = x - observed_.x();
+    residual[1] = y - observed_.y();
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d point_;
+  Eigen::Vector2d observed_;
+  std::vector<double> port_;
+};
+
+}  // namespace
+
+PoseBlock ToPose(const Rigid3d& rigid) {
+  const Eigen::Quaterniond q = rigid.rotation.normalized();
+  return {q.x(), q.y(), q.z(), q.w(), rigid.translation.x(), rigid.translation.y(), rigid.translation.z()};
+}
+
+Rigid3d FromPose(const PoseBlock& p) {
+  return Rigid3d(Eigen::Quaterniond(p[3], p[0], p[1], p[2]).normalized(), Eigen::Vector3d(p[4], p[5], p[6]));
+}
+
+void AddRigView(const CalibrationView& view, const RigCamera& rig_camera, double* cam1_from_target,
+             double* camk_from_cam1, double* intrinsics, ceres::Problem* problem) {
+  VisitCameraModel(rig_camera.camera.model_id, [&](auto camera_tag) {
+    using CameraModel = decltype(camera_tag);
+    const auto add = [&](auto make) {
+      for (size_t i = 0; i < view.pixels.size(); ++i) {
+        problem->AddResidualBlock(make(view.points_in_target[i], view.pixels[i]), nullptr,
+                                  cam1_from_target, camk_from_cam1, intrinsics);
+      }
+    };
+    if (!rig_camera.housing) {
+      add([&](const Eigen::Vector3d& p, const Eigen::Vector2d& o) {
+        return RigBoardError<CameraModel, void>::Create(p, o, std::vector<double>{});
+      });
+      return;
+    }
+    VisitHousingModel(rig_camera.housing->model_id, [&](auto port_tag) {
+      using Port = decltype(port_tag);
+      add([&](const Eigen::Vector3d& p, const Eigen::Vector2d& o) {
+        return RigBoardError<CameraModel, Port>::Create(p, o, rig_camera.housing->params);
+      });
+    });
+  });
+}
+
+ceres::Manifold* PoseManifold() {
+  return new ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>();
+}
+
+// cam_from_target of one camera and view: homography on the undistorted
+// rays, then a pose-only solve through lens and port.
+Rigid3d EstimateViewPose(const CalibrationView& view, const RigCamera& rig_camera, int num_threads) {
+  PlanarView planar;
+  for (size_t i = 0; i < view.pixels.size(); ++i) {
+    const auto ray = rig_camera.camera.CamFromImg(view.pixels[i]);
+    if (!ray) continue;
+    planar.target_xy.push_back(view.points_in_target[i].head<2>());
+    planar.pixels.push_back(ray->head<2>());
+  }
+  const std::optional<Rigid3d> pose = PoseFromNormalizedPlanarView(planar);
+  if (!pose) throw NumericalError(view.image_name + ": no initial pose from the target");
+  PoseBlock p = ToPose(*pose);
+  PoseBlock identity = {0, 0, 0, 1, 0, 0, 0};
+  std::vector<double> intrinsics = rig_camera.camera.params;
+  ceres::Problem problem;
+  AddRigView(view, rig_camera, p.data(), identity.data(), intrinsics.data(), &problem);
+  problem.SetManifold(p.data(), PoseManifold());
+  problem.SetParameterBlockConstant(identity.data());
+  problem.SetParameterBlockConstant(intrinsics.data());
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.logging_type = ceres::SILENT;
+  options.num_threads = num_threads;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  if (!summary.IsSolutionUsable()) throw NumericalError(view.image_name + ": pose solve failed");
+  return FromPose(p);
+}
+
+double ViewRms(const CalibrationView& view, const RigCamera& rig_camera, const Rigid3d& cam_from_target) {
+  double sum = 0;
+  for (size_t i = 0; i < view.pixels.size(); ++i) {
+    const auto pixel = ProjectPoint(rig_camera.camera, rig_camera.housing ? &*rig_camera.housing : nullptr,
+                                    cam_from_target * view.points_in_target[i]);
+    sum += pixel ? (*pixel - view.pixels[i]).squaredNorm() : 1e6;
+  }
+  return std::sqrt(sum / std::max<size_t>(1, view.pixels.size()));
+}
+
+
+double HeldOutRms(const std::vector<CalibrationView>& views, const RigCamera& camera, int num_threads) {
+  double sum = 0;
+  size_t count = 0;
+  for (const CalibrationView& view : views) {
+    const double rms = ViewRms(view, camera, EstimateViewPose(view, camera, num_threads));
+    sum += rms * rms * view.pixels.size();
+    count += view.pixels.size();
+  }
+  if (count == 0) throw NumericalError("held-out evaluation without points");
+  return std::sqrt(sum / count);
+}
+
+}  // namespace portcal

@@ -1,0 +1,44 @@
+// The pose of one view of a planar target, seen by a camera that may sit
+// behind a housing, and the pieces the rig adjustments share.
+#pragma once
+
+#include <ceres/ceres.h>
+
+#include <optional>
+#include <vector>
+
+#include "colmap_ext/camera/camera.h"
+#include "colmap_ext/housing/housing.h"
+#include "pipelines/calibration/camera_calibration.h"
+
+namespace portcal {
+
+struct RigCamera {
+  Camera camera;
+  std::optional<Housing> housing;
+};
+
+using PoseBlock = std::array<double, 7>;  // quaternion x, y, z, w + translation
+
+PoseBlock ToPose(const Rigid3d& rigid);
+Rigid3d FromPose(const PoseBlock& pose);
+// Quaternion (Eigen's manifold) x translation.
+ceres::Manifold* PoseManifold();
+
+// Adds the view's points: X_k = camk_from_cam1 * cam1_from_target * X
+// through lens and housing (fixed), residuals in pixels.
+void AddRigView(const CalibrationView& view, const RigCamera& camera, double* cam1_from_target,
+                double* camk_from_cam1, double* intrinsics, ceres::Problem* problem);
+
+// cam_from_target of a view: homography on the undistorted rays, then a
+// pose-only solve through lens and housing. Throws NumericalError.
+Rigid3d EstimateViewPose(const CalibrationView& view, const RigCamera& camera, int num_threads);
+
+// RMS (px) of a view at a pose, through lens and housing.
+double ViewRms(const CalibrationView& view, const RigCamera& camera, const Rigid3d& cam_from_target);
+
+// Held-out error of a calibration: each view's pose estimated alone (pose
+// only, everything else fixed), RMS over all points of all views.
+double HeldOutRms(const std::vector<CalibrationView>& views, const RigCamera& camera, int num_threads);
+
+}  // namespace portcal
