@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Camera calibration from chessboard images, end to end. Copy and adapt.
+# Usage: workflows/calibrate_camera.sh IMAGE_DIR OUTPUT_DIR [COLS ROWS SQUARE_M MODEL]
+#   COLS x ROWS inner corners (default 10 7), square side in metres (0.02),
+#   COLMAP camera model (OPENCV).
+set -euo pipefail
+images="$1"; out="$2"
+cols="${3:-10}"; rows="${4:-7}"; square="${5:-0.02}"; model="${6:-OPENCV}"
+portcal="$(dirname "$0")/../build/portcal"
+mkdir -p "$out"
+"$portcal" target_extractor --database_path "$out/database.db" --image_path "$images" \
+  --ImageReader.camera_model "$model" --ImageReader.single_camera 1 \
+  --Target.cols "$cols" --Target.rows "$rows" --Target.square_size "$square"
+"$portcal" camera_calibrator --database_path "$out/database.db" --output_path "$out" \
+  --Calibration.drop_outlier_views 1
+cat "$out/calibration.txt"
