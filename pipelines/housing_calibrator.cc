@@ -1,13 +1,12 @@
 #include "pipelines/housing_calibrator.h"
 
-#include <map>
-
 #include "colmap_ext/housing/housing_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/string_utils.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
+#include "pipelines/calibration/target_views.h"
 
 namespace portcal {
 
@@ -30,34 +29,9 @@ HousingCalibrationResult CalibrateHousingStage(const HousingCalibratorOptions& o
       "--Housing.params");
   const CalibrationReport in_air = ReadCalibrationReport(options.input_calibration);
   Database database(options.database_path, Database::OpenMode::kReadOnly);
-  std::map<camera_t, std::vector<CalibrationView>> views_by_camera;
-  std::string target;
-  for (const DatabaseImage& image : database.ReadAllImages()) {
-    const auto status = database.ReadTargetDetectionStatus(image.image_id);
-    if (!status || !status->found) continue;
-    target = status->target;
-    CalibrationView view;
-    view.image_name = image.name;
-    for (const TargetObservation& o : database.ReadTargetObservations(image.image_id)) {
-      view.points_in_target.push_back(o.point_in_target);
-      view.pixels.push_back(o.xy);
-    }
-    views_by_camera[image.camera_id].push_back(view);
-  }
-  if (views_by_camera.empty()) {
-    throw InputError(options.database_path + ": no target observations; run target_extractor first");
-  }
-  camera_t camera_id = static_cast<camera_t>(options.camera_id);
-  if (options.camera_id < 0) {
-    if (views_by_camera.size() > 1) {
-      throw InputError(options.database_path + ": several cameras have observations; choose one with --camera_id");
-    }
-    camera_id = views_by_camera.begin()->first;
-  }
-  const auto views = views_by_camera.find(camera_id);
-  if (views == views_by_camera.end()) {
-    throw InputError(options.database_path + ": camera " + std::to_string(camera_id) + " has no observations");
-  }
+  const TargetViews target_views = ReadTargetViews(&database);
+  const camera_t camera_id = ChooseCamera(target_views, options.camera_id, options.database_path);
+  const std::vector<CalibrationView>& views = target_views.by_camera.at(camera_id);
   const std::optional<Camera> database_camera = database.ReadCamera(camera_id);
   if (database_camera->width != in_air.camera.width || database_camera->height != in_air.camera.height) {
     throw InputError(options.input_calibration + ": calibrated for " + std::to_string(in_air.camera.width) +
@@ -65,9 +39,8 @@ HousingCalibrationResult CalibrateHousingStage(const HousingCalibratorOptions& o
                      std::to_string(database_camera->width) + "x" + std::to_string(database_camera->height));
   }
   LOG(INFO) << "housing_calibrator: " << housing.ModelName() << ", camera " << in_air.camera.ModelName()
-            << " from " << options.input_calibration << ", " << views->second.size() << " views";
-  const HousingCalibrationResult result =
-      CalibrateHousing(views->second, in_air.camera, housing, options.calibration);
+            << " from " << options.input_calibration << ", " << views.size() << " views";
+  const HousingCalibrationResult result = CalibrateHousing(views, in_air.camera, housing, options.calibration);
 
   CalibrationReport report;
   report.camera = result.camera;
@@ -78,7 +51,7 @@ HousingCalibrationResult CalibrateHousingStage(const HousingCalibratorOptions& o
   report.residual_sigma_px = result.residual_sigma_px;
   report.num_points = result.num_points;
   report.views = result.views;
-  report.target_description = target;
+  report.target_description = target_views.target;
   WriteCalibrationReport(report, options.output_path);
   LOG(INFO) << "housing_calibrator: RMS " << result.overall_rms_px << " px -> " << options.output_path;
   return result;

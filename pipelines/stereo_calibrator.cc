@@ -7,6 +7,7 @@
 #include "colmap_ext/util/logging.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
+#include "pipelines/calibration/target_views.h"
 
 namespace fs = std::filesystem;
 
@@ -44,20 +45,8 @@ RigCamera CameraFor(const std::string& input_calibration, const Camera& database
 StereoCalibrationResult CalibrateStereoStage(const StereoCalibratorOptions& options) {
   options.Check();
   Database database(options.database_path, Database::OpenMode::kReadOnly);
-  std::map<camera_t, std::vector<CalibrationView>> views_by_camera;
-  std::string target;
-  for (const DatabaseImage& image : database.ReadAllImages()) {
-    const auto status = database.ReadTargetDetectionStatus(image.image_id);
-    if (!status || !status->found) continue;
-    target = status->target;
-    CalibrationView view;
-    view.image_name = image.name;
-    for (const TargetObservation& o : database.ReadTargetObservations(image.image_id)) {
-      view.points_in_target.push_back(o.point_in_target);
-      view.pixels.push_back(o.xy);
-    }
-    views_by_camera[image.camera_id].push_back(view);
-  }
+  TargetViews target_views = ReadTargetViews(&database);
+  auto& views_by_camera = target_views.by_camera;
   std::vector<camera_t> ids;
   for (const auto& [id, views] : views_by_camera) ids.push_back(id);
   camera_t id1 = static_cast<camera_t>(options.camera1_id), id2 = static_cast<camera_t>(options.camera2_id);
@@ -95,7 +84,7 @@ StereoCalibrationResult CalibrateStereoStage(const StereoCalibratorOptions& opti
   const RigCamera camera2 = CameraFor(options.input_calibration2, *database.ReadCamera(id2), views2,
                                       options.stereo.num_threads);
   const StereoCalibrationResult result = CalibrateStereo(frames, camera1, camera2, options.stereo);
-  WriteStereoCalibrationReport(result, camera1, camera2, target, options.output_path);
+  WriteStereoCalibrationReport(result, camera1, camera2, target_views.target, options.output_path);
   LOG(INFO) << "stereo_calibrator: baseline " << result.cam2_from_cam1.translation.norm() << " m, RMS "
             << result.overall_rms_px << " px -> " << options.output_path;
   return result;

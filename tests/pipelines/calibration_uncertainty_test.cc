@@ -8,6 +8,7 @@
 #include "colmap_ext/io/ground_truth.h"
 #include "database/database.h"
 #include "pipelines/calibration/camera_calibration.h"
+#include "pipelines/calibration/target_views.h"
 #include "pipelines/synthesize/synthesize.h"
 #include "pipelines/target_extractor.h"
 #include "tests/test_utils.h"
@@ -49,16 +50,7 @@ render: {spp: 4, noise_sigma: 2.0}
     extract.square_size_m = 0.025;
     ExtractTargets(extract, progress);
     Database db(set / "db.db", Database::OpenMode::kReadOnly);
-    std::vector<CalibrationView> views;
-    for (const DatabaseImage& image : db.ReadAllImages()) {
-      CalibrationView view;
-      view.image_name = image.name;
-      for (const TargetObservation& o : db.ReadTargetObservations(image.image_id)) {
-        view.points_in_target.push_back(o.point_in_target);
-        view.pixels.push_back(o.xy);
-      }
-      views.push_back(view);
-    }
+    const std::vector<CalibrationView> views = ReadTargetViews(&db).by_camera.begin()->second;
     const Camera initial = Camera::FromModelName("RADIAL", 600, 800, 600);
     const CameraCalibrationResult result = CalibrateCamera(views, initial, {});
     for (int i = 0; i < 5; ++i) {

@@ -9,6 +9,7 @@
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
+#include "pipelines/calibration/target_views.h"
 #include "pipelines/camera_calibrator.h"
 #include "pipelines/target_extractor.h"
 #include "tests/test_utils.h"
@@ -20,17 +21,7 @@ namespace {
 
 std::vector<CalibrationView> ViewsFromDatabase(const fs::path& path) {
   Database db(path, Database::OpenMode::kReadOnly);
-  std::vector<CalibrationView> views;
-  for (const DatabaseImage& image : db.ReadAllImages()) {
-    CalibrationView view;
-    view.image_name = image.name;
-    for (const TargetObservation& o : db.ReadTargetObservations(image.image_id)) {
-      view.points_in_target.push_back(o.point_in_target);
-      view.pixels.push_back(o.xy);
-    }
-    if (!view.pixels.empty()) views.push_back(view);
-  }
-  return views;
+  return ReadTargetViews(&db).by_camera.begin()->second;
 }
 
 void Extract(const fs::path& images, const fs::path& database, const std::string& model, int cols,

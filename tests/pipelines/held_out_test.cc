@@ -9,6 +9,7 @@
 #include "database/database.h"
 #include "pipelines/calibration/camera_calibration.h"
 #include "pipelines/calibration/housing_calibration.h"
+#include "pipelines/calibration/target_views.h"
 #include "pipelines/calibration/view_pose.h"
 #include "pipelines/synthesize/synthesize.h"
 #include "pipelines/target_extractor.h"
@@ -32,17 +33,7 @@ std::vector<CalibrationView> Extract(const fs::path& images, const fs::path& dat
   NullProgress progress;
   ExtractTargets(options, progress);
   Database db(database, Database::OpenMode::kReadOnly);
-  std::vector<CalibrationView> views;
-  for (const DatabaseImage& image : db.ReadAllImages()) {
-    CalibrationView view;
-    view.image_name = image.name;
-    for (const TargetObservation& o : db.ReadTargetObservations(image.image_id)) {
-      view.points_in_target.push_back(o.point_in_target);
-      view.pixels.push_back(o.xy);
-    }
-    if (!view.pixels.empty()) views.push_back(view);
-  }
-  return views;
+  return ReadTargetViews(&db).by_camera.begin()->second;
 }
 
 void Split(const std::vector<CalibrationView>& views, std::vector<CalibrationView>* even,

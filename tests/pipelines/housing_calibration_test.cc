@@ -7,6 +7,7 @@
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
+#include "pipelines/calibration/target_views.h"
 #include "pipelines/housing_calibrator.h"
 #include "pipelines/target_extractor.h"
 #include "tests/test_utils.h"
@@ -25,17 +26,7 @@ std::vector<CalibrationView> ExtractViews(const fs::path& images, const fs::path
   NullProgress progress;
   ExtractTargets(options, progress);
   Database db(database, Database::OpenMode::kReadOnly);
-  std::vector<CalibrationView> views;
-  for (const DatabaseImage& image : db.ReadAllImages()) {
-    CalibrationView view;
-    view.image_name = image.name;
-    for (const TargetObservation& o : db.ReadTargetObservations(image.image_id)) {
-      view.points_in_target.push_back(o.point_in_target);
-      view.pixels.push_back(o.xy);
-    }
-    views.push_back(view);
-  }
-  return views;
+  return ReadTargetViews(&db).by_camera.begin()->second;
 }
 
 TEST(HousingCalibration, DomeDecenteringFromTheSharedRender) {
