@@ -260,6 +260,7 @@ CameraCalibrationResult CalibrateCamera(const std::vector<CalibrationView>& all_
 
   CameraCalibrationResult result;
   std::vector<bool> dropped(views.size(), false);
+  std::vector<double> dropped_rms(views.size(), 0.0);  // RMS when dropped
   Solution solution;
   for (int round = 0; round < 4; ++round) {
     std::vector<const CalibrationView*> kept;
@@ -267,7 +268,7 @@ CameraCalibrationResult CalibrateCamera(const std::vector<CalibrationView>& all_
     for (size_t v = 0; v < views.size(); ++v) {
       if (!dropped[v]) {
         kept.push_back(views[v]);
-        kept_poses.push_back(round == 0 ? poses[v] : poses[v]);
+        kept_poses.push_back(poses[v]);
       }
     }
     if (kept.size() < 2) throw NumericalError("camera calibration: fewer than 2 views left after dropping outliers");
@@ -283,6 +284,7 @@ CameraCalibrationResult CalibrateCamera(const std::vector<CalibrationView>& all_
       poses[v] = solution.poses[k];
       if (settings.drop_outlier_views && solution.view_rms[k] > settings.outlier_view_factor * median) {
         dropped[v] = true;
+        dropped_rms[v] = solution.view_rms[k];
         any_new = true;
         LOG(WARNING) << views[v]->image_name << ": RMS " << solution.view_rms[k] << " px > "
                      << settings.outlier_view_factor << " x median " << median << " px; dropped";
@@ -313,7 +315,10 @@ CameraCalibrationResult CalibrateCamera(const std::vector<CalibrationView>& all_
     const auto& p = poses[v];
     out.cam_from_target = Rigid3d(Eigen::Quaterniond(p[3], p[0], p[1], p[2]).normalized(),
                                   Eigen::Vector3d(p[4], p[5], p[6]));
-    if (!dropped[v]) {
+    if (dropped[v]) {
+      out.rms_px = dropped_rms[v];
+      out.outlier = true;
+    } else {
       out.rms_px = solution.view_rms[k++];
       out.outlier = out.rms_px > settings.outlier_view_factor * median;
     }
