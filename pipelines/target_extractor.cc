@@ -18,24 +18,64 @@ namespace portcal {
 void TargetExtractorOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (image_path.empty()) throw OptionError("--image_path", "''", "a directory of images");
-  if (target_type != "chessboard") {
-    throw OptionError("--Target.type", target_type,
-                      "chessboard (aruco_grid and charuco detection are not available yet)");
+  if (target_type != "chessboard" && target_type != "aruco_grid" && target_type != "charuco") {
+    throw OptionError("--Target.type", target_type, "chessboard, aruco_grid or charuco");
   }
   if (!(square_size_m > 0)) throw OptionError("--Target.square_size", std::to_string(square_size_m), "> 0 m");
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
   reader.Check();
-  chessboard.Check();
+  if (target_type == "chessboard") {
+    chessboard.Check();
+  } else {
+    MarkerBoardOptions board = markers;
+    board.type = target_type;
+    board.square_size_m = square_size_m;
+    board.Check();
+  }
 }
 
 namespace {
 
+// What one image gave, whatever the target.
 struct ImageResult {
   std::string name;
   int width = 0, height = 0;
   bool readable = false;
-  ChessboardDetection detection;
+  bool found = false;
+  bool symmetric = false;  // chessboard that looks the same turned by 180 deg
+  std::string reason;
+  std::vector<TargetObservation> observations;
+  std::vector<MarkerDetection> markers;
 };
+
+void Detect(const cv::Mat& gray, const TargetExtractorOptions& o, ImageResult* result) {
+  if (o.target_type == "chessboard") {
+    const ChessboardDetection d = DetectChessboard(gray, o.chessboard);
+    result->found = d.found;
+    result->reason = d.reason;
+    result->symmetric = d.symmetric;
+    if (!d.found) return;
+    for (size_t i = 0; i < d.corners.size(); ++i) {
+      if (!d.corners[i]) continue;
+      TargetObservation observation;
+      observation.point_id = static_cast<int64_t>(i);
+      observation.xy = *d.corners[i];
+      observation.point_in_target = Eigen::Vector3d((i % o.chessboard.cols) * o.square_size_m,
+                                                    (i / o.chessboard.cols) * o.square_size_m, 0.0);
+      result->observations.push_back(observation);
+    }
+    return;
+  }
+  MarkerBoardOptions board = o.markers;
+  board.type = o.target_type;
+  board.square_size_m = o.square_size_m;
+  const MarkerBoardDetection d = DetectMarkerBoard(gray, board);
+  result->found = d.found;
+  result->reason = d.reason;
+  result->markers = d.markers;
+  if (!d.found) return;
+  for (const BoardPoint& p : d.points) result->observations.push_back({p.point_id, p.xy, p.point_in_target});
+}
 
 std::string OptionsText(const TargetExtractorOptions& o) {
   std::ostringstream out;
@@ -55,8 +95,7 @@ TargetExtractionSummary ExtractTargets(const TargetExtractorOptions& options,
   options.Check();
   StageRun run("target_extractor", OptionsText(options));
   const std::vector<std::string> names = ListImages(options.image_path);
-  LOG(INFO) << "target_extractor: " << names.size() << " images, chessboard "
-            << options.chessboard.cols << "x" << options.chessboard.rows << " inner corners";
+  LOG(INFO) << "target_extractor: " << names.size() << " images, " << options.target_type;
 
   // Detection in parallel, outside the database transaction.
   std::vector<ImageResult> results(names.size());
@@ -76,7 +115,7 @@ TargetExtractionSummary ExtractTargets(const TargetExtractorOptions& options,
           result.readable = true;
           result.width = gray.cols;
           result.height = gray.rows;
-          result.detection = DetectChessboard(gray, options.chessboard);
+          Detect(gray, options, &result);
         }
         progress.Advance(1);
       } catch (...) {
@@ -98,8 +137,14 @@ TargetExtractionSummary ExtractTargets(const TargetExtractorOptions& options,
   Transaction transaction = database.BeginTransaction();
   TargetExtractionSummary summary;
   SharedCameras shared_cameras;
-  const std::string target = "chessboard " + std::to_string(options.chessboard.cols) + "x" +
-                             std::to_string(options.chessboard.rows);
+  const std::string target =
+      options.target_type == "chessboard"
+          ? "chessboard " + std::to_string(options.chessboard.cols) + "x" + std::to_string(options.chessboard.rows)
+      : options.target_type == "aruco_grid"
+          ? "aruco_grid " + std::to_string(options.markers.markers_x) + "x" +
+                std::to_string(options.markers.markers_y) + " " + options.markers.dictionary
+          : "charuco " + std::to_string(options.markers.squares_x) + "x" +
+                std::to_string(options.markers.squares_y) + " " + options.markers.dictionary;
   for (const ImageResult& result : results) {
     if (!result.readable) {
       LOG(WARNING) << result.name << ": cannot read the image; skipped";
@@ -107,33 +152,20 @@ TargetExtractionSummary ExtractTargets(const TargetExtractorOptions& options,
     }
     const image_t image_id = ImportImage(&database, options.reader, result.name, result.width,
                                          result.height, &shared_cameras);
-    std::vector<TargetObservation> observations;
-    const ChessboardDetection& d = result.detection;
-    if (d.found) {
-      for (size_t i = 0; i < d.corners.size(); ++i) {
-        if (!d.corners[i]) continue;
-        TargetObservation observation;
-        observation.point_id = static_cast<int64_t>(i);
-        observation.xy = *d.corners[i];
-        observation.point_in_target = Eigen::Vector3d(
-            (i % options.chessboard.cols) * options.square_size_m,
-            (i / options.chessboard.cols) * options.square_size_m, 0.0);
-        observations.push_back(observation);
-      }
-    } else {
-      LOG(WARNING) << result.name << ": " << d.reason;
-    }
+    const std::vector<TargetObservation>& observations = result.observations;
+    if (!result.found) LOG(WARNING) << result.name << ": " << result.reason;
     database.WriteTargetObservations(image_id, observations);
+    database.WriteMarkerDetections(image_id, result.markers);
     TargetDetectionStatus status;
     status.target = target;
-    status.found = d.found;
+    status.found = result.found;
     status.num_points = static_cast<int>(observations.size());
-    status.reason = d.found ? (d.symmetric ? "found (symmetric board: order may be rotated by 180 deg)"
-                                           : "found")
-                            : d.reason;
+    status.reason = result.found ? (result.symmetric ? "found (symmetric board: order may be rotated by 180 deg)"
+                                                     : "found")
+                                 : result.reason;
     database.WriteTargetDetectionStatus(image_id, status);
     ++summary.num_images;
-    summary.num_found += d.found;
+    summary.num_found += result.found;
     summary.num_points += static_cast<int64_t>(observations.size());
   }
   run.Finish(&database, {{"images", summary.num_images},

@@ -8,6 +8,7 @@
 #include "colmap_ext/util/progress.h"
 #include "pipelines/image_reader.h"
 #include "pipelines/target/chessboard_detector.h"
+#include "pipelines/target/marker_board_detector.h"
 
 namespace portcal {
 
@@ -15,10 +16,10 @@ struct TargetExtractorOptions {
   std::string database_path;  // created if missing
   std::string image_path;     // directory of images
   ImageReaderOptions reader;
-  // chessboard (aruco_grid and charuco follow with the calibrators)
-  std::string target_type = "chessboard";
+  std::string target_type = "chessboard";  // chessboard | aruco_grid | charuco
   ChessboardDetectionOptions chessboard;
-  double square_size_m = 0.02;  // > 0
+  double square_size_m = 0.02;  // chessboard and charuco squares, > 0
+  MarkerBoardOptions markers;   // aruco_grid and charuco
   int num_threads = 2;          // >= 1
   void Check() const;           // throws OptionError naming the option
 };

@@ -23,10 +23,18 @@ int RunTargetExtractor(int argc, char** argv) {
           "one camera per sub-folder, e.g. a stereo rig's cam1/ and cam2/ (0 | 1)");
   cli.Add("ImageReader.camera_params", &options.reader.camera_params,
           "initial parameters in COLMAP's order (default: from the image size)");
-  cli.Add("Target.type", &options.target_type, "chessboard");
+  cli.Add("Target.type", &options.target_type, "chessboard | aruco_grid | charuco");
   cli.Add("Target.cols", &options.chessboard.cols, "inner corners per row");
   cli.Add("Target.rows", &options.chessboard.rows, "inner corners per column");
-  cli.Add("Target.square_size", &options.square_size_m, "square side, metres");
+  cli.Add("Target.square_size", &options.square_size_m, "chessboard/ChArUco square side, metres");
+  cli.Add("Target.dictionary", &options.markers.dictionary, "ArUco dictionary (aruco_grid, charuco)");
+  cli.Add("Target.markers_x", &options.markers.markers_x, "aruco_grid: markers per row");
+  cli.Add("Target.markers_y", &options.markers.markers_y, "aruco_grid: markers per column");
+  cli.Add("Target.marker_size", &options.markers.marker_size_m, "marker side, metres");
+  cli.Add("Target.marker_separation", &options.markers.marker_separation_m, "aruco_grid: gap, metres");
+  cli.Add("Target.first_marker", &options.markers.first_marker, "aruco_grid: id of the first marker");
+  cli.Add("Target.squares_x", &options.markers.squares_x, "charuco: squares per row");
+  cli.Add("Target.squares_y", &options.markers.squares_y, "charuco: squares per column");
   cli.Add("Target.coarse_max_image_size", &options.chessboard.coarse_max_image_size,
           "coarse detection on images downscaled to this size (0: full size)");
   cli.Add("num_threads", &options.num_threads, "threads");

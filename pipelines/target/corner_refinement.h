@@ -40,6 +40,13 @@ struct RefinedCorner {
   double blur_sigma_px = 0;
 };
 
+// Refines one corner from `start` (COLMAP pixels) with a circular window of
+// `half_window_px` and initial edge-normal angles (radians). nullopt when the
+// fit fails.
+std::optional<RefinedCorner> RefineCorner(const cv::Mat& gray, const Eigen::Vector2d& start,
+                                          double half_window_px, double normal_angle1,
+                                          double normal_angle2, const CornerRefinementOptions& options);
+
 // Refines corners (COLMAP pixel convention) of a grid of rows x cols inner
 // corners, index r * cols + c, in an 8-bit gray image. nullopt for corners
 // whose fit failed (no contrast, diverged, moved too far).

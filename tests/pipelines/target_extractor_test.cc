@@ -11,6 +11,8 @@
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
 #include "pipelines/synthesize/synthesize.h"
+#include "pipelines/calibration/camera_calibration.h"
+#include "pipelines/calibration/target_views.h"
 #include "pipelines/target_extractor.h"
 #include "tests/test_utils.h"
 
@@ -132,6 +134,81 @@ TEST(TargetExtractor, AFailedRunLeavesTheDatabaseAsItWas) {
   }
   EXPECT_EQ(testing::ReadFileToString(dir / "db.db"), before);
 }
+
+}  // namespace
+}  // namespace portcal
+
+namespace portcal {
+namespace {
+
+// ArUco grid and ChArUco boards: observations where the ground truth puts
+// them (ChArUco corners refined to hundredths of a pixel, marker corners to
+// OpenCV's contour fit), and a camera calibration from them within its
+// standard deviations of the truth.
+class MarkerBoards : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(MarkerBoards, ObservationsAndCalibration) {
+  testing::TempDir dir;
+  const bool charuco = GetParam() == "charuco";
+  std::ofstream(dir / "set.yaml") << "name: boards\nseed: 12\nnum_images: 10\n"
+      << "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 401.0, 299.0, -0.08, 0.01]}\n"
+      << "housing: null\n"
+      << (charuco ? "target: {type: charuco, squares_x: 7, squares_y: 5, square_size: 0.03, marker_size: 0.022}\n"
+                  : "target: {type: aruco_grid, markers_x: 5, markers_y: 4, marker_size: 0.03, marker_separation: 0.008}\n")
+      << "poses: {distance: [0.35, 0.8], tilt_max_deg: 40, roll_max_deg: 40}\n";
+  SynthesizeOptions synthesize;
+  synthesize.config_path = (dir / "set.yaml").string();
+  synthesize.output_path = (dir / "set").string();
+  NullProgress progress;
+  Synthesize(synthesize, progress);
+  const GroundTruth truth = ReadGroundTruth(dir / "set/ground_truth.yaml");
+
+  TargetExtractorOptions options = Options(dir / "db.db", dir / "set/images");
+  options.target_type = GetParam();
+  options.square_size_m = 0.03;
+  options.markers.markers_x = 5;
+  options.markers.markers_y = 4;
+  options.markers.marker_size_m = charuco ? 0.022 : 0.03;
+  options.markers.marker_separation_m = 0.008;
+  options.markers.squares_x = 7;
+  options.markers.squares_y = 5;
+  const TargetExtractionSummary summary = ExtractTargets(options, progress);
+  EXPECT_EQ(summary.num_found, 10);
+  Database db(dir / "db.db", Database::OpenMode::kReadOnly);
+  std::vector<double> errors;
+  for (const FrameTruth& frame : truth.images) {
+    const auto image = db.ReadImageWithName(fs::path(frame.cam1.file).filename().string());
+    ASSERT_TRUE(image.has_value());
+    EXPECT_FALSE(db.ReadMarkerDetections(image->image_id).empty());
+    for (const TargetObservation& o : db.ReadTargetObservations(image->image_id)) {
+      if (charuco) {
+        errors.push_back((o.xy - *frame.cam1.corners_px[o.point_id]).norm());
+      } else {
+        for (const auto& marker : frame.cam1.markers) {
+          if (marker.id == o.point_id / 4) errors.push_back((o.xy - marker.corners_px[o.point_id % 4]).norm());
+        }
+      }
+    }
+  }
+  ASSERT_FALSE(errors.empty());
+  std::sort(errors.begin(), errors.end());
+  // ChArUco: the ideal-pattern fit, in windows that must stay inside the
+  // white margins around the markers (~4 px here against ~10 px on a
+  // chessboard, so ~2.5x the chessboard's worst case). ArUco grid: OpenCV's
+  // contour corners, measured here at a median of ~0.6 px (their bias; a fit
+  // of the marker's ideal outline would do better).
+  EXPECT_LT(errors[errors.size() / 2], charuco ? 0.02 : 1.0) << GetParam();
+  EXPECT_LT(errors.back(), charuco ? 0.3 : 2.0) << GetParam();
+  if (!charuco) return;  // marker corners carry OpenCV's contour bias
+  const CameraCalibrationResult result = CalibrateCamera(ReadTargetViews(&db).by_camera.begin()->second,
+                                                         Camera::FromModelName("RADIAL", 700, 800, 600), {});
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_LT(std::abs(result.camera.params[i] - truth.camera.params[i]), 4 * result.params_std_dev[i] + 1e-9)
+        << "parameter " << i;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Targets, MarkerBoards, ::testing::Values("aruco_grid", "charuco"));
 
 }  // namespace
 }  // namespace portcal
