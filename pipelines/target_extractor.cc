@@ -137,14 +137,24 @@ TargetExtractionSummary ExtractTargets(const TargetExtractorOptions& options,
   Transaction transaction = database.BeginTransaction();
   TargetExtractionSummary summary;
   SharedCameras shared_cameras;
+  const auto metres = [](double value) {
+    std::ostringstream out;
+    out << value << " m";
+    return out.str();
+  };
+  const MarkerBoardOptions& m = options.markers;
   const std::string target =
       options.target_type == "chessboard"
-          ? "chessboard " + std::to_string(options.chessboard.cols) + "x" + std::to_string(options.chessboard.rows)
+          ? "chessboard " + std::to_string(options.chessboard.cols) + "x" +
+                std::to_string(options.chessboard.rows) + " inner corners, square " +
+                metres(options.square_size_m)
       : options.target_type == "aruco_grid"
-          ? "aruco_grid " + std::to_string(options.markers.markers_x) + "x" +
-                std::to_string(options.markers.markers_y) + " " + options.markers.dictionary
-          : "charuco " + std::to_string(options.markers.squares_x) + "x" +
-                std::to_string(options.markers.squares_y) + " " + options.markers.dictionary;
+          ? "aruco_grid " + std::to_string(m.markers_x) + "x" + std::to_string(m.markers_y) + " " +
+                m.dictionary + ", marker " + metres(m.marker_size_m) + ", separation " +
+                metres(m.marker_separation_m)
+          : "charuco " + std::to_string(m.squares_x) + "x" + std::to_string(m.squares_y) + " squares " +
+                m.dictionary + ", square " + metres(options.square_size_m) + ", marker " +
+                metres(m.marker_size_m);
   for (const ImageResult& result : results) {
     if (!result.readable) {
       LOG(WARNING) << result.name << ": cannot read the image; skipped";

@@ -161,8 +161,11 @@ StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames, 
   if (covariance.Compute(blocks, &problem)) {
     double c[36];
     covariance.GetCovarianceBlockInTangentSpace(cam2_from_cam1.data(), cam2_from_cam1.data(), c);
+    // Ceres' quaternion manifold perturbs as exp(delta) * q with the
+    // quaternion of delta being (cos|delta|, sin|delta| delta/|delta|): the
+    // tangent vector is half the rotation vector.
     for (int i = 0; i < 3; ++i) {
-      result.rotation_std_dev_deg[i] = std::sqrt(std::max(0.0, c[7 * i] * variance)) * 180 / M_PI;
+      result.rotation_std_dev_deg[i] = 2 * std::sqrt(std::max(0.0, c[7 * i] * variance)) * 180 / M_PI;
       result.translation_std_dev[i] = std::sqrt(std::max(0.0, c[7 * (i + 3)] * variance));
     }
     if (settings.refine_intrinsics) {
