@@ -11,6 +11,7 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/string_utils.h"
+#include "pipelines/calibration/view_pose.h"
 #include "pipelines/calibration/zhang_initialization.h"
 
 namespace portcal {
@@ -118,8 +119,7 @@ Solution Solve(const std::vector<const CalibrationView*>& views, const Camera& c
     }
   });
   for (auto& pose : s.poses) {
-    problem.SetManifold(pose.data(), new ceres::ProductManifold<ceres::EigenQuaternionManifold,
-                                                                ceres::EuclideanManifold<3>>());
+    problem.SetManifold(pose.data(), PoseManifold());
   }
   const int num_params = static_cast<int>(camera.params.size());
   if (static_cast<int>(fixed.size()) == num_params) {
@@ -129,17 +129,7 @@ Solution Solve(const std::vector<const CalibrationView*>& views, const Camera& c
   }
   if (!settings.estimate_board_warp) problem.SetParameterBlockConstant(s.warp.data());
 
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_SCHUR;
-  options.max_num_iterations = settings.max_num_iterations;
-  options.num_threads = settings.num_threads;
-  options.function_tolerance = 1e-12;
-  options.parameter_tolerance = 1e-12;
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
-  if (!summary.IsSolutionUsable()) {
-    throw NumericalError("camera calibration did not converge: " + summary.BriefReport());
-  }
+  SolveCalibration(&problem, settings.max_num_iterations, settings.num_threads, "camera calibration");
   for (double p : s.intrinsics) {
     if (!std::isfinite(p)) throw NumericalError("camera calibration produced a non-finite parameter");
   }
@@ -178,10 +168,7 @@ Solution Solve(const std::vector<const CalibrationView*>& views, const Camera& c
   // observations' noise is estimated from the fit, not assumed to be 1 px.
   const double dof = s.num_residuals - s.num_free;
   const double variance = dof > 0 ? s.sum_squares / dof : 0;
-  ceres::Covariance::Options covariance_options;
-  covariance_options.algorithm_type = ceres::DENSE_SVD;
-  covariance_options.num_threads = settings.num_threads;
-  ceres::Covariance covariance(covariance_options);
+  ceres::Covariance covariance(CalibrationCovarianceOptions(settings.num_threads));
   std::vector<std::pair<const double*, const double*>> blocks = {
       {s.intrinsics.data(), s.intrinsics.data()}};
   if (settings.estimate_board_warp) blocks.emplace_back(s.warp.data(), s.warp.data());

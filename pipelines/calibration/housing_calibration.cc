@@ -12,6 +12,7 @@
 #include "colmap_ext/housing/port_projection.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "pipelines/calibration/view_pose.h"
 #include "pipelines/calibration/zhang_initialization.h"
 
 namespace portcal {
@@ -76,12 +77,7 @@ struct BoardThroughPortError
   double constants_[4];
 };
 
-using Pose = std::array<double, 7>;
-
-Pose ToPose(const Rigid3d& rigid) {
-  const Eigen::Quaterniond q = rigid.rotation.normalized();
-  return {q.x(), q.y(), q.z(), q.w(), rigid.translation.x(), rigid.translation.y(), rigid.translation.z()};
-}
+using Pose = PoseBlock;
 
 // Pose of each view ignoring refraction: homography from the target plane
 // to the undistorted rays.
@@ -160,10 +156,6 @@ void AddResiduals(const std::vector<CalibrationView>& views, int camera_model, i
       }
     });
   });
-}
-
-ceres::Manifold* PoseManifold() {
-  return new ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>();
 }
 
 // Solves poses only (housing and intrinsics fixed); returns the final cost.
@@ -270,19 +262,9 @@ HousingCalibrationResult CalibrateHousing(const std::vector<CalibrationView>& vi
     } else {
       problem.SetParameterBlockConstant(&state.scalar);  // the dome radius is given
     }
-    ceres::Solver::Options options;
-    options.linear_solver_type = ceres::DENSE_SCHUR;
-    options.logging_type = ceres::SILENT;
-    options.max_num_iterations = settings.max_num_iterations;
-    options.num_threads = settings.num_threads;
-    options.function_tolerance = 1e-12;
-    options.parameter_tolerance = 1e-12;
-    ceres::Solver::Summary summary;
-    ceres::Solve(options, &problem, &summary);
-    if (!summary.IsSolutionUsable()) {
-      throw NumericalError("housing calibration did not converge: " + summary.BriefReport());
-    }
-    sum_squares = 2 * summary.final_cost;
+    sum_squares = 2 * SolveCalibration(&problem, settings.max_num_iterations, settings.num_threads,
+                                       "housing calibration")
+                          .final_cost;
   }
   // Flat: normal (2 on the sphere) + distance; dome: centre (3).
   num_free = 6 * static_cast<int>(views.size()) + 3 +
@@ -296,11 +278,7 @@ HousingCalibrationResult CalibrateHousing(const std::vector<CalibrationView>& vi
   for (const auto& view : views) num_points += static_cast<int>(view.pixels.size());
   const double dof = 2.0 * num_points - num_free;
   const double variance = dof > 0 ? sum_squares / dof : 0;
-  ceres::Covariance::Options covariance_options;
-  covariance_options.algorithm_type = ceres::DENSE_SVD;
-  covariance_options.num_threads = settings.num_threads;
-  covariance_options.min_reciprocal_condition_number = 1e-14;
-  ceres::Covariance covariance(covariance_options);
+  ceres::Covariance covariance(CalibrationCovarianceOptions(settings.num_threads));
   std::vector<std::pair<const double*, const double*>> blocks = {{state.axis.data(), state.axis.data()}};
   if (flat) blocks.emplace_back(&state.scalar, &state.scalar);
   if (settings.refine_intrinsics) blocks.emplace_back(state.intrinsics.data(), state.intrinsics.data());

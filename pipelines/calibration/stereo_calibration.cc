@@ -131,26 +131,15 @@ StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames, 
     problem.SetParameterBlockConstant(intrinsics1.data());
     problem.SetParameterBlockConstant(intrinsics2.data());
   }
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_SCHUR;
-  options.logging_type = ceres::SILENT;
-  options.max_num_iterations = settings.max_num_iterations;
-  options.num_threads = settings.num_threads;
-  options.function_tolerance = 1e-12;
-  options.parameter_tolerance = 1e-12;
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
-  if (!summary.IsSolutionUsable()) throw NumericalError("stereo calibration did not converge: " + summary.BriefReport());
+  const ceres::Solver::Summary summary =
+      SolveCalibration(&problem, settings.max_num_iterations, settings.num_threads, "stereo calibration");
 
   const double sum_squares = 2 * summary.final_cost;
   const int num_free = 6 * static_cast<int>(frames.size()) + 6 +
                        (settings.refine_intrinsics ? static_cast<int>(intrinsics1.size() + intrinsics2.size()) : 0);
   const double dof = 2.0 * num_points - num_free;
   const double variance = dof > 0 ? sum_squares / dof : 0;
-  ceres::Covariance::Options covariance_options;
-  covariance_options.algorithm_type = ceres::DENSE_SVD;
-  covariance_options.num_threads = settings.num_threads;
-  ceres::Covariance covariance(covariance_options);
+  ceres::Covariance covariance(CalibrationCovarianceOptions(settings.num_threads));
   std::vector<std::pair<const double*, const double*>> blocks = {{cam2_from_cam1.data(), cam2_from_cam1.data()}};
   if (settings.refine_intrinsics) {
     blocks.emplace_back(intrinsics1.data(), intrinsics1.data());

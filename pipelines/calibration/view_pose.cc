@@ -47,6 +47,31 @@ struct RigBoardError
 
 }  // namespace
 
+ceres::Solver::Summary SolveCalibration(ceres::Problem* problem, int max_num_iterations, int num_threads,
+                                        const std::string& what) {
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_SCHUR;
+  options.logging_type = ceres::SILENT;
+  options.max_num_iterations = max_num_iterations;
+  options.num_threads = num_threads;
+  options.function_tolerance = 1e-12;
+  options.parameter_tolerance = 1e-12;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, problem, &summary);
+  if (!summary.IsSolutionUsable()) {
+    throw NumericalError(what + " did not converge: " + summary.BriefReport());
+  }
+  return summary;
+}
+
+ceres::Covariance::Options CalibrationCovarianceOptions(int num_threads) {
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::DENSE_SVD;
+  options.num_threads = num_threads;
+  options.min_reciprocal_condition_number = 1e-14;
+  return options;
+}
+
 PoseBlock ToPose(const Rigid3d& rigid) {
   const Eigen::Quaterniond q = rigid.rotation.normalized();
   return {q.x(), q.y(), q.z(), q.w(), rigid.translation.x(), rigid.translation.y(), rigid.translation.z()};

@@ -5,6 +5,7 @@
 #include <ceres/ceres.h>
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "colmap_ext/camera/camera.h"
@@ -24,6 +25,14 @@ PoseBlock ToPose(const Rigid3d& rigid);
 Rigid3d FromPose(const PoseBlock& pose);
 // Quaternion (Eigen's manifold) x translation.
 ceres::Manifold* PoseManifold();
+
+// Solves a calibration problem: Schur complement, tight tolerances, silent.
+// Throws NumericalError("<what> did not converge: ...").
+ceres::Solver::Summary SolveCalibration(ceres::Problem* problem, int max_num_iterations, int num_threads,
+                                        const std::string& what);
+
+// Dense SVD covariance (small problems; reports rank deficiency).
+ceres::Covariance::Options CalibrationCovarianceOptions(int num_threads);
 
 // Adds the view's points: X_k = camk_from_cam1 * cam1_from_target * X
 // through lens and housing (fixed), residuals in pixels.

@@ -1,6 +1,7 @@
 // Standard deviations that mean something: over 20 renders with different
 // seeds, (estimate - truth) / reported std dev must have an RMS between 0.7
-// and 1.4 for every estimated parameter.
+// and 1.4 for every estimated parameter — camera intrinsics, dome
+// decentering, flat-port normal and distance, stereo relative pose.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -20,6 +21,53 @@ namespace fs = std::filesystem;
 namespace portcal {
 namespace {
 
+constexpr int kNumSeeds = 20;
+
+struct Rendered {
+  GroundTruth truth;
+  TargetViews views;
+};
+
+// Renders the config with `seed`, extracts its chessboard (cols x rows,
+// square metres), and frees the images.
+Rendered RenderAndExtract(const fs::path& config, const fs::path& set, int64_t seed, const std::string& model,
+                          int cols, int rows, double square, bool per_folder = false) {
+  SynthesizeOptions synthesize;
+  synthesize.config_path = config.string();
+  synthesize.output_path = set.string();
+  synthesize.seed = seed;
+  NullProgress progress;
+  Synthesize(synthesize, progress);
+  TargetExtractorOptions extract;
+  extract.database_path = (set / "db.db").string();
+  extract.image_path = (set / "images").string();
+  extract.reader.camera_model = model;
+  extract.reader.single_camera = !per_folder;
+  extract.reader.single_camera_per_folder = per_folder;
+  extract.chessboard.cols = cols;
+  extract.chessboard.rows = rows;
+  extract.square_size_m = square;
+  ExtractTargets(extract, progress);
+  Rendered rendered;
+  rendered.truth = ReadGroundTruth(set / "ground_truth.yaml");
+  Database db(set / "db.db", Database::OpenMode::kReadOnly);
+  rendered.views = ReadTargetViews(&db);
+  fs::remove_all(set / "images");
+  return rendered;
+}
+
+// z[i]: the normalized errors of parameter names[i] over the seeds.
+void ExpectHonest(const std::vector<std::string>& names, const std::vector<std::vector<double>>& z) {
+  for (size_t i = 0; i < names.size(); ++i) {
+    double sum = 0;
+    for (double v : z[i]) sum += v * v;
+    const double rms = std::sqrt(sum / z[i].size());
+    std::cout << "z-score RMS of " << names[i] << ": " << rms << "\n";
+    EXPECT_GT(rms, 0.7) << names[i];
+    EXPECT_LT(rms, 1.4) << names[i];
+  }
+}
+
 TEST(CalibrationUncertainty, CameraStdDevsAreHonestAcrossSeeds) {
   testing::TempDir dir;
   std::ofstream(dir / "set.yaml") << R"(name: z_scores
@@ -30,56 +78,21 @@ target: {type: chessboard, cols: 8, rows: 6, square_size: 0.025, margin: 0.015}
 poses: {distance: [0.35, 0.8], tilt_max_deg: 45, roll_max_deg: 30}
 render: {spp: 4, noise_sigma: 2.0}
 )";
-  const int num_seeds = 20;
   std::vector<std::vector<double>> z(5);
-  for (int seed = 0; seed < num_seeds; ++seed) {
-    const fs::path set = dir / ("set" + std::to_string(seed));
-    SynthesizeOptions synthesize;
-    synthesize.config_path = (dir / "set.yaml").string();
-    synthesize.output_path = set.string();
-    synthesize.seed = 1000 + seed;
-    NullProgress progress;
-    Synthesize(synthesize, progress);
-    const GroundTruth truth = ReadGroundTruth(set / "ground_truth.yaml");
-
-    TargetExtractorOptions extract;
-    extract.database_path = (set / "db.db").string();
-    extract.image_path = (set / "images").string();
-    extract.reader.camera_model = "RADIAL";
-    extract.reader.single_camera = true;
-    extract.chessboard.cols = 8;
-    extract.chessboard.rows = 6;
-    extract.square_size_m = 0.025;
-    ExtractTargets(extract, progress);
-    Database db(set / "db.db", Database::OpenMode::kReadOnly);
-    const std::vector<CalibrationView> views = ReadTargetViews(&db).by_camera.begin()->second;
-    const Camera initial = Camera::FromModelName("RADIAL", 600, 800, 600);
-    const CameraCalibrationResult result = CalibrateCamera(views, initial, {});
+  for (int seed = 0; seed < kNumSeeds; ++seed) {
+    const Rendered r = RenderAndExtract(dir / "set.yaml", dir / ("set" + std::to_string(seed)), 1000 + seed,
+                                        "RADIAL", 8, 6, 0.025);
+    const CameraCalibrationResult result = CalibrateCamera(
+        r.views.by_camera.begin()->second, Camera::FromModelName("RADIAL", 600, 800, 600), {});
     for (int i = 0; i < 5; ++i) {
       ASSERT_GT(result.params_std_dev[i], 0);
-      z[i].push_back((result.camera.params[i] - truth.camera.params[i]) / result.params_std_dev[i]);
+      z[i].push_back((result.camera.params[i] - r.truth.camera.params[i]) / result.params_std_dev[i]);
     }
-    fs::remove_all(set / "images");
   }
-  const char* names[] = {"f", "cx", "cy", "k1", "k2"};
-  for (int i = 0; i < 5; ++i) {
-    double sum = 0;
-    for (double v : z[i]) sum += v * v;
-    const double rms = std::sqrt(sum / z[i].size());
-    RecordProperty(names[i], std::to_string(rms));
-    std::cout << "z-score RMS of " << names[i] << ": " << rms << "\n";
-    EXPECT_GT(rms, 0.7) << names[i];
-    EXPECT_LT(rms, 1.4) << names[i];
-  }
+  ExpectHonest({"f", "cx", "cy", "k1", "k2"}, z);
 }
 
-}  // namespace
-}  // namespace portcal
-
-namespace portcal {
-namespace {
-
-// The same for a dome port's decentering, the intrinsics given exactly.
+// The dome's decentering, the intrinsics given exactly.
 TEST(CalibrationUncertainty, DomeStdDevsAreHonestAcrossSeeds) {
   testing::TempDir dir;
   std::ofstream(dir / "set.yaml") << R"(name: z_scores_dome
@@ -90,55 +103,24 @@ target: {type: chessboard, cols: 8, rows: 6, square_size: 0.025, margin: 0.015}
 poses: {distance: [0.35, 0.8], tilt_max_deg: 45, roll_max_deg: 30}
 render: {spp: 4, noise_sigma: 2.0}
 )";
-  const int num_seeds = 20;
   std::vector<std::vector<double>> z(3);
-  for (int seed = 0; seed < num_seeds; ++seed) {
-    const fs::path set = dir / ("set" + std::to_string(seed));
-    SynthesizeOptions synthesize;
-    synthesize.config_path = (dir / "set.yaml").string();
-    synthesize.output_path = set.string();
-    synthesize.seed = 2000 + seed;
-    NullProgress progress;
-    Synthesize(synthesize, progress);
-    const GroundTruth truth = ReadGroundTruth(set / "ground_truth.yaml");
-    TargetExtractorOptions extract;
-    extract.database_path = (set / "db.db").string();
-    extract.image_path = (set / "images").string();
-    extract.reader.camera_model = "SIMPLE_RADIAL";
-    extract.reader.single_camera = true;
-    extract.chessboard.cols = 8;
-    extract.chessboard.rows = 6;
-    extract.square_size_m = 0.025;
-    ExtractTargets(extract, progress);
-    Database db(set / "db.db", Database::OpenMode::kReadOnly);
-    Housing guess = *truth.housing;
+  for (int seed = 0; seed < kNumSeeds; ++seed) {
+    const Rendered r = RenderAndExtract(dir / "set.yaml", dir / ("set" + std::to_string(seed)), 2000 + seed,
+                                        "SIMPLE_RADIAL", 8, 6, 0.025);
+    Housing guess = *r.truth.housing;
     guess.params[0] = guess.params[1] = guess.params[2] = 0;
     const HousingCalibrationResult result =
-        CalibrateHousing(ReadTargetViews(&db).by_camera.begin()->second, truth.camera, guess, {});
+        CalibrateHousing(r.views.by_camera.begin()->second, r.truth.camera, guess, {});
     for (int i = 0; i < 3; ++i) {
       ASSERT_GT(result.housing_std_dev[i], 0);
-      z[i].push_back((result.housing.params[i] - truth.housing->params[i]) / result.housing_std_dev[i]);
+      z[i].push_back((result.housing.params[i] - r.truth.housing->params[i]) / result.housing_std_dev[i]);
     }
-    fs::remove_all(set / "images");
   }
-  const char* names[] = {"Cx", "Cy", "Cz"};
-  for (int i = 0; i < 3; ++i) {
-    double sum = 0;
-    for (double v : z[i]) sum += v * v;
-    const double rms = std::sqrt(sum / z[i].size());
-    std::cout << "z-score RMS of " << names[i] << ": " << rms << "\n";
-    EXPECT_GT(rms, 0.7) << names[i];
-    EXPECT_LT(rms, 1.4) << names[i];
-  }
+  ExpectHonest({"Cx", "Cy", "Cz"}, z);
 }
 
-}  // namespace
-}  // namespace portcal
-
-namespace portcal {
-namespace {
-
-// And for a flat port's normal (tangent angles) and distance.
+// The flat port's normal (Nx, Ny: to first order its tangent angles) and
+// distance.
 TEST(CalibrationUncertainty, FlatPortStdDevsAreHonestAcrossSeeds) {
   testing::TempDir dir;
   std::ofstream(dir / "set.yaml") << R"(name: z_scores_flat
@@ -149,61 +131,28 @@ target: {type: chessboard, cols: 8, rows: 6, square_size: 0.03, margin: 0.015}
 poses: {distance: [0.4, 1.0], tilt_max_deg: 45, roll_max_deg: 30}
 render: {spp: 4, noise_sigma: 2.0}
 )";
-  const int num_seeds = 20;
   std::vector<std::vector<double>> z(3);
-  for (int seed = 0; seed < num_seeds; ++seed) {
-    const fs::path set = dir / ("set" + std::to_string(seed));
-    SynthesizeOptions synthesize;
-    synthesize.config_path = (dir / "set.yaml").string();
-    synthesize.output_path = set.string();
-    synthesize.seed = 3000 + seed;
-    NullProgress progress;
-    Synthesize(synthesize, progress);
-    const GroundTruth truth = ReadGroundTruth(set / "ground_truth.yaml");
-    TargetExtractorOptions extract;
-    extract.database_path = (set / "db.db").string();
-    extract.image_path = (set / "images").string();
-    extract.reader.camera_model = "SIMPLE_RADIAL";
-    extract.reader.single_camera = true;
-    extract.chessboard.cols = 8;
-    extract.chessboard.rows = 6;
-    extract.square_size_m = 0.03;
-    ExtractTargets(extract, progress);
-    Database db(set / "db.db", Database::OpenMode::kReadOnly);
-    Housing guess = *truth.housing;
+  for (int seed = 0; seed < kNumSeeds; ++seed) {
+    const Rendered r = RenderAndExtract(dir / "set.yaml", dir / ("set" + std::to_string(seed)), 3000 + seed,
+                                        "SIMPLE_RADIAL", 8, 6, 0.03);
+    Housing guess = *r.truth.housing;
     guess.params[0] = 0;
     guess.params[1] = 0;
     guess.params[2] = 1;
     guess.params[3] = 0.05;
     const HousingCalibrationResult result =
-        CalibrateHousing(ReadTargetViews(&db).by_camera.begin()->second, truth.camera, guess, {});
-    // Nx and Ny are (to first order) the normal's two tangent angles.
-    for (int i : {0, 1, 3}) {
+        CalibrateHousing(r.views.by_camera.begin()->second, r.truth.camera, guess, {});
+    const int params[] = {0, 1, 3};
+    for (int k = 0; k < 3; ++k) {
+      const int i = params[k];
       ASSERT_GT(result.housing_std_dev[i], 0);
+      z[k].push_back((result.housing.params[i] - r.truth.housing->params[i]) / result.housing_std_dev[i]);
     }
-    z[0].push_back((result.housing.params[0] - truth.housing->params[0]) / result.housing_std_dev[0]);
-    z[1].push_back((result.housing.params[1] - truth.housing->params[1]) / result.housing_std_dev[1]);
-    z[2].push_back((result.housing.params[3] - truth.housing->params[3]) / result.housing_std_dev[3]);
-    fs::remove_all(set / "images");
   }
-  const char* names[] = {"Nx", "Ny", "int_dist"};
-  for (int i = 0; i < 3; ++i) {
-    double sum = 0;
-    for (double v : z[i]) sum += v * v;
-    const double rms = std::sqrt(sum / z[i].size());
-    std::cout << "z-score RMS of " << names[i] << ": " << rms << "\n";
-    EXPECT_GT(rms, 0.7) << names[i];
-    EXPECT_LT(rms, 1.4) << names[i];
-  }
+  ExpectHonest({"Nx", "Ny", "int_dist"}, z);
 }
 
-}  // namespace
-}  // namespace portcal
-
-namespace portcal {
-namespace {
-
-// And for a stereo rig's relative pose (intrinsics given).
+// A stereo rig's relative pose, the intrinsics given.
 TEST(CalibrationUncertainty, StereoStdDevsAreHonestAcrossSeeds) {
   testing::TempDir dir;
   std::ofstream(dir / "set.yaml") << R"(name: z_scores_stereo
@@ -216,57 +165,30 @@ target: {type: chessboard, cols: 9, rows: 6, square_size: 0.025, margin: 0.015}
 poses: {distance: [0.4, 0.9], tilt_max_deg: 40, roll_max_deg: 30}
 render: {spp: 4, noise_sigma: 2.0}
 )";
-  const int num_seeds = 20;
   std::vector<std::vector<double>> z(6);
-  for (int seed = 0; seed < num_seeds; ++seed) {
-    const fs::path set = dir / ("set" + std::to_string(seed));
-    SynthesizeOptions synthesize;
-    synthesize.config_path = (dir / "set.yaml").string();
-    synthesize.output_path = set.string();
-    synthesize.seed = 4000 + seed;
-    NullProgress progress;
-    Synthesize(synthesize, progress);
-    const GroundTruth truth = ReadGroundTruth(set / "ground_truth.yaml");
-    TargetExtractorOptions extract;
-    extract.database_path = (set / "db.db").string();
-    extract.image_path = (set / "images").string();
-    extract.reader.camera_model = "SIMPLE_RADIAL";
-    extract.reader.single_camera_per_folder = true;
-    extract.chessboard.cols = 9;
-    extract.chessboard.rows = 6;
-    extract.square_size_m = 0.025;
-    ExtractTargets(extract, progress);
-    Database db(set / "db.db", Database::OpenMode::kReadOnly);
-    const TargetViews views = ReadTargetViews(&db);
-    ASSERT_EQ(views.by_camera.size(), 2u);
-    const auto& views1 = views.by_camera.begin()->second;
-    const auto& views2 = std::next(views.by_camera.begin())->second;
+  for (int seed = 0; seed < kNumSeeds; ++seed) {
+    const Rendered r = RenderAndExtract(dir / "set.yaml", dir / ("set" + std::to_string(seed)), 4000 + seed,
+                                        "SIMPLE_RADIAL", 9, 6, 0.025, /*per_folder=*/true);
+    ASSERT_EQ(r.views.by_camera.size(), 2u);
+    const auto& views1 = r.views.by_camera.begin()->second;
+    const auto& views2 = std::next(r.views.by_camera.begin())->second;
     std::vector<StereoFrame> frames;
     for (size_t i = 0; i < std::min(views1.size(), views2.size()); ++i) frames.push_back({views1[i], views2[i]});
     const StereoCalibrationResult result =
-        CalibrateStereo(frames, {truth.camera, std::nullopt}, {truth.stereo->camera2, std::nullopt}, {});
+        CalibrateStereo(frames, {r.truth.camera, std::nullopt}, {r.truth.stereo->camera2, std::nullopt}, {});
     // Rotation error as the rotation vector of est * truth^-1 (Ceres'
     // quaternion manifold perturbs on the left), in degrees.
-    const Eigen::AngleAxisd delta(result.cam2_from_cam1.rotation * truth.stereo->cam2_from_cam1.rotation.inverse());
+    const Eigen::AngleAxisd delta(result.cam2_from_cam1.rotation * r.truth.stereo->cam2_from_cam1.rotation.inverse());
     const Eigen::Vector3d rotation_error = delta.angle() * delta.axis() * 180 / M_PI;
     const Eigen::Vector3d translation_error =
-        result.cam2_from_cam1.translation - truth.stereo->cam2_from_cam1.translation;
+        result.cam2_from_cam1.translation - r.truth.stereo->cam2_from_cam1.translation;
     for (int i = 0; i < 3; ++i) {
       ASSERT_GT(result.rotation_std_dev_deg[i], 0);
       z[i].push_back(rotation_error[i] / result.rotation_std_dev_deg[i]);
       z[3 + i].push_back(translation_error[i] / result.translation_std_dev[i]);
     }
-    fs::remove_all(set / "images");
   }
-  const char* names[] = {"rx", "ry", "rz", "tx", "ty", "tz"};
-  for (int i = 0; i < 6; ++i) {
-    double sum = 0;
-    for (double v : z[i]) sum += v * v;
-    const double rms = std::sqrt(sum / z[i].size());
-    std::cout << "z-score RMS of " << names[i] << ": " << rms << "\n";
-    EXPECT_GT(rms, 0.7) << names[i];
-    EXPECT_LT(rms, 1.4) << names[i];
-  }
+  ExpectHonest({"rx", "ry", "rz", "tx", "ty", "tz"}, z);
 }
 
 }  // namespace
