@@ -176,6 +176,14 @@ std::vector<std::pair<image_pair_t, TwoViewGeometry>> Database::ReadTwoViewGeome
   return all;
 }
 
+std::vector<image_pair_t> Database::ReadTwoViewGeometryPairIds() {
+  Statement& stmt = Prepare("read_geometry_pair_ids",
+                            "SELECT pair_id FROM two_view_geometries ORDER BY pair_id;");
+  std::vector<image_pair_t> pair_ids;
+  while (stmt.Step()) pair_ids.push_back(static_cast<image_pair_t>(stmt.ColumnInt64(0)));
+  return pair_ids;
+}
+
 void Database::DeleteMatchesOfImage(image_t image_id) {
   // pair_id = id1 * kMaxNumImages + id2: the image is id1 or id2.
   for (const char* table : {"matches", "two_view_geometries"}) {

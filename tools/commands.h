@@ -11,5 +11,10 @@ int RunTargetExtractor(int argc, char** argv);
 int RunCameraCalibrator(int argc, char** argv);
 int RunHousingCalibrator(int argc, char** argv);
 int RunStereoCalibrator(int argc, char** argv);
+int RunFeatureExtractor(int argc, char** argv);
+int RunFeatureMasker(int argc, char** argv);
+int RunExhaustiveMatcher(int argc, char** argv);
+int RunSequentialMatcher(int argc, char** argv);
+int RunRefractiveMapper(int argc, char** argv);
 
 }  // namespace portcal

@@ -1,0 +1,50 @@
+// `portcal feature_masker`: keeps only the SIFT features on the calibration
+// object, i.e. near its ArUco markers. Each detected marker's quad is scaled
+// about its centroid by `enlargement_factor`; features inside any scaled
+// quad stay, the rest are deleted with their descriptors. Detections are
+// stored in portcal_marker_detections (they later pre-calibrate the
+// intrinsics and give scale). Matches and two-view geometries of every
+// image whose features change are deleted in the same transaction, so the
+// database never holds matches into re-indexed keypoints. Rerunning is safe
+// (masking is idempotent).
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <array>
+#include <string>
+#include <vector>
+
+#include "colmap_ext/util/progress.h"
+#include "database/feature_types.h"
+
+namespace portcal {
+
+struct FeatureMaskerOptions {
+  std::string database_path;  // must exist, with features
+  std::string image_path;     // the images the database names
+  std::string dictionary = "DICT_4X4_50";
+  double enlargement_factor = 3.0;  // >= 1
+  int num_threads = 2;
+  void Check() const;  // throws OptionError naming --Mask.* or the option
+};
+
+struct FeatureMaskingSummary {
+  int num_images = 0;
+  int num_without_markers = 0;
+  int64_t num_markers = 0;
+  int64_t num_features_before = 0;
+  int64_t num_features_kept = 0;
+};
+
+// The ArUco markers of `dictionary` in an 8-bit gray image, corners in
+// COLMAP pixels and OpenCV's order (sub-pixel, contour refinement).
+std::vector<MarkerDetection> DetectArucoMarkers(const cv::Mat& gray, const std::string& dictionary);
+
+// Whether `xy` lies inside the marker quad scaled about its centroid.
+bool InsideEnlargedQuad(const std::array<Eigen::Vector2d, 4>& quad, double factor,
+                        const Eigen::Vector2d& xy);
+
+FeatureMaskingSummary MaskFeatures(const FeatureMaskerOptions& options, ProgressSink& progress);
+
+}  // namespace portcal

@@ -1,0 +1,57 @@
+// `portcal exhaustive_matcher` and `portcal sequential_matcher`: descriptor
+// matching of image pairs and geometric verification, written to COLMAP's
+// `matches` and `two_view_geometries` tables in one transaction. Pairs that
+// already have a two-view geometry are skipped (rerunning is safe and
+// resumes), unless `overwrite`.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "colmap_ext/util/progress.h"
+#include "pipelines/features/descriptor_matching.h"
+#include "pipelines/features/two_view_verification.h"
+
+namespace portcal {
+
+struct SequentialPairingOptions {
+  int overlap = 10;               // each image with its next `overlap` images (name order)
+  bool quadratic_overlap = true;  // also with the images 2^k ahead, k < overlap
+  // Loop closure by image retrieval: every `loop_detection_period`-th image
+  // is matched with its `loop_detection_num_images` most similar images
+  // (bag of visual words, tf-idf) outside the overlap window.
+  bool loop_detection = false;
+  int loop_detection_period = 10;
+  int loop_detection_num_images = 20;
+  int vocabulary_size = 512;  // visual words, trained on this database
+  void Check() const;         // throws OptionError naming --SequentialMatching.*
+};
+
+struct FeatureMatcherOptions {
+  std::string database_path;
+  std::string mode = "exhaustive";  // exhaustive | sequential
+  SequentialPairingOptions sequential;
+  DescriptorMatchingOptions matching;
+  TwoViewVerificationOptions verification;
+  bool overwrite = false;
+  int num_threads = 2;
+  void Check() const;  // throws OptionError naming the option
+};
+
+struct FeatureMatchingSummary {
+  int64_t num_pairs = 0;     // candidate pairs
+  int64_t num_matched = 0;   // matched in this run
+  int64_t num_skipped = 0;   // already had a geometry
+  int64_t num_verified = 0;  // with inliers, of those matched
+  int64_t num_loop_pairs = 0;
+};
+
+// Candidate pairs (image_id1, image_id2) for images sorted by name.
+std::vector<std::pair<image_t, image_t>> ExhaustivePairs(const std::vector<image_t>& images);
+std::vector<std::pair<image_t, image_t>> SequentialPairs(const std::vector<image_t>& images,
+                                                         const SequentialPairingOptions& options);
+
+FeatureMatchingSummary MatchFeatures(const FeatureMatcherOptions& options, ProgressSink& progress);
+
+}  // namespace portcal

@@ -1,0 +1,98 @@
+#include "pipelines/features/descriptor_matching.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "colmap_ext/util/error.h"
+
+namespace portcal {
+
+void DescriptorMatchingOptions::Check() const {
+  if (!(max_ratio > 0 && max_ratio <= 1)) {
+    throw OptionError("--SiftMatching.max_ratio", std::to_string(max_ratio), "in (0, 1]");
+  }
+  if (!(max_distance > 0 && max_distance <= M_PI)) {
+    throw OptionError("--SiftMatching.max_distance", std::to_string(max_distance), "in (0, pi]");
+  }
+  if (max_num_matches < 1) {
+    throw OptionError("--SiftMatching.max_num_matches", std::to_string(max_num_matches), ">= 1");
+  }
+}
+
+UnitDescriptors ToUnitDescriptors(const FeatureDescriptors& descriptors) {
+  UnitDescriptors unit = descriptors.cast<float>();
+  for (Eigen::Index r = 0; r < unit.rows(); ++r) {
+    const float norm = unit.row(r).norm();
+    if (norm > 0) unit.row(r) /= norm;
+  }
+  return unit;
+}
+
+namespace {
+
+struct Nearest {
+  int index = -1;
+  float best = -2, second = -2;  // dot products (larger is closer)
+};
+
+}  // namespace
+
+FeatureMatches MatchDescriptors(const UnitDescriptors& descriptors1,
+                                const UnitDescriptors& descriptors2,
+                                const DescriptorMatchingOptions& options) {
+  const Eigen::Index n1 = descriptors1.rows(), n2 = descriptors2.rows();
+  FeatureMatches matches;
+  if (n1 == 0 || n2 == 0) return matches;
+  // Dot products in blocks of rows so that memory stays bounded for large
+  // feature counts; columns' best rows are tracked for the cross check.
+  std::vector<Nearest> nearest1(static_cast<size_t>(n1));
+  std::vector<Nearest> nearest2(static_cast<size_t>(n2));
+  constexpr Eigen::Index kBlock = 1024;
+  Eigen::MatrixXf dots;
+  for (Eigen::Index start = 0; start < n1; start += kBlock) {
+    const Eigen::Index rows = std::min(kBlock, n1 - start);
+    dots.noalias() = descriptors1.middleRows(start, rows) * descriptors2.transpose();
+    for (Eigen::Index r = 0; r < rows; ++r) {
+      Nearest& a = nearest1[static_cast<size_t>(start + r)];
+      for (Eigen::Index c = 0; c < n2; ++c) {
+        const float d = dots(r, c);
+        if (d > a.best) {
+          a.second = a.best;
+          a.best = d;
+          a.index = static_cast<int>(c);
+        } else if (d > a.second) {
+          a.second = d;
+        }
+        Nearest& b = nearest2[static_cast<size_t>(c)];
+        if (d > b.best) {
+          b.second = b.best;
+          b.best = d;
+          b.index = static_cast<int>(start + r);
+        } else if (d > b.second) {
+          b.second = d;
+        }
+      }
+    }
+  }
+  const auto angle = [](float dot) { return std::acos(std::min(1.0f, std::max(-1.0f, dot))); };
+  for (Eigen::Index i = 0; i < n1; ++i) {
+    const Nearest& a = nearest1[static_cast<size_t>(i)];
+    if (a.index < 0) continue;
+    const float best = angle(a.best);
+    if (best > options.max_distance) continue;
+    // With a single candidate there is no second best: the ratio test passes.
+    if (n2 > 1 && best >= options.max_ratio * angle(a.second)) continue;
+    if (options.cross_check) {
+      // COLMAP's cross check: the reverse match passes the same tests.
+      const Nearest& b = nearest2[static_cast<size_t>(a.index)];
+      if (b.index != i) continue;
+      if (n1 > 1 && angle(b.best) >= options.max_ratio * angle(b.second)) continue;
+    }
+    matches.push_back({static_cast<uint32_t>(i), static_cast<uint32_t>(a.index)});
+    if (static_cast<int>(matches.size()) >= options.max_num_matches) break;
+  }
+  return matches;
+}
+
+}  // namespace portcal

@@ -1,0 +1,143 @@
+#include "pipelines/features/two_view_verification.h"
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include "colmap_ext/util/error.h"
+
+namespace portcal {
+
+void TwoViewVerificationOptions::Check() const {
+  if (!(max_error > 0)) throw OptionError("--TwoViewGeometry.max_error", std::to_string(max_error), "> 0 px");
+  if (!(confidence > 0 && confidence < 1)) {
+    throw OptionError("--TwoViewGeometry.confidence", std::to_string(confidence), "in (0, 1)");
+  }
+  if (max_num_trials < 1) {
+    throw OptionError("--TwoViewGeometry.max_num_trials", std::to_string(max_num_trials), ">= 1");
+  }
+  if (min_num_inliers < 8) {
+    throw OptionError("--TwoViewGeometry.min_num_inliers", std::to_string(min_num_inliers), ">= 8");
+  }
+  if (!(min_inlier_ratio >= 0 && min_inlier_ratio <= 1)) {
+    throw OptionError("--TwoViewGeometry.min_inlier_ratio", std::to_string(min_inlier_ratio), "in [0, 1]");
+  }
+}
+
+namespace {
+
+FeatureMatches Inliers(const FeatureMatches& matches, const std::vector<int>& indices,
+                       const cv::Mat& mask) {
+  FeatureMatches inliers;
+  if (mask.empty()) return inliers;
+  for (size_t k = 0; k < indices.size(); ++k) {
+    if (mask.at<uchar>(static_cast<int>(k))) inliers.push_back(matches[static_cast<size_t>(indices[k])]);
+  }
+  return inliers;
+}
+
+}  // namespace
+
+TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& keypoints1,
+                              const Camera& camera2, const FeatureKeypoints& keypoints2,
+                              const FeatureMatches& matches,
+                              const TwoViewVerificationOptions& options) {
+  TwoViewGeometry geometry;
+  geometry.config = TwoViewGeometryConfig::kDegenerate;
+  if (static_cast<int>(matches.size()) < options.min_num_inliers) return geometry;
+
+  // Pixels as stored (COLMAP convention, like the F and H COLMAP writes)
+  // and normalised image coordinates.
+  std::vector<cv::Point2d> pixels1, pixels2, rays1, rays2;
+  std::vector<int> ray_index;  // match index of each normalised pair
+  for (size_t m = 0; m < matches.size(); ++m) {
+    const FeatureKeypoint& k1 = keypoints1.at(matches[m].point2D_idx1);
+    const FeatureKeypoint& k2 = keypoints2.at(matches[m].point2D_idx2);
+    pixels1.emplace_back(k1.x, k1.y);
+    pixels2.emplace_back(k2.x, k2.y);
+    const auto r1 = camera1.CamFromImg(Eigen::Vector2d(k1.x, k1.y));
+    const auto r2 = camera2.CamFromImg(Eigen::Vector2d(k2.x, k2.y));
+    if (r1 && r2) {
+      rays1.emplace_back(r1->x() / r1->z(), r1->y() / r1->z());
+      rays2.emplace_back(r2->x() / r2->z(), r2->y() / r2->z());
+      ray_index.push_back(static_cast<int>(m));
+    }
+  }
+  std::vector<int> all(matches.size());
+  for (size_t m = 0; m < all.size(); ++m) all[m] = static_cast<int>(m);
+
+  // F first, by RANSAC over all matches. E and H are then searched among
+  // F's inliers only: both models' inliers satisfy the epipolar constraint,
+  // so this loses nothing COLMAP's rules use (they compare the counts), and
+  // RANSAC on a clean set needs few iterations where the 5-point solver on
+  // the raw matches would need thousands.
+  cv::Mat f_mask, e_mask, h_mask;
+  const cv::Mat F = cv::findFundamentalMat(pixels1, pixels2, cv::FM_RANSAC, options.max_error,
+                                           options.confidence, options.max_num_trials, f_mask);
+  const FeatureMatches f_inliers = F.rows == 3 ? Inliers(matches, all, f_mask) : FeatureMatches();
+  if (static_cast<int>(f_inliers.size()) < options.min_num_inliers) return geometry;
+  std::vector<int> f_index;  // match indices of F's inliers
+  std::vector<cv::Point2d> f_pixels1, f_pixels2;
+  for (size_t k = 0; k < all.size(); ++k) {
+    if (!f_mask.at<uchar>(static_cast<int>(k))) continue;
+    f_index.push_back(static_cast<int>(k));
+    f_pixels1.push_back(pixels1[k]);
+    f_pixels2.push_back(pixels2[k]);
+  }
+  std::vector<int> e_index;
+  std::vector<cv::Point2d> e_rays1, e_rays2;
+  for (size_t k = 0; k < ray_index.size(); ++k) {
+    const size_t m = static_cast<size_t>(ray_index[k]);
+    if (!f_mask.at<uchar>(static_cast<int>(m))) continue;
+    e_index.push_back(ray_index[k]);
+    e_rays1.push_back(rays1[k]);
+    e_rays2.push_back(rays2[k]);
+  }
+  cv::Mat E;
+  if (static_cast<int>(e_rays1.size()) >= options.min_num_inliers) {
+    const double focal = 0.5 * (camera1.MeanFocalLength() + camera2.MeanFocalLength());
+    E = cv::findEssentialMat(e_rays1, e_rays2, cv::Mat::eye(3, 3, CV_64F), cv::RANSAC, options.confidence,
+                             options.max_error / focal, options.max_num_trials, e_mask);
+  }
+  const cv::Mat H = cv::findHomography(f_pixels1, f_pixels2, cv::RANSAC, options.max_error, h_mask,
+                                       options.max_num_trials, options.confidence);
+  const FeatureMatches e_inliers = E.rows == 3 ? Inliers(matches, e_index, e_mask) : FeatureMatches();
+  const FeatureMatches h_inliers = H.rows == 3 ? Inliers(matches, f_index, h_mask) : FeatureMatches();
+  const double nf = static_cast<double>(f_inliers.size());
+  const double ne = static_cast<double>(e_inliers.size());
+  const double nh = static_cast<double>(h_inliers.size());
+  const double min_inliers = std::max<double>(options.min_num_inliers,
+                                              options.min_inlier_ratio * matches.size());
+
+  if (F.rows == 3) cv::cv2eigen(F, geometry.F);
+  if (E.rows == 3) cv::cv2eigen(E, geometry.E);
+  if (H.rows == 3) cv::cv2eigen(H, geometry.H);
+  if (ne >= min_inliers && nf > 0 && ne / nf >= options.min_E_F_inlier_ratio) {
+    geometry.config = nh / ne > options.max_H_inlier_ratio ? TwoViewGeometryConfig::kPlanarOrPanoramic
+                                                           : TwoViewGeometryConfig::kCalibrated;
+    geometry.inlier_matches = e_inliers;
+    // Relative pose of the calibrated pair (unit baseline).
+    std::vector<cv::Point2d> in1, in2;
+    for (size_t k = 0; k < e_index.size(); ++k) {
+      if (e_mask.at<uchar>(static_cast<int>(k))) {
+        in1.push_back(e_rays1[k]);
+        in2.push_back(e_rays2[k]);
+      }
+    }
+    cv::Mat R, t;
+    if (cv::recoverPose(E, in1, in2, cv::Mat::eye(3, 3, CV_64F), R, t) > 0) {
+      Eigen::Matrix3d rotation;
+      Eigen::Vector3d translation;
+      cv::cv2eigen(R, rotation);
+      cv::cv2eigen(t, translation);
+      geometry.cam2_from_cam1 = Rigid3d(Eigen::Quaterniond(rotation), translation);
+    }
+  } else if (nf >= min_inliers) {
+    geometry.config = nh / nf > options.max_H_inlier_ratio ? TwoViewGeometryConfig::kPlanarOrPanoramic
+                                                           : TwoViewGeometryConfig::kUncalibrated;
+    geometry.inlier_matches = f_inliers;
+    geometry.E.setZero();
+  }
+  return geometry;
+}
+
+}  // namespace portcal

@@ -1,0 +1,34 @@
+// Geometric verification of putative matches between two images, with
+// COLMAP's decision rules (TwoViewGeometry in COLMAP 3.8): RANSAC for the
+// essential matrix (on normalised rays of the calibrated cameras), the
+// fundamental matrix and a homography; the configuration is
+//   CALIBRATED when E explains >= min_E_F_inlier_ratio of F's inliers,
+//   UNCALIBRATED when only F does,
+//   PLANAR_OR_PANORAMIC when H explains > max_H_inlier_ratio of them,
+//   DEGENERATE when nothing reaches min_num_inliers.
+// Behind a housing the rays are not central, but over a pair's baseline the
+// error of a central model is far below max_error (a few pixels), so the
+// epipolar models still separate right matches from wrong ones.
+#pragma once
+
+#include "database/feature_types.h"
+
+namespace portcal {
+
+struct TwoViewVerificationOptions {
+  double max_error = 4.0;  // pixels
+  double confidence = 0.999;
+  int max_num_trials = 10000;
+  int min_num_inliers = 15;
+  double min_inlier_ratio = 0.25;
+  double min_E_F_inlier_ratio = 0.95;
+  double max_H_inlier_ratio = 0.8;
+  void Check() const;  // throws OptionError naming --TwoViewGeometry.*
+};
+
+TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& keypoints1,
+                              const Camera& camera2, const FeatureKeypoints& keypoints2,
+                              const FeatureMatches& matches,
+                              const TwoViewVerificationOptions& options);
+
+}  // namespace portcal

@@ -1,0 +1,101 @@
+#include "pipelines/refractive_mapper.h"
+
+#include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/string_utils.h"
+#include "pipelines/sfm/ray_geometry.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+
+void RefractiveMapperOptions::Check() const {
+  if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
+  if (output_path.empty()) throw OptionError("--output_path", "''", "a directory for the models");
+  if (init_focal_from_markers < -1 || init_focal_from_markers > 1) {
+    throw OptionError("--Mapper.init_focal_from_markers", std::to_string(init_focal_from_markers), "-1, 0 or 1");
+  }
+  if (housing.model.empty() != housing.params.empty()) {
+    throw OptionError("--Housing.params", housing.params, "given together with --Housing.model");
+  }
+  mapper.Check();
+}
+
+void ApplyHousingOverride(const HousingOverride& override_housing, std::map<camera_t, SfmCamera>* cameras) {
+  if (override_housing.model.empty()) return;
+  std::vector<double> params;
+  for (const std::string& token : SplitTokens(override_housing.params, ", ")) {
+    try {
+      params.push_back(std::stod(token));
+    } catch (const std::exception&) {
+      throw OptionError("--Housing.params", override_housing.params, "numbers");
+    }
+  }
+  const Housing housing = Housing::FromName(override_housing.model, params, "--Housing.params");
+  for (auto& [id, camera] : *cameras) camera.housing = housing;
+}
+
+void InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<camera_t, SfmCamera>* cameras) {
+  if (mode == 0) return;
+  for (auto& [camera_id, camera] : *cameras) {
+    if (mode == -1 && camera.camera.has_prior_focal_length) continue;
+    std::vector<MarkerQuad> quads;
+    for (const auto& [image_id, image] : inputs.images) {
+      if (image.camera_id != camera_id) continue;
+      for (const MarkerDetection& m : image.markers) quads.push_back({m.corners});
+    }
+    auto focal = FocalLengthFromMarkers(quads, camera.camera.PrincipalPointX(), camera.camera.PrincipalPointY());
+    // The markers give the focal length the camera appears to have in
+    // water. A flat port magnifies paraxial rays by n_water / n_air
+    // (tan a_air = n_w / n_a tan a_water near the axis); a dome, centred,
+    // does not magnify. Bundle adjustment refines the rest.
+    if (focal && camera.housing && camera.housing->model_id == 0) {
+      *focal *= camera.housing->params[5] / camera.housing->params[7];
+    }
+    if (!focal) {
+      LOG(WARNING) << "camera " << camera_id << ": too few markers for a focal length; keeping "
+                   << camera.camera.MeanFocalLength() << " px";
+      continue;
+    }
+    LOG(INFO) << "camera " << camera_id << ": focal length from " << quads.size() << " markers: " << *focal
+              << " px (was " << camera.camera.MeanFocalLength() << ")";
+    for (int idx : CameraModelFocalLengthIdxs(camera.camera.model_id)) camera.camera.params[idx] = *focal;
+  }
+}
+
+RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& options, ProgressSink& progress) {
+  options.Check();
+  SfmInputs inputs;
+  {
+    Database database(options.database_path, Database::OpenMode::kReadOnly);
+    inputs = SfmInputs::Read(&database);
+  }
+  if (inputs.pair_inliers.empty()) {
+    throw InputError(options.database_path + ": no verified image pairs; run a matcher first");
+  }
+  std::map<camera_t, SfmCamera> cameras = inputs.cameras;
+  ApplyHousingOverride(options.housing, &cameras);
+  InitializeFocalFromMarkers(inputs, options.init_focal_from_markers, &cameras);
+  const std::vector<Reconstruction> models = RunIncrementalMapper(inputs, cameras, options.mapper, progress);
+  if (models.empty()) {
+    throw NumericalError("refractive_mapper: no model could be initialised from " +
+                         std::to_string(inputs.pair_inliers.size()) +
+                         " verified pairs (too few inlier matches or too little parallax; see "
+                         "--Mapper.init_min_num_inliers and --Mapper.init_min_tri_angle)");
+  }
+  RefractiveMapperSummary summary;
+  summary.num_images = static_cast<int>(inputs.images.size());
+  for (size_t m = 0; m < models.size(); ++m) {
+    const fs::path dir = fs::path(options.output_path) / std::to_string(m);
+    WriteSparseModel(models[m].ToSparseModel(), dir, ModelFormat::kBinary);
+    summary.model_paths.push_back(dir);
+    summary.num_registered += static_cast<int>(models[m].poses().size());
+  }
+  summary.num_models = static_cast<int>(models.size());
+  LOG(INFO) << "refractive_mapper: " << summary.num_models << " model(s), " << summary.num_registered << " of "
+            << summary.num_images << " images registered; written to " << options.output_path;
+  return summary;
+}
+
+}  // namespace portcal

@@ -1,0 +1,49 @@
+// `portcal refractive_mapper`: incremental structure-from-motion on the
+// database's verified matches, every observation a ray in water when the
+// camera has a housing (portcal_housings, or --Housing.* for all cameras).
+// When a camera has no prior focal length and ArUco markers were detected
+// (feature_masker), the markers pre-calibrate its focal length. Writes one
+// COLMAP sparse model per reconstructed component into output_path/0, /1,
+// ... (binary, plus housings.txt), largest first.
+#pragma once
+
+#include <string>
+
+#include "colmap_ext/util/progress.h"
+#include "pipelines/sfm/incremental_mapper.h"
+
+namespace portcal {
+
+struct HousingOverride {
+  std::string model;   // "" = the database's housings
+  std::string params;  // comma or space separated, the model's order
+};
+
+struct RefractiveMapperOptions {
+  std::string database_path;
+  std::string image_path;  // accepted for COLMAP compatibility
+  std::string output_path;
+  IncrementalMapperOptions mapper;
+  HousingOverride housing;
+  // -1: when the camera has no prior focal length; 0: never; 1: always.
+  int init_focal_from_markers = -1;
+  void Check() const;  // throws OptionError naming the option
+};
+
+struct RefractiveMapperSummary {
+  int num_models = 0;
+  int num_registered = 0;  // over all models
+  int num_images = 0;
+  std::vector<std::filesystem::path> model_paths;
+};
+
+// Sets the housing of every camera when `override.model` is given.
+void ApplyHousingOverride(const HousingOverride& override_housing, std::map<camera_t, SfmCamera>* cameras);
+
+// Focal lengths from the markers of each camera's images (see
+// FocalLengthFromMarkers), where `mode` asks for it.
+void InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<camera_t, SfmCamera>* cameras);
+
+RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& options, ProgressSink& progress);
+
+}  // namespace portcal

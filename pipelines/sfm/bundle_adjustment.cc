@@ -1,0 +1,327 @@
+#include "pipelines/sfm/bundle_adjustment.h"
+
+#include <cmath>
+#include <limits>
+
+#include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/housing/housing_models.h"
+#include "colmap_ext/util/error.h"
+#include "pipelines/calibration/view_pose.h"
+#include "pipelines/sfm/bundle_costs.h"
+#include "pipelines/sfm/bundle_costs_fixed.h"
+#include "pipelines/sfm/ray_geometry.h"
+
+namespace portcal {
+
+void BundleAdjustmentOptions::Check() const {
+  if (!(sigma_px > 0)) throw OptionError("--BundleAdjustment.sigma_px", std::to_string(sigma_px), "> 0");
+  if (max_num_iterations < 1) {
+    throw OptionError("--BundleAdjustment.max_num_iterations", std::to_string(max_num_iterations), ">= 1");
+  }
+  if (refine_housing && !virtual_camera_error) {
+    // Both errors work; the exact one is just slower. Nothing to refuse.
+  }
+}
+
+std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconstruction, double max_error_px) {
+  std::map<std::pair<int, int>, MarkerCorner> corners;
+  for (const auto& [image_id, pose] : reconstruction.poses()) {
+    for (const MarkerDetection& m : reconstruction.inputs().images.at(image_id).markers) {
+      for (int c = 0; c < 4; ++c) {
+        MarkerCorner& corner = corners[{m.marker_id, c}];
+        corner.marker_id = m.marker_id;
+        corner.corner = c;
+        corner.observations.emplace_back(image_id, m.corners[c]);
+      }
+    }
+  }
+  std::vector<MarkerCorner> result;
+  for (auto& [key, corner] : corners) {
+    if (corner.observations.size() < 2) continue;
+    std::vector<Ray3d> rays;
+    for (const auto& [image_id, pixel] : corner.observations) {
+      const SfmCamera& camera = reconstruction.CameraOf(image_id);
+      const auto ray = UnprojectPixel(camera.camera, camera.housing ? &*camera.housing : nullptr, pixel);
+      if (ray) rays.push_back(RayInWorld(*ray, reconstruction.poses().at(image_id)));
+    }
+    const auto xyz = TriangulateRays(rays);
+    if (!xyz) continue;
+    // Drop observations that disagree (a marker id seen twice, a bad corner).
+    std::vector<std::pair<image_t, Eigen::Vector2d>> kept;
+    for (const auto& [image_id, pixel] : corner.observations) {
+      const SfmCamera& camera = reconstruction.CameraOf(image_id);
+      const auto projected = ProjectPoint(camera.camera, camera.housing ? &*camera.housing : nullptr,
+                                          reconstruction.poses().at(image_id) * *xyz);
+      if (projected && (*projected - pixel).norm() < max_error_px) kept.emplace_back(image_id, pixel);
+    }
+    if (kept.size() < 2) continue;
+    corner.observations = kept;
+    corner.xyz = *xyz;
+    result.push_back(corner);
+  }
+  return result;
+}
+
+namespace {
+
+// |a - b| = length, in units of sigma.
+struct DistanceError {
+  DistanceError(double length, double sigma) : length_(length), inv_sigma_(1.0 / sigma) {}
+  template <typename T>
+  bool operator()(const T* a, const T* b, T* residual) const {
+    const T dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+    residual[0] = (ceres::sqrt(dx * dx + dy * dy + dz * dz) - T(length_)) * T(inv_sigma_);
+    return true;
+  }
+  double length_, inv_sigma_;
+};
+
+// The parameter indices of a camera that stay constant.
+std::vector<int> ConstantIntrinsics(const Camera& camera, const BundleAdjustmentOptions& o) {
+  std::vector<int> constant;
+  const auto add = [&](const std::vector<int>& idxs) { constant.insert(constant.end(), idxs.begin(), idxs.end()); };
+  if (!o.refine_focal_length) add(CameraModelFocalLengthIdxs(camera.model_id));
+  if (!o.refine_principal_point) add(CameraModelPrincipalPointIdxs(camera.model_id));
+  if (!o.refine_extra_params) add(CameraModelExtraParamsIdxs(camera.model_id));
+  return constant;
+}
+
+}  // namespace
+
+ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const BundleAdjustmentOptions& options,
+                                    const BundleAdjustmentScope& scope, std::vector<MarkerCorner>* markers,
+                                    const MarkerScale& marker_scale, CalibrationStdDevs* std_devs) {
+  options.Check();
+  std::map<image_t, Rigid3d>& poses = reconstruction->mutable_poses();
+  PORTCAL_CHECK(poses.size() >= 2);
+  std::map<image_t, PoseBlock> pose_blocks;
+  for (const auto& [id, pose] : poses) pose_blocks[id] = ToPose(pose);
+  std::map<camera_t, SfmCamera>& cameras = reconstruction->mutable_cameras();
+  std::map<camera_t, std::vector<double>> intrinsics, housings;
+  for (auto& [id, camera] : cameras) {
+    intrinsics[id] = camera.camera.params;
+    if (camera.housing) housings[id] = camera.housing->params;
+  }
+
+  // One loss object shared by the residuals; the problem deletes it once.
+  ceres::Problem problem;
+  ceres::LossFunction* loss = options.loss_scale > 0 ? new ceres::CauchyLoss(options.loss_scale) : nullptr;
+
+  const bool local = !scope.variable_images.empty();
+  const auto is_variable = [&](image_t id) { return !local || scope.variable_images.count(id) > 0; };
+  std::map<point3D_t, Eigen::Vector3d> point_blocks;
+  std::set<camera_t> used_cameras;
+  int64_t num_residuals = 0;
+  // Which blocks the residuals carry: constants are captured instead (see
+  // bundle_costs.h), which makes the autodiff Jets much narrower.
+  const bool refine_intrinsics =
+      !local && (options.refine_focal_length || options.refine_principal_point || options.refine_extra_params);
+  const bool refine_housing = !local && options.refine_housing;
+  const auto blocks_of = [&](const SfmCamera& camera) {
+    if (refine_housing && camera.housing) return CostBlocks::kAll;
+    if (refine_intrinsics || (options.virtual_camera_error && camera.housing)) {
+      return camera.housing && options.virtual_camera_error ? CostBlocks::kAll : CostBlocks::kPosePointIntrinsics;
+    }
+    return CostBlocks::kPosePoint;
+  };
+  const auto add_observation = [&](image_t image_id, const Eigen::Vector2d& pixel, double* xyz) {
+    const SfmImage& image = reconstruction->inputs().images.at(image_id);
+    const SfmCamera& camera = cameras.at(image.camera_id);
+    ObservationModel model;
+    model.camera_model_id = camera.camera.model_id;
+    model.intrinsics = camera.camera.params;
+    if (camera.housing) {
+      model.housing_model_id = camera.housing->model_id;
+      model.housing = camera.housing->params;
+    }
+    const CostBlocks kind = blocks_of(camera);
+    ceres::CostFunction* cost =
+        options.virtual_camera_error && camera.housing
+            ? CreateVirtualCameraCost(camera.camera.model_id, camera.housing->model_id, pixel, options.sigma_px)
+            : CreateReprojectionCost(model, kind, pixel, options.sigma_px);
+    std::vector<double*> blocks = {pose_blocks.at(image_id).data(), xyz};
+    if (kind != CostBlocks::kPosePoint) blocks.push_back(intrinsics.at(image.camera_id).data());
+    if (kind == CostBlocks::kAll && camera.housing) blocks.push_back(housings.at(image.camera_id).data());
+    problem.AddResidualBlock(cost, loss, blocks);
+    used_cameras.insert(image.camera_id);
+    num_residuals += 2;
+  };
+
+  // Points: those seen by a variable image (all, in a global adjustment).
+  for (const auto& [point_id, point] : reconstruction->points()) {
+    bool seen_by_variable = !local;
+    for (const TrackElement& e : point.track) seen_by_variable |= is_variable(e.image_id);
+    if (!seen_by_variable) continue;
+    point_blocks[point_id] = point.xyz;
+  }
+  for (auto& [point_id, xyz] : point_blocks) {
+    for (const TrackElement& e : reconstruction->points().at(point_id).track) {
+      const SfmCamera& camera = reconstruction->CameraOf(e.image_id);
+      const auto& ray = reconstruction->RayOf(e.image_id, e.point2D_idx);
+      if (blocks_of(camera) == CostBlocks::kPosePoint && ray && ray->direction.z() > 1e-6) {
+        // Intrinsics and housing held: the cheap fixed-ray error.
+        problem.AddResidualBlock(CreateFixedRayCost(VirtualCenterOf(camera, *ray), ray->direction,
+                                                    camera.camera.MeanFocalLength(), options.sigma_px),
+                                 loss, pose_blocks.at(e.image_id).data(), xyz.data());
+        num_residuals += 2;
+        continue;
+      }
+      add_observation(e.image_id, reconstruction->inputs().images.at(e.image_id).keypoints[e.point2D_idx],
+                      xyz.data());
+    }
+  }
+  const bool use_markers = markers && marker_scale.side_length_m > 0 && !markers->empty();
+  if (use_markers) {
+    std::map<int, std::array<double*, 4>> corners_of;
+    for (MarkerCorner& corner : *markers) {
+      for (const auto& [image_id, pixel] : corner.observations) {
+        if (poses.count(image_id)) add_observation(image_id, pixel, corner.xyz.data());
+      }
+      if (!corners_of.count(corner.marker_id)) corners_of[corner.marker_id] = {nullptr, nullptr, nullptr, nullptr};
+      corners_of[corner.marker_id][corner.corner] = corner.xyz.data();
+    }
+    const double side = marker_scale.side_length_m;
+    for (const auto& [id, c] : corners_of) {
+      for (int a = 0; a < 4; ++a) {
+        for (int b = a + 1; b < 4; ++b) {
+          if (!c[a] || !c[b]) continue;
+          const double length = (b - a == 2) ? side * std::sqrt(2.0) : side;
+          problem.AddResidualBlock(new ceres::AutoDiffCostFunction<DistanceError, 1, 3, 3>(
+                                       new DistanceError(length, marker_scale.sigma_m)),
+                                   nullptr, c[a], c[b]);
+        }
+      }
+    }
+  }
+
+  // Poses: manifold; constant outside the local scope; the gauge.
+  const image_t first = poses.begin()->first;
+  const image_t second = std::next(poses.begin())->first;
+  for (auto& [id, block] : pose_blocks) {
+    if (!problem.HasParameterBlock(block.data())) continue;
+    if (!is_variable(id) || id == first) {
+      problem.SetParameterBlockConstant(block.data());
+      continue;
+    }
+    if (id == second && !use_markers && !local) {
+      // Hold the largest translation coordinate: it fixes the scale.
+      const Eigen::Vector3d t(block[4], block[5], block[6]);
+      int k;
+      t.cwiseAbs().maxCoeff(&k);
+      problem.SetManifold(block.data(),
+                          new ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::SubsetManifold>(
+                              ceres::EigenQuaternionManifold(), ceres::SubsetManifold(3, {k})));
+      continue;
+    }
+    problem.SetManifold(block.data(), PoseManifold());
+  }
+  // Intrinsics and housings.
+  for (camera_t id : used_cameras) {
+    const SfmCamera& camera = cameras.at(id);
+    double* params = intrinsics.at(id).data();
+    if (problem.HasParameterBlock(params)) {
+      const std::vector<int> constant = local ? std::vector<int>() : ConstantIntrinsics(camera.camera, options);
+      const int n = static_cast<int>(camera.camera.params.size());
+      if (local || static_cast<int>(constant.size()) == n) {
+        problem.SetParameterBlockConstant(params);
+      } else if (!constant.empty()) {
+        problem.SetManifold(params, new ceres::SubsetManifold(n, constant));
+      }
+    }
+    if (!camera.housing || !problem.HasParameterBlock(housings.at(id).data())) continue;
+    double* housing = housings.at(id).data();
+    if (local || !options.refine_housing) {
+      problem.SetParameterBlockConstant(housing);
+    } else if (camera.housing->model_id == 0) {
+      // FLATPORT: normal on the unit sphere, distance free; thickness and
+      // refractive indices are the user's constants.
+      problem.SetManifold(housing, new ceres::ProductManifold<ceres::SphereManifold<3>, ceres::SubsetManifold>(
+                                       ceres::SphereManifold<3>(), ceres::SubsetManifold(5, {1, 2, 3, 4})));
+    } else {
+      // DOMEPORT: the decentering (Cx, Cy, Cz) only.
+      problem.SetManifold(housing, new ceres::SubsetManifold(8, {3, 4, 5, 6, 7}));
+    }
+  }
+
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = pose_blocks.size() > 100 ? ceres::ITERATIVE_SCHUR : ceres::DENSE_SCHUR;
+  if (solver.linear_solver_type == ceres::ITERATIVE_SCHUR) solver.preconditioner_type = ceres::SCHUR_JACOBI;
+  solver.max_num_iterations = options.max_num_iterations;
+  solver.num_threads = options.num_threads;
+  solver.logging_type = ceres::SILENT;
+  solver.function_tolerance = 1e-8;
+  solver.parameter_tolerance = 1e-10;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+  if (!summary.IsSolutionUsable()) throw NumericalError("bundle adjustment failed: " + summary.BriefReport());
+
+  if (std_devs) {
+    std_devs->num_residuals = num_residuals;
+    const double dof = std::max<double>(1.0, summary.num_residuals_reduced - summary.num_effective_parameters_reduced);
+    // sigma0^2 = sum of squared (sigma-normalised) residuals / dof, from the
+    // unrobustified residuals.
+    double sum_sq = 0;
+    ceres::Problem::EvaluateOptions evaluate;
+    evaluate.apply_loss_function = false;
+    std::vector<double> residuals;
+    problem.Evaluate(evaluate, nullptr, &residuals, nullptr, nullptr);
+    for (double r : residuals) sum_sq += r * r;
+    std_devs->sigma0 = std::sqrt(sum_sq / dof) * options.sigma_px;
+    const double scale = std::sqrt(sum_sq / dof);
+    ceres::Covariance::Options covariance_options;
+    covariance_options.algorithm_type = ceres::SPARSE_QR;
+    covariance_options.num_threads = options.num_threads;
+    covariance_options.apply_loss_function = true;
+    ceres::Covariance covariance(covariance_options);
+    std::vector<std::pair<const double*, const double*>> blocks;
+    const auto is_free = [&](const std::vector<double>& block) {
+      return problem.HasParameterBlock(block.data()) && !problem.IsParameterBlockConstant(block.data());
+    };
+    for (camera_t id : used_cameras) {
+      if (is_free(intrinsics.at(id))) {
+        blocks.emplace_back(intrinsics.at(id).data(), intrinsics.at(id).data());
+      }
+      if (housings.count(id) && is_free(housings.at(id))) {
+        blocks.emplace_back(housings.at(id).data(), housings.at(id).data());
+      }
+    }
+    if (!covariance.Compute(blocks, &problem)) {
+      throw NumericalError("bundle adjustment: the covariance is rank deficient (a parameter is not "
+                           "observable from these views; hold it fixed)");
+    }
+    const auto extract = [&](const std::vector<double>& block, std::vector<double>* out) {
+      const int n = static_cast<int>(block.size());
+      std::vector<double> cov(static_cast<size_t>(n * n));
+      covariance.GetCovarianceBlock(block.data(), block.data(), cov.data());
+      out->assign(static_cast<size_t>(n), std::numeric_limits<double>::quiet_NaN());
+      for (int i = 0; i < n; ++i) {
+        const double v = cov[static_cast<size_t>(i * n + i)];
+        if (v > 0) (*out)[static_cast<size_t>(i)] = std::sqrt(v) * scale;
+      }
+    };
+    for (camera_t id : used_cameras) {
+      if (is_free(intrinsics.at(id))) {
+        extract(intrinsics.at(id), &std_devs->intrinsics[id]);
+      }
+      if (housings.count(id) && is_free(housings.at(id))) {
+        extract(housings.at(id), &std_devs->housing[id]);
+      }
+    }
+  }
+
+  for (auto& [id, block] : pose_blocks) poses[id] = FromPose(block);
+  for (const auto& [point_id, xyz] : point_blocks) reconstruction->point(point_id).xyz = xyz;
+  bool cameras_changed = false;
+  for (auto& [id, camera] : cameras) {
+    cameras_changed |= camera.camera.params != intrinsics.at(id);
+    camera.camera.params = intrinsics.at(id);
+    if (camera.housing) {
+      cameras_changed |= camera.housing->params != housings.at(id);
+      camera.housing->params = housings.at(id);
+    }
+  }
+  if (cameras_changed) reconstruction->UpdateRays();
+  return summary;
+}
+
+}  // namespace portcal

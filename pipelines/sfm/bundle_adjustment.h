@@ -1,0 +1,73 @@
+// Refractive bundle adjustment over a Reconstruction: poses, points and,
+// optionally, intrinsics and housings, with the exact reprojection error or
+// the virtual-camera error, a robust loss, and ArUco markers as scale: the
+// marker corners are extra points, observed where they were detected, whose
+// distances must equal the known side length (and diagonal).
+#pragma once
+
+#include <ceres/ceres.h>
+
+#include <set>
+#include <vector>
+
+#include "pipelines/sfm/reconstruction.h"
+
+namespace portcal {
+
+struct BundleAdjustmentOptions {
+  bool refine_focal_length = false;
+  bool refine_principal_point = false;
+  bool refine_extra_params = false;
+  bool refine_housing = false;
+  bool virtual_camera_error = false;  // else the exact reprojection error
+  double sigma_px = 1.0;              // residuals in units of this
+  double loss_scale = 1.0;            // Cauchy loss scale, in sigma; <= 0: no robust loss
+  int max_num_iterations = 100;
+  int num_threads = 2;
+  void Check() const;  // throws OptionError naming --BundleAdjustment.*
+};
+
+// A physical marker corner: its point and where it was seen.
+struct MarkerCorner {
+  int marker_id = 0;
+  int corner = 0;  // 0..3, OpenCV's order
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
+  std::vector<std::pair<image_t, Eigen::Vector2d>> observations;
+};
+
+struct MarkerScale {
+  double side_length_m = 0;   // <= 0: markers do not constrain the scale
+  double sigma_m = 0.0001;    // of each side and diagonal
+};
+
+// Marker corners seen by at least two registered images, triangulated from
+// the current poses (corners whose rays miss each other are dropped).
+std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconstruction,
+                                                   double max_error_px);
+
+struct BundleAdjustmentScope {
+  // Images whose poses are free; all registered images when empty.
+  std::set<image_t> variable_images;
+  // Points to adjust; all points of the variable images when empty.
+  bool all_points = true;
+};
+
+// Standard deviations of the cameras' and housings' parameters from the
+// covariance of the solution, scaled by the residual variance (NaN for
+// parameters held fixed).
+struct CalibrationStdDevs {
+  std::map<camera_t, std::vector<double>> intrinsics;
+  std::map<camera_t, std::vector<double>> housing;
+  double sigma0 = 0;  // estimated pixel noise (residual RMS corrected for the degrees of freedom)
+  int64_t num_residuals = 0;
+};
+
+// Adjusts in place. The gauge: the first registered image's pose is held,
+// and, without marker scale, one translation coordinate of the second.
+// Returns Ceres' summary; throws NumericalError if the solve fails.
+ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const BundleAdjustmentOptions& options,
+                                    const BundleAdjustmentScope& scope, std::vector<MarkerCorner>* markers,
+                                    const MarkerScale& marker_scale,
+                                    CalibrationStdDevs* std_devs = nullptr);
+
+}  // namespace portcal

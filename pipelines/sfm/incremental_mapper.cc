@@ -1,0 +1,479 @@
+#include "pipelines/sfm/incremental_mapper.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
+#include "pipelines/sfm/bundle_costs.h"
+#include "pipelines/sfm/bundle_costs_fixed.h"
+#include "pipelines/calibration/view_pose.h"
+#include "pipelines/sfm/ray_geometry.h"
+
+namespace portcal {
+
+void IncrementalMapperOptions::Check() const {
+  const auto positive = [](double v, const char* name) {
+    if (!(v > 0)) throw OptionError(std::string("--Mapper.") + name, std::to_string(v), "> 0");
+  };
+  positive(init_min_num_inliers, "init_min_num_inliers");
+  positive(init_max_error_px, "init_max_error");
+  positive(init_scene_depth_m, "init_scene_depth");
+  positive(abs_pose_max_error_px, "abs_pose_max_error");
+  positive(filter_max_reproj_error_px, "filter_max_reproj_error");
+  positive(ba_global_images_ratio, "ba_global_images_ratio");
+  positive(max_num_models, "max_num_models");
+  if (abs_pose_min_num_inliers < 6) {
+    throw OptionError("--Mapper.abs_pose_min_num_inliers", std::to_string(abs_pose_min_num_inliers), ">= 6");
+  }
+  if (min_model_size < 2) throw OptionError("--Mapper.min_model_size", std::to_string(min_model_size), ">= 2");
+  if (ba_local_num_images < 1) {
+    throw OptionError("--Mapper.ba_local_num_images", std::to_string(ba_local_num_images), ">= 1");
+  }
+}
+
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+class Mapper {
+ public:
+  Mapper(const SfmInputs& inputs, const std::map<camera_t, SfmCamera>& cameras,
+         const IncrementalMapperOptions& options)
+      : inputs_(inputs), cameras_(cameras), options_(options) {}
+
+  std::vector<Reconstruction> Run(ProgressSink& progress);
+
+ private:
+  double FocalOf(image_t image_id) const {
+    return cameras_.at(inputs_.images.at(image_id).camera_id).camera.MeanFocalLength();
+  }
+  bool Initialize(Reconstruction* r, std::set<image_pair_t>* tried);
+  bool TryInitialPair(Reconstruction* r, image_t a, image_t b);
+  bool Register(Reconstruction* r, image_t image_id);
+  int Triangulate(Reconstruction* r, image_t image_id);
+  int Filter(Reconstruction* r, const std::set<image_t>* images);
+  void LocalAdjust(Reconstruction* r, image_t image_id);
+  void GlobalAdjust(Reconstruction* r, bool refine_intrinsics);
+  std::vector<image_t> NextImages(const Reconstruction& r) const;
+
+  const SfmInputs& inputs_;
+  const std::map<camera_t, SfmCamera>& cameras_;
+  const IncrementalMapperOptions& options_;
+  std::set<image_t> used_;    // registered in an earlier model
+  std::set<image_t> failed_;  // failed to register since the model last grew
+};
+
+std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
+  std::vector<Reconstruction> models;
+  std::set<image_pair_t> tried;
+  progress.Begin("refractive_mapper: images registered", inputs_.images.size());
+  while (static_cast<int>(models.size()) < options_.max_num_models) {
+    Reconstruction r(&inputs_, cameras_);
+    failed_.clear();
+    if (!Initialize(&r, &tried)) break;
+    progress.Advance(2);
+    size_t last_global = r.poses().size();
+    size_t last_refine = r.poses().size();
+    while (true) {
+      CancelFlag::ThrowIfRequested();
+      bool added = false;
+      for (image_t image_id : NextImages(r)) {
+        if (!Register(&r, image_id)) {
+          failed_.insert(image_id);
+          continue;
+        }
+        failed_.clear();
+        Triangulate(&r, image_id);
+        LocalAdjust(&r, image_id);
+        progress.Advance(1);
+        if (r.poses().size() >= options_.ba_global_images_ratio * last_global) {
+          // Intrinsics move the rays of every image (and need the exact,
+          // slower error): refine them while the model is small and then
+          // whenever it has grown by a third.
+          const bool refine = r.poses().size() <= 8 || r.poses().size() >= 1.33 * last_refine;
+          GlobalAdjust(&r, refine);
+          if (refine) last_refine = r.poses().size();
+          last_global = r.poses().size();
+        }
+        added = true;
+        break;
+      }
+      if (!added) break;
+    }
+    // Rays may have moved with the intrinsics: triangulate what is left,
+    // adjust once more and filter.
+    for (const auto& [id, pose] : std::map<image_t, Rigid3d>(r.poses())) Triangulate(&r, id);
+    GlobalAdjust(&r, true);
+    Filter(&r, nullptr);
+    GlobalAdjust(&r, true);
+    LOG(INFO) << "refractive_mapper: model " << models.size() << ": " << r.poses().size() << " images, "
+              << r.points().size() << " points, mean reprojection error " << r.MeanReprojectionError()
+              << " px";
+    const bool keep = static_cast<int>(r.poses().size()) >= options_.min_model_size;
+    for (const auto& [id, pose] : r.poses()) used_.insert(id);
+    if (keep) models.push_back(std::move(r));
+    if (!options_.multiple_models) break;
+    if (inputs_.images.size() - used_.size() < 2) break;
+  }
+  progress.End();
+  std::stable_sort(models.begin(), models.end(), [](const Reconstruction& a, const Reconstruction& b) {
+    return a.poses().size() > b.poses().size();
+  });
+  return models;
+}
+
+bool Mapper::Initialize(Reconstruction* r, std::set<image_pair_t>* tried) {
+  std::vector<std::pair<int, image_pair_t>> candidates;
+  for (const auto& [pair_id, count] : inputs_.pair_inliers) {
+    image_t a, b;
+    PairIdToImagePair(pair_id, &a, &b);
+    if (used_.count(a) || used_.count(b) || tried->count(pair_id)) continue;
+    if (count < options_.init_min_num_inliers) continue;
+    candidates.emplace_back(count, pair_id);
+  }
+  std::sort(candidates.rbegin(), candidates.rend());
+  int trials = 0;
+  for (const auto& [count, pair_id] : candidates) {
+    if (trials++ >= options_.init_max_num_trials) break;
+    tried->insert(pair_id);
+    image_t a, b;
+    PairIdToImagePair(pair_id, &a, &b);
+    if (TryInitialPair(r, a, b)) {
+      LOG(INFO) << "refractive_mapper: initial pair '" << inputs_.images.at(a).name << "' + '"
+                << inputs_.images.at(b).name << "' (" << count << " inlier matches), " << r->points().size()
+                << " points";
+      return true;
+    }
+  }
+  return false;
+}
+
+bool Mapper::TryInitialPair(Reconstruction* r, image_t a, image_t b) {
+  const SfmImage& image_a = inputs_.images.at(a);
+  std::vector<std::pair<point2D_t, point2D_t>> pairs;
+  std::vector<Eigen::Vector3d> dirs_a, dirs_b;
+  for (point2D_t k = 0; k < image_a.correspondences.size(); ++k) {
+    for (const Correspondence& c : image_a.correspondences[k]) {
+      if (c.image_id != b) continue;
+      const auto& ra = r->RayOf(a, k);
+      const auto& rb = r->RayOf(b, c.point2D_idx);
+      if (!ra || !rb) continue;
+      pairs.emplace_back(k, c.point2D_idx);
+      dirs_a.push_back(ra->direction);
+      dirs_b.push_back(rb->direction);
+    }
+  }
+  if (static_cast<int>(pairs.size()) < options_.init_min_num_inliers) return false;
+  std::vector<char> inliers;
+  const double angle = options_.init_max_error_px / std::min(FocalOf(a), FocalOf(b));
+  const auto b_from_a = EstimateRelativePose(dirs_a, dirs_b, angle, &inliers);
+  if (!b_from_a) return false;
+  const auto triangulate = [&](const Rigid3d& pose_b, std::vector<Eigen::Vector3d>* points,
+                               std::vector<double>* angles) {
+    points->assign(pairs.size(), Eigen::Vector3d::Constant(std::nan("")));
+    angles->clear();
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      if (!inliers[i]) continue;
+      const std::vector<Ray3d> rays = {*r->RayOf(a, pairs[i].first),
+                                       RayInWorld(*r->RayOf(b, pairs[i].second), pose_b)};
+      const auto x = TriangulateRays(rays);
+      if (!x || (*x).z() <= 0 || (pose_b * *x).z() <= 0) continue;
+      (*points)[i] = *x;
+      angles->push_back(MaxTriangulationAngle(rays, *x));
+    }
+  };
+  std::vector<Eigen::Vector3d> points;
+  std::vector<double> angles;
+  Rigid3d pose_b = *b_from_a;
+  triangulate(pose_b, &points, &angles);
+  if (static_cast<int>(angles.size()) < options_.init_min_num_inliers) return false;
+  std::nth_element(angles.begin(), angles.begin() + angles.size() / 2, angles.end());
+  if (angles[angles.size() / 2] < options_.init_min_tri_angle_deg * kDegree) return false;
+  // Scale: the rays' origins are in metres, so the baseline must be too
+  // before the exact rays are triangulated again.
+  std::vector<double> depths;
+  for (const Eigen::Vector3d& x : points) {
+    if (x.allFinite()) depths.push_back(x.z());
+  }
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  pose_b.translation *= options_.init_scene_depth_m / depths[depths.size() / 2];
+  r->Register(a, Rigid3d());
+  r->Register(b, pose_b);
+  if (options_.marker_scale.side_length_m > 0) {
+    // Markers seen by both: their measured side against the known one.
+    const std::vector<MarkerCorner> corners = TriangulateMarkerCorners(*r, 1e9);
+    std::map<int, std::map<int, Eigen::Vector3d>> by_marker;
+    for (const MarkerCorner& c : corners) by_marker[c.marker_id][c.corner] = c.xyz;
+    std::vector<double> ratios;
+    for (const auto& [id, c] : by_marker) {
+      for (int k = 0; k < 4; ++k) {
+        if (c.count(k) && c.count((k + 1) % 4)) {
+          ratios.push_back(options_.marker_scale.side_length_m / (c.at(k) - c.at((k + 1) % 4)).norm());
+        }
+      }
+    }
+    if (!ratios.empty()) {
+      std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+      pose_b.translation *= ratios[ratios.size() / 2];
+      r->Register(b, pose_b);
+    }
+  }
+  triangulate(pose_b, &points, &angles);
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    if (!points[i].allFinite()) continue;
+    if (r->ReprojectionError(a, pairs[i].first, points[i]) > options_.init_max_error_px ||
+        r->ReprojectionError(b, pairs[i].second, points[i]) > options_.init_max_error_px) {
+      continue;
+    }
+    r->AddPoint(points[i], {{a, pairs[i].first}, {b, pairs[i].second}});
+  }
+  if (static_cast<int>(r->points().size()) < options_.init_min_num_inliers) {
+    r->Deregister(b);
+    r->Deregister(a);
+    return false;
+  }
+  GlobalAdjust(r, false);
+  Filter(r, nullptr);
+  if (static_cast<int>(r->points().size()) < options_.init_min_num_inliers) {
+    r->Deregister(b);
+    r->Deregister(a);
+    return false;
+  }
+  return true;
+}
+
+std::vector<image_t> Mapper::NextImages(const Reconstruction& r) const {
+  // Unregistered images ranked by how many of their keypoints see a point
+  // of the model (Schoenberger 2016 also weighs their spread; the count is
+  // what matters most for success).
+  std::vector<std::pair<int, image_t>> ranked;
+  for (const auto& [id, image] : inputs_.images) {
+    if (r.IsRegistered(id) || used_.count(id) || failed_.count(id)) continue;
+    int visible = 0;
+    for (point2D_t k = 0; k < image.correspondences.size(); ++k) {
+      for (const Correspondence& c : image.correspondences[k]) {
+        if (r.PointOf(c.image_id, c.point2D_idx) != kInvalidPoint3DId) {
+          ++visible;
+          break;
+        }
+      }
+    }
+    if (visible >= options_.abs_pose_min_num_inliers) ranked.emplace_back(visible, id);
+  }
+  std::sort(ranked.rbegin(), ranked.rend());
+  std::vector<image_t> next;
+  for (const auto& [count, id] : ranked) next.push_back(id);
+  return next;
+}
+
+bool Mapper::Register(Reconstruction* r, image_t image_id) {
+  const SfmImage& image = inputs_.images.at(image_id);
+  std::vector<Ray3d> rays;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<std::pair<point2D_t, point3D_t>> links;
+  for (point2D_t k = 0; k < image.correspondences.size(); ++k) {
+    const auto& ray = r->RayOf(image_id, k);
+    if (!ray) continue;
+    for (const Correspondence& c : image.correspondences[k]) {
+      const point3D_t p = r->PointOf(c.image_id, c.point2D_idx);
+      if (p == kInvalidPoint3DId) continue;
+      rays.push_back(*ray);
+      points.push_back(r->points().at(p).xyz);
+      links.emplace_back(k, p);
+      break;
+    }
+  }
+  GeneralizedAbsolutePoseOptions pose_options;
+  pose_options.max_angle_error_rad = options_.abs_pose_max_error_px / FocalOf(image_id);
+  pose_options.min_num_inliers = options_.abs_pose_min_num_inliers;
+  std::vector<char> inliers;
+  const auto cam_from_world = EstimateGeneralizedAbsolutePose(rays, points, pose_options, &inliers);
+  if (!cam_from_world) return false;
+
+  // Pose-only refinement through the exact projection, robust loss.
+  PoseBlock pose = ToPose(*cam_from_world);
+  const SfmCamera& camera = r->CameraOf(image_id);
+  ObservationModel model;
+  model.camera_model_id = camera.camera.model_id;
+  model.intrinsics = camera.camera.params;
+  if (camera.housing) {
+    model.housing_model_id = camera.housing->model_id;
+    model.housing = camera.housing->params;
+  }
+  std::vector<Eigen::Vector3d> fixed_points;
+  fixed_points.reserve(links.size());
+  ceres::Problem problem;
+  ceres::LossFunction* loss = new ceres::CauchyLoss(1.0);
+  for (size_t i = 0; i < links.size(); ++i) {
+    if (!inliers[i]) continue;
+    fixed_points.push_back(points[i]);
+    const Ray3d& ray = rays[i];
+    ceres::CostFunction* cost =
+        ray.direction.z() > 1e-6
+            ? CreateFixedRayCost(VirtualCenterOf(camera, ray), ray.direction, camera.camera.MeanFocalLength(), 1.0)
+            : CreateReprojectionCost(model, CostBlocks::kPosePoint, image.keypoints[links[i].first], 1.0);
+    problem.AddResidualBlock(cost, loss, pose.data(), fixed_points.back().data());
+    problem.SetParameterBlockConstant(fixed_points.back().data());
+  }
+  problem.SetManifold(pose.data(), PoseManifold());
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.logging_type = ceres::SILENT;
+  solver.max_num_iterations = 50;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+  if (!summary.IsSolutionUsable()) return false;
+  const Rigid3d refined = FromPose(pose);
+
+  r->Register(image_id, refined);
+  int added = 0;
+  for (size_t i = 0; i < links.size(); ++i) {
+    const auto& [k, p] = links[i];
+    if (r->points().count(p) == 0 || r->PointOf(image_id, k) != kInvalidPoint3DId) continue;
+    bool already = false;  // two keypoints of one image on one point
+    for (const TrackElement& e : r->points().at(p).track) already |= e.image_id == image_id;
+    if (already) continue;
+    if (r->ReprojectionError(image_id, k, r->points().at(p).xyz) > options_.filter_max_reproj_error_px) continue;
+    r->AddObservation(p, {image_id, k});
+    ++added;
+  }
+  if (added < options_.abs_pose_min_num_inliers) {
+    r->Deregister(image_id);
+    return false;
+  }
+  VLOG(1) << "registered '" << image.name << "' with " << added << " points";
+  return true;
+}
+
+int Mapper::Triangulate(Reconstruction* r, image_t image_id) {
+  const SfmImage& image = inputs_.images.at(image_id);
+  const double max_error = options_.filter_max_reproj_error_px;
+  int created = 0;
+  for (point2D_t k = 0; k < image.correspondences.size(); ++k) {
+    if (r->PointOf(image_id, k) != kInvalidPoint3DId || !r->RayOf(image_id, k)) continue;
+    // Continue a track if a corresponding keypoint has a point that
+    // projects here.
+    bool continued = false;
+    for (const Correspondence& c : image.correspondences[k]) {
+      const point3D_t p = r->PointOf(c.image_id, c.point2D_idx);
+      if (p == kInvalidPoint3DId) continue;
+      bool already = false;
+      for (const TrackElement& e : r->points().at(p).track) already |= e.image_id == image_id;
+      if (already || r->ReprojectionError(image_id, k, r->points().at(p).xyz) > max_error) continue;
+      r->AddObservation(p, {image_id, k});
+      continued = true;
+      break;
+    }
+    if (continued) continue;
+    std::vector<TrackElement> track = {{image_id, k}};
+    std::vector<Ray3d> rays = {RayInWorld(*r->RayOf(image_id, k), r->poses().at(image_id))};
+    std::set<image_t> images = {image_id};
+    for (const Correspondence& c : image.correspondences[k]) {
+      if (!r->IsRegistered(c.image_id) || images.count(c.image_id)) continue;
+      if (r->PointOf(c.image_id, c.point2D_idx) != kInvalidPoint3DId) continue;
+      const auto& ray = r->RayOf(c.image_id, c.point2D_idx);
+      if (!ray) continue;
+      track.push_back({c.image_id, c.point2D_idx});
+      rays.push_back(RayInWorld(*ray, r->poses().at(c.image_id)));
+      images.insert(c.image_id);
+    }
+    if (track.size() < 2) continue;
+    const auto x = TriangulateRays(rays);
+    if (!x || MaxTriangulationAngle(rays, *x) < options_.tri_min_angle_deg * kDegree) continue;
+    std::vector<TrackElement> good;
+    for (const TrackElement& e : track) {
+      if (r->ReprojectionError(e.image_id, e.point2D_idx, *x) <= max_error) good.push_back(e);
+    }
+    if (good.size() < 2 || good[0].image_id != image_id) continue;
+    r->AddPoint(*x, good);
+    ++created;
+  }
+  return created;
+}
+
+int Mapper::Filter(Reconstruction* r, const std::set<image_t>* images) {
+  int removed = 0;
+  std::vector<point3D_t> ids;
+  for (const auto& [id, point] : r->points()) {
+    bool in_scope = images == nullptr;
+    for (const TrackElement& e : point.track) in_scope |= images && images->count(e.image_id) > 0;
+    if (in_scope) ids.push_back(id);
+  }
+  for (point3D_t id : ids) {
+    if (!r->points().count(id)) continue;
+    const std::vector<TrackElement> track = r->points().at(id).track;
+    for (const TrackElement& e : track) {
+      if (!r->points().count(id)) break;
+      if (r->ReprojectionError(e.image_id, e.point2D_idx, r->points().at(id).xyz) >
+          options_.filter_max_reproj_error_px) {
+        r->DeleteObservation(e.image_id, e.point2D_idx);
+        ++removed;
+      }
+    }
+    if (!r->points().count(id)) continue;
+    std::vector<Ray3d> rays;
+    for (const TrackElement& e : r->points().at(id).track) {
+      rays.push_back(RayInWorld(*r->RayOf(e.image_id, e.point2D_idx), r->poses().at(e.image_id)));
+    }
+    if (MaxTriangulationAngle(rays, r->points().at(id).xyz) < options_.filter_min_tri_angle_deg * kDegree) {
+      removed += static_cast<int>(rays.size());
+      r->DeletePoint(id);
+    }
+  }
+  return removed;
+}
+
+void Mapper::LocalAdjust(Reconstruction* r, image_t image_id) {
+  // The new image and the images sharing the most points with it.
+  std::map<image_t, int> shared;
+  for (point2D_t k = 0; k < inputs_.images.at(image_id).keypoints.size(); ++k) {
+    const point3D_t p = r->PointOf(image_id, k);
+    if (p == kInvalidPoint3DId) continue;
+    for (const TrackElement& e : r->points().at(p).track) {
+      if (e.image_id != image_id) ++shared[e.image_id];
+    }
+  }
+  std::vector<std::pair<int, image_t>> ranked;
+  for (const auto& [id, count] : shared) ranked.emplace_back(count, id);
+  std::sort(ranked.rbegin(), ranked.rend());
+  BundleAdjustmentScope scope;
+  scope.variable_images.insert(image_id);
+  for (size_t i = 0; i < ranked.size() && static_cast<int>(i) < options_.ba_local_num_images - 1; ++i) {
+    scope.variable_images.insert(ranked[i].second);
+  }
+  BundleAdjustmentOptions ba;
+  ba.max_num_iterations = options_.ba_max_num_iterations;
+  ba.num_threads = options_.num_threads;
+  AdjustBundle(r, ba, scope, nullptr, MarkerScale());
+  Filter(r, &scope.variable_images);
+}
+
+void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
+  BundleAdjustmentOptions ba;
+  ba.refine_focal_length = refine_intrinsics && options_.ba_refine_focal_length;
+  ba.refine_principal_point = refine_intrinsics && options_.ba_refine_principal_point;
+  ba.refine_extra_params = refine_intrinsics && options_.ba_refine_extra_params;
+  ba.max_num_iterations = options_.ba_max_num_iterations;
+  ba.num_threads = options_.num_threads;
+  std::vector<MarkerCorner> markers;
+  if (options_.marker_scale.side_length_m > 0) {
+    markers = TriangulateMarkerCorners(*r, options_.filter_max_reproj_error_px * 4);
+  }
+  AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
+  Filter(r, nullptr);
+}
+
+}  // namespace
+
+std::vector<Reconstruction> RunIncrementalMapper(const SfmInputs& inputs,
+                                                 const std::map<camera_t, SfmCamera>& cameras,
+                                                 const IncrementalMapperOptions& options,
+                                                 ProgressSink& progress) {
+  options.Check();
+  Mapper mapper(inputs, cameras, options);
+  return mapper.Run(progress);
+}
+
+}  // namespace portcal

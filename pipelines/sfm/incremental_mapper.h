@@ -1,0 +1,52 @@
+// Incremental structure-from-motion on refracted rays (Schoenberger and
+// Frahm, "Structure-from-motion revisited", CVPR 2016, with every
+// observation a ray in water as in She et al., "Refractive COLMAP", IROS
+// 2024): an initial pair by relative pose, then one image at a time by
+// generalized absolute pose (gp3p in RANSAC), triangulation of the new
+// rays, local and periodic global refractive bundle adjustment, outlier
+// filtering; several models when the scene falls apart. With no housing it
+// is ordinary SfM through the same code.
+#pragma once
+
+#include <vector>
+
+#include "colmap_ext/util/progress.h"
+#include "pipelines/sfm/bundle_adjustment.h"
+#include "pipelines/sfm/reconstruction.h"
+
+namespace portcal {
+
+struct IncrementalMapperOptions {
+  int init_min_num_inliers = 50;
+  double init_min_tri_angle_deg = 4.0;  // median over the initial points
+  int init_max_num_trials = 20;         // candidate initial pairs tried per model
+  double init_max_error_px = 4.0;
+  // Scale of a model when markers do not give it: the initial pair's median
+  // scene depth, metres.
+  double init_scene_depth_m = 1.0;
+  double abs_pose_max_error_px = 12.0;
+  int abs_pose_min_num_inliers = 30;
+  double filter_max_reproj_error_px = 4.0;
+  double filter_min_tri_angle_deg = 1.5;
+  double tri_min_angle_deg = 1.5;
+  bool ba_refine_focal_length = true;
+  bool ba_refine_principal_point = false;
+  bool ba_refine_extra_params = true;
+  int ba_local_num_images = 6;
+  double ba_global_images_ratio = 1.1;
+  int ba_max_num_iterations = 50;
+  bool multiple_models = true;
+  int max_num_models = 50;
+  int min_model_size = 3;
+  MarkerScale marker_scale;  // side_length_m > 0: markers fix the scale
+  int num_threads = 2;
+  void Check() const;  // throws OptionError naming --Mapper.*
+};
+
+// Grows models until no image can be added; returns them largest first.
+std::vector<Reconstruction> RunIncrementalMapper(const SfmInputs& inputs,
+                                                 const std::map<camera_t, SfmCamera>& cameras,
+                                                 const IncrementalMapperOptions& options,
+                                                 ProgressSink& progress);
+
+}  // namespace portcal

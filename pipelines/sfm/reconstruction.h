@@ -1,0 +1,115 @@
+// What incremental structure-from-motion works on: the database's images,
+// keypoints and verified correspondences (read once), and the growing
+// reconstruction (registered poses, 3-D points and their tracks). Every
+// keypoint is also kept as a ray in the camera frame -- in water, starting
+// on the port's outer surface, when the camera sits behind a housing -- so
+// that registration and triangulation work on refracted rays.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "colmap_ext/housing/housing.h"
+#include "colmap_ext/io/sparse_model.h"
+#include "database/database.h"
+
+namespace portcal {
+
+struct SfmCamera {
+  Camera camera;
+  std::optional<Housing> housing;
+};
+
+struct Correspondence {
+  image_t image_id;
+  point2D_t point2D_idx;
+};
+
+struct SfmImage {
+  image_t image_id = 0;
+  std::string name;
+  camera_t camera_id = kInvalidCameraId;
+  std::vector<Eigen::Vector2d> keypoints;               // COLMAP pixels
+  std::vector<std::vector<Correspondence>> correspondences;  // per keypoint
+  std::vector<MarkerDetection> markers;
+  int num_correspondences = 0;  // keypoints with at least one
+};
+
+// Read-only inputs of the mapper.
+struct SfmInputs {
+  std::map<camera_t, SfmCamera> cameras;
+  std::map<image_t, SfmImage> images;
+  // Verified pairs (pair id -> number of inlier matches).
+  std::map<image_pair_t, int> pair_inliers;
+  // Reads images, cameras, housings (portcal_housings), keypoints, marker
+  // detections and the inlier matches of verified pairs.
+  static SfmInputs Read(Database* database);
+};
+
+struct SfmPoint {
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
+  std::vector<TrackElement> track;
+};
+
+// The centre of the virtual camera that sees `ray` as a central ray: the
+// point of the housing's refraction axis closest to it (flat port: the axis
+// along the normal; dome: through the sphere's centre), or the camera
+// centre without a housing or for a ray along the axis.
+Eigen::Vector3d VirtualCenterOf(const SfmCamera& camera, const Ray3d& ray_in_cam);
+
+// One model being grown.
+class Reconstruction {
+ public:
+  // `cameras`: the intrinsics and housings to start from.
+  Reconstruction(const SfmInputs* inputs, std::map<camera_t, SfmCamera> cameras);
+
+  const SfmInputs& inputs() const { return *inputs_; }
+  bool IsRegistered(image_t image_id) const { return poses_.count(image_id) > 0; }
+  const std::map<image_t, Rigid3d>& poses() const { return poses_; }
+  std::map<image_t, Rigid3d>& mutable_poses() { return poses_; }
+  void Register(image_t image_id, const Rigid3d& cam_from_world);
+  void Deregister(image_t image_id);  // drops its observations
+
+  const std::map<point3D_t, SfmPoint>& points() const { return points_; }
+  SfmPoint& point(point3D_t id) { return points_.at(id); }
+  // The point a keypoint observes, or kInvalidPoint3DId.
+  point3D_t PointOf(image_t image_id, point2D_t idx) const;
+  point3D_t AddPoint(const Eigen::Vector3d& xyz, const std::vector<TrackElement>& track);
+  void AddObservation(point3D_t id, const TrackElement& element);
+  void DeleteObservation(image_t image_id, point2D_t idx);  // deletes points left with < 2
+  void DeletePoint(point3D_t id);
+  // Number of the image's keypoints that observe a point.
+  int NumObservations(image_t image_id) const;
+
+  // Camera and housing of an image (the inputs' unless refined here).
+  const SfmCamera& CameraOf(image_t image_id) const;
+  std::map<camera_t, SfmCamera>& mutable_cameras() { return cameras_; }
+  const std::map<camera_t, SfmCamera>& cameras() const { return cameras_; }
+
+  // The keypoint's ray in the camera frame (nullopt: the pixel has none).
+  const std::optional<Ray3d>& RayOf(image_t image_id, point2D_t idx) const {
+    return rays_.at(image_id)[idx];
+  }
+  // Recomputes the rays of every image (after intrinsics or housing changed).
+  void UpdateRays();
+
+  // Pixel error of a point seen by a keypoint (infinity where not visible).
+  double ReprojectionError(image_t image_id, point2D_t idx, const Eigen::Vector3d& xyz) const;
+  // Mean reprojection error over all observations.
+  double MeanReprojectionError() const;
+
+  SparseModel ToSparseModel() const;
+
+ private:
+  const SfmInputs* inputs_;
+  std::map<camera_t, SfmCamera> cameras_;
+  std::map<image_t, Rigid3d> poses_;
+  std::map<point3D_t, SfmPoint> points_;
+  std::map<image_t, std::vector<point3D_t>> point_of_;
+  std::map<image_t, std::vector<std::optional<Ray3d>>> rays_;  // per registered image, per keypoint
+  point3D_t next_point_id_ = 1;
+};
+
+}  // namespace portcal
