@@ -10,6 +10,7 @@
 #include "database/database.h"
 #include "pipelines/render/aruco.h"
 #include "pipelines/stage_log.h"
+#include "pipelines/target/marker_edge_refinement.h"
 
 namespace fs = std::filesystem;
 
@@ -33,13 +34,17 @@ std::vector<MarkerDetection> DetectArucoMarkers(const cv::Mat& gray, const std::
   std::vector<int> ids;
   cv::aruco::detectMarkers(gray, dict, corners, ids, parameters);
   std::vector<MarkerDetection> markers;
+  MarkerEdgeRefinementOptions refinement;
+  refinement.bits_per_side = dict->markerSize;
   for (size_t m = 0; m < ids.size(); ++m) {
     MarkerDetection detection;
     detection.dictionary = dictionary;
     detection.marker_id = ids[m];
-    for (int c = 0; c < 4; ++c) {
-      detection.corners[c] = Eigen::Vector2d(corners[m][c].x + 0.5, corners[m][c].y + 0.5);
-    }
+    std::array<cv::Point2d, 4> quad;
+    for (int c = 0; c < 4; ++c) quad[c] = cv::Point2d(corners[m][c].x, corners[m][c].y);
+    // Edge-line corners where the edges allow (see marker_edge_refinement.h).
+    RefineMarkerCorners(gray, refinement, &quad);
+    for (int c = 0; c < 4; ++c) detection.corners[c] = Eigen::Vector2d(quad[c].x + 0.5, quad[c].y + 0.5);
     markers.push_back(detection);
   }
   return markers;

@@ -46,6 +46,10 @@ const std::vector<Command>& Commands() {
        "match and verify neighbouring images (and loop candidates)"},
       {"refractive_mapper", portcal::RunRefractiveMapper,
        "incremental structure-from-motion on refracted rays"},
+      {"refractive_bundle_adjuster", portcal::RunRefractiveBundleAdjuster,
+       "bundle adjustment that self-calibrates the housing (and intrinsics)"},
+      {"auto_calibrator", portcal::RunAutoCalibrator,
+       "calibrate from ArUco-marked objects without a known target: all stages"},
       {"synthesize", portcal::RunSynthesize,
        "render a calibration image set (targets, stereo, surveys, underwater "
        "effects) with exact ground truth"},

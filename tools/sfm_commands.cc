@@ -1,12 +1,14 @@
 // Subcommands of the reconstruction back end: refractive_mapper,
 // refractive_bundle_adjuster, auto_calibrator.
+#include "pipelines/auto_calibrator.h"
+#include "pipelines/refractive_bundle_adjuster.h"
 #include "pipelines/refractive_mapper.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 
 namespace portcal {
 
-void AddMapperOptions(CommandLine* cli, IncrementalMapperOptions* o) {
+static void AddMapperOptions(CommandLine* cli, IncrementalMapperOptions* o) {
   cli->Add("Mapper.init_min_num_inliers", &o->init_min_num_inliers, "inlier matches of the initial pair");
   cli->Add("Mapper.init_min_tri_angle", &o->init_min_tri_angle_deg, "median triangulation angle, degrees");
   cli->Add("Mapper.init_max_error", &o->init_max_error_px, "initial pair inlier threshold, pixels");
@@ -49,6 +51,77 @@ int RunRefractiveMapper(int argc, char** argv) {
     if (!cli.Parse(argc, argv)) return;
     StderrProgress progress;
     RunRefractiveMapper(options, progress);
+  });
+}
+
+}  // namespace portcal
+
+namespace portcal {
+
+namespace {
+
+void AddBundleOptions(CommandLine* cli, BundleAdjustmentOptions* ba) {
+  cli->Add("BundleAdjustment.refine_housing", &ba->refine_housing, "flat: normal + distance; dome: centre (0 | 1)");
+  cli->Add("BundleAdjustment.refine_focal_length", &ba->refine_focal_length, "0 | 1");
+  cli->Add("BundleAdjustment.refine_principal_point", &ba->refine_principal_point, "0 | 1");
+  cli->Add("BundleAdjustment.refine_extra_params", &ba->refine_extra_params, "0 | 1");
+  cli->Add("BundleAdjustment.virtual_camera_error", &ba->virtual_camera_error,
+           "virtual-camera error (1) or exact reprojection error (0)");
+  cli->Add("BundleAdjustment.loss_scale", &ba->loss_scale, "Cauchy loss scale in pixels (0: none)");
+  cli->Add("BundleAdjustment.max_num_iterations", &ba->max_num_iterations, "iterations");
+  cli->Add("num_threads", &ba->num_threads, "threads");
+}
+
+}  // namespace
+
+int RunRefractiveBundleAdjuster(int argc, char** argv) {
+  RefractiveBundleAdjusterOptions options;
+  CommandLine cli("refractive_bundle_adjuster",
+                  "Bundle adjustment of a sparse model that self-calibrates the housing (flat: "
+                  "normal + distance; dome: decentering) and optionally the intrinsics, with "
+                  "standard deviations. --Markers.side_length (with --database_path) fixes the "
+                  "scale by the ArUco markers. Writes the model and calibration.yaml/.txt.");
+  cli.AddRequired("input_path", &options.input_path, "sparse model (+ housings.txt)");
+  cli.AddRequired("output_path", &options.output_path, "directory for the model and reports");
+  cli.Add("database_path", &options.database_path, "database with marker detections (for the scale)");
+  cli.Add("Housing.model", &options.housing.model, "FLATPORT | DOMEPORT replacing the model's housings");
+  cli.Add("Housing.params", &options.housing.params, "housing parameters (first guess)");
+  cli.Add("Markers.side_length", &options.marker_scale.side_length_m, "ArUco marker side, metres (0: no scale)");
+  cli.Add("Markers.side_sigma", &options.marker_scale.sigma_m, "uncertainty of a marker side, metres");
+  cli.Add("BundleAdjustment.max_reproj_error", &options.max_reproj_error_px, "observations beyond are dropped");
+  AddBundleOptions(&cli, &options.ba);
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    RunRefractiveBundleAdjuster(options);
+  });
+}
+
+int RunAutoCalibrator(int argc, char** argv) {
+  AutoCalibratorOptions options;
+  CommandLine cli("auto_calibrator",
+                  "Calibration without a known target: extract, mask (ArUco), match, refractive "
+                  "mapper and refractive bundle adjustment in one run. Writes calibration.yaml/.txt, "
+                  "the sparse models and the database under --output_path.");
+  cli.AddRequired("image_path", &options.image_path, "directory of images");
+  cli.AddRequired("output_path", &options.output_path, "directory for the results");
+  cli.Add("ImageReader.camera_model", &options.camera_model, "COLMAP camera model");
+  cli.Add("ImageReader.camera_params", &options.camera_params, "known intrinsics (then held)");
+  cli.Add("Housing.model", &options.housing.model, "FLATPORT | DOMEPORT (none: in air)");
+  cli.Add("Housing.params", &options.housing.params, "first guess, the model's order");
+  cli.Add("Markers.dictionary", &options.marker_dictionary, "ArUco dictionary");
+  cli.Add("Markers.side_length", &options.marker_side_length_m, "marker side, metres: metric scale (0: none)");
+  cli.Add("Mask.enabled", &options.mask, "keep only features near markers (0 | 1)");
+  cli.Add("Mask.enlargement_factor", &options.mask_enlargement_factor, "marker quad scale");
+  cli.Add("AutoCalibration.matcher", &options.matcher, "exhaustive | sequential");
+  cli.Add("AutoCalibration.refine_intrinsics", &options.refine_intrinsics,
+          "-1: when --ImageReader.camera_params is empty; 0; 1");
+  cli.Add("SiftExtraction.max_num_features", &options.sift.max_num_features, "per image");
+  cli.Add("SiftExtraction.max_image_size", &options.sift.max_image_size, "pixels");
+  cli.Add("num_threads", &options.num_threads, "threads");
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    StderrProgress progress;
+    RunAutoCalibrator(options, progress);
   });
 }
 

@@ -9,6 +9,10 @@
 
 namespace portcal {
 
+namespace {
+constexpr double kUpsamplingShift = 0.25;
+}  // namespace
+
 void SiftExtractionOptions::Check() const {
   if (max_num_features < 1) {
     throw OptionError("--SiftExtraction.max_num_features", std::to_string(max_num_features), ">= 1");
@@ -88,10 +92,15 @@ SiftFeatures ExtractSift(const cv::Mat& gray, const SiftExtractionOptions& optio
   features.descriptors.resize(static_cast<Eigen::Index>(keypoints.size()), 128);
   for (size_t i = 0; i < keypoints.size(); ++i) {
     const cv::KeyPoint& k = keypoints[i];
-    // OpenCV pixel centres are integers; COLMAP's are at +0.5. The
-    // working image's pixel grid maps to the original's by the scales.
-    const float x = static_cast<float>((k.pt.x + 0.5) * sx);
-    const float y = static_cast<float>((k.pt.y + 0.5) * sy);
+    // OpenCV 4.6 builds its first octave by upsampling 2x (pixel j of it
+    // is centred at j/2 - 0.25 of the input) but reports j/2: every
+    // keypoint is 0.25 px too far right and down (measured: a Gaussian
+    // blob at (100, 100) comes out at (100.23, 100.23); OpenCV 4.8 added
+    // enable_precise_upscale for this). Undo it, then shift from OpenCV's
+    // integer pixel centres to COLMAP's +0.5, and scale the working image
+    // grid back to the original's.
+    const float x = static_cast<float>((k.pt.x - kUpsamplingShift + 0.5) * sx);
+    const float y = static_cast<float>((k.pt.y - kUpsamplingShift + 0.5) * sy);
     // cv::KeyPoint::size is the diameter of the neighbourhood, 2 x the
     // scale COLMAP stores; angle in degrees.
     const float feature_scale = static_cast<float>(0.5 * k.size * 0.5 * (sx + sy));

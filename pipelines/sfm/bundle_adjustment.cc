@@ -9,6 +9,7 @@
 #include "pipelines/calibration/view_pose.h"
 #include "pipelines/sfm/bundle_costs.h"
 #include "pipelines/sfm/bundle_costs_fixed.h"
+#include "pipelines/sfm/calibration_covariance.h"
 #include "pipelines/sfm/ray_geometry.h"
 
 namespace portcal {
@@ -63,6 +64,9 @@ std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconst
 }
 
 namespace {
+
+// Keypoints up to this scale (pixels) get sigma_px; coarser ones more.
+constexpr double kReferenceScale = 2.0;
 
 // |a - b| = length, in units of sigma.
 struct DistanceError {
@@ -124,7 +128,7 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
     }
     return CostBlocks::kPosePoint;
   };
-  const auto add_observation = [&](image_t image_id, const Eigen::Vector2d& pixel, double* xyz) {
+  const auto add_observation = [&](image_t image_id, const Eigen::Vector2d& pixel, double* xyz, double sigma) {
     const SfmImage& image = reconstruction->inputs().images.at(image_id);
     const SfmCamera& camera = cameras.at(image.camera_id);
     ObservationModel model;
@@ -137,8 +141,8 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
     const CostBlocks kind = blocks_of(camera);
     ceres::CostFunction* cost =
         options.virtual_camera_error && camera.housing
-            ? CreateVirtualCameraCost(camera.camera.model_id, camera.housing->model_id, pixel, options.sigma_px)
-            : CreateReprojectionCost(model, kind, pixel, options.sigma_px);
+            ? CreateVirtualCameraCost(camera.camera.model_id, camera.housing->model_id, pixel, sigma)
+            : CreateReprojectionCost(model, kind, pixel, sigma);
     std::vector<double*> blocks = {pose_blocks.at(image_id).data(), xyz};
     if (kind != CostBlocks::kPosePoint) blocks.push_back(intrinsics.at(image.camera_id).data());
     if (kind == CostBlocks::kAll && camera.housing) blocks.push_back(housings.at(image.camera_id).data());
@@ -154,20 +158,35 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
     if (!seen_by_variable) continue;
     point_blocks[point_id] = point.xyz;
   }
+  // A keypoint found at a coarse scale is located less precisely: SIFT's
+  // localisation error grows with the feature's scale (measured on the
+  // shared renders: median reprojection error 0.14 px below scale 2,
+  // 0.49 px at 5-8, 0.89 px beyond 15), and behind a port it is also
+  // biased, because refraction distorts a coarse blob unevenly. Sigma
+  // growing with the square of the scale (above 2 px) measured best:
+  // flat-port normal error 0.145 -> 0.085 (linear) -> 0.06 deg, dome
+  // decentering 1.6 -> 0.15 -> 0.10 mm (with the exact error).
+  const auto sigma_of = [&](const TrackElement& e) {
+    const SfmImage& image = reconstruction->inputs().images.at(e.image_id);
+    if (!options.scale_weighting || image.scales.empty()) return options.sigma_px;
+    const double r = std::max(1.0, static_cast<double>(image.scales[e.point2D_idx]) / kReferenceScale);
+    return options.sigma_px * r * r;
+  };
   for (auto& [point_id, xyz] : point_blocks) {
     for (const TrackElement& e : reconstruction->points().at(point_id).track) {
       const SfmCamera& camera = reconstruction->CameraOf(e.image_id);
+      const double sigma = sigma_of(e);
       const auto& ray = reconstruction->RayOf(e.image_id, e.point2D_idx);
       if (blocks_of(camera) == CostBlocks::kPosePoint && ray && ray->direction.z() > 1e-6) {
         // Intrinsics and housing held: the cheap fixed-ray error.
         problem.AddResidualBlock(CreateFixedRayCost(VirtualCenterOf(camera, *ray), ray->direction,
-                                                    camera.camera.MeanFocalLength(), options.sigma_px),
+                                                    camera.camera.MeanFocalLength(), sigma),
                                  loss, pose_blocks.at(e.image_id).data(), xyz.data());
         num_residuals += 2;
         continue;
       }
       add_observation(e.image_id, reconstruction->inputs().images.at(e.image_id).keypoints[e.point2D_idx],
-                      xyz.data());
+                      xyz.data(), sigma);
     }
   }
   const bool use_markers = markers && marker_scale.side_length_m > 0 && !markers->empty();
@@ -175,7 +194,7 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
     std::map<int, std::array<double*, 4>> corners_of;
     for (MarkerCorner& corner : *markers) {
       for (const auto& [image_id, pixel] : corner.observations) {
-        if (poses.count(image_id)) add_observation(image_id, pixel, corner.xyz.data());
+        if (poses.count(image_id)) add_observation(image_id, pixel, corner.xyz.data(), options.sigma_px);
       }
       if (!corners_of.count(corner.marker_id)) corners_of[corner.marker_id] = {nullptr, nullptr, nullptr, nullptr};
       corners_of[corner.marker_id][corner.corner] = corner.xyz.data();
@@ -195,15 +214,30 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
   }
 
   // Poses: manifold; constant outside the local scope; the gauge.
+  // Gauge: the first registered image is held. The scale is held by the
+  // markers, or by a second held image (a local adjustment's neighbours), or
+  // else by one translation coordinate of another image -- left free, the
+  // scale drifts (refraction observes it only weakly, and a wrong housing
+  // guess pulls it towards infinity, where the port's offsets vanish).
   const image_t first = poses.begin()->first;
-  const image_t second = std::next(poses.begin())->first;
+  int num_held = 0;
+  image_t scale_image = first;
+  for (const auto& [id, block] : pose_blocks) {
+    if (!problem.HasParameterBlock(block.data())) continue;
+    if (!is_variable(id) || id == first) {
+      ++num_held;
+    } else if (scale_image == first) {
+      scale_image = id;
+    }
+  }
+  const bool hold_scale = !use_markers && num_held < 2 && scale_image != first;
   for (auto& [id, block] : pose_blocks) {
     if (!problem.HasParameterBlock(block.data())) continue;
     if (!is_variable(id) || id == first) {
       problem.SetParameterBlockConstant(block.data());
       continue;
     }
-    if (id == second && !use_markers && !local) {
+    if (hold_scale && id == scale_image) {
       // Hold the largest translation coordinate: it fixes the scale.
       const Eigen::Vector3d t(block[4], block[5], block[6]);
       int k;
@@ -268,44 +302,39 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
     for (double r : residuals) sum_sq += r * r;
     std_devs->sigma0 = std::sqrt(sum_sq / dof) * options.sigma_px;
     const double scale = std::sqrt(sum_sq / dof);
-    ceres::Covariance::Options covariance_options;
-    covariance_options.algorithm_type = ceres::SPARSE_QR;
-    covariance_options.num_threads = options.num_threads;
-    covariance_options.apply_loss_function = true;
-    ceres::Covariance covariance(covariance_options);
-    std::vector<std::pair<const double*, const double*>> blocks;
-    const auto is_free = [&](const std::vector<double>& block) {
-      return problem.HasParameterBlock(block.data()) && !problem.IsParameterBlockConstant(block.data());
+    const auto is_free = [&](const double* block) {
+      return problem.HasParameterBlock(block) && !problem.IsParameterBlockConstant(block);
     };
-    for (camera_t id : used_cameras) {
-      if (is_free(intrinsics.at(id))) {
-        blocks.emplace_back(intrinsics.at(id).data(), intrinsics.at(id).data());
-      }
-      if (housings.count(id) && is_free(housings.at(id))) {
-        blocks.emplace_back(housings.at(id).data(), housings.at(id).data());
+    std::vector<double*> points, others;
+    std::vector<const double*> wanted;
+    for (auto& [id, xyz] : point_blocks) {
+      if (is_free(xyz.data())) points.push_back(xyz.data());
+    }
+    for (auto& [id, block] : pose_blocks) {
+      if (is_free(block.data())) others.push_back(block.data());
+    }
+    if (use_markers) {
+      for (MarkerCorner& corner : *markers) {
+        if (is_free(corner.xyz.data())) others.push_back(corner.xyz.data());
       }
     }
-    if (!covariance.Compute(blocks, &problem)) {
-      throw NumericalError("bundle adjustment: the covariance is rank deficient (a parameter is not "
-                           "observable from these views; hold it fixed)");
-    }
-    const auto extract = [&](const std::vector<double>& block, std::vector<double>* out) {
-      const int n = static_cast<int>(block.size());
-      std::vector<double> cov(static_cast<size_t>(n * n));
-      covariance.GetCovarianceBlock(block.data(), block.data(), cov.data());
-      out->assign(static_cast<size_t>(n), std::numeric_limits<double>::quiet_NaN());
-      for (int i = 0; i < n; ++i) {
-        const double v = cov[static_cast<size_t>(i * n + i)];
-        if (v > 0) (*out)[static_cast<size_t>(i)] = std::sqrt(v) * scale;
-      }
-    };
     for (camera_t id : used_cameras) {
-      if (is_free(intrinsics.at(id))) {
-        extract(intrinsics.at(id), &std_devs->intrinsics[id]);
+      if (is_free(intrinsics.at(id).data())) {
+        others.push_back(intrinsics.at(id).data());
+        wanted.push_back(intrinsics.at(id).data());
       }
-      if (housings.count(id) && is_free(housings.at(id))) {
-        extract(housings.at(id), &std_devs->housing[id]);
+      if (housings.count(id) && is_free(housings.at(id).data())) {
+        others.push_back(housings.at(id).data());
+        wanted.push_back(housings.at(id).data());
       }
+    }
+    const auto marginal = MarginalStdDevs(&problem, points, others, wanted, scale);
+    for (camera_t id : used_cameras) {
+      const auto it = marginal.find(intrinsics.at(id).data());
+      if (it != marginal.end()) std_devs->intrinsics[id] = it->second;
+      if (!housings.count(id)) continue;
+      const auto ith = marginal.find(housings.at(id).data());
+      if (ith != marginal.end()) std_devs->housing[id] = ith->second;
     }
   }
 

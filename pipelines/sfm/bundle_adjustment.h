@@ -21,6 +21,7 @@ struct BundleAdjustmentOptions {
   bool refine_housing = false;
   bool virtual_camera_error = false;  // else the exact reprojection error
   double sigma_px = 1.0;              // residuals in units of this
+  bool scale_weighting = true;        // sigma grows with the keypoint's scale (above 2 px)
   double loss_scale = 1.0;            // Cauchy loss scale, in sigma; <= 0: no robust loss
   int max_num_iterations = 100;
   int num_threads = 2;

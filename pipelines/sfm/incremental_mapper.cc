@@ -448,6 +448,11 @@ void Mapper::LocalAdjust(Reconstruction* r, image_t image_id) {
   ba.num_threads = options_.num_threads;
   AdjustBundle(r, ba, scope, nullptr, MarkerScale());
   Filter(r, &scope.variable_images);
+  if (getenv("PORTCAL_DEBUG_SCALE")) {
+    double m = 0;
+    for (const auto& [id, pose] : r->poses()) m = std::max(m, pose.translation.norm());
+    fprintf(stderr, "local %zu images: max |t| %g\n", r->poses().size(), m);
+  }
 }
 
 void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
@@ -463,6 +468,11 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   }
   AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
   Filter(r, nullptr);
+  if (getenv("PORTCAL_DEBUG_SCALE")) {
+    double m = 0;
+    for (const auto& [id, pose] : r->poses()) m = std::max(m, pose.translation.norm());
+    fprintf(stderr, "global %zu images, %zu marker corners: max |t| %g\n", r->poses().size(), markers.size(), m);
+  }
 }
 
 }  // namespace

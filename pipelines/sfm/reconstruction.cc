@@ -23,6 +23,7 @@ SfmInputs SfmInputs::Read(Database* database) {
     image.camera_id = row.camera_id;
     for (const FeatureKeypoint& k : database->ReadKeypoints(row.image_id)) {
       image.keypoints.emplace_back(k.x, k.y);
+      image.scales.push_back(k.ComputeScale());
     }
     image.correspondences.resize(image.keypoints.size());
     image.markers = database->ReadMarkerDetections(row.image_id);
@@ -48,6 +49,38 @@ SfmInputs SfmInputs::Read(Database* database) {
     for (const auto& c : image.correspondences) image.num_correspondences += !c.empty();
   }
   return inputs;
+}
+
+SfmInputs SfmInputs::FromSparseModel(const SparseModel& model) {
+  SfmInputs inputs;
+  for (const auto& [id, camera] : model.cameras) {
+    inputs.cameras[id].camera = camera;
+    const auto it = model.housings.find(id);
+    if (it != model.housings.end()) inputs.cameras[id].housing = it->second;
+  }
+  for (const auto& [id, image] : model.images) {
+    SfmImage& sfm = inputs.images[id];
+    sfm.image_id = id;
+    sfm.name = image.name;
+    sfm.camera_id = image.camera_id;
+    for (const Point2D& p : image.points2D) sfm.keypoints.push_back(p.xy);
+    sfm.correspondences.resize(sfm.keypoints.size());
+  }
+  return inputs;
+}
+
+Reconstruction Reconstruction::FromSparseModel(const SfmInputs* inputs, const SparseModel& model) {
+  Reconstruction r(inputs, inputs->cameras);
+  for (const auto& [id, image] : model.images) r.Register(id, image.cam_from_world);
+  for (const auto& [id, point] : model.points3D) {
+    if (point.track.size() < 2) continue;
+    const point3D_t new_id = r.AddPoint(point.xyz, {});
+    for (const TrackElement& e : point.track) {
+      if (r.PointOf(e.image_id, e.point2D_idx) == kInvalidPoint3DId) r.AddObservation(new_id, e);
+    }
+    if (r.points().at(new_id).track.size() < 2) r.DeletePoint(new_id);
+  }
+  return r;
 }
 
 Eigen::Vector3d VirtualCenterOf(const SfmCamera& camera, const Ray3d& ray) {

@@ -32,6 +32,7 @@ struct SfmImage {
   std::string name;
   camera_t camera_id = kInvalidCameraId;
   std::vector<Eigen::Vector2d> keypoints;               // COLMAP pixels
+  std::vector<float> scales;                            // SIFT scale per keypoint (empty: unknown)
   std::vector<std::vector<Correspondence>> correspondences;  // per keypoint
   std::vector<MarkerDetection> markers;
   int num_correspondences = 0;  // keypoints with at least one
@@ -46,6 +47,9 @@ struct SfmInputs {
   // Reads images, cameras, housings (portcal_housings), keypoints, marker
   // detections and the inlier matches of verified pairs.
   static SfmInputs Read(Database* database);
+  // From a sparse model: its images' keypoints (no correspondences), its
+  // cameras and housings. Marker detections are added separately.
+  static SfmInputs FromSparseModel(const SparseModel& model);
 };
 
 struct SfmPoint {
@@ -101,6 +105,8 @@ class Reconstruction {
   double MeanReprojectionError() const;
 
   SparseModel ToSparseModel() const;
+  // The model's poses and points (inputs from SfmInputs::FromSparseModel).
+  static Reconstruction FromSparseModel(const SfmInputs* inputs, const SparseModel& model);
 
  private:
   const SfmInputs* inputs_;

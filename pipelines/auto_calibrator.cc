@@ -1,0 +1,104 @@
+#include "pipelines/auto_calibrator.h"
+
+#include <chrono>
+
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+
+void AutoCalibratorOptions::Check() const {
+  if (image_path.empty()) throw OptionError("--image_path", "''", "a directory of images");
+  if (output_path.empty()) throw OptionError("--output_path", "''", "a directory for the results");
+  if (housing.model.empty() != housing.params.empty()) {
+    throw OptionError("--Housing.params", housing.params, "given together with --Housing.model");
+  }
+  if (matcher != "exhaustive" && matcher != "sequential") {
+    throw OptionError("--AutoCalibration.matcher", matcher, "exhaustive or sequential");
+  }
+  if (refine_intrinsics < -1 || refine_intrinsics > 1) {
+    throw OptionError("--AutoCalibration.refine_intrinsics", std::to_string(refine_intrinsics), "-1, 0 or 1");
+  }
+  if (marker_side_length_m < 0) {
+    throw OptionError("--Markers.side_length", std::to_string(marker_side_length_m), ">= 0 m");
+  }
+}
+
+AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, ProgressSink& progress) {
+  options.Check();
+  fs::create_directories(options.output_path);
+  const std::string database_path = (fs::path(options.output_path) / "database.db").string();
+  const bool intrinsics_given = !options.camera_params.empty();
+  const bool refine_intrinsics = options.refine_intrinsics == -1 ? !intrinsics_given : options.refine_intrinsics == 1;
+  AutoCalibrationResult result;
+  auto clock = std::chrono::steady_clock::now();
+  const auto lap = [&](const std::string& stage) {
+    const auto now = std::chrono::steady_clock::now();
+    result.stage_seconds.emplace_back(stage, std::chrono::duration<double>(now - clock).count());
+    clock = now;
+  };
+
+  FeatureExtractorOptions extract;
+  extract.database_path = database_path;
+  extract.image_path = options.image_path;
+  extract.reader.camera_model = options.camera_model;
+  extract.reader.single_camera = true;
+  extract.reader.camera_params = options.camera_params;
+  extract.sift = options.sift;
+  extract.num_threads = options.num_threads;
+  result.num_images = ExtractFeatures(extract, progress).num_images;
+  lap("feature_extractor");
+
+  if (options.mask) {
+    FeatureMaskerOptions mask;
+    mask.database_path = database_path;
+    mask.image_path = options.image_path;
+    mask.dictionary = options.marker_dictionary;
+    mask.enlargement_factor = options.mask_enlargement_factor;
+    mask.num_threads = options.num_threads;
+    MaskFeatures(mask, progress);
+    lap("feature_masker");
+  }
+
+  FeatureMatcherOptions match;
+  match.database_path = database_path;
+  match.mode = options.matcher;
+  match.num_threads = options.num_threads;
+  MatchFeatures(match, progress);
+  lap(options.matcher + "_matcher");
+
+  RefractiveMapperOptions map;
+  map.database_path = database_path;
+  map.image_path = options.image_path;
+  map.output_path = (fs::path(options.output_path) / "sparse").string();
+  map.housing = options.housing;
+  map.mapper.num_threads = options.num_threads;
+  map.mapper.marker_scale.side_length_m = options.marker_side_length_m;
+  map.mapper.ba_refine_focal_length = refine_intrinsics;
+  map.mapper.ba_refine_extra_params = refine_intrinsics;
+  const RefractiveMapperSummary mapped = RunRefractiveMapper(map, progress);
+  result.num_registered = static_cast<int>(ReadSparseModel(mapped.model_paths.at(0)).images.size());
+  lap("refractive_mapper");
+
+  RefractiveBundleAdjusterOptions refine;
+  refine.input_path = mapped.model_paths.at(0).string();
+  refine.output_path = (fs::path(options.output_path) / "refined").string();
+  refine.database_path = database_path;
+  refine.marker_scale.side_length_m = options.marker_side_length_m;
+  refine.ba.refine_housing = !options.housing.model.empty();
+  refine.ba.refine_focal_length = refine_intrinsics;
+  refine.ba.refine_extra_params = refine_intrinsics;
+  refine.ba.num_threads = options.num_threads;
+  result.refined = RunRefractiveBundleAdjuster(refine);
+  WriteCalibrationReport(result.refined.report, options.output_path);
+  lap("refractive_bundle_adjuster");
+  std::string times;
+  for (const auto& [stage, seconds] : result.stage_seconds) times += " " + stage + " " + std::to_string(seconds) + " s;";
+  LOG(INFO) << "auto_calibrator: " << result.num_registered << " of " << result.num_images
+            << " images calibrated; times:" << times;
+  return result;
+}
+
+}  // namespace portcal

@@ -1,0 +1,48 @@
+// `portcal auto_calibrator`: calibration without a known target, all the
+// database stages in one command with defaults for a calibration object
+// carrying ArUco markers: feature_extractor -> feature_masker ->
+// exhaustive (or sequential) matcher -> refractive_mapper ->
+// refractive_bundle_adjuster. Writes, under output_path: database.db,
+// sparse/0 (the mapper's model), refined/ (the self-calibrated model) and
+// calibration.yaml / calibration.txt.
+#pragma once
+
+#include <string>
+
+#include "colmap_ext/util/progress.h"
+#include "pipelines/feature_extractor.h"
+#include "pipelines/feature_masker.h"
+#include "pipelines/feature_matcher.h"
+#include "pipelines/refractive_bundle_adjuster.h"
+#include "pipelines/refractive_mapper.h"
+
+namespace portcal {
+
+struct AutoCalibratorOptions {
+  std::string image_path;
+  std::string output_path;
+  std::string camera_model = "RADIAL";
+  std::string camera_params;  // given: intrinsics known and held
+  HousingOverride housing;    // the housing to calibrate, with a first guess
+  std::string marker_dictionary = "DICT_4X4_50";
+  double marker_side_length_m = 0;  // > 0: metric scale from the markers
+  double mask_enlargement_factor = 3.0;
+  bool mask = true;                   // keep only features near markers
+  std::string matcher = "exhaustive";  // exhaustive | sequential
+  SiftExtractionOptions sift;
+  // Refine the intrinsics with the housing; -1: when camera_params is empty.
+  int refine_intrinsics = -1;
+  int num_threads = 2;
+  void Check() const;  // throws OptionError naming the option
+};
+
+struct AutoCalibrationResult {
+  RefractiveBundleAdjusterResult refined;
+  int num_images = 0;
+  int num_registered = 0;
+  std::vector<std::pair<std::string, double>> stage_seconds;
+};
+
+AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, ProgressSink& progress);
+
+}  // namespace portcal

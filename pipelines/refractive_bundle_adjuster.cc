@@ -1,0 +1,171 @@
+#include "pipelines/refractive_bundle_adjuster.h"
+
+#include <cmath>
+
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+
+void RefractiveBundleAdjusterOptions::Check() const {
+  if (input_path.empty()) throw OptionError("--input_path", "''", "a sparse model directory");
+  if (output_path.empty()) throw OptionError("--output_path", "''", "a directory for the results");
+  if (marker_scale.side_length_m > 0 && database_path.empty()) {
+    throw OptionError("--database_path", "''", "the database with the marker detections (--Markers.side_length)");
+  }
+  if (marker_scale.side_length_m < 0) {
+    throw OptionError("--Markers.side_length", std::to_string(marker_scale.side_length_m), ">= 0 m");
+  }
+  if (!(marker_scale.sigma_m > 0)) {
+    throw OptionError("--Markers.side_sigma", std::to_string(marker_scale.sigma_m), "> 0 m");
+  }
+  if (!(max_reproj_error_px > 0)) {
+    throw OptionError("--BundleAdjustment.max_reproj_error", std::to_string(max_reproj_error_px), "> 0 px");
+  }
+  ba.Check();
+}
+
+namespace {
+
+// Drops observations whose exact reprojection error exceeds the limit.
+int FilterObservations(Reconstruction* r, double max_error_px) {
+  int removed = 0;
+  std::vector<std::pair<image_t, point2D_t>> bad;
+  for (const auto& [id, point] : r->points()) {
+    for (const TrackElement& e : point.track) {
+      if (r->ReprojectionError(e.image_id, e.point2D_idx, point.xyz) > max_error_px) {
+        bad.emplace_back(e.image_id, e.point2D_idx);
+      }
+    }
+  }
+  for (const auto& [image_id, idx] : bad) {
+    r->DeleteObservation(image_id, idx);
+    ++removed;
+  }
+  return removed;
+}
+
+}  // namespace
+
+RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options) {
+  options.Check();
+  const SparseModel model = ReadSparseModel(options.input_path);
+  model.Validate(options.input_path);
+  if (model.images.size() < 2) {
+    throw InputError(options.input_path + ": " + std::to_string(model.images.size()) +
+                     " registered image(s); bundle adjustment needs at least 2");
+  }
+  SfmInputs inputs = SfmInputs::FromSparseModel(model);
+  ApplyHousingOverride(options.housing, &inputs.cameras);
+  if (options.ba.refine_housing) {
+    bool any = false;
+    for (const auto& [id, camera] : inputs.cameras) any |= camera.housing.has_value();
+    if (!any) {
+      throw InputError(options.input_path + ": no camera has a housing (housings.txt) to refine; give "
+                       "--Housing.model and --Housing.params or --BundleAdjustment.refine_housing 0");
+    }
+  }
+  if (!options.database_path.empty()) {
+    Database database(options.database_path, Database::OpenMode::kReadOnly);
+    for (auto& [id, image] : inputs.images) {
+      const auto row = database.ReadImageWithName(image.name);
+      if (!row) continue;
+      image.markers = database.ReadMarkerDetections(row->image_id);
+      // The keypoints' scales, for weighting, when the model's points are
+      // the database's keypoints.
+      const FeatureKeypoints keypoints = database.ReadKeypoints(row->image_id);
+      if (keypoints.size() != image.keypoints.size()) continue;
+      bool same = true;
+      for (size_t k = 0; k < keypoints.size() && same; ++k) {
+        same = std::abs(keypoints[k].x - image.keypoints[k].x()) < 1e-3 &&
+               std::abs(keypoints[k].y - image.keypoints[k].y()) < 1e-3;
+      }
+      if (!same) continue;
+      for (const FeatureKeypoint& k : keypoints) image.scales.push_back(k.ComputeScale());
+    }
+  }
+  Reconstruction r = Reconstruction::FromSparseModel(&inputs, model);
+  RefractiveBundleAdjusterResult result;
+  std::vector<MarkerCorner> markers;
+  if (options.marker_scale.side_length_m > 0) {
+    markers = TriangulateMarkerCorners(r, 4 * options.max_reproj_error_px);
+    result.num_marker_corners = static_cast<int>(markers.size());
+    if (markers.empty()) {
+      throw InputError(options.database_path + ": no marker corner is seen by two registered images; the "
+                       "scale cannot come from --Markers.side_length (run feature_masker, or set it to 0)");
+    }
+    LOG(INFO) << "refractive_bundle_adjuster: " << markers.size() << " marker corners give the scale";
+  }
+
+  // A first solve, outliers out, then the final solve with covariance.
+  AdjustBundle(&r, options.ba, BundleAdjustmentScope(), &markers, options.marker_scale);
+  result.num_filtered = FilterObservations(&r, options.max_reproj_error_px);
+  CalibrationStdDevs std_devs;
+  AdjustBundle(&r, options.ba, BundleAdjustmentScope(), &markers, options.marker_scale, &std_devs);
+
+  // Report: the first camera, RMS of the exact reprojection error.
+  const camera_t camera_id = r.cameras().begin()->first;
+  if (r.cameras().size() > 1) {
+    LOG(WARNING) << "refractive_bundle_adjuster: " << r.cameras().size()
+                 << " cameras; the report describes camera " << camera_id << " (the model has all)";
+  }
+  CalibrationReport& report = result.report;
+  const SfmCamera& camera = r.cameras().at(camera_id);
+  report.camera = camera.camera;
+  report.housing = camera.housing;
+  report.parameters_std_dev = std_devs.intrinsics.count(camera_id)
+                                  ? std_devs.intrinsics.at(camera_id)
+                                  : std::vector<double>(camera.camera.params.size(), 0.0);
+  if (camera.housing) {
+    report.housing_std_dev = std_devs.housing.count(camera_id)
+                                 ? std_devs.housing.at(camera_id)
+                                 : std::vector<double>(camera.housing->params.size(), 0.0);
+  }
+  for (double& v : report.parameters_std_dev) if (!std::isfinite(v)) v = 0.0;
+  for (double& v : report.housing_std_dev) if (!std::isfinite(v)) v = 0.0;
+  report.residual_sigma_px = std_devs.sigma0;
+  report.target_description = options.marker_scale.side_length_m > 0
+                                  ? "auto-calibration (SIFT points, ArUco markers of side " +
+                                        std::to_string(options.marker_scale.side_length_m) + " m give the scale)"
+                                  : "auto-calibration (SIFT points; no metric scale)";
+  double sum_sq = 0;
+  int64_t count = 0;
+  std::map<image_t, std::pair<double, int>> per_image;
+  for (const auto& [id, point] : r.points()) {
+    for (const TrackElement& e : point.track) {
+      const double err = r.ReprojectionError(e.image_id, e.point2D_idx, point.xyz);
+      if (!std::isfinite(err)) continue;
+      sum_sq += err * err;
+      ++count;
+      per_image[e.image_id].first += err * err;
+      per_image[e.image_id].second += 1;
+    }
+  }
+  report.overall_rms_px = count ? std::sqrt(sum_sq / count) : 0.0;
+  report.num_points = static_cast<int>(count);
+  for (const auto& [image_id, pose] : r.poses()) {
+    if (inputs.images.at(image_id).camera_id != camera_id) continue;
+    CalibratedView view;
+    view.image_name = inputs.images.at(image_id).name;
+    view.cam_from_target = pose;
+    const auto it = per_image.find(image_id);
+    view.num_points = it == per_image.end() ? 0 : it->second.second;
+    view.rms_px = view.num_points ? std::sqrt(it->second.first / view.num_points) : 0.0;
+    report.views.push_back(view);
+  }
+  WriteSparseModel(r.ToSparseModel(), options.output_path, ModelFormat::kBinary);
+  WriteCalibrationReport(report, options.output_path);
+  LOG(INFO) << "refractive_bundle_adjuster: RMS " << report.overall_rms_px << " px over " << count
+            << " observations; " << result.num_filtered << " observations dropped; written to "
+            << options.output_path;
+  if (camera.housing) LOG(INFO) << "housing: " << camera.housing->ModelName() << " " << [&] {
+    std::string s;
+    for (double v : camera.housing->params) s += std::to_string(v) + " ";
+    return s;
+  }();
+  return result;
+}
+
+}  // namespace portcal

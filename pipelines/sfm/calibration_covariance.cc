@@ -1,0 +1,127 @@
+#include "pipelines/sfm/calibration_covariance.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <unordered_map>
+
+#include "colmap_ext/util/error.h"
+
+namespace portcal {
+
+std::map<const double*, std::vector<double>> MarginalStdDevs(ceres::Problem* problem,
+                                                             const std::vector<double*>& points,
+                                                             const std::vector<double*>& others,
+                                                             const std::vector<const double*>& wanted,
+                                                             double scale) {
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.apply_loss_function = false;
+  evaluate.parameter_blocks = others;
+  evaluate.parameter_blocks.insert(evaluate.parameter_blocks.end(), points.begin(), points.end());
+  std::map<const double*, int> offset;  // tangent column of each other block
+  int nc = 0;
+  for (double* block : others) {
+    offset[block] = nc;
+    nc += problem->ParameterBlockTangentSize(block);
+  }
+  ceres::CRSMatrix jacobian;
+  std::vector<double> residuals;
+  if (!problem->Evaluate(evaluate, nullptr, &residuals, nullptr, &jacobian)) {
+    throw NumericalError("covariance: the residuals cannot be evaluated at the solution");
+  }
+
+  // Accumulate H_cc, and per point H_pp and H_pc (sparse in c).
+  Eigen::MatrixXd Hcc = Eigen::MatrixXd::Zero(nc, nc);
+  struct PointBlocks {
+    Eigen::Matrix3d Hpp = Eigen::Matrix3d::Zero();
+    std::unordered_map<int, Eigen::Vector3d> Hpc;  // column -> 3-vector
+  };
+  std::vector<PointBlocks> point_blocks(points.size());
+  std::vector<std::pair<int, double>> camera_entries;
+  for (int row = 0; row < jacobian.num_rows; ++row) {
+    camera_entries.clear();
+    int point = -1;
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
+      const int col = jacobian.cols[k];
+      const double value = jacobian.values[k];
+      if (col < nc) {
+        camera_entries.emplace_back(col, value);
+      } else {
+        const int p = (col - nc) / 3;
+        PORTCAL_CHECK_MSG(point == -1 || point == p, "a residual touches two marginalised points");
+        point = p;
+        b((col - nc) % 3) = value;
+      }
+    }
+    for (const auto& [i, vi] : camera_entries) {
+      for (const auto& [j, vj] : camera_entries) Hcc(i, j) += vi * vj;
+    }
+    if (point < 0) continue;
+    PointBlocks& pb = point_blocks[static_cast<size_t>(point)];
+    pb.Hpp += b * b.transpose();
+    for (const auto& [i, vi] : camera_entries) {
+      auto it = pb.Hpc.find(i);
+      if (it == pb.Hpc.end()) it = pb.Hpc.emplace(i, Eigen::Vector3d::Zero()).first;
+      it->second += b * vi;
+    }
+  }
+  if (getenv("PORTCAL_DEBUG_COV")) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> e0(Hcc);
+    for (int row = 0; row < 3; ++row) {
+      for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) fprintf(stderr, "(%d %.3g) ", jacobian.cols[k], jacobian.values[k]);
+      fprintf(stderr, "\n");
+    }
+    fprintf(stderr, "Hcc alone: min eig %g max %g; points %zu rows %d\n", e0.eigenvalues()(0), e0.eigenvalues()(nc - 1), points.size(), jacobian.num_rows);
+  }
+  // Schur complement S = Hcc - sum_p Hcp Hpp^+ Hpc.
+  for (const PointBlocks& pb : point_blocks) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(pb.Hpp);
+    const Eigen::Vector3d values = eig.eigenvalues();
+    Eigen::Vector3d inverse = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      if (values(k) > 1e-12 * values(2)) inverse(k) = 1.0 / values(k);
+    }
+    const Eigen::Matrix3d Hpp_pinv = eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
+    for (const auto& [i, hi] : pb.Hpc) {
+      const Eigen::Vector3d w = Hpp_pinv * hi;
+      for (const auto& [j, hj] : pb.Hpc) Hcc(i, j) -= w.dot(hj);
+    }
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (Hcc + Hcc.transpose()));
+  const Eigen::VectorXd values = eig.eigenvalues();
+  if (getenv("PORTCAL_DEBUG_COV")) {
+    for (int k = 0; k < std::min(nc, 5); ++k) {
+      Eigen::Index arg;
+      eig.eigenvectors().col(k).cwiseAbs().maxCoeff(&arg);
+      fprintf(stderr, "eig %d = %g (max %g), main column %ld of %d:", k, values(k), values(nc - 1), (long)arg, nc);
+      for (int c = 0; c < nc; ++c) if (std::abs(eig.eigenvectors()(c, k)) > 0.1) fprintf(stderr, " %d:%.2f", c, eig.eigenvectors()(c, k));
+      fprintf(stderr, "\n");
+    }
+  }
+  if (nc == 0 || !(values(0) > 1e-14 * values(nc - 1))) {
+    throw NumericalError("covariance: the calibration is not fully observable from these views (reduced "
+                         "system rank deficient); hold the unobservable parameters fixed or add views");
+  }
+  const Eigen::MatrixXd covariance = eig.eigenvectors() * values.cwiseInverse().asDiagonal() *
+                                     eig.eigenvectors().transpose();
+
+  std::map<const double*, std::vector<double>> result;
+  for (const double* block : wanted) {
+    double* mutable_block = const_cast<double*>(block);
+    const int start = offset.at(mutable_block);
+    const int tangent = problem->ParameterBlockTangentSize(block);
+    const int ambient = problem->ParameterBlockSize(block);
+    Eigen::MatrixXd plus = Eigen::MatrixXd::Identity(ambient, tangent);
+    if (const ceres::Manifold* manifold = problem->GetManifold(block)) {
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> J(ambient, tangent);
+      manifold->PlusJacobian(block, J.data());
+      plus = J;
+    }
+    const Eigen::MatrixXd ambient_cov = plus * covariance.block(start, start, tangent, tangent) * plus.transpose();
+    std::vector<double>& std_dev = result[block];
+    for (int i = 0; i < ambient; ++i) std_dev.push_back(std::sqrt(std::max(0.0, ambient_cov(i, i))) * scale);
+  }
+  return result;
+}
+
+}  // namespace portcal
