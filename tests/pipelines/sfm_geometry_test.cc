@@ -1,0 +1,267 @@
+// The building blocks of auto-calibration: SIFT keypoints in COLMAP's pixel
+// convention, descriptor matching, ray triangulation, generalized absolute
+// pose on refracted rays, focal length from markers, marker corners by edge
+// fits, the marginal covariance and the ordered parallel loop.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "colmap_ext/util/parallel.h"
+#include "pipelines/feature_masker.h"
+#include "pipelines/features/descriptor_matching.h"
+#include "pipelines/features/sift.h"
+#include "pipelines/sfm/calibration_covariance.h"
+#include "pipelines/sfm/ray_geometry.h"
+#include "pipelines/target/marker_edge_refinement.h"
+
+namespace portcal {
+namespace {
+
+// A Gaussian blob centred at `center` (COLMAP pixels).
+cv::Mat Blob(const Eigen::Vector2d& center, double sigma) {
+  cv::Mat image(200, 200, CV_8UC1);
+  for (int r = 0; r < image.rows; ++r) {
+    for (int c = 0; c < image.cols; ++c) {
+      const double dx = c + 0.5 - center.x(), dy = r + 0.5 - center.y();
+      image.at<uint8_t>(r, c) =
+          cv::saturate_cast<uint8_t>(40 + 180 * std::exp(-(dx * dx + dy * dy) / (2 * sigma * sigma)));
+    }
+  }
+  return image;
+}
+
+TEST(Sift, KeypointOfABlobIsAtItsCentreInColmapPixels) {
+  // OpenCV 4.6 reports first-octave keypoints 0.25 px off; portcal undoes it
+  // (a control without the correction would be off by ~0.25 px).
+  for (const Eigen::Vector2d& center : {Eigen::Vector2d(100.5, 100.5), Eigen::Vector2d(100.8, 100.1)}) {
+    const SiftFeatures features = ExtractSift(Blob(center, 4.0), SiftExtractionOptions());
+    ASSERT_FALSE(features.keypoints.empty());
+    double best = 1e9;
+    for (const FeatureKeypoint& k : features.keypoints) {
+      best = std::min(best, (Eigen::Vector2d(k.x, k.y) - center).norm());
+    }
+    EXPECT_LT(best, 0.06) << center.transpose();
+  }
+}
+
+TEST(Sift, DescriptorsAreRootSiftQuantisedLikeColmap) {
+  float descriptor[128];
+  for (int k = 0; k < 128; ++k) descriptor[k] = static_cast<float>(k % 7);
+  uint8_t out[128];
+  QuantizeRootSift(descriptor, out);
+  double norm = 0, l1 = 0;
+  for (int k = 0; k < 128; ++k) l1 += descriptor[k];
+  for (int k = 0; k < 128; ++k) {
+    EXPECT_EQ(out[k], static_cast<uint8_t>(std::min(255.0, std::round(512 * std::sqrt(descriptor[k] / l1)))));
+    norm += (out[k] / 512.0) * (out[k] / 512.0);
+  }
+  EXPECT_NEAR(std::sqrt(norm), 1.0, 0.01);  // unit length before quantisation
+}
+
+TEST(DescriptorMatching, FindsMutualNearestNeighboursAndRejectsAmbiguousOnes) {
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> byte(0, 60);
+  FeatureDescriptors a(50, 128), b(50, 128);
+  for (int r = 0; r < 50; ++r) {
+    for (int c = 0; c < 128; ++c) a(r, c) = static_cast<uint8_t>(byte(rng));
+  }
+  // b = a permuted, slightly perturbed; rows 0 and 1 of a made identical so
+  // that their matches are ambiguous.
+  a.row(1) = a.row(0);
+  std::vector<int> perm(50);
+  for (int i = 0; i < 50; ++i) perm[i] = (i * 17 + 5) % 50;
+  for (int i = 0; i < 50; ++i) {
+    for (int c = 0; c < 128; ++c) b(perm[i], c) = static_cast<uint8_t>(std::min(255, a(i, c) + (c % 3 == 0)));
+  }
+  const FeatureMatches matches = MatchDescriptors(ToUnitDescriptors(a), ToUnitDescriptors(b),
+                                                  DescriptorMatchingOptions());
+  EXPECT_EQ(matches.size(), 48u);
+  for (const FeatureMatch& m : matches) {
+    EXPECT_GE(m.point2D_idx1, 2u);
+    EXPECT_EQ(static_cast<int>(m.point2D_idx2), perm[m.point2D_idx1]);
+  }
+}
+
+// Rays of a camera behind a tilted flat port, for generalized pose tests.
+struct PortRig {
+  Camera camera = Camera::FromModelName("PINHOLE", 800, 1000, 800);
+  Housing housing = Housing::FromName("FLATPORT", {0.0871557, 0.0, 0.9961947, 0.03, 0.01, 1.0, 1.49, 1.334}, "test");
+};
+
+TEST(RayGeometry, TriangulatesRefractedRaysExactly) {
+  const PortRig rig;
+  const Eigen::Vector3d point(0.1, -0.05, 1.2);
+  const Rigid3d cam1;  // identity
+  const Rigid3d cam2(Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY())),
+                     Eigen::Vector3d(-0.3, 0.02, 0.05));
+  std::vector<Ray3d> rays;
+  for (const Rigid3d& pose : {cam1, cam2}) {
+    const auto pixel = ProjectPoint(rig.camera, &rig.housing, pose * point);
+    ASSERT_TRUE(pixel);
+    const auto ray = UnprojectPixel(rig.camera, &rig.housing, *pixel);
+    ASSERT_TRUE(ray);
+    rays.push_back(RayInWorld(*ray, pose));
+  }
+  const auto x = TriangulateRays(rays);
+  ASSERT_TRUE(x);
+  EXPECT_LT((*x - point).norm(), 1e-9);
+  EXPECT_GT(MaxTriangulationAngle(rays, point), 0.2);
+}
+
+TEST(RayGeometry, GeneralizedAbsolutePoseRecoversThePoseBehindAPortWithOutliers) {
+  const PortRig rig;
+  const Rigid3d truth(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 0.5).normalized())),
+                      Eigen::Vector3d(0.1, -0.2, 0.4));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Ray3d> rays;
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 80; ++i) {
+    const Eigen::Vector3d in_cam(0.4 * u(rng), 0.3 * u(rng), 1.0 + 0.3 * u(rng));
+    const Eigen::Vector3d world = truth.Inverse() * in_cam;
+    auto pixel = ProjectPoint(rig.camera, &rig.housing, in_cam);
+    ASSERT_TRUE(pixel);
+    if (i % 5 == 0) *pixel += Eigen::Vector2d(40 * u(rng), 40 * u(rng));  // 20 % outliers
+    const auto ray = UnprojectPixel(rig.camera, &rig.housing, *pixel);
+    ASSERT_TRUE(ray);
+    rays.push_back(*ray);
+    points.push_back(world);
+  }
+  std::vector<char> inliers;
+  const auto pose = EstimateGeneralizedAbsolutePose(rays, points, GeneralizedAbsolutePoseOptions(), &inliers);
+  ASSERT_TRUE(pose);
+  EXPECT_LT((pose->translation - truth.translation).norm(), 1e-6);
+  EXPECT_LT(pose->rotation.angularDistance(truth.rotation), 1e-6);
+  int correct = 0;
+  for (int i = 0; i < 80; ++i) correct += inliers[i] == (i % 5 != 0);
+  EXPECT_GE(correct, 78);
+}
+
+TEST(RayGeometry, FocalLengthFromMarkerQuads) {
+  const double f = 1100, cx = 640, cy = 360;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<MarkerQuad> quads;
+  for (int m = 0; m < 30; ++m) {
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(0.6 * u(rng), Eigen::Vector3d(u(rng), u(rng), 0.3).normalized())
+                                  .toRotationMatrix();
+    const Eigen::Vector3d t(0.2 * u(rng), 0.1 * u(rng), 0.8 + 0.2 * u(rng));
+    MarkerQuad quad;
+    const double s = 0.05;
+    const Eigen::Vector3d corners[4] = {{0, 0, 0}, {s, 0, 0}, {s, s, 0}, {0, s, 0}};
+    for (int c = 0; c < 4; ++c) {
+      const Eigen::Vector3d p = R * corners[c] + t;
+      quad.corners[c] = Eigen::Vector2d(f * p.x() / p.z() + cx, f * p.y() / p.z() + cy);
+    }
+    quads.push_back(quad);
+  }
+  const auto estimate = FocalLengthFromMarkers(quads, cx, cy);
+  ASSERT_TRUE(estimate);
+  EXPECT_NEAR(*estimate, f, 0.5);  // float homographies: sub-pixel
+  EXPECT_FALSE(FocalLengthFromMarkers({quads[0], quads[1]}, cx, cy));  // too few
+}
+
+TEST(FeatureMasker, EnlargedQuadContainsItsScaledNeighbourhoodOnly) {
+  const std::array<Eigen::Vector2d, 4> quad = {Eigen::Vector2d(10, 10), Eigen::Vector2d(20, 10),
+                                               Eigen::Vector2d(20, 20), Eigen::Vector2d(10, 20)};
+  EXPECT_TRUE(InsideEnlargedQuad(quad, 1.0, Eigen::Vector2d(15, 15)));
+  EXPECT_FALSE(InsideEnlargedQuad(quad, 1.0, Eigen::Vector2d(21, 15)));
+  EXPECT_TRUE(InsideEnlargedQuad(quad, 3.0, Eigen::Vector2d(29.9, 15)));   // centre 15 + 1.5 x 10
+  EXPECT_FALSE(InsideEnlargedQuad(quad, 3.0, Eigen::Vector2d(30.1, 15)));
+}
+
+// A dark quad (a marker's border) on a light surround, sampled at 8 x 8
+// points per pixel and area-averaged, then blurred: the exact corners are
+// known; the edge fit must find them.
+TEST(MarkerEdgeRefinement, FindsTheCornersOfABlurredMarker) {
+  const int s = 8;
+  cv::Mat big(160 * s, 160 * s, CV_8UC1, cv::Scalar(200));
+  const std::array<Eigen::Vector2d, 4> truth = {Eigen::Vector2d(40.3, 45.2), Eigen::Vector2d(118.9, 38.7),
+                                                Eigen::Vector2d(124.6, 117.5), Eigen::Vector2d(43.1, 121.8)};
+  for (int r = 0; r < big.rows; ++r) {
+    for (int c = 0; c < big.cols; ++c) {
+      // COLMAP pixels of the sample.
+      if (InsideEnlargedQuad(truth, 1.0, Eigen::Vector2d((c + 0.5) / s, (r + 0.5) / s))) {
+        big.at<uint8_t>(r, c) = 30;
+      }
+    }
+  }
+  cv::Mat gray;
+  cv::resize(big, gray, cv::Size(160, 160), 0, 0, cv::INTER_AREA);
+  cv::GaussianBlur(gray, gray, cv::Size(0, 0), 1.2);
+  std::array<cv::Point2d, 4> corners;
+  for (int c = 0; c < 4; ++c) {
+    // A rough start (as OpenCV's detector gives), OpenCV pixel convention.
+    corners[c] = cv::Point2d(truth[c].x() - 0.5 + 0.6, truth[c].y() - 0.5 - 0.4);
+  }
+  MarkerEdgeRefinementOptions options;
+  ASSERT_TRUE(RefineMarkerCorners(gray, options, &corners));
+  for (int c = 0; c < 4; ++c) {
+    // Sampling at 1/8 px leaves ~0.01 px of aliasing on an edge's position.
+    EXPECT_NEAR(corners[c].x + 0.5, truth[c].x(), 0.03) << c;
+    EXPECT_NEAR(corners[c].y + 0.5, truth[c].y(), 0.03) << c;
+  }
+}
+
+// y = a x + b fitted to points, a and b each a 1-block, points marginalised:
+// the marginal std devs must equal those of ceres::Covariance on the full
+// problem.
+struct LineResidual {
+  LineResidual(double x, double y) : x_(x), y_(y) {}
+  template <typename T>
+  bool operator()(const T* a, const T* b, const T* p, T* r) const {
+    r[0] = a[0] * T(x_) + b[0] + p[0] - T(y_);
+    r[1] = p[0] * T(0.5) + p[1] - p[2];
+    r[2] = p[1] - T(0.1 * x_);
+    r[3] = p[2] - T(0.2);
+    return true;
+  }
+  double x_, y_;
+};
+
+TEST(CalibrationCovariance, MarginalMatchesTheFullCovariance) {
+  double a = 1, b = 0;
+  std::vector<std::array<double, 3>> p(20, {0, 0, 0});
+  ceres::Problem problem;
+  for (int i = 0; i < 20; ++i) {
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LineResidual, 4, 1, 1, 3>(
+                                 new LineResidual(i * 0.1, 2 * i * 0.1 + 0.3 + 0.01 * (i % 3))),
+                             nullptr, &a, &b, p[i].data());
+  }
+  ceres::Solver::Options options;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  std::vector<double*> points;
+  for (auto& q : p) points.push_back(q.data());
+  const auto marginal = MarginalStdDevs(&problem, points, {&a, &b}, {&a, &b}, 1.0);
+  ceres::Covariance::Options covariance_options;
+  ceres::Covariance covariance(covariance_options);
+  ASSERT_TRUE(covariance.Compute({{&a, &a}, {&b, &b}}, &problem));
+  double va, vb;
+  covariance.GetCovarianceBlock(&a, &a, &va);
+  covariance.GetCovarianceBlock(&b, &b, &vb);
+  EXPECT_NEAR(marginal.at(&a)[0], std::sqrt(va), 1e-9);
+  EXPECT_NEAR(marginal.at(&b)[0], std::sqrt(vb), 1e-9);
+}
+
+TEST(Parallel, OrderedParallelForConsumesInOrderAndPropagatesErrors) {
+  std::vector<int> computed(100, 0), order;
+  OrderedParallelFor(100, 2, 4, [&](size_t i) { computed[i] = static_cast<int>(i) * 2; },
+                     [&](size_t i) {
+                       EXPECT_EQ(computed[i], static_cast<int>(i) * 2);
+                       order.push_back(static_cast<int>(i));
+                     });
+  ASSERT_EQ(order.size(), 100u);
+  for (int i = 0; i < 100; ++i) EXPECT_EQ(order[i], i);
+  EXPECT_THROW(OrderedParallelFor(
+                   50, 2, 4,
+                   [](size_t i) {
+                     if (i == 20) throw std::runtime_error("boom");
+                   },
+                   [](size_t) {}),
+               std::runtime_error);
+}
+
+}  // namespace
+}  // namespace portcal
