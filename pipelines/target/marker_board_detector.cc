@@ -7,6 +7,7 @@
 
 #include "colmap_ext/util/error.h"
 #include "pipelines/render/aruco.h"
+#include "pipelines/target/marker_edge_refinement.h"
 
 namespace portcal {
 
@@ -69,6 +70,16 @@ MarkerBoardDetection DetectMarkerBoard(const cv::Mat& gray, const MarkerBoardOpt
     if (it == board_index.end()) continue;  // a marker of another target
     board_corners.push_back(corners[m]);
     board_ids.push_back(ids[m]);
+    // The outline's edge curves give unbiased corners (OpenCV's contour
+    // corners sit ~0.6 px inside); where the edges are unusable the contour
+    // corners stay.
+    std::array<cv::Point2d, 4> quad;
+    for (int k = 0; k < 4; ++k) quad[k] = cv::Point2d(corners[m][k].x, corners[m][k].y);
+    MarkerEdgeRefinementOptions edge_options;
+    edge_options.bits_per_side = dictionary->markerSize;
+    if (RefineMarkerCorners(gray, edge_options, &quad)) {
+      for (int k = 0; k < 4; ++k) corners[m][k] = cv::Point2f(static_cast<float>(quad[k].x), static_cast<float>(quad[k].y));
+    }
     MarkerDetection marker;
     marker.dictionary = options.dictionary;
     marker.marker_id = ids[m];
