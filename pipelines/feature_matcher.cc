@@ -94,17 +94,20 @@ std::vector<std::pair<image_t, image_t>> LoopPairs(Database* database,
                                                    const std::vector<image_t>& images,
                                                    const SequentialPairingOptions& options,
                                                    ProgressSink& progress) {
-  std::vector<UnitDescriptors> all(images.size());
+  // Vocabulary from the descriptors of up to 200 images spread over the
+  // sequence; then each image's words, one image in memory at a time.
+  const size_t stride = std::max<size_t>(1, images.size() / 200);
+  std::vector<UnitDescriptors> samples;
+  for (size_t i = 0; i < images.size(); i += stride) {
+    samples.push_back(ToUnitDescriptors(database->ReadDescriptors(images[i])));
+  }
+  const VisualVocabulary vocabulary = VisualVocabulary::Train(samples, options.vocabulary_size);
+  samples.clear();
+  ImageRetrievalIndex index(vocabulary.NumWords());
   progress.Begin("sequential_matcher: retrieval index", images.size());
   for (size_t i = 0; i < images.size(); ++i) {
-    all[i] = ToUnitDescriptors(database->ReadDescriptors(images[i]));
     CancelFlag::ThrowIfRequested();
-  }
-  const VisualVocabulary vocabulary = VisualVocabulary::Train(all, options.vocabulary_size);
-  ImageRetrievalIndex index(vocabulary.NumWords());
-  for (size_t i = 0; i < images.size(); ++i) {
-    index.Add(vocabulary.Assign(all[i]));
-    all[i].resize(0, 128);
+    index.Add(vocabulary.Assign(ToUnitDescriptors(database->ReadDescriptors(images[i]))));
     progress.Advance(1);
   }
   progress.End();

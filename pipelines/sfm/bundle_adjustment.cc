@@ -6,6 +6,7 @@
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/housing/housing_models.h"
 #include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
 #include "pipelines/calibration/view_pose.h"
 #include "pipelines/sfm/bundle_costs.h"
 #include "pipelines/sfm/bundle_costs_fixed.h"
@@ -64,6 +65,9 @@ std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconst
 }
 
 namespace {
+
+// Largest reduced (Schur) system whose covariance is computed.
+constexpr int kMaxReducedSystem = 6000;
 
 // Keypoints up to this scale (pixels) get sigma_px; coarser ones more.
 constexpr double kReferenceScale = 2.0;
@@ -219,7 +223,15 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
   // else by one translation coordinate of another image -- left free, the
   // scale drifts (refraction observes it only weakly, and a wrong housing
   // guess pulls it towards infinity, where the port's offsets vanish).
-  const image_t first = poses.begin()->first;
+  // (The first image that has residuals: one whose observations were all
+  // filtered out would hold nothing.)
+  image_t first = poses.begin()->first;
+  for (const auto& [id, block] : pose_blocks) {
+    if (problem.HasParameterBlock(block.data())) {
+      first = id;
+      break;
+    }
+  }
   int num_held = 0;
   image_t scale_image = first;
   for (const auto& [id, block] : pose_blocks) {
@@ -283,7 +295,7 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
   solver.max_num_iterations = options.max_num_iterations;
   solver.num_threads = options.num_threads;
   solver.logging_type = ceres::SILENT;
-  solver.function_tolerance = 1e-8;
+  solver.function_tolerance = options.function_tolerance;
   solver.parameter_tolerance = 1e-10;
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
@@ -328,7 +340,34 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
         wanted.push_back(housings.at(id).data());
       }
     }
-    const auto marginal = MarginalStdDevs(&problem, points, others, wanted, scale);
+    const auto describe = [&](const double* block, int index) -> std::string {
+      for (const auto& [id, b] : pose_blocks) {
+        if (b.data() == block) {
+          return "the pose of image '" + reconstruction->inputs().images.at(id).name + "' (tangent " +
+                 std::to_string(index) + ")";
+        }
+      }
+      for (const auto& [id, b] : intrinsics) {
+        if (b.data() == block) return "an intrinsic parameter of camera " + std::to_string(id) + " (refined ones: " +
+                                      cameras.at(id).camera.ParamsInfo() + ")";
+      }
+      for (const auto& [id, b] : housings) {
+        if (b.data() == block) return "a housing parameter of camera " + std::to_string(id);
+      }
+      return "a marker corner";
+    };
+    // The reduced system is dense: 6 x images columns. Beyond ~1000 images
+    // its inversion costs minutes and gigabytes; the std devs are skipped.
+    int reduced = 0;
+    for (double* block : others) reduced += problem.ParameterBlockTangentSize(block);
+    if (reduced > kMaxReducedSystem) {
+      LOG(WARNING) << "bundle adjustment: " << reduced << " pose and calibration parameters; standard "
+                   << "deviations are computed up to " << kMaxReducedSystem << " and are not reported";
+      others.clear();
+      wanted.clear();
+    }
+    const auto marginal = wanted.empty() ? std::map<const double*, std::vector<double>>()
+                                         : MarginalStdDevs(&problem, points, others, wanted, scale, describe);
     for (camera_t id : used_cameras) {
       const auto it = marginal.find(intrinsics.at(id).data());
       if (it != marginal.end()) std_devs->intrinsics[id] = it->second;

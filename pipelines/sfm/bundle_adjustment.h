@@ -24,6 +24,7 @@ struct BundleAdjustmentOptions {
   bool scale_weighting = true;        // sigma grows with the keypoint's scale (above 2 px)
   double loss_scale = 1.0;            // Cauchy loss scale, in sigma; <= 0: no robust loss
   int max_num_iterations = 100;
+  double function_tolerance = 1e-8;  // relative cost change that ends the solve
   int num_threads = 2;
   void Check() const;  // throws OptionError naming --BundleAdjustment.*
 };

@@ -2,17 +2,17 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <sstream>
 #include <unordered_map>
 
 #include "colmap_ext/util/error.h"
 
 namespace portcal {
 
-std::map<const double*, std::vector<double>> MarginalStdDevs(ceres::Problem* problem,
-                                                             const std::vector<double*>& points,
-                                                             const std::vector<double*>& others,
-                                                             const std::vector<const double*>& wanted,
-                                                             double scale) {
+std::map<const double*, std::vector<double>> MarginalStdDevs(
+    ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others,
+    const std::vector<const double*>& wanted, double scale,
+    const std::function<std::string(const double*, int)>& describe) {
   ceres::Problem::EvaluateOptions evaluate;
   evaluate.apply_loss_function = false;
   evaluate.parameter_blocks = others;
@@ -65,14 +65,6 @@ std::map<const double*, std::vector<double>> MarginalStdDevs(ceres::Problem* pro
       it->second += b * vi;
     }
   }
-  if (getenv("PORTCAL_DEBUG_COV")) {
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> e0(Hcc);
-    for (int row = 0; row < 3; ++row) {
-      for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) fprintf(stderr, "(%d %.3g) ", jacobian.cols[k], jacobian.values[k]);
-      fprintf(stderr, "\n");
-    }
-    fprintf(stderr, "Hcc alone: min eig %g max %g; points %zu rows %d\n", e0.eigenvalues()(0), e0.eigenvalues()(nc - 1), points.size(), jacobian.num_rows);
-  }
   // Schur complement S = Hcc - sum_p Hcp Hpp^+ Hpc.
   for (const PointBlocks& pb : point_blocks) {
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(pb.Hpp);
@@ -87,23 +79,33 @@ std::map<const double*, std::vector<double>> MarginalStdDevs(ceres::Problem* pro
       for (const auto& [j, hj] : pb.Hpc) Hcc(i, j) -= w.dot(hj);
     }
   }
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (Hcc + Hcc.transpose()));
+  // Jacobi scaling: rotations (radians), translations (metres), focal
+  // lengths (pixels) and distortion differ by many orders of magnitude in
+  // their information; the rank test and the inverse work on the scaled
+  // system S' = D^-1/2 S D^-1/2 (D = diag S), whose diagonal is 1.
+  Eigen::VectorXd d_inv_sqrt(nc);
+  for (int i = 0; i < nc; ++i) d_inv_sqrt(i) = Hcc(i, i) > 0 ? 1.0 / std::sqrt(Hcc(i, i)) : 0.0;
+  const Eigen::MatrixXd scaled = d_inv_sqrt.asDiagonal() * (0.5 * (Hcc + Hcc.transpose())) * d_inv_sqrt.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaled);
   const Eigen::VectorXd values = eig.eigenvalues();
-  if (getenv("PORTCAL_DEBUG_COV")) {
-    for (int k = 0; k < std::min(nc, 5); ++k) {
-      Eigen::Index arg;
-      eig.eigenvectors().col(k).cwiseAbs().maxCoeff(&arg);
-      fprintf(stderr, "eig %d = %g (max %g), main column %ld of %d:", k, values(k), values(nc - 1), (long)arg, nc);
-      for (int c = 0; c < nc; ++c) if (std::abs(eig.eigenvectors()(c, k)) > 0.1) fprintf(stderr, " %d:%.2f", c, eig.eigenvectors()(c, k));
-      fprintf(stderr, "\n");
+  if (nc == 0) throw NumericalError("covariance: no free parameters");
+  if (!(values(0) > 1e-12 * values(nc - 1))) {
+    Eigen::Index column;
+    eig.eigenvectors().col(0).cwiseAbs().maxCoeff(&column);
+    std::string name = "parameter " + std::to_string(column);
+    for (const auto& [block, start] : offset) {
+      const int size = problem->ParameterBlockTangentSize(block);
+      if (column >= start && column < start + size) name = describe(block, static_cast<int>(column) - start) + " [tangent " + std::to_string(column - start) + "]";
     }
+    std::ostringstream ratio;
+    ratio << values(0) / values(nc - 1);
+    throw NumericalError("covariance: the views do not determine " + name +
+                         " (reduced system rank deficient: eigenvalue ratio " + ratio.str() +
+                         "); hold it fixed or add views");
   }
-  if (nc == 0 || !(values(0) > 1e-14 * values(nc - 1))) {
-    throw NumericalError("covariance: the calibration is not fully observable from these views (reduced "
-                         "system rank deficient); hold the unobservable parameters fixed or add views");
-  }
-  const Eigen::MatrixXd covariance = eig.eigenvectors() * values.cwiseInverse().asDiagonal() *
-                                     eig.eigenvectors().transpose();
+  const Eigen::MatrixXd covariance = d_inv_sqrt.asDiagonal() * eig.eigenvectors() *
+                                     values.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose() *
+                                     d_inv_sqrt.asDiagonal();
 
   std::map<const double*, std::vector<double>> result;
   for (const double* block : wanted) {

@@ -10,7 +10,9 @@
 
 #include <ceres/ceres.h>
 
+#include <functional>
 #include <map>
+#include <string>
 #include <vector>
 
 namespace portcal {
@@ -21,11 +23,12 @@ namespace portcal {
 // for each of `wanted` (a subset of `others`) the standard deviation of
 // every ambient parameter (0 where held by its manifold), scaled by
 // `scale`. Residuals are taken without the loss function. Throws
-// NumericalError when the reduced system is rank deficient.
-std::map<const double*, std::vector<double>> MarginalStdDevs(ceres::Problem* problem,
-                                                             const std::vector<double*>& points,
-                                                             const std::vector<double*>& others,
-                                                             const std::vector<const double*>& wanted,
-                                                             double scale);
+// NumericalError when the reduced system is rank deficient, naming the
+// parameter that dominates the unobservable direction by `describe(block,
+// tangent index)`.
+std::map<const double*, std::vector<double>> MarginalStdDevs(
+    ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others,
+    const std::vector<const double*>& wanted, double scale,
+    const std::function<std::string(const double*, int)>& describe);
 
 }  // namespace portcal

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <tuple>
 
+#include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "pipelines/sfm/bundle_costs.h"
@@ -36,6 +38,20 @@ void IncrementalMapperOptions::Check() const {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
+constexpr int kMinImagesForIntrinsics = 5;
+
+// COLMAP's bogus-camera test (min/max_focal_length_ratio, max_extra_param),
+// against the intrinsics before the adjustment.
+bool BogusIntrinsics(const std::map<camera_t, SfmCamera>& before, const std::map<camera_t, SfmCamera>& after) {
+  for (const auto& [id, camera] : after) {
+    const double ratio = camera.camera.MeanFocalLength() / before.at(id).camera.MeanFocalLength();
+    if (!(ratio > 0.5 && ratio < 2.0)) return true;
+    for (int idx : CameraModelExtraParamsIdxs(camera.camera.model_id)) {
+      if (!(std::abs(camera.camera.params[idx]) < 1.0)) return true;
+    }
+  }
+  return false;
+}
 
 class Mapper {
  public:
@@ -125,17 +141,22 @@ std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
 }
 
 bool Mapper::Initialize(Reconstruction* r, std::set<image_pair_t>* tried) {
-  std::vector<std::pair<int, image_pair_t>> candidates;
+  // Most inlier matches first, but pairs whose geometry is a homography
+  // last: a relative pose from a plane seen twice is ambiguous (two
+  // decompositions), and a wrong start warps the model and sends the
+  // intrinsics astray (measured: focal length 16600 px for 650 on a render
+  // whose best pair saw one face of the target).
+  std::vector<std::tuple<bool, int, image_pair_t>> candidates;
   for (const auto& [pair_id, count] : inputs_.pair_inliers) {
     image_t a, b;
     PairIdToImagePair(pair_id, &a, &b);
     if (used_.count(a) || used_.count(b) || tried->count(pair_id)) continue;
     if (count < options_.init_min_num_inliers) continue;
-    candidates.emplace_back(count, pair_id);
+    candidates.emplace_back(inputs_.planar_pairs.count(pair_id) == 0, count, pair_id);
   }
   std::sort(candidates.rbegin(), candidates.rend());
   int trials = 0;
-  for (const auto& [count, pair_id] : candidates) {
+  for (const auto& [general, count, pair_id] : candidates) {
     if (trials++ >= options_.init_max_num_trials) break;
     tried->insert(pair_id);
     image_t a, b;
@@ -443,19 +464,23 @@ void Mapper::LocalAdjust(Reconstruction* r, image_t image_id) {
   for (size_t i = 0; i < ranked.size() && static_cast<int>(i) < options_.ba_local_num_images - 1; ++i) {
     scope.variable_images.insert(ranked[i].second);
   }
+  // COLMAP's local adjustment budget: a few iterations refine a pose
+  // that registration already placed well.
   BundleAdjustmentOptions ba;
-  ba.max_num_iterations = options_.ba_max_num_iterations;
+  ba.max_num_iterations = std::min(25, options_.ba_max_num_iterations);
+  ba.function_tolerance = 1e-6;
   ba.num_threads = options_.num_threads;
   AdjustBundle(r, ba, scope, nullptr, MarkerScale());
   Filter(r, &scope.variable_images);
-  if (getenv("PORTCAL_DEBUG_SCALE")) {
-    double m = 0;
-    for (const auto& [id, pose] : r->poses()) m = std::max(m, pose.translation.norm());
-    fprintf(stderr, "local %zu images: max |t| %g\n", r->poses().size(), m);
-  }
 }
 
 void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
+  // Intrinsics from a handful of views are barely constrained: they are
+  // refined from kMinImagesForIntrinsics images on, and a result that is
+  // bogus (COLMAP's test: focal length off by more than a factor 2 from the
+  // start, a distortion parameter beyond 1) is undone and the adjustment
+  // repeated with the intrinsics held.
+  refine_intrinsics = refine_intrinsics && static_cast<int>(r->poses().size()) >= kMinImagesForIntrinsics;
   BundleAdjustmentOptions ba;
   ba.refine_focal_length = refine_intrinsics && options_.ba_refine_focal_length;
   ba.refine_principal_point = refine_intrinsics && options_.ba_refine_principal_point;
@@ -466,13 +491,24 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   if (options_.marker_scale.side_length_m > 0) {
     markers = TriangulateMarkerCorners(*r, options_.filter_max_reproj_error_px * 4);
   }
+  const std::map<camera_t, SfmCamera> cameras_before = r->cameras();
+  const std::map<image_t, Rigid3d> poses_before = r->poses();
+  std::map<point3D_t, Eigen::Vector3d> points_before;
+  for (const auto& [id, point] : r->points()) points_before[id] = point.xyz;
+  const std::vector<MarkerCorner> markers_before = markers;
   AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
-  Filter(r, nullptr);
-  if (getenv("PORTCAL_DEBUG_SCALE")) {
-    double m = 0;
-    for (const auto& [id, pose] : r->poses()) m = std::max(m, pose.translation.norm());
-    fprintf(stderr, "global %zu images, %zu marker corners: max |t| %g\n", r->poses().size(), markers.size(), m);
+  if (refine_intrinsics && BogusIntrinsics(cameras_before, r->cameras())) {
+    LOG(WARNING) << "refractive_mapper: intrinsics refined on " << r->poses().size()
+                 << " images came out implausible; held for now";
+    r->mutable_cameras() = cameras_before;
+    r->mutable_poses() = poses_before;
+    for (const auto& [id, xyz] : points_before) r->point(id).xyz = xyz;
+    r->UpdateRays();
+    markers = markers_before;
+    ba.refine_focal_length = ba.refine_principal_point = ba.refine_extra_params = false;
+    AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
   }
+  Filter(r, nullptr);
 }
 
 }  // namespace

@@ -44,6 +44,10 @@ SfmInputs SfmInputs::Read(Database* database) {
       image2.correspondences[m.point2D_idx2].push_back({id1, m.point2D_idx1});
     }
     inputs.pair_inliers[pair_id] = static_cast<int>(geometry.inlier_matches.size());
+    if (geometry.config == TwoViewGeometryConfig::kPlanar || geometry.config == TwoViewGeometryConfig::kPanoramic ||
+        geometry.config == TwoViewGeometryConfig::kPlanarOrPanoramic) {
+      inputs.planar_pairs.insert(pair_id);
+    }
   }
   for (auto& [id, image] : inputs.images) {
     for (const auto& c : image.correspondences) image.num_correspondences += !c.empty();

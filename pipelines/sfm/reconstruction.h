@@ -8,6 +8,7 @@
 
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,8 @@ struct SfmInputs {
   std::map<image_t, SfmImage> images;
   // Verified pairs (pair id -> number of inlier matches).
   std::map<image_pair_t, int> pair_inliers;
+  // Pairs whose geometry is (nearly) a homography: a plane or a rotation.
+  std::set<image_pair_t> planar_pairs;
   // Reads images, cameras, housings (portcal_housings), keypoints, marker
   // detections and the inlier matches of verified pairs.
   static SfmInputs Read(Database* database);

@@ -234,7 +234,8 @@ TEST(CalibrationCovariance, MarginalMatchesTheFullCovariance) {
   ceres::Solve(options, &problem, &summary);
   std::vector<double*> points;
   for (auto& q : p) points.push_back(q.data());
-  const auto marginal = MarginalStdDevs(&problem, points, {&a, &b}, {&a, &b}, 1.0);
+  const auto marginal = MarginalStdDevs(&problem, points, {&a, &b}, {&a, &b}, 1.0,
+                                        [](const double*, int) { return std::string("?"); });
   ceres::Covariance::Options covariance_options;
   ceres::Covariance covariance(covariance_options);
   ASSERT_TRUE(covariance.Compute({{&a, &a}, {&b, &b}}, &problem));
