@@ -20,8 +20,9 @@ void BundleAdjustmentOptions::Check() const {
   if (max_num_iterations < 1) {
     throw OptionError("--BundleAdjustment.max_num_iterations", std::to_string(max_num_iterations), ">= 1");
   }
-  if (refine_housing && !virtual_camera_error) {
-    // Both errors work; the exact one is just slower. Nothing to refuse.
+  if (!(loss_scale >= 0)) throw OptionError("--BundleAdjustment.loss_scale", std::to_string(loss_scale), ">= 0");
+  if (!(function_tolerance > 0)) {
+    throw OptionError("--BundleAdjustment.function_tolerance", std::to_string(function_tolerance), "> 0");
   }
 }
 

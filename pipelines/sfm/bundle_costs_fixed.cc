@@ -41,6 +41,20 @@ constexpr int PortSize() {
   }
 }
 
+// The residual of both narrow errors: the port's constants cast to T,
+// the point moved into the camera and projected.
+template <typename CameraModel, typename Port, typename T, int kPort>
+bool PixelResidual(const T* intrinsics, const PortConstants<kPort>& port_values, const T* cam_from_world,
+                   const T* point, const Eigen::Vector2d& observed, double inv_sigma, T* residual) {
+  T port[kPort > 0 ? kPort : 1];
+  for (int i = 0; i < kPort; ++i) port[i] = T(port_values.values[i]);
+  T x, y;
+  if (!Project<CameraModel, Port, T>(intrinsics, port, Transform(cam_from_world, point), &x, &y)) return false;
+  residual[0] = (x - observed.x()) * inv_sigma;
+  residual[1] = (y - observed.y()) * inv_sigma;
+  return true;
+}
+
 // Pose and point free; intrinsics and port constant.
 template <typename CameraModel, typename Port>
 struct PosePointError : AutoDiffFunctor<PosePointError<CameraModel, Port>, 2, 7, 3> {
@@ -53,13 +67,8 @@ struct PosePointError : AutoDiffFunctor<PosePointError<CameraModel, Port>, 2, 7,
   bool operator()(const T* cam_from_world, const T* point, T* residual) const {
     T intrinsics[CameraModel::kNumParams];
     for (int i = 0; i < CameraModel::kNumParams; ++i) intrinsics[i] = T(intrinsics_[i]);
-    T port[PortSize<Port>() > 0 ? PortSize<Port>() : 1];
-    for (int i = 0; i < PortSize<Port>(); ++i) port[i] = T(port_.values[i]);
-    T x, y;
-    if (!Project<CameraModel, Port, T>(intrinsics, port, Transform(cam_from_world, point), &x, &y)) return false;
-    residual[0] = (x - observed_.x()) * inv_sigma_;
-    residual[1] = (y - observed_.y()) * inv_sigma_;
-    return true;
+    return PixelResidual<CameraModel, Port>(intrinsics, port_, cam_from_world, point, observed_, inv_sigma_,
+                                            residual);
   }
   Eigen::Vector2d observed_;
   double inv_sigma_;
@@ -77,13 +86,8 @@ struct PosePointIntrinsicsError
   }
   template <typename T>
   bool operator()(const T* cam_from_world, const T* point, const T* intrinsics, T* residual) const {
-    T port[PortSize<Port>() > 0 ? PortSize<Port>() : 1];
-    for (int i = 0; i < PortSize<Port>(); ++i) port[i] = T(port_.values[i]);
-    T x, y;
-    if (!Project<CameraModel, Port, T>(intrinsics, port, Transform(cam_from_world, point), &x, &y)) return false;
-    residual[0] = (x - observed_.x()) * inv_sigma_;
-    residual[1] = (y - observed_.y()) * inv_sigma_;
-    return true;
+    return PixelResidual<CameraModel, Port>(intrinsics, port_, cam_from_world, point, observed_, inv_sigma_,
+                                            residual);
   }
   Eigen::Vector2d observed_;
   double inv_sigma_;
