@@ -99,6 +99,11 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
     LOG(INFO) << "refractive_bundle_adjuster: " << markers.size() << " marker corners give the scale";
   }
 
+  if (options.ba.refine_housing && options.marker_scale.side_length_m <= 0) {
+    LOG(WARNING) << "refractive_bundle_adjuster: no marker scale (--Markers.side_length): the model's scale "
+                    "is arbitrary, so a flat port's distance and a dome's decentering are not in metres "
+                    "(refraction observes the scale only weakly)";
+  }
   // A first solve, outliers out, then the final solve with covariance.
   AdjustBundle(&r, options.ba, BundleAdjustmentScope(), &markers, options.marker_scale);
   result.num_filtered = FilterObservations(&r, options.max_reproj_error_px);

@@ -67,6 +67,9 @@ std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconst
 
 namespace {
 
+// Smallest flat-port interface distance an adjustment may reach, metres.
+constexpr double kMinPortDistance = 1e-4;
+
 // Largest reduced (Schur) system whose covariance is computed.
 constexpr int kMaxReducedSystem = 6000;
 
@@ -284,9 +287,18 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
       // refractive indices are the user's constants.
       problem.SetManifold(housing, new ceres::ProductManifold<ceres::SphereManifold<3>, ceres::SubsetManifold>(
                                        ceres::SphereManifold<3>(), ceres::SubsetManifold(5, {1, 2, 3, 4})));
+      // The interface is in front of the lens: a distance the data cannot
+      // fix (no scale) must not wander through zero.
+      problem.SetParameterLowerBound(housing, 3, kMinPortDistance);
     } else {
       // DOMEPORT: the decentering (Cx, Cy, Cz) only.
       problem.SetManifold(housing, new ceres::SubsetManifold(8, {3, 4, 5, 6, 7}));
+      // The camera centre stays inside the dome.
+      const double bound = 0.9 * camera.housing->params[3];
+      for (int k = 0; k < 3; ++k) {
+        problem.SetParameterLowerBound(housing, k, -bound);
+        problem.SetParameterUpperBound(housing, k, bound);
+      }
     }
   }
 
