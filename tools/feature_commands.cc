@@ -5,6 +5,7 @@
 #include "pipelines/feature_matcher.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
+#include "tools/option_groups.h"
 
 namespace portcal {
 
@@ -17,12 +18,7 @@ int RunFeatureExtractor(int argc, char** argv) {
                   "use them. Images with features are skipped unless --overwrite 1.");
   cli.AddRequired("database_path", &options.database_path, "database (created if missing)");
   cli.AddRequired("image_path", &options.image_path, "directory of images");
-  cli.Add("ImageReader.camera_model", &options.reader.camera_model, "COLMAP camera model");
-  cli.Add("ImageReader.single_camera", &options.reader.single_camera, "one camera for all images (0 | 1)");
-  cli.Add("ImageReader.single_camera_per_folder", &options.reader.single_camera_per_folder,
-          "one camera per sub-folder (0 | 1)");
-  cli.Add("ImageReader.camera_params", &options.reader.camera_params,
-          "initial parameters in COLMAP's order (default: from the image size)");
+  AddImageReaderOptions(&cli, &options.reader);
   cli.Add("SiftExtraction.max_num_features", &options.sift.max_num_features, "strongest features kept");
   cli.Add("SiftExtraction.max_image_size", &options.sift.max_image_size, "larger images are downscaled");
   cli.Add("SiftExtraction.first_octave", &options.sift.first_octave, "-1: start at 2x upsampled");

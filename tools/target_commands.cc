@@ -5,6 +5,7 @@
 #include "pipelines/target_extractor.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
+#include "tools/option_groups.h"
 
 namespace portcal {
 
@@ -17,12 +18,7 @@ int RunTargetExtractor(int argc, char** argv) {
                   "outcome in portcal_target_detections. One transaction; safe to rerun.");
   cli.AddRequired("database_path", &options.database_path, "database (created if missing)");
   cli.AddRequired("image_path", &options.image_path, "directory of images");
-  cli.Add("ImageReader.camera_model", &options.reader.camera_model, "COLMAP camera model");
-  cli.Add("ImageReader.single_camera", &options.reader.single_camera, "one camera for all images (0 | 1)");
-  cli.Add("ImageReader.single_camera_per_folder", &options.reader.single_camera_per_folder,
-          "one camera per sub-folder, e.g. a stereo rig's cam1/ and cam2/ (0 | 1)");
-  cli.Add("ImageReader.camera_params", &options.reader.camera_params,
-          "initial parameters in COLMAP's order (default: from the image size)");
+  AddImageReaderOptions(&cli, &options.reader);
   cli.Add("Target.type", &options.target_type, "chessboard | aruco_grid | charuco");
   cli.Add("Target.cols", &options.chessboard.cols, "inner corners per row");
   cli.Add("Target.rows", &options.chessboard.rows, "inner corners per column");
