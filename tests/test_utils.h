@@ -43,6 +43,11 @@ CommandResult RunCommand(const std::string& command);
 
 std::string ReadFileToString(const std::filesystem::path& path);
 
+// The `target:` block of a synthesize config for the shared sets' 3-D
+// target: two faces folded at 120 deg, dots, ArUco markers 0 and 1 of
+// DICT_4X4_50, 0.06 m.
+extern const char* const kTwoFaceTargetYaml;
+
 }  // namespace testing
 }  // namespace portcal
 

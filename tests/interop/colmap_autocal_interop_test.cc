@@ -27,18 +27,7 @@ void RenderSet(const fs::path& dir, int num_images) {
   std::ofstream(dir / "set.yaml") << "name: interop\nnum_images: " << num_images << R"(
 camera: {model: SIMPLE_RADIAL, width: 800, height: 450, params: [620.0, 400.0, 225.0, -0.02]}
 housing: null
-target:
-  type: target3d
-  num_faces: 2
-  fold_angle_deg: 120
-  face_width: 0.2
-  face_height: 0.25
-  aruco_dict: DICT_4X4_50
-  marker_ids: [0, 1]
-  marker_size: 0.06
-  quiet_zone_modules: 1
-  dots: {seed: 11, r_min: 0.0015, r_max: 0.009, coverage: 0.5, gray_min: 20, gray_max: 110, edge_margin: 0.004}
-poses: {distance: [0.45, 0.9], tilt_max_deg: 35, roll_max_deg: 60, visibility: markers, border_margin_px: 10, max_view_angle_deg: 60}
+)" << testing::kTwoFaceTargetYaml << R"(poses: {distance: [0.45, 0.9], tilt_max_deg: 35, roll_max_deg: 60, visibility: markers, border_margin_px: 10, max_view_angle_deg: 60}
 render: {spp: 4, noise_sigma: 1.0, white: 220, black: 30, background: 110}
 )";
   SynthesizeOptions options;

@@ -22,23 +22,12 @@ namespace {
 
 constexpr double kDegree = M_PI / 180.0;
 
-const char* kTarget3d = R"(target:
-  type: target3d
-  num_faces: 2
-  fold_angle_deg: 120
-  face_width: 0.2
-  face_height: 0.25
-  aruco_dict: DICT_4X4_50
-  marker_ids: [0, 1]
-  marker_size: 0.06
-  quiet_zone_modules: 1
-  dots: {seed: 11, r_min: 0.0015, r_max: 0.009, coverage: 0.5, gray_min: 20, gray_max: 110, edge_margin: 0.004}
-poses: {distance: [0.4, 1.0], tilt_max_deg: 45, roll_max_deg: 180, visibility: markers, border_margin_px: 10, max_view_angle_deg: 70}
+const char* kViews = R"(poses: {distance: [0.4, 1.0], tilt_max_deg: 45, roll_max_deg: 180, visibility: markers, border_margin_px: 10, max_view_angle_deg: 70}
 render: {spp: 4, noise_sigma: 1.0, white: 220, black: 30, background: 110}
 )";
 
 GroundTruth Render(const fs::path& dir, const std::string& camera_and_housing) {
-  std::ofstream(dir / "set.yaml") << "name: auto\nnum_images: 15\n" << camera_and_housing << kTarget3d;
+  std::ofstream(dir / "set.yaml") << "name: auto\nnum_images: 15\n" << camera_and_housing << testing::kTwoFaceTargetYaml << kViews;
   SynthesizeOptions synthesize;
   synthesize.config_path = (dir / "set.yaml").string();
   synthesize.output_path = (dir / "set").string();
