@@ -18,5 +18,6 @@ int RunSequentialMatcher(int argc, char** argv);
 int RunRefractiveMapper(int argc, char** argv);
 int RunRefractiveBundleAdjuster(int argc, char** argv);
 int RunAutoCalibrator(int argc, char** argv);
+int RunCrossCheck(int argc, char** argv);
 
 }  // namespace portcal

@@ -50,6 +50,8 @@ const std::vector<Command>& Commands() {
        "bundle adjustment that self-calibrates the housing (and intrinsics)"},
       {"auto_calibrator", portcal::RunAutoCalibrator,
        "calibrate from ArUco-marked objects without a known target: all stages"},
+      {"cross_check", portcal::RunCrossCheck,
+       "cross-check an in-air calibration with mrcal, and cross-validate it"},
       {"synthesize", portcal::RunSynthesize,
        "render a calibration image set (targets, stereo, surveys, underwater "
        "effects) with exact ground truth"},

@@ -217,6 +217,21 @@ CalibrationReport ReadCalibrationReport(const fs::path& path) {
                                          root["non_svp_parameters"].as<std::vector<double>>(),
                                          path.string() + ": non_svp_parameters");
     }
+    // portcal's own keys (absent in calibmar's files).
+    if (root["parameters_std_dev"]) {
+      for (const YAML::Node& value : root["parameters_std_dev"]) {
+        report.parameters_std_dev.push_back(value.IsNull() ? -1.0 : value.as<double>());
+      }
+    }
+    if (root["board_warp"] && root["board_warp_std_dev"]) {
+      const auto warp = root["board_warp"].as<std::vector<double>>();
+      const auto warp_std_dev = root["board_warp_std_dev"].as<std::vector<double>>();
+      if (warp.size() != 2 || warp_std_dev.size() != 2) {
+        throw InputError(path.string() + ": board_warp and board_warp_std_dev need 2 values each");
+      }
+      report.board_warp = Eigen::Vector2d(warp[0], warp[1]);
+      report.board_warp_std_dev = Eigen::Vector2d(warp_std_dev[0], warp_std_dev[1]);
+    }
   } catch (const YAML::Exception& e) {
     throw InputError(path.string() + ": " + e.what());
   }

@@ -91,6 +91,7 @@ struct Solution {
   std::vector<std::array<double, 7>> poses;  // per kept view
   Eigen::Vector2d warp = Eigen::Vector2d::Zero();
   std::vector<double> params_std_dev;
+  Eigen::MatrixXd params_covariance;
   Eigen::Vector2d warp_std_dev = Eigen::Vector2d::Zero();
   std::vector<double> view_rms;
   double sum_squares = 0;
@@ -173,9 +174,12 @@ Solution Solve(const std::vector<const CalibrationView*>& views, const Camera& c
       {s.intrinsics.data(), s.intrinsics.data()}};
   if (settings.estimate_board_warp) blocks.emplace_back(s.warp.data(), s.warp.data());
   s.params_std_dev.assign(num_params, 0.0);
+  s.params_covariance = Eigen::MatrixXd::Zero(num_params, num_params);
   if (static_cast<int>(fixed.size()) < num_params && covariance.Compute(blocks, &problem)) {
     std::vector<double> c(num_params * num_params);
     covariance.GetCovarianceBlock(s.intrinsics.data(), s.intrinsics.data(), c.data());
+    s.params_covariance =
+        Eigen::Map<const Eigen::MatrixXd>(c.data(), num_params, num_params) * variance;
     for (int i = 0; i < num_params; ++i) s.params_std_dev[i] = std::sqrt(std::max(0.0, c[i * num_params + i] * variance));
     if (settings.estimate_board_warp) {
       double w[4];
@@ -284,6 +288,7 @@ CameraCalibrationResult CalibrateCamera(const std::vector<CalibrationView>& all_
 
   result.camera = camera;
   result.params_std_dev = solution.params_std_dev;
+  result.params_covariance = solution.params_covariance;
   result.board_warp = solution.warp;
   result.board_warp_std_dev = solution.warp_std_dev;
   result.num_points = solution.num_residuals / 2;

@@ -52,6 +52,10 @@ struct CalibratedView {
 struct CameraCalibrationResult {
   Camera camera;
   std::vector<double> params_std_dev;  // 0 for fixed parameters
+  // Full covariance of camera.params (px^2 ...), the residual variance
+  // applied; zero rows and columns for fixed parameters, all zero when the
+  // system is rank deficient.
+  Eigen::MatrixXd params_covariance;
   Eigen::Vector2d board_warp = Eigen::Vector2d::Zero();  // metres
   Eigen::Vector2d board_warp_std_dev = Eigen::Vector2d::Zero();
   double overall_rms_px = 0;       // over all points of the kept views

@@ -1,0 +1,168 @@
+#include "colmap_ext/io/mrcal_model.h"
+
+#include <Eigen/Geometry>
+#include <cstdlib>
+#include <memory>
+#include <iomanip>
+#include <ostream>
+
+#include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/io/sparse_model.h"
+#include "colmap_ext/util/error.h"
+
+extern "C" {
+#include <mrcal/mrcal.h>
+}
+
+namespace portcal {
+namespace {
+
+// mrcal pixel = COLMAP pixel - 0.5 (both axes).
+constexpr double kPixelShift = 0.5;
+
+struct CameraModelDeleter {
+  void operator()(mrcal_cameramodel_t* model) const { mrcal_free_cameramodel(&model); }
+};
+
+}  // namespace
+
+std::string MrcalLensModelFor(const std::string& colmap_model) {
+  if (colmap_model == "SIMPLE_PINHOLE" || colmap_model == "PINHOLE") return "LENSMODEL_PINHOLE";
+  if (colmap_model == "SIMPLE_RADIAL" || colmap_model == "RADIAL" || colmap_model == "OPENCV") {
+    return "LENSMODEL_OPENCV4";
+  }
+  if (colmap_model == "FULL_OPENCV") return "LENSMODEL_OPENCV8";
+  // No exact counterpart in mrcal 2.2: name what comes closest.
+  std::string nearest;
+  if (colmap_model == "OPENCV_FISHEYE" || colmap_model == "SIMPLE_RADIAL_FISHEYE" ||
+      colmap_model == "RADIAL_FISHEYE" || colmap_model == "THIN_PRISM_FISHEYE") {
+    nearest = "LENSMODEL_SPLINED_STEREOGRAPHIC (or LENSMODEL_OPENCV8 for fields of view "
+              "below ~100 deg, i.e. COLMAP's FULL_OPENCV)";
+  } else if (colmap_model == "FOV") {
+    nearest = "LENSMODEL_OPENCV8 (COLMAP's FULL_OPENCV)";
+  } else {
+    throw InputError("camera model " + colmap_model + " is not a COLMAP model (one of " +
+                     CameraModelNames() + ")");
+  }
+  throw InputError("camera model " + colmap_model + " has no mrcal counterpart (mrcal 2.2); "
+                   "nearest: " + nearest + ". Re-calibrate with that model to cross-check it");
+}
+
+std::string MrcalExtraFreedom(const std::string& colmap_model) {
+  if (colmap_model == "SIMPLE_PINHOLE") return "fx != fy";
+  if (colmap_model == "SIMPLE_RADIAL") return "fx != fy, k2, p1, p2";
+  if (colmap_model == "RADIAL") return "fx != fy, p1, p2";
+  return "";
+}
+
+std::vector<int> MrcalParamSources(const std::string& colmap_model) {
+  const std::string lensmodel = MrcalLensModelFor(colmap_model);
+  if (colmap_model == "SIMPLE_PINHOLE") return {0, 0, 1, 2};
+  if (colmap_model == "SIMPLE_RADIAL") return {0, 0, 1, 2, 3, -1, -1, -1};
+  if (colmap_model == "RADIAL") return {0, 0, 1, 2, 3, 4, -1, -1};
+  // PINHOLE, OPENCV, FULL_OPENCV: the same order.
+  const int n = lensmodel == "LENSMODEL_PINHOLE" ? 4 : lensmodel == "LENSMODEL_OPENCV4" ? 8 : 12;
+  std::vector<int> sources(n);
+  for (int i = 0; i < n; ++i) sources[i] = i;
+  return sources;
+}
+
+MrcalLens MrcalLensFromCamera(const Camera& camera) {
+  MrcalLens lens;
+  lens.lensmodel = MrcalLensModelFor(camera.ModelName());
+  for (const int source : MrcalParamSources(camera.ModelName())) {
+    lens.intrinsics.push_back(source >= 0 ? camera.params[source] : 0.0);
+  }
+  lens.intrinsics[2] -= kPixelShift;
+  lens.intrinsics[3] -= kPixelShift;
+  return lens;
+}
+
+Camera CameraFromMrcalLens(const MrcalLens& lens, uint64_t width, uint64_t height,
+                           const std::string& context) {
+  std::vector<double> p = lens.intrinsics;
+  std::string model;
+  if (lens.lensmodel == "LENSMODEL_PINHOLE" && p.size() == 4) {
+    model = "PINHOLE";
+  } else if (lens.lensmodel == "LENSMODEL_OPENCV4" && p.size() == 8) {
+    model = "OPENCV";
+  } else if (lens.lensmodel == "LENSMODEL_OPENCV5" && p.size() == 9) {
+    model = "FULL_OPENCV";
+    p.resize(12, 0.0);  // k4 = k5 = k6 = 0: the rational term is 1
+  } else if (lens.lensmodel == "LENSMODEL_OPENCV8" && p.size() == 12) {
+    model = "FULL_OPENCV";
+  } else if (lens.lensmodel == "LENSMODEL_OPENCV12") {
+    throw InputError(context + ": " + lens.lensmodel + " (thin prism) has no COLMAP "
+                     "counterpart; nearest: FULL_OPENCV (LENSMODEL_OPENCV8)");
+  } else {
+    throw InputError(context + ": mrcal lens model " + lens.lensmodel + " with " +
+                     std::to_string(p.size()) + " intrinsics has no COLMAP counterpart (COLMAP "
+                     "expresses LENSMODEL_PINHOLE, OPENCV4, OPENCV5 and OPENCV8)");
+  }
+  p[2] += kPixelShift;
+  p[3] += kPixelShift;
+  Camera camera;
+  camera.model_id = CameraModelNameToId(model);
+  camera.width = width;
+  camera.height = height;
+  camera.params = p;
+  camera.Validate(context);
+  return camera;
+}
+
+MrcalCameraModelFile ReadMrcalCameraModel(const std::filesystem::path& path) {
+  std::unique_ptr<mrcal_cameramodel_t, CameraModelDeleter> model(
+      mrcal_read_cameramodel_file(path.c_str()));
+  if (!model) {
+    throw InputError(path.string() + ": not a readable mrcal .cameramodel (mrcal's parser "
+                     "rejected it; its message is above)");
+  }
+  const int num_params = mrcal_lensmodel_num_params(&model->lensmodel);
+  char name[256];
+  if (!mrcal_lensmodel_name(name, sizeof(name), &model->lensmodel)) {
+    throw InputError(path.string() + ": unnamed mrcal lens model");
+  }
+  MrcalLens lens;
+  lens.lensmodel = name;
+  lens.intrinsics.assign(model->intrinsics, model->intrinsics + num_params);
+  MrcalCameraModelFile file;
+  file.camera = CameraFromMrcalLens(lens, model->imagersize[0], model->imagersize[1],
+                                    path.string());
+  const Eigen::Vector3d r(model->rt_cam_ref[0], model->rt_cam_ref[1], model->rt_cam_ref[2]);
+  const double angle = r.norm();
+  const Eigen::Quaterniond rotation =
+      angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, r / angle))
+                : Eigen::Quaterniond::Identity();
+  file.cam_from_ref = Rigid3d(rotation, Eigen::Vector3d(model->rt_cam_ref[3], model->rt_cam_ref[4],
+                                                        model->rt_cam_ref[5]));
+  return file;
+}
+
+void WriteMrcalCameraModel(const Camera& camera, const Rigid3d& cam_from_ref,
+                           const std::filesystem::path& path) {
+  // mrcal's own writer rounds to 6 decimals (distortion terms lose digits);
+  // the format is a Python dict literal, written here at full precision and
+  // read back by mrcal's parser in the tests.
+  const MrcalLens lens = MrcalLensFromCamera(camera);
+  const Eigen::AngleAxisd aa(cam_from_ref.rotation.normalized());
+  const Eigen::Vector3d r = aa.angle() * aa.axis();
+  const std::vector<double> extrinsics = {r[0], r[1], r[2], cam_from_ref.translation[0],
+                                          cam_from_ref.translation[1], cam_from_ref.translation[2]};
+  const auto list = [](std::ostream& out, const std::vector<double>& values) {
+    out << "[ ";
+    for (const double v : values) out << v << ", ";
+    out << "]";
+  };
+  WriteFileAtomically(path, false, [&](std::ostream& out) {
+    out << std::setprecision(17);
+    out << "# generated by portcal (COLMAP " << camera.ModelName() << ")\n{\n"
+        << "  'lensmodel':  '" << lens.lensmodel << "',\n  'intrinsics': ";
+    list(out, lens.intrinsics);
+    out << ",\n  'imagersize': [ " << camera.width << ", " << camera.height << " ],\n"
+        << "  'extrinsics': ";
+    list(out, extrinsics);
+    out << "\n}\n";
+  });
+}
+
+}  // namespace portcal

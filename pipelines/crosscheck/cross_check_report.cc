@@ -1,0 +1,159 @@
+#include "pipelines/crosscheck/cross_check_report.h"
+
+#include <iomanip>
+#include <sstream>
+
+#include "colmap_ext/io/sparse_model.h"
+
+namespace portcal {
+namespace {
+
+std::string Fixed(double value, int digits) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(digits) << value;
+  return out.str();
+}
+
+std::string DiffLine(const ProjectionDiff& diff) {
+  return "mean " + Fixed(diff.mean_px, 3) + " px, p95 " + Fixed(diff.p95_px, 3) + " px, max " +
+         Fixed(diff.max_px, 3) + " px; worst: " + diff.worst_region + " (mean " +
+         Fixed(diff.worst_region_mean_px, 3) + " px)";
+}
+
+void ParameterTable(std::ostream& out, const std::vector<ParameterComparison>& parameters) {
+  out << "  parameter        portcal     +-std dev          mrcal     +-std dev    difference     z\n";
+  for (const ParameterComparison& p : parameters) {
+    const bool held = p.portcal_std_dev == 0;
+    out << "  " << std::left << std::setw(8) << p.name << std::right << std::setw(15)
+        << Fixed(p.portcal, 6) << std::setw(14) << (held ? std::string("(held)") : Fixed(p.portcal_std_dev, 6))
+        << std::setw(15) << Fixed(p.mrcal, 6) << std::setw(14) << Fixed(p.mrcal_std_dev, 6)
+        << std::setw(14) << Fixed(p.mrcal - p.portcal, 6) << std::setw(7) << Fixed(p.z, 1) << "\n";
+  }
+}
+
+std::string YamlParameters(const std::vector<ParameterComparison>& parameters, const std::string& indent) {
+  std::ostringstream out;
+  out << std::setprecision(12);
+  for (const ParameterComparison& p : parameters) {
+    out << indent << "- {name: " << p.name << ", portcal: " << p.portcal
+        << ", portcal_std_dev: " << p.portcal_std_dev << ", mrcal: " << p.mrcal
+        << ", mrcal_std_dev: " << p.mrcal_std_dev << ", z: " << p.z << "}\n";
+  }
+  return out.str();
+}
+
+std::string YamlDiff(const ProjectionDiff& d, const std::string& indent) {
+  std::ostringstream out;
+  out << std::setprecision(6) << indent << "mean_px: " << d.mean_px << "\n"
+      << indent << "p95_px: " << d.p95_px << "\n" << indent << "max_px: " << d.max_px << "\n"
+      << indent << "worst_region: '" << d.worst_region << "'\n"
+      << indent << "worst_region_mean_px: " << d.worst_region_mean_px << "\n";
+  return out.str();
+}
+
+}  // namespace
+
+std::string CrossCheckResult::Verdict() const {
+  std::string line = std::string(pass ? "PASS" : "FAIL") + ": portcal vs mrcal projection diff p95 " +
+                     Fixed(diff.p95_px, 3) + " px " + (pass ? "<=" : ">") + " " +
+                     Fixed(max_diff_px, 3) + " px; worst region: " + diff.worst_region + " (mean " +
+                     Fixed(diff.worst_region_mean_px, 3) + " px)";
+  if (!pass && !causes.empty()) line += "; likely cause: " + causes.front();
+  if (!pass && rerun_diff) {
+    line += "; " + rerun_description + ": p95 " + Fixed(rerun_diff->p95_px, 3) + " px (" +
+            (rerun_diff->p95_px <= max_diff_px ? "agree" : "still disagree") + ")";
+  }
+  return line;
+}
+
+std::string CrossCheckText(const CrossCheckResult& r) {
+  std::ostringstream out;
+  out << "portcal cross_check\n===================\n\n"
+      << "Camera model " << r.camera_model << " (mrcal: " << r.mrcal_lensmodel << "), " << r.num_views
+      << " views, " << r.num_points << " corners\n"
+      << "RMS reprojection error: portcal " << Fixed(r.portcal_rms_px, 4) << " px, mrcal "
+      << Fixed(r.mrcal_rms_px, 4) << " px (inliers)\n"
+      << "mrcal rejected " << r.mrcal_outliers << " corners as outliers";
+  if (!r.mrcal_outliers_per_view.empty()) {
+    out << " (";
+    for (size_t i = 0; i < r.mrcal_outliers_per_view.size(); ++i) {
+      out << (i ? ", " : "") << r.mrcal_outliers_per_view[i].first << ": "
+          << r.mrcal_outliers_per_view[i].second;
+    }
+    out << ")";
+  }
+  out << "\nBoard warp (parabolic sag, mm): mrcal x " << Fixed(r.mrcal_warp.x() * 1e3, 3) << " +- "
+      << Fixed(r.mrcal_warp_std_dev.x() * 1e3, 3) << ", y " << Fixed(r.mrcal_warp.y() * 1e3, 3)
+      << " +- " << Fixed(r.mrcal_warp_std_dev.y() * 1e3, 3);
+  if (r.portcal_warp) {
+    out << "; portcal x " << Fixed(r.portcal_warp->x() * 1e3, 3) << " +- "
+        << Fixed(r.portcal_warp_std_dev->x() * 1e3, 3) << ", y " << Fixed(r.portcal_warp->y() * 1e3, 3)
+        << " +- " << Fixed(r.portcal_warp_std_dev->y() * 1e3, 3);
+  } else {
+    out << "; portcal: flat board";
+  }
+  out << "\n\nParameters (COLMAP pixel convention; z = difference / combined std dev)\n";
+  ParameterTable(out, r.parameters);
+  out << "\nProjection difference (mrcal's definition: rays at infinity, best-fit rotation, "
+      << r.diff.grid_width << "x" << r.diff.grid_height << " grid; heat map projection_diff.png)\n  "
+      << DiffLine(r.diff) << "\n";
+  if (!r.causes.empty()) {
+    out << "\nLikely causes of the disagreement\n";
+    for (const std::string& cause : r.causes) out << "  - " << cause << "\n";
+  }
+  if (r.rerun_diff) {
+    out << "\nRe-run: " << r.rerun_description << " (heat map projection_diff_rerun.png)\n  "
+        << DiffLine(*r.rerun_diff) << "\n  "
+        << (r.rerun_diff->p95_px <= r.max_diff_px ? "the two now agree" : "the two still disagree")
+        << " (threshold p95 " << Fixed(r.max_diff_px, 3) << " px)\n";
+    ParameterTable(out, r.rerun_parameters);
+  }
+  if (!r.folds.empty()) {
+    out << "\nCross-validation (" << r.folds.size() << " pair(s) of disjoint, interleaved view "
+        << "subsets, each calibrated alone; predicted = what their uncertainty allows)\n"
+        << "  folds   views      mean    p95    predicted mean    p95\n";
+    for (const FoldComparison& f : r.folds) {
+      out << "  " << f.fold_a << " vs " << f.fold_b << "  " << std::setw(3) << f.views_a << "/"
+          << std::left << std::setw(3) << f.views_b << std::right << std::setw(9)
+          << Fixed(f.mean_px, 3) << std::setw(7) << Fixed(f.p95_px, 3) << std::setw(17)
+          << Fixed(f.predicted_mean_px, 3) << std::setw(7) << Fixed(f.predicted_p95_px, 3) << "\n";
+    }
+    out << "  " << r.fold_verdict << "\n";
+  }
+  out << "\n" << r.Verdict() << "\n";
+  return out.str();
+}
+
+void WriteCrossCheckReport(const CrossCheckResult& r, const std::filesystem::path& dir) {
+  std::ostringstream yaml;
+  yaml << std::setprecision(10) << "# portcal cross_check\n"
+       << "camera_model: " << r.camera_model << "\nmrcal_lensmodel: " << r.mrcal_lensmodel
+       << "\nnum_views: " << r.num_views << "\nnum_points: " << r.num_points
+       << "\nportcal_rms_px: " << r.portcal_rms_px << "\nmrcal_rms_px: " << r.mrcal_rms_px
+       << "\nmrcal_outliers: " << r.mrcal_outliers << "\nmrcal_board_warp: [" << r.mrcal_warp.x()
+       << ", " << r.mrcal_warp.y() << "]\nmrcal_board_warp_std_dev: [" << r.mrcal_warp_std_dev.x()
+       << ", " << r.mrcal_warp_std_dev.y() << "]\nparameters:\n"
+       << YamlParameters(r.parameters, "  ") << "projection_diff:\n" << YamlDiff(r.diff, "  ")
+       << "max_diff_px: " << r.max_diff_px << "\nresult: " << (r.pass ? "PASS" : "FAIL") << "\n";
+  yaml << "causes:\n";
+  for (const std::string& cause : r.causes) yaml << "  - '" << cause << "'\n";
+  if (r.rerun_diff) {
+    yaml << "rerun:\n  description: '" << r.rerun_description << "'\n  projection_diff:\n"
+         << YamlDiff(*r.rerun_diff, "    ") << "  parameters:\n" << YamlParameters(r.rerun_parameters, "    ");
+  }
+  if (!r.folds.empty()) {
+    yaml << "cross_validation:\n";
+    for (const FoldComparison& f : r.folds) {
+      yaml << "  - {folds: [" << f.fold_a << ", " << f.fold_b << "], views: [" << f.views_a << ", "
+           << f.views_b << "], mean_px: " << f.mean_px << ", p95_px: " << f.p95_px
+           << ", predicted_mean_px: " << f.predicted_mean_px
+           << ", predicted_p95_px: " << f.predicted_p95_px << "}\n";
+    }
+    yaml << "cross_validation_verdict: '" << r.fold_verdict << "'\n";
+  }
+  const std::string text = CrossCheckText(r);
+  WriteFileAtomically(dir / "cross_check.yaml", false, [&](std::ostream& out) { out << yaml.str(); });
+  WriteFileAtomically(dir / "cross_check.txt", false, [&](std::ostream& out) { out << text; });
+}
+
+}  // namespace portcal

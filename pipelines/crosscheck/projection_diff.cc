@@ -1,0 +1,324 @@
+#include "pipelines/crosscheck/projection_diff.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "colmap_ext/io/sparse_model.h"
+#include "colmap_ext/util/error.h"
+
+namespace portcal {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct Grid {
+  int width = 0, height = 0;
+  std::vector<Eigen::Vector2d> pixels;
+};
+
+// mrcal's grid: gridn_width points from the first to the last pixel centre.
+Grid MakeGrid(const Camera& camera, int gridn_width) {
+  Grid grid;
+  grid.width = gridn_width;
+  grid.height = std::max(2, static_cast<int>(std::lround(static_cast<double>(camera.height) /
+                                                         camera.width * gridn_width)));
+  for (int r = 0; r < grid.height; ++r) {
+    for (int c = 0; c < grid.width; ++c) {
+      grid.pixels.emplace_back(0.5 + (camera.width - 1.0) * c / (grid.width - 1),
+                               0.5 + (camera.height - 1.0) * r / (grid.height - 1));
+    }
+  }
+  return grid;
+}
+
+std::optional<Eigen::Vector3d> UnitRay(const Camera& camera, const Eigen::Vector2d& pixel) {
+  const auto ray = camera.CamFromImg(pixel);
+  if (!ray || !ray->allFinite()) return std::nullopt;
+  return ray->normalized();
+}
+
+// Diff vectors (B's projection minus the grid pixel) after the weighted fit
+// of b_from_a; NaN where a projection fails.
+struct Evaluation {
+  std::vector<Eigen::Vector2d> diff;
+  Eigen::Matrix3d b_from_a = Eigen::Matrix3d::Identity();
+};
+
+Evaluation Evaluate(const Camera& a, const Camera& b, const Grid& grid,
+                    const std::vector<double>& weights) {
+  const size_t n = grid.pixels.size();
+  std::vector<std::optional<Eigen::Vector3d>> rays_a(n);
+  Eigen::Matrix3d correlation = Eigen::Matrix3d::Zero();
+  for (size_t k = 0; k < n; ++k) {
+    rays_a[k] = UnitRay(a, grid.pixels[k]);
+    if (!rays_a[k] || weights[k] <= 0) continue;
+    const auto ray_b = UnitRay(b, grid.pixels[k]);
+    if (!ray_b) continue;
+    correlation += weights[k] * (*ray_b) * rays_a[k]->transpose();
+  }
+  // Procrustes: the rotation R maximising sum w v_b^T R v_a.
+  Evaluation out;
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(correlation, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d fix = Eigen::Matrix3d::Identity();
+  fix(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
+  out.b_from_a = svd.matrixU() * fix * svd.matrixV().transpose();
+  out.diff.assign(n, Eigen::Vector2d::Constant(kNaN));
+  for (size_t k = 0; k < n; ++k) {
+    if (!rays_a[k]) continue;
+    const auto pixel = b.ImgFromCam(out.b_from_a * *rays_a[k]);
+    if (pixel && pixel->allFinite()) out.diff[k] = *pixel - grid.pixels[k];
+  }
+  return out;
+}
+
+// Central-difference step for parameter i: a hundredth of its standard
+// deviation (the map is smooth on that scale; round-off is far below).
+double Step(const Eigen::MatrixXd& covariance, int i) {
+  return 1e-2 * std::sqrt(covariance(i, i));
+}
+
+// Worst-direction projection standard deviation of a ray fixed in the camera
+// frame (what mrcal weighs its fit with), from the intrinsics covariance.
+std::vector<double> ProjectionStdDev(const CalibratedLens& lens, const Grid& grid) {
+  const size_t n = grid.pixels.size();
+  const int p = static_cast<int>(lens.camera.params.size());
+  std::vector<Eigen::Matrix<double, 2, Eigen::Dynamic>> jacobians(
+      n, Eigen::Matrix<double, 2, Eigen::Dynamic>::Zero(2, p));
+  std::vector<std::optional<Eigen::Vector3d>> rays(n);
+  for (size_t k = 0; k < n; ++k) rays[k] = UnitRay(lens.camera, grid.pixels[k]);
+  for (int i = 0; i < p; ++i) {
+    if (!(lens.covariance(i, i) > 0)) continue;
+    const double h = Step(lens.covariance, i);
+    Camera plus = lens.camera, minus = lens.camera;
+    plus.params[i] += h;
+    minus.params[i] -= h;
+    for (size_t k = 0; k < n; ++k) {
+      if (!rays[k]) continue;
+      const auto qp = plus.ImgFromCam(*rays[k]);
+      const auto qm = minus.ImgFromCam(*rays[k]);
+      if (qp && qm) jacobians[k].col(i) = (*qp - *qm) / (2 * h);
+    }
+  }
+  std::vector<double> sigma(n, kNaN);
+  for (size_t k = 0; k < n; ++k) {
+    if (!rays[k]) continue;
+    const Eigen::Matrix2d c = jacobians[k] * lens.covariance * jacobians[k].transpose();
+    sigma[k] = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(c)
+                                           .eigenvalues()
+                                           .maxCoeff()));
+  }
+  return sigma;
+}
+
+// Adds tr(J C J^T) of one model's parameters to `variance`, J the Jacobian of
+// the whole diff (fit included) with respect to them.
+void AddPredictedVariance(const CalibratedLens& lens, bool lens_is_a, const Camera& other,
+                          const Grid& grid, const std::vector<double>& weights,
+                          std::vector<double>* variance) {
+  const size_t n = grid.pixels.size();
+  const int p = static_cast<int>(lens.camera.params.size());
+  std::vector<Eigen::Matrix<double, 2, Eigen::Dynamic>> jacobians(
+      n, Eigen::Matrix<double, 2, Eigen::Dynamic>::Zero(2, p));
+  for (int i = 0; i < p; ++i) {
+    if (!(lens.covariance(i, i) > 0)) continue;
+    const double h = Step(lens.covariance, i);
+    Camera plus = lens.camera, minus = lens.camera;
+    plus.params[i] += h;
+    minus.params[i] -= h;
+    const Evaluation ep = lens_is_a ? Evaluate(plus, other, grid, weights)
+                                    : Evaluate(other, plus, grid, weights);
+    const Evaluation em = lens_is_a ? Evaluate(minus, other, grid, weights)
+                                    : Evaluate(other, minus, grid, weights);
+    for (size_t k = 0; k < n; ++k) jacobians[k].col(i) = (ep.diff[k] - em.diff[k]) / (2 * h);
+  }
+  for (size_t k = 0; k < n; ++k) {
+    (*variance)[k] += (jacobians[k] * lens.covariance * jacobians[k].transpose()).trace();
+  }
+}
+
+double Percentile(std::vector<double> values, double fraction) {
+  values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
+               values.end());
+  if (values.empty()) return kNaN;
+  std::sort(values.begin(), values.end());
+  const size_t index = std::min(values.size() - 1,
+                                static_cast<size_t>(std::ceil(fraction * values.size())) - 1);
+  return values[index];
+}
+
+const char* kRegionNames[3][3] = {{"top-left corner", "top edge", "top-right corner"},
+                                  {"left edge", "centre", "right edge"},
+                                  {"bottom-left corner", "bottom edge", "bottom-right corner"}};
+
+}  // namespace
+
+void ProjectionDiffOptions::Check() const {
+  if (gridn_width < 3) throw OptionError("gridn_width", std::to_string(gridn_width), ">= 3");
+}
+
+ProjectionDiff ComputeProjectionDiff(const CalibratedLens& a, const CalibratedLens& b,
+                                     const ProjectionDiffOptions& options) {
+  options.Check();
+  if (a.camera.width != b.camera.width || a.camera.height != b.camera.height) {
+    throw InputError("projection diff: image sizes differ (" + std::to_string(a.camera.width) +
+                     "x" + std::to_string(a.camera.height) + " vs " +
+                     std::to_string(b.camera.width) + "x" + std::to_string(b.camera.height) + ")");
+  }
+  const Grid grid = MakeGrid(a.camera, options.gridn_width);
+  const size_t n = grid.pixels.size();
+  const bool with_covariance = a.covariance.size() > 0 && b.covariance.size() > 0;
+
+  std::vector<double> weights(n, 0.0);
+  if (with_covariance && options.focus_radius < 0) {
+    const std::vector<double> sigma_a = ProjectionStdDev(a, grid);
+    const std::vector<double> sigma_b = ProjectionStdDev(b, grid);
+    for (size_t k = 0; k < n; ++k) {
+      const double s = sigma_a[k] * sigma_b[k];
+      weights[k] = std::isfinite(s) && s > 0 ? 1.0 / (s * s) : 0.0;
+    }
+  } else {
+    const double radius = options.focus_radius < 0
+                              ? std::min(a.camera.width, a.camera.height) / 6.0
+                              : options.focus_radius;
+    const Eigen::Vector2d centre(a.camera.width / 2.0, a.camera.height / 2.0);
+    for (size_t k = 0; k < n; ++k) weights[k] = (grid.pixels[k] - centre).norm() <= radius;
+  }
+
+  const Evaluation evaluation = Evaluate(a.camera, b.camera, grid, weights);
+  ProjectionDiff out;
+  out.grid_width = grid.width;
+  out.grid_height = grid.height;
+  out.pixels = grid.pixels;
+  out.b_from_a = evaluation.b_from_a;
+  out.diff_px.resize(n);
+  int valid = 0;
+  double sum = 0;
+  for (size_t k = 0; k < n; ++k) {
+    out.diff_px[k] = evaluation.diff[k].norm();
+    if (std::isfinite(out.diff_px[k])) {
+      ++valid;
+      sum += out.diff_px[k];
+      out.max_px = std::max(out.max_px, out.diff_px[k]);
+    }
+  }
+  if (valid < static_cast<int>(n) / 2) {
+    throw NumericalError("projection diff: only " + std::to_string(valid) + " of " +
+                         std::to_string(n) + " grid points project through both cameras");
+  }
+  out.mean_px = sum / valid;
+  out.p95_px = Percentile(out.diff_px, 0.95);
+
+  // The worst ninth of the image.
+  double region_sum[3][3] = {}, region_count[3][3] = {};
+  for (size_t k = 0; k < n; ++k) {
+    if (!std::isfinite(out.diff_px[k])) continue;
+    const int r = std::min(2, static_cast<int>(3 * (grid.pixels[k].y() - 0.5) / a.camera.height));
+    const int c = std::min(2, static_cast<int>(3 * (grid.pixels[k].x() - 0.5) / a.camera.width));
+    region_sum[r][c] += out.diff_px[k];
+    region_count[r][c] += 1;
+  }
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      if (region_count[r][c] == 0) continue;
+      const double mean = region_sum[r][c] / region_count[r][c];
+      if (mean >= out.worst_region_mean_px) {
+        out.worst_region_mean_px = mean;
+        out.worst_region = kRegionNames[r][c];
+      }
+    }
+  }
+
+  if (with_covariance) {
+    std::vector<double> variance(n, 0.0);
+    AddPredictedVariance(a, true, b.camera, grid, weights, &variance);
+    AddPredictedVariance(b, false, a.camera, grid, weights, &variance);
+    out.predicted_px.resize(n);
+    double predicted_sum = 0;
+    for (size_t k = 0; k < n; ++k) {
+      out.predicted_px[k] = std::isfinite(out.diff_px[k]) ? std::sqrt(variance[k]) : kNaN;
+      if (std::isfinite(out.predicted_px[k])) predicted_sum += out.predicted_px[k];
+    }
+    out.predicted_mean_px = predicted_sum / valid;
+    out.predicted_p95_px = Percentile(out.predicted_px, 0.95);
+  }
+  return out;
+}
+
+void WriteProjectionDiffHeatMap(const ProjectionDiff& diff, int width, int height,
+                                const std::string& title, const std::filesystem::path& path) {
+  // The image at most 960 px wide, a colour bar to its right, a title above.
+  const double scale = std::min(1.0, 960.0 / width);
+  const int w = std::max(1, static_cast<int>(width * scale));
+  const int h = std::max(1, static_cast<int>(height * scale));
+  cv::Mat grid(diff.grid_height, diff.grid_width, CV_32F);
+  for (int r = 0; r < diff.grid_height; ++r) {
+    for (int c = 0; c < diff.grid_width; ++c) {
+      const double v = diff.diff_px[r * diff.grid_width + c];
+      grid.at<float>(r, c) = std::isfinite(v) ? static_cast<float>(v) : -1.0f;
+    }
+  }
+  cv::Mat dense;
+  cv::resize(grid, dense, cv::Size(w, h), 0, 0, cv::INTER_LINEAR);
+  const double vmax = diff.max_px > 0 ? diff.max_px : 1.0;
+  cv::Mat gray(h, w, CV_8U);
+  for (int r = 0; r < h; ++r) {
+    for (int c = 0; c < w; ++c) {
+      gray.at<uint8_t>(r, c) =
+          cv::saturate_cast<uint8_t>(255.0 * std::max(0.0f, dense.at<float>(r, c)) / vmax);
+    }
+  }
+  cv::Mat colour;
+  cv::applyColorMap(gray, colour, cv::COLORMAP_VIRIDIS);
+  for (int r = 0; r < h; ++r) {
+    for (int c = 0; c < w; ++c) {
+      if (dense.at<float>(r, c) < 0) colour.at<cv::Vec3b>(r, c) = cv::Vec3b(128, 128, 128);
+    }
+  }
+  // Iso-lines at the mean and the 95th percentile.
+  for (const double level : {diff.mean_px, diff.p95_px}) {
+    cv::Mat above = dense >= level;
+    std::vector<std::vector<cv::Point>> contours;
+    cv::findContours(above, contours, cv::RETR_LIST, cv::CHAIN_APPROX_SIMPLE);
+    cv::drawContours(colour, contours, -1, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  }
+
+  const int top = 40, bar = 90;
+  cv::Mat canvas(h + top + 10, w + bar, CV_8UC3, cv::Scalar(255, 255, 255));
+  colour.copyTo(canvas(cv::Rect(0, top, w, h)));
+  for (int r = 0; r < h; ++r) {
+    const uint8_t v = cv::saturate_cast<uint8_t>(255.0 * (h - 1 - r) / std::max(1, h - 1));
+    cv::Mat one(1, 1, CV_8U, cv::Scalar(v)), rgb;
+    cv::applyColorMap(one, rgb, cv::COLORMAP_VIRIDIS);
+    cv::line(canvas, cv::Point(w + 10, top + r), cv::Point(w + 30, top + r),
+             cv::Scalar(rgb.at<cv::Vec3b>(0, 0)), 1);
+  }
+  for (int t = 0; t <= 4; ++t) {
+    const int y = top + (h - 1) - (h - 1) * t / 4;
+    std::ostringstream label;
+    label << std::setprecision(3) << vmax * t / 4;
+    cv::putText(canvas, label.str(), cv::Point(w + 34, y + 5), cv::FONT_HERSHEY_SIMPLEX, 0.4,
+                cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  }
+  cv::putText(canvas, "px", cv::Point(w + 34, top - 8), cv::FONT_HERSHEY_SIMPLEX, 0.45,
+              cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  std::ostringstream heading;
+  heading << std::setprecision(3) << title << ": mean " << diff.mean_px << ", p95 " << diff.p95_px
+          << ", max " << diff.max_px << " px (lines: mean, p95)";
+  cv::putText(canvas, heading.str(), cv::Point(6, 26), cv::FONT_HERSHEY_SIMPLEX, 0.5,
+              cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+
+  std::vector<uchar> png;
+  if (!cv::imencode(".png", canvas, png)) throw InputError(path.string() + ": PNG encoding failed");
+  WriteFileAtomically(path, true, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+  });
+}
+
+}  // namespace portcal
