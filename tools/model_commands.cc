@@ -11,13 +11,19 @@ int RunModelConverter(int argc, char** argv) {
   ModelConverterOptions options;
   CommandLine cli("model_converter",
                   "Converts a COLMAP sparse model (cameras, images, points3D "
-                  "and portcal's housings.txt) between BIN and TXT. A "
-                  "cameras.txt of the refractive COLMAP fork (housing after "
-                  "the camera parameters) is imported into housings.txt.");
-  cli.AddRequired("input_path", &options.input_path, "model directory to read");
+                  "and portcal's housings.txt) between BIN and TXT; a cameras.txt of the "
+                  "refractive COLMAP fork (housing after the camera parameters) is imported "
+                  "into housings.txt. Also converts one camera: from a model, a portcal "
+                  "calibration.yaml or an mrcal .cameramodel, to an mrcal .cameramodel "
+                  "(LENSMODEL_PINHOLE / OPENCV4 / OPENCV8), OpenCV's YAML (camera_matrix, "
+                  "distortion_coefficients) or ROS camera_info YAML; or a .cameramodel to a "
+                  "COLMAP model (BIN / TXT, cameras only).");
+  cli.AddRequired("input_path", &options.input_path,
+                  "model directory, .cameramodel or calibration.yaml");
   cli.AddRequired("output_path", &options.output_path,
-                  "model directory to write (created if missing)");
-  cli.Add("output_type", &options.output_type, "BIN | TXT");
+                  "model directory (BIN, TXT) or file (CAMERAMODEL, OPENCV_YAML, ROS_YAML)");
+  cli.Add("output_type", &options.output_type, "BIN | TXT | CAMERAMODEL | OPENCV_YAML | ROS_YAML");
+  cli.Add("camera_id", &options.camera_id, "camera to export from a model (-1: the only one)");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
     ConvertModel(options);

@@ -51,24 +51,83 @@ struct Evaluation {
   Eigen::Matrix3d b_from_a = Eigen::Matrix3d::Identity();
 };
 
-Evaluation Evaluate(const Camera& a, const Camera& b, const Grid& grid,
-                    const std::vector<double>& weights) {
-  const size_t n = grid.pixels.size();
-  std::vector<std::optional<Eigen::Vector3d>> rays_a(n);
+// mrcal's fit of the rotation at infinity (implied_Rt10__from_unprojections):
+// least squares on r_k = w_k * 2 (1 - v_b . R v_a), i.e. on the weighted
+// squared angle between the rays, not the angle itself. Started from the
+// Procrustes rotation (the weighted least-squares fit on the angle), then
+// Levenberg-Marquardt on a rotation increment R <- exp(delta) R, for which
+// dr_k / d delta = -2 w_k (R v_a x v_b).
+Eigen::Matrix3d FitRotation(const std::vector<std::optional<Eigen::Vector3d>>& rays_a,
+                            const std::vector<std::optional<Eigen::Vector3d>>& rays_b,
+                            const std::vector<double>& weights) {
   Eigen::Matrix3d correlation = Eigen::Matrix3d::Zero();
-  for (size_t k = 0; k < n; ++k) {
-    rays_a[k] = UnitRay(a, grid.pixels[k]);
-    if (!rays_a[k] || weights[k] <= 0) continue;
-    const auto ray_b = UnitRay(b, grid.pixels[k]);
-    if (!ray_b) continue;
-    correlation += weights[k] * (*ray_b) * rays_a[k]->transpose();
+  for (size_t k = 0; k < rays_a.size(); ++k) {
+    if (rays_a[k] && rays_b[k] && weights[k] > 0) correlation += weights[k] * *rays_b[k] * rays_a[k]->transpose();
   }
-  // Procrustes: the rotation R maximising sum w v_b^T R v_a.
-  Evaluation out;
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(correlation, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d fix = Eigen::Matrix3d::Identity();
   fix(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
-  out.b_from_a = svd.matrixU() * fix * svd.matrixV().transpose();
+  Eigen::Matrix3d rotation = svd.matrixU() * fix * svd.matrixV().transpose();
+  // The residuals are of the order of the squared angles and so are their
+  // second derivatives' contributions: plain Gauss-Newton may overshoot, so
+  // steps are damped (Levenberg-Marquardt) and taken only when they lower the
+  // cost, as mrcal's trust-region solver does.
+  const auto cost = [&](const Eigen::Matrix3d& r) {
+    double sum = 0;
+    for (size_t k = 0; k < rays_a.size(); ++k) {
+      if (!rays_a[k] || !rays_b[k] || weights[k] <= 0) continue;
+      const double residual = weights[k] * 2 * (1 - rays_b[k]->dot(r * *rays_a[k]));
+      sum += residual * residual;
+    }
+    return sum;
+  };
+  double current = cost(rotation);
+  double lambda = 1e-3;
+  for (int iteration = 0; iteration < 100 && current > 0; ++iteration) {
+    Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
+    for (size_t k = 0; k < rays_a.size(); ++k) {
+      if (!rays_a[k] || !rays_b[k] || weights[k] <= 0) continue;
+      const Eigen::Vector3d u = rotation * *rays_a[k];
+      const double r = weights[k] * 2 * (1 - rays_b[k]->dot(u));
+      const Eigen::Vector3d j = -2 * weights[k] * u.cross(*rays_b[k]);
+      jtj += j * j.transpose();
+      jtr += j * r;
+    }
+    bool improved = false;
+    while (lambda < 1e12) {
+      Eigen::Matrix3d damped = jtj;
+      damped.diagonal() *= 1 + lambda;
+      const Eigen::Vector3d delta = -damped.ldlt().solve(jtr);
+      if (!delta.allFinite()) break;
+      const Eigen::Matrix3d candidate =
+          (delta.norm() > 0 ? Eigen::AngleAxisd(delta.norm(), delta.normalized()).toRotationMatrix()
+                            : Eigen::Matrix3d::Identity()) * rotation;
+      const double next = cost(candidate);
+      if (next < current) {
+        improved = current - next > 1e-15 * current;
+        rotation = candidate;
+        current = next;
+        lambda = std::max(1e-9, lambda / 10);
+        break;
+      }
+      lambda *= 10;
+    }
+    if (!improved) break;
+  }
+  return rotation;
+}
+
+Evaluation Evaluate(const Camera& a, const Camera& b, const Grid& grid,
+                    const std::vector<double>& weights) {
+  const size_t n = grid.pixels.size();
+  std::vector<std::optional<Eigen::Vector3d>> rays_a(n), rays_b(n);
+  for (size_t k = 0; k < n; ++k) {
+    rays_a[k] = UnitRay(a, grid.pixels[k]);
+    if (rays_a[k] && weights[k] > 0) rays_b[k] = UnitRay(b, grid.pixels[k]);
+  }
+  Evaluation out;
+  out.b_from_a = FitRotation(rays_a, rays_b, weights);
   out.diff.assign(n, Eigen::Vector2d::Constant(kNaN));
   for (size_t k = 0; k < n; ++k) {
     if (!rays_a[k]) continue;

@@ -1,10 +1,11 @@
 // The projection difference of two lens calibrations, as mrcal defines it
 // (mrcal.projection_diff, "differencing" in mrcal's docs): grid the imager,
 // unproject each grid pixel with camera A to a ray at infinity, rotate the
-// rays by the rotation that best aligns A's frame with B's (a weighted
-// Procrustes fit: two calibrations of one lens may disagree on where the
-// optical axis points without disagreeing on the lens), project with B, and
-// measure the pixel distance.
+// rays by the rotation that best aligns A's frame with B's (two calibrations
+// of one lens may disagree on where the optical axis points without
+// disagreeing on the lens; mrcal's fit: least squares on the weighted
+// squared angle between the rays), project with B, and measure the pixel
+// distance.
 //
 // With both covariances given, the fit weighs every grid point by
 // 1 / (sigma_A sigma_B)^2 over the whole imager (mrcal's choice when it has

@@ -1,0 +1,331 @@
+// portcal cross_check: mrcal's solution of the same corners, the projection
+// difference (against mrcal's own Python implementation), the difference the
+// covariances predict (against Monte Carlo), a warped board caught and
+// explained, and the shared sets (rendered: agreement; real: the report).
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+#include <fstream>
+#include <random>
+
+#include "colmap_ext/io/mrcal_model.h"
+#include "colmap_ext/util/error.h"
+#include "database/database.h"
+#include "pipelines/calibration/calibration_report.h"
+#include "pipelines/camera_calibrator.h"
+#include "pipelines/cross_checker.h"
+#include "pipelines/crosscheck/mrcal_calibration.h"
+#include "pipelines/target_extractor.h"
+#include "tests/test_utils.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+namespace {
+
+constexpr int kBoardW = 12, kBoardH = 9;
+constexpr double kSpacing = 0.04;
+
+Camera TruthCamera() {
+  Camera camera = Camera::FromModelName("OPENCV", 1000, 1280, 960);
+  camera.params = {1000, 1003, 640.3, 479.6, -0.2, 0.08, 0.0008, -0.0005};
+  return camera;
+}
+
+// Chessboard views from random poses, the board bent by mrcal's parabolic
+// sag `warp` (metres) while the stored target points stay flat; Gaussian
+// pixel noise `noise_px` per coordinate.
+std::vector<CalibrationView> SyntheticViews(const Camera& camera, const Eigen::Vector2d& warp,
+                                            double noise_px, int num_views, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::normal_distribution<double> noise(0, noise_px);
+  const Eigen::Vector3d centre((kBoardW - 1) * kSpacing / 2, (kBoardH - 1) * kSpacing / 2, 0);
+  std::vector<CalibrationView> views;
+  while (static_cast<int>(views.size()) < num_views) {
+    const double distance = 0.8 + 0.3 * u(rng);
+    const Eigen::Vector3d axis(u(rng), u(rng), 0);
+    const Eigen::Quaterniond rotation =
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.3 * u(rng), Eigen::Vector3d::UnitZ())) *
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.6 * axis.norm(), axis.normalized()));
+    const Eigen::Vector3d position(0.3 * distance * u(rng), 0.25 * distance * u(rng), distance);
+    CalibrationView view;
+    view.image_name = "view" + std::to_string(views.size()) + ".png";
+    for (int j = 0; j < kBoardH; ++j) {
+      for (int i = 0; i < kBoardW; ++i) {
+        const double ur = 2.0 * i / (kBoardW - 1) - 1, vr = 2.0 * j / (kBoardH - 1) - 1;
+        const Eigen::Vector3d flat(i * kSpacing, j * kSpacing, 0);
+        const Eigen::Vector3d bent = flat + Eigen::Vector3d(0, 0, warp.x() * (1 - ur * ur) + warp.y() * (1 - vr * vr));
+        const auto pixel = camera.ImgFromCam(rotation * (bent - centre) + position);
+        if (!pixel || pixel->x() < 0 || pixel->y() < 0 || pixel->x() > camera.width ||
+            pixel->y() > camera.height) {
+          continue;
+        }
+        view.points_in_target.push_back(flat);
+        view.pixels.push_back(*pixel + Eigen::Vector2d(noise(rng), noise(rng)));
+      }
+    }
+    if (view.pixels.size() >= 60) views.push_back(view);
+  }
+  return views;
+}
+
+void WriteDatabase(const fs::path& path, const Camera& camera, const std::vector<CalibrationView>& views) {
+  Database db(path, Database::OpenMode::kCreate);
+  const camera_t camera_id = db.WriteCamera(camera);
+  for (const CalibrationView& view : views) {
+    DatabaseImage image;
+    image.name = view.image_name;
+    image.camera_id = camera_id;
+    const image_t image_id = db.WriteImage(image);
+    std::vector<TargetObservation> rows;
+    for (size_t i = 0; i < view.pixels.size(); ++i) {
+      TargetObservation o;
+      o.point_id = static_cast<int64_t>(i);
+      o.xy = view.pixels[i];
+      o.point_in_target = view.points_in_target[i];
+      rows.push_back(o);
+    }
+    db.WriteTargetObservations(image_id, rows);
+    TargetDetectionStatus status;
+    status.target = "chessboard 12x9";
+    status.found = true;
+    status.num_points = static_cast<int>(rows.size());
+    db.WriteTargetDetectionStatus(image_id, status);
+  }
+}
+
+std::vector<Rigid3d> Poses(const CameraCalibrationResult& result) {
+  std::vector<Rigid3d> poses;
+  for (const CalibratedView& v : result.views) poses.push_back(v.cam_from_target);
+  return poses;
+}
+
+// Same corners, flat board, 0.1 px noise: the two solvers' lenses agree far
+// below the 0.05 px the issue asks, and mrcal's own estimate is within its
+// standard deviations of the truth (its warp within them of zero).
+TEST(CrossCheck, MrcalAndPortcalAgreeOnAFlatBoard) {
+  const Camera truth = TruthCamera();
+  const auto views = SyntheticViews(truth, Eigen::Vector2d::Zero(), 0.1, 20, 1);
+  const CameraCalibrationResult portcal =
+      CalibrateCamera(views, Camera::FromModelName("OPENCV", 900, 1280, 960), {});
+  const MrcalCalibrationResult mrcal = CalibrateWithMrcal(views, portcal.camera, Poses(portcal), {});
+  EXPECT_EQ(mrcal.lensmodel, "LENSMODEL_OPENCV4");
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_LT(std::abs(mrcal.camera.params[i] - truth.params[i]), 4 * mrcal.params_std_dev[i]) << i;
+  }
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_GT(mrcal.board_warp_std_dev[i], 0);
+    EXPECT_LT(std::abs(mrcal.board_warp[i]), 4 * mrcal.board_warp_std_dev[i]);
+  }
+  EXPECT_NEAR(mrcal.residual_sigma_px, 0.1, 0.015);
+  const ProjectionDiff diff = ComputeProjectionDiff({portcal.camera, portcal.params_covariance},
+                                                    {mrcal.camera, mrcal.params_covariance}, {});
+  EXPECT_LT(diff.mean_px, 0.05);
+  // Same data: the two agree much better than independent fits would.
+  EXPECT_LT(diff.mean_px, diff.predicted_mean_px);
+}
+
+// The difference two independent calibrations show, sampled from their
+// covariances, against the first-order prediction (fit included).
+TEST(CrossCheck, PredictedDifferenceMatchesMonteCarlo) {
+  const Camera truth = TruthCamera();
+  const auto views = SyntheticViews(truth, Eigen::Vector2d::Zero(), 0.3, 8, 2);
+  const CameraCalibrationResult fit = CalibrateCamera(views, Camera::FromModelName("OPENCV", 900, 1280, 960), {});
+  const Eigen::MatrixXd& c = fit.params_covariance;
+  ProjectionDiffOptions options;
+  options.gridn_width = 16;
+  const ProjectionDiff predicted = ComputeProjectionDiff({fit.camera, c}, {fit.camera, c}, options);
+  ASSERT_GT(predicted.predicted_mean_px, 0);
+
+  const Eigen::MatrixXd l = Eigen::LLT<Eigen::MatrixXd>(c).matrixL();
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal;
+  const auto sample = [&] {
+    Eigen::VectorXd z(c.rows());
+    for (int i = 0; i < z.size(); ++i) z[i] = normal(rng);
+    const Eigen::VectorXd delta = l * z;
+    Camera camera = fit.camera;
+    for (int i = 0; i < delta.size(); ++i) camera.params[i] += delta[i];
+    return camera;
+  };
+  const int num_samples = 300;
+  std::vector<double> sum_squares(predicted.diff_px.size(), 0.0);
+  for (int s = 0; s < num_samples; ++s) {
+    // Weights from the same covariances as the prediction.
+    const ProjectionDiff d = ComputeProjectionDiff({sample(), c}, {sample(), c}, options);
+    for (size_t k = 0; k < d.diff_px.size(); ++k) sum_squares[k] += d.diff_px[k] * d.diff_px[k];
+  }
+  double empirical_mean = 0;
+  for (const double ss : sum_squares) empirical_mean += std::sqrt(ss / num_samples);
+  empirical_mean /= sum_squares.size();
+  // 300 samples: ~4 % Monte-Carlo scatter; 15 % allows for it and the
+  // linearisation.
+  EXPECT_NEAR(empirical_mean / predicted.predicted_mean_px, 1.0, 0.15)
+      << "empirical " << empirical_mean << " px, predicted " << predicted.predicted_mean_px << " px";
+}
+
+// mrcal's Python projection_diff (focus region, no uncertainties) on the
+// same two .cameramodel files.
+TEST(CrossCheck, ProjectionDiffEqualsMrcalsPython) {
+  if (testing::RunCommand("/usr/bin/python3 -c 'import mrcal' 2>&1").exit_code != 0) {
+    GTEST_SKIP() << "mrcal's Python module is not importable by /usr/bin/python3";
+  }
+  testing::TempDir dir;
+  const Camera a = TruthCamera();
+  Camera b = a;
+  b.params[0] += 4;
+  b.params[2] += 3;
+  b.params[4] += 0.01;
+  b.params[6] += 0.0005;
+  WriteMrcalCameraModel(a, Rigid3d(), dir / "a.cameramodel");
+  WriteMrcalCameraModel(b, Rigid3d(), dir / "b.cameramodel");
+  const std::string script =
+      "import mrcal, numpy as np\n"
+      "m = [mrcal.cameramodel('" + (dir / "a.cameramodel").string() + "'), mrcal.cameramodel('" +
+      (dir / "b.cameramodel").string() + "')]\n"
+      "d = mrcal.projection_diff(m, use_uncertainties=False)[0]\n"
+      "print('%.9f %.9f' % (np.mean(d), np.max(d)))\n";
+  {
+    std::ofstream out(dir / "diff.py");
+    out << script;
+  }
+  const auto run = testing::RunCommand("/usr/bin/python3 " + (dir / "diff.py").string() + " 2>/dev/null");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::istringstream in(run.output);
+  double mrcal_mean = 0, mrcal_max = 0;
+  in >> mrcal_mean >> mrcal_max;
+  const ProjectionDiff ours = ComputeProjectionDiff({a, {}}, {b, {}}, {});
+  EXPECT_GT(mrcal_mean, 0.1);  // a real difference to compare
+  EXPECT_NEAR(ours.mean_px, mrcal_mean, 1e-4 * mrcal_mean);
+  EXPECT_NEAR(ours.max_px, mrcal_max, 1e-4 * mrcal_max) << "mean " << ours.mean_px << " vs " << mrcal_mean;
+}
+
+// A board bent by 0.5 mm, calibrated as flat: cross_check fails, blames the
+// warp, and portcal re-run with the warp agrees with mrcal again.
+TEST(CrossCheck, WarpedBoardIsCaughtAndExplained) {
+  testing::TempDir dir;
+  const Camera truth = TruthCamera();
+  const Eigen::Vector2d warp(0.0, 0.5e-3);
+  const auto views = SyntheticViews(truth, warp, 0.1, 18, 4);
+  WriteDatabase(dir / "db.db", truth, views);
+  CameraCalibratorOptions calibrate;
+  calibrate.database_path = (dir / "db.db").string();
+  calibrate.output_path = (dir / "cal").string();
+  CalibrateCameraStage(calibrate);
+
+  CrossCheckerOptions options;
+  options.database_path = (dir / "db.db").string();
+  options.input_calibration = (dir / "cal/calibration.yaml").string();
+  options.output_path = (dir / "check").string();
+  options.folds = 2;
+  const CrossCheckResult result = CrossCheck(options);
+  EXPECT_FALSE(result.pass) << result.Verdict();
+  ASSERT_FALSE(result.causes.empty());
+  EXPECT_EQ(result.causes.front().rfind("board warp", 0), 0u) << result.causes.front();
+  EXPECT_LT(std::abs(result.mrcal_warp.y() - warp.y()), 4 * result.mrcal_warp_std_dev.y());
+  ASSERT_TRUE(result.rerun_diff.has_value());
+  EXPECT_LT(result.rerun_diff->mean_px, 0.05);
+  EXPECT_EQ(result.Verdict().rfind("FAIL", 0), 0u);
+  EXPECT_NE(result.Verdict().find("agree"), std::string::npos);
+  ASSERT_EQ(result.folds.size(), 1u);
+  for (const char* file : {"cross_check.txt", "cross_check.yaml", "projection_diff.png",
+                           "projection_diff_rerun.png", "cross_validation_diff.png", "mrcal.cameramodel"}) {
+    EXPECT_TRUE(fs::exists(dir / "check" / file)) << file;
+  }
+  const std::string text = testing::ReadFileToString(dir / "check/cross_check.txt");
+  EXPECT_EQ(text.substr(text.rfind('\n', text.size() - 2) + 1), result.Verdict() + "\n");
+  // mrcal's solution re-imported: the report's file is what mrcal reads.
+  EXPECT_EQ(ReadMrcalCameraModel(dir / "check/mrcal.cameramodel").camera.ModelName(), "OPENCV");
+}
+
+TEST(CrossCheck, BadOptionsAndModelsAreNamed) {
+  testing::TempDir dir;
+  const Camera truth = TruthCamera();
+  WriteDatabase(dir / "db.db", truth, SyntheticViews(truth, Eigen::Vector2d::Zero(), 0.1, 5, 5));
+  CameraCalibratorOptions calibrate;
+  calibrate.database_path = (dir / "db.db").string();
+  calibrate.output_path = (dir / "cal").string();
+  CalibrateCameraStage(calibrate);
+  CrossCheckerOptions options;
+  options.database_path = (dir / "db.db").string();
+  options.input_calibration = (dir / "cal/calibration.yaml").string();
+  options.output_path = (dir / "check").string();
+  options.folds = 1;
+  EXPECT_THROW(CrossCheck(options), OptionError);
+  options.folds = 3;  // 5 views: folds of 2
+  try {
+    CrossCheck(options);
+    FAIL() << "3 folds of 5 views must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--CrossCheck.folds"), std::string::npos) << e.what();
+  }
+  CalibrationReport fisheye;
+  fisheye.camera = Camera::FromModelName("OPENCV_FISHEYE", 1000, 1280, 960);
+  WriteCalibrationReport(fisheye, dir / "fisheye");
+  options.folds = 0;
+  options.input_calibration = (dir / "fisheye/calibration.yaml").string();
+  try {
+    CrossCheck(options);
+    FAIL() << "OPENCV_FISHEYE must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("nearest"), std::string::npos) << e.what();
+  }
+}
+
+CrossCheckResult CheckSharedSet(const fs::path& images, const std::string& model, int cols, int rows,
+                                double square, const fs::path& dir, int folds) {
+  TargetExtractorOptions extract;
+  extract.database_path = (dir / "db.db").string();
+  extract.image_path = images.string();
+  extract.reader.camera_model = model;
+  extract.reader.single_camera = true;
+  extract.chessboard.cols = cols;
+  extract.chessboard.rows = rows;
+  extract.square_size_m = square;
+  NullProgress progress;
+  ExtractTargets(extract, progress);
+  CameraCalibratorOptions calibrate;
+  calibrate.database_path = extract.database_path;
+  calibrate.output_path = (dir / "cal").string();
+  CalibrateCameraStage(calibrate);
+  CrossCheckerOptions options;
+  options.database_path = extract.database_path;
+  options.input_calibration = (dir / "cal/calibration.yaml").string();
+  options.output_path = (dir / "check").string();
+  options.folds = folds;
+  const CrossCheckResult result = CrossCheck(options);
+  std::cout << CrossCheckText(result);
+  return result;
+}
+
+// The issue's bar on a rendered set: the two agree to < 0.05 px mean.
+TEST(CrossCheck, SharedRenderedSetAgrees) {
+  PORTCAL_REQUIRE_SHARED(shared);
+  testing::TempDir dir;
+  const CrossCheckResult result = CheckSharedSet(shared / "datasets/rendered/chess_air_distorted/images",
+                                                 "RADIAL", 10, 7, 0.02, dir.path(), 3);
+  EXPECT_LT(result.diff.mean_px, 0.05);
+  EXPECT_TRUE(result.pass);
+}
+
+// The real in-air set: the flat-board calibration and mrcal's disagree by
+// ~21 px in fx and ~28 px in cx (the issue: about 22 and 29 with OpenCV's
+// corners); the cause is the board warp, and with it the two agree.
+TEST(CrossCheck, RealInAirSetBlamesTheBoardWarp) {
+  PORTCAL_REQUIRE_SHARED(shared);
+  testing::TempDir dir;
+  const CrossCheckResult result =
+      CheckSharedSet(shared / "datasets/real-dome/air", "OPENCV", 8, 6, 0.03, dir.path(), 2);
+  EXPECT_FALSE(result.pass);
+  ASSERT_GE(result.parameters.size(), 4u);
+  EXPECT_GT(result.parameters[0].mrcal - result.parameters[0].portcal, 10.0);  // fx
+  EXPECT_GT(result.parameters[2].mrcal - result.parameters[2].portcal, 10.0);  // cx
+  ASSERT_FALSE(result.causes.empty());
+  EXPECT_EQ(result.causes.front().rfind("board warp", 0), 0u) << result.causes.front();
+  ASSERT_TRUE(result.rerun_diff.has_value());
+  EXPECT_LT(result.rerun_diff->p95_px, result.max_diff_px);
+}
+
+}  // namespace
+}  // namespace portcal
