@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 
 packages=(
   build-essential cmake ccache pkg-config
-  libceres-dev libeigen3-dev libgoogle-glog-dev
+  libceres-dev libeigen3-dev libgoogle-glog-dev libsuitesparse-dev
   libopencv-dev libopencv-contrib-dev
   libsqlite3-dev sqlite3
   libboost-program-options-dev

@@ -83,6 +83,32 @@ TEST(MrcalModel, CameraModelFileRoundTripsThroughMrcalsParser) {
   }
 }
 
+// A file mrcal itself wrote (its writer, its layout) imports exactly.
+TEST(MrcalModel, ImportsWhatMrcalsPythonWrites) {
+  if (testing::RunCommand("/usr/bin/python3 -c 'import mrcal' 2>&1").exit_code != 0) {
+    GTEST_SKIP() << "mrcal's Python module is not importable by /usr/bin/python3";
+  }
+  testing::TempDir dir;
+  const std::string path = (dir / "mrcal.cameramodel").string();
+  const auto run = testing::RunCommand(
+      "/usr/bin/python3 -c \"import mrcal, numpy as np; mrcal.cameramodel(intrinsics=("
+      "'LENSMODEL_OPENCV8', np.array([1210., 1215., 800.8, 597.7, -0.12, 0.03, 0.001, -0.0007, "
+      "0.004, 0.01, -0.002, 0.0005])), imagersize=(1600, 1200), extrinsics_rt_toref=np.array([0.1, 0.2, "
+      "0.3, 1., 2., 3.])).write('" + path + "')\" 2>&1");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const MrcalCameraModelFile read = ReadMrcalCameraModel(path);
+  EXPECT_EQ(read.camera.ModelName(), "FULL_OPENCV");
+  const Camera expected = Cameras()[5];  // the same lens in COLMAP's convention
+  // mrcal's writer keeps 6 decimals.
+  for (size_t i = 0; i < expected.params.size(); ++i) {
+    EXPECT_NEAR(read.camera.params[i], expected.params[i], 1e-6) << i;
+  }
+  // rt_cam_ref (what the file stores) is the inverse of the rt_toref given.
+  const Rigid3d ref_from_cam = read.cam_from_ref.Inverse();
+  EXPECT_NEAR(ref_from_cam.translation.x(), 1.0, 1e-6);
+  EXPECT_NEAR(ref_from_cam.translation.z(), 3.0, 1e-6);
+}
+
 TEST(MrcalModel, ModelsWithoutCounterpartNameTheNearest) {
   const Camera fisheye = Camera::FromModelName("OPENCV_FISHEYE", 500, 640, 480);
   try {

@@ -166,5 +166,38 @@ TEST(Cli, ModelConverterImportsTheForksCameras) {
   EXPECT_NE(result.output.find("--output_type"), std::string::npos);
 }
 
+// One camera out to mrcal, OpenCV and ROS and back from mrcal, through the
+// command line; a multi-camera model needs --camera_id.
+TEST(Cli, ModelConverterExportsAndImportsOneCamera) {
+  testing::TempDir dir;
+  fs::create_directories(dir / "model");
+  std::ofstream(dir / "model" / "cameras.txt")
+      << "1 OPENCV 1440 1080 2412 2415 731.9 548.8 -0.36 0.16 0.0017 0.0016\n"
+      << "2 PINHOLE 640 480 500 500 320 240\n";
+  std::ofstream(dir / "model" / "images.txt") << "";
+  std::ofstream(dir / "model" / "points3D.txt") << "";
+  const std::string input = " --input_path " + (dir / "model").string();
+  auto result = RunCommand(Portcal("model_converter" + input + " --output_type CAMERAMODEL --output_path " +
+                                   (dir / "c.cameramodel").string()));
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("--camera_id"), std::string::npos) << result.output;
+  for (const char* type : {"CAMERAMODEL", "OPENCV_YAML", "ROS_YAML"}) {
+    const std::string out = (dir / (std::string("c_") + type)).string() +
+                            (std::string(type) == "CAMERAMODEL" ? ".cameramodel" : ".yaml");
+    result = RunCommand(Portcal("model_converter --log_level error" + input + " --camera_id 1 --output_type " +
+                                type + " --output_path " + out));
+    ASSERT_EQ(result.exit_code, 0) << result.output;
+    EXPECT_TRUE(fs::exists(out)) << type;
+  }
+  result = RunCommand(Portcal("model_converter --log_level error --input_path " +
+                              (dir / "c_CAMERAMODEL.cameramodel").string() + " --output_type TXT --output_path " +
+                              (dir / "back").string()));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const SparseModel back = ReadSparseModel(dir / "back");
+  ASSERT_EQ(back.cameras.size(), 1u);
+  EXPECT_EQ(back.cameras.at(1).ModelName(), "OPENCV");
+  EXPECT_DOUBLE_EQ(back.cameras.at(1).params[2], 731.9);
+}
+
 }  // namespace
 }  // namespace portcal
