@@ -78,9 +78,10 @@ bool WarpSignificant(const MrcalCalibrationResult& mrcal) {
 // Cross-validation: disjoint interleaved subsets (view i in fold i mod K, so
 // each fold spans the whole capture), each calibrated alone, every pair
 // differenced and set against the difference their covariances predict.
-void CrossValidate(const std::vector<CalibrationView>& views, const Camera& initial,
-                   const CameraCalibrationSettings& settings, const CrossCheckerOptions& options,
-                   CrossCheckResult* result) {
+CrossValidation CrossValidate(const std::vector<CalibrationView>& views, const Camera& initial,
+                              const CameraCalibrationSettings& settings,
+                              const CrossCheckerOptions& options, const std::string& description,
+                              const std::filesystem::path& heat_map) {
   const int k = options.folds;
   std::vector<std::vector<CalibrationView>> subsets(k);
   for (size_t v = 0; v < views.size(); ++v) subsets[v % k].push_back(views[v]);
@@ -94,12 +95,13 @@ void CrossValidate(const std::vector<CalibrationView>& views, const Camera& init
                        std::to_string(views.size()) + " views; at least 3 per fold are needed");
     }
     fits.push_back(CalibrateCamera(subsets[f], initial, fold_settings));
-    LOG(INFO) << "cross_check: fold " << f << " (" << subsets[f].size() << " views): RMS "
-              << fits.back().overall_rms_px << " px";
+    LOG(INFO) << "cross_check: fold " << f << " (" << subsets[f].size() << " views, " << description
+              << "): RMS " << fits.back().overall_rms_px << " px";
   }
   ProjectionDiffOptions diff_options;
   diff_options.gridn_width = options.gridn_width;
-  double worst_ratio = 0;
+  CrossValidation out;
+  out.settings = description;
   for (int a = 0; a < k; ++a) {
     for (int b = a + 1; b < k; ++b) {
       const ProjectionDiff diff = ComputeProjectionDiff(LensOf(fits[a]), LensOf(fits[b]), diff_options);
@@ -112,25 +114,25 @@ void CrossValidate(const std::vector<CalibrationView>& views, const Camera& init
       fold.p95_px = diff.p95_px;
       fold.predicted_mean_px = diff.predicted_mean_px;
       fold.predicted_p95_px = diff.predicted_p95_px;
-      result->folds.push_back(fold);
-      if (diff.predicted_p95_px > 0) worst_ratio = std::max(worst_ratio, diff.p95_px / diff.predicted_p95_px);
+      out.pairs.push_back(fold);
+      if (diff.predicted_p95_px > 0) out.worst_ratio = std::max(out.worst_ratio, diff.p95_px / diff.predicted_p95_px);
       if (a == 0 && b == 1) {
         WriteProjectionDiffHeatMap(diff, static_cast<int>(initial.width), static_cast<int>(initial.height),
-                                   "fold 0 vs fold 1", std::filesystem::path(options.output_path) /
-                                                           "cross_validation_diff.png");
+                                   "fold 0 vs fold 1, " + description, heat_map);
       }
     }
   }
   // The differences of independent fits scatter like a chi distribution
   // around the prediction; beyond twice the prediction the spread is not
   // noise.
-  result->fold_verdict =
-      worst_ratio <= 2.0
+  out.verdict =
+      out.worst_ratio <= 2.0
           ? "consistent: the folds differ by what their uncertainty predicts (worst ratio " +
-                Format(worst_ratio, 2) + ")"
-          : "NOT consistent: the folds differ by up to " + Format(worst_ratio, 2) +
+                Format(out.worst_ratio, 2) + ")"
+          : "NOT consistent: the folds differ by up to " + Format(out.worst_ratio, 2) +
                 "x what their uncertainty predicts; the lens model is too lean for this lens, "
                 "or the data carry a systematic error (board warp, outliers, rolling shutter)";
+  return out;
 }
 
 }  // namespace
@@ -257,11 +259,11 @@ CrossCheckResult CrossCheck(const CrossCheckerOptions& options) {
     }
   }
 
+  CameraCalibrationSettings rerun_settings = settings;
+  std::vector<CalibrationView> rerun_views = views;
   if ((!result.pass || max_z > 3) && (warp_cause || outlier_cause)) {
     // Re-run portcal with what mrcal did differently, and compare again.
-    CameraCalibrationSettings rerun_settings = settings;
     rerun_settings.estimate_board_warp = true;
-    std::vector<CalibrationView> rerun_views = views;
     if (outlier_cause) {
       for (size_t v = 0; v < views.size(); ++v) {
         std::vector<int> drop = mrcal.outliers[v];
@@ -282,7 +284,17 @@ CrossCheckResult CrossCheck(const CrossCheckerOptions& options) {
                                dir / "projection_diff_rerun.png");
   }
 
-  if (options.folds >= 2) CrossValidate(views, input.camera, settings, options, &result);
+  if (options.folds >= 2) {
+    result.cross_validations.push_back(CrossValidate(
+        views, input.camera, settings, options,
+        settings.estimate_board_warp ? "as the input (board warp)" : "as the input (flat board)",
+        dir / "cross_validation_diff.png"));
+    if (result.rerun_diff) {
+      result.cross_validations.push_back(CrossValidate(rerun_views, input.camera, rerun_settings,
+                                                       options, "as the re-run",
+                                                       dir / "cross_validation_diff_rerun.png"));
+    }
+  }
   WriteCrossCheckReport(result, dir);
   LOG(INFO) << "cross_check: " << result.Verdict();
   return result;

@@ -14,6 +14,13 @@ std::string Fixed(double value, int digits) {
   return out.str();
 }
 
+// A YAML single-quoted scalar.
+std::string Quoted(const std::string& text) {
+  std::string out = "'";
+  for (const char c : text) out += c == '\'' ? std::string("''") : std::string(1, c);
+  return out + "'";
+}
+
 std::string DiffLine(const ProjectionDiff& diff) {
   return "mean " + Fixed(diff.mean_px, 3) + " px, p95 " + Fixed(diff.p95_px, 3) + " px, max " +
          Fixed(diff.max_px, 3) + " px; worst: " + diff.worst_region + " (mean " +
@@ -46,7 +53,7 @@ std::string YamlDiff(const ProjectionDiff& d, const std::string& indent) {
   std::ostringstream out;
   out << std::setprecision(6) << indent << "mean_px: " << d.mean_px << "\n"
       << indent << "p95_px: " << d.p95_px << "\n" << indent << "max_px: " << d.max_px << "\n"
-      << indent << "worst_region: '" << d.worst_region << "'\n"
+      << indent << "worst_region: " << Quoted(d.worst_region) << "\n"
       << indent << "worst_region_mean_px: " << d.worst_region_mean_px << "\n";
   return out.str();
 }
@@ -108,17 +115,18 @@ std::string CrossCheckText(const CrossCheckResult& r) {
         << " (threshold p95 " << Fixed(r.max_diff_px, 3) << " px)\n";
     ParameterTable(out, r.rerun_parameters);
   }
-  if (!r.folds.empty()) {
-    out << "\nCross-validation (" << r.folds.size() << " pair(s) of disjoint, interleaved view "
-        << "subsets, each calibrated alone; predicted = what their uncertainty allows)\n"
+  for (const CrossValidation& cv : r.cross_validations) {
+    out << "\nCross-validation, " << cv.settings << " (" << cv.pairs.size()
+        << " pair(s) of disjoint, interleaved view subsets, each calibrated alone; predicted = "
+        << "what their uncertainty allows)\n"
         << "  folds   views      mean    p95    predicted mean    p95\n";
-    for (const FoldComparison& f : r.folds) {
+    for (const FoldComparison& f : cv.pairs) {
       out << "  " << f.fold_a << " vs " << f.fold_b << "  " << std::setw(3) << f.views_a << "/"
           << std::left << std::setw(3) << f.views_b << std::right << std::setw(9)
           << Fixed(f.mean_px, 3) << std::setw(7) << Fixed(f.p95_px, 3) << std::setw(17)
           << Fixed(f.predicted_mean_px, 3) << std::setw(7) << Fixed(f.predicted_p95_px, 3) << "\n";
     }
-    out << "  " << r.fold_verdict << "\n";
+    out << "  " << cv.verdict << "\n";
   }
   out << "\n" << r.Verdict() << "\n";
   return out.str();
@@ -136,20 +144,21 @@ void WriteCrossCheckReport(const CrossCheckResult& r, const std::filesystem::pat
        << YamlParameters(r.parameters, "  ") << "projection_diff:\n" << YamlDiff(r.diff, "  ")
        << "max_diff_px: " << r.max_diff_px << "\nresult: " << (r.pass ? "PASS" : "FAIL") << "\n";
   yaml << "causes:\n";
-  for (const std::string& cause : r.causes) yaml << "  - '" << cause << "'\n";
+  for (const std::string& cause : r.causes) yaml << "  - " << Quoted(cause) << "\n";
   if (r.rerun_diff) {
-    yaml << "rerun:\n  description: '" << r.rerun_description << "'\n  projection_diff:\n"
+    yaml << "rerun:\n  description: " << Quoted(r.rerun_description) << "\n  projection_diff:\n"
          << YamlDiff(*r.rerun_diff, "    ") << "  parameters:\n" << YamlParameters(r.rerun_parameters, "    ");
   }
-  if (!r.folds.empty()) {
-    yaml << "cross_validation:\n";
-    for (const FoldComparison& f : r.folds) {
-      yaml << "  - {folds: [" << f.fold_a << ", " << f.fold_b << "], views: [" << f.views_a << ", "
+  if (!r.cross_validations.empty()) yaml << "cross_validation:\n";
+  for (const CrossValidation& cv : r.cross_validations) {
+    yaml << "  - settings: " << Quoted(cv.settings) << "\n    worst_ratio: " << cv.worst_ratio
+         << "\n    verdict: " << Quoted(cv.verdict) << "\n    pairs:\n";
+    for (const FoldComparison& f : cv.pairs) {
+      yaml << "      - {folds: [" << f.fold_a << ", " << f.fold_b << "], views: [" << f.views_a << ", "
            << f.views_b << "], mean_px: " << f.mean_px << ", p95_px: " << f.p95_px
            << ", predicted_mean_px: " << f.predicted_mean_px
            << ", predicted_p95_px: " << f.predicted_p95_px << "}\n";
     }
-    yaml << "cross_validation_verdict: '" << r.fold_verdict << "'\n";
   }
   const std::string text = CrossCheckText(r);
   WriteFileAtomically(dir / "cross_check.yaml", false, [&](std::ostream& out) { out << yaml.str(); });

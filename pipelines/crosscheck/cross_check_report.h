@@ -26,6 +26,13 @@ struct FoldComparison {
   double predicted_mean_px = 0, predicted_p95_px = 0;
 };
 
+struct CrossValidation {
+  std::string settings;  // e.g. "as the input calibration (flat board)"
+  std::vector<FoldComparison> pairs;
+  double worst_ratio = 0;  // max over pairs of p95 / predicted p95
+  std::string verdict;
+};
+
 struct CrossCheckResult {
   std::string camera_model, mrcal_lensmodel;
   int num_views = 0, num_points = 0;
@@ -46,8 +53,8 @@ struct CrossCheckResult {
   std::optional<ProjectionDiff> rerun_diff;
   std::vector<ParameterComparison> rerun_parameters;
 
-  std::vector<FoldComparison> folds;
-  std::string fold_verdict;
+  // With --CrossCheck.folds: the input's settings, then the re-run's.
+  std::vector<CrossValidation> cross_validations;
 
   std::string Verdict() const;  // the last line: "PASS ..." / "FAIL ..."
 };
