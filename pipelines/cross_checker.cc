@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <numeric>
+#include <set>
 #include <sstream>
 
 #include "colmap_ext/io/mrcal_model.h"
@@ -156,7 +157,18 @@ CrossCheckResult CrossCheck(const CrossCheckerOptions& options) {
   Database database(options.database_path, Database::OpenMode::kReadOnly);
   const TargetViews target_views = ReadTargetViews(&database);
   const camera_t camera_id = ChooseCamera(target_views, options.camera_id, options.database_path);
-  const std::vector<CalibrationView>& views = target_views.by_camera.at(camera_id);
+  // The views the input calibration used: its dropped outlier views stay out.
+  std::set<std::string> dropped;
+  for (const CalibratedView& view : input.views) {
+    if (view.dropped) dropped.insert(view.image_name);
+  }
+  std::vector<CalibrationView> views;
+  for (const CalibrationView& view : target_views.by_camera.at(camera_id)) {
+    if (!dropped.count(view.image_name)) views.push_back(view);
+  }
+  if (!dropped.empty()) {
+    LOG(INFO) << "cross_check: " << dropped.size() << " views dropped by the input calibration left out";
+  }
   const Camera db_camera = *database.ReadCamera(camera_id);
   if (db_camera.width != input.camera.width || db_camera.height != input.camera.height) {
     throw InputError(options.input_calibration + ": image size " + std::to_string(input.camera.width) +

@@ -14,3 +14,9 @@ mkdir -p "$out"
 "$portcal" camera_calibrator --database_path "$out/database.db" --output_path "$out" \
   --Calibration.drop_outlier_views 1
 cat "$out/calibration.txt"
+# Second opinion: mrcal on the same corners (needs a model mrcal can express:
+# PINHOLE, RADIAL, OPENCV, FULL_OPENCV ...), 3-fold cross-validation. The
+# last line says PASS or FAIL; details and heat maps in $out/cross_check/.
+"$portcal" cross_check --database_path "$out/database.db" \
+  --input_calibration "$out/calibration.yaml" --output_path "$out/cross_check" \
+  --CrossCheck.folds 3 | tail -n 1

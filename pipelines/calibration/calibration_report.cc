@@ -223,6 +223,17 @@ CalibrationReport ReadCalibrationReport(const fs::path& path) {
         report.parameters_std_dev.push_back(value.IsNull() ? -1.0 : value.as<double>());
       }
     }
+    if (root["per_view"]) {
+      for (const YAML::Node& entry : root["per_view"]) {
+        CalibratedView view;
+        view.image_name = entry["image"].as<std::string>();
+        if (entry["rms"]) view.rms_px = entry["rms"].as<double>();
+        if (entry["points"]) view.num_points = entry["points"].as<int>();
+        if (entry["outlier"]) view.outlier = entry["outlier"].as<bool>();
+        if (entry["dropped"]) view.dropped = entry["dropped"].as<bool>();
+        report.views.push_back(view);
+      }
+    }
     if (root["board_warp"] && root["board_warp_std_dev"]) {
       const auto warp = root["board_warp"].as<std::vector<double>>();
       const auto warp_std_dev = root["board_warp_std_dev"].as<std::vector<double>>();

@@ -244,6 +244,31 @@ TEST(CrossCheck, WarpedBoardIsCaughtAndExplained) {
   EXPECT_EQ(ReadMrcalCameraModel(dir / "check/mrcal.cameramodel").camera.ModelName(), "OPENCV");
 }
 
+// Views the input calibration dropped as outliers stay out of the check, so
+// portcal's re-solve is the input's solution and the two agree.
+TEST(CrossCheck, ViewsDroppedByTheInputStayOut) {
+  testing::TempDir dir;
+  const Camera truth = TruthCamera();
+  std::vector<CalibrationView> views = SyntheticViews(truth, Eigen::Vector2d::Zero(), 0.1, 12, 6);
+  std::mt19937 rng(8);
+  std::normal_distribution<double> blur(0, 3.0);
+  for (Eigen::Vector2d& pixel : views[4].pixels) pixel += Eigen::Vector2d(blur(rng), blur(rng));
+  WriteDatabase(dir / "db.db", truth, views);
+  CameraCalibratorOptions calibrate;
+  calibrate.database_path = (dir / "db.db").string();
+  calibrate.output_path = (dir / "cal").string();
+  calibrate.calibration.drop_outlier_views = true;
+  CalibrateCameraStage(calibrate);
+  CrossCheckerOptions options;
+  options.database_path = (dir / "db.db").string();
+  options.input_calibration = (dir / "cal/calibration.yaml").string();
+  options.output_path = (dir / "check").string();
+  const CrossCheckResult result = CrossCheck(options);
+  EXPECT_EQ(result.num_views, 11);
+  EXPECT_TRUE(result.pass) << result.Verdict();
+  EXPECT_TRUE(result.causes.empty()) << result.causes.front();
+}
+
 TEST(CrossCheck, BadOptionsAndModelsAreNamed) {
   testing::TempDir dir;
   const Camera truth = TruthCamera();
