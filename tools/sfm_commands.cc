@@ -88,6 +88,7 @@ int RunRefractiveBundleAdjuster(int argc, char** argv) {
   cli.Add("Housing.params", &options.housing.params, "housing parameters (first guess)");
   cli.Add("Markers.side_length", &options.marker_scale.side_length_m, "ArUco marker side, metres (0: no scale)");
   cli.Add("Markers.side_sigma", &options.marker_scale.sigma_m, "uncertainty of a marker side, metres");
+  cli.Add("Markers.corner_sigma", &options.ba.marker_sigma_px, "uncertainty of a marker corner, px");
   cli.Add("BundleAdjustment.max_reproj_error", &options.max_reproj_error_px, "observations beyond are dropped");
   AddBundleOptions(&cli, &options.ba);
   return ReportErrors([&] {

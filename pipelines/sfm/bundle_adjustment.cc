@@ -202,7 +202,7 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
     std::map<int, std::array<double*, 4>> corners_of;
     for (MarkerCorner& corner : *markers) {
       for (const auto& [image_id, pixel] : corner.observations) {
-        if (poses.count(image_id)) add_observation(image_id, pixel, corner.xyz.data(), options.sigma_px);
+        if (poses.count(image_id)) add_observation(image_id, pixel, corner.xyz.data(), options.marker_sigma_px);
       }
       if (!corners_of.count(corner.marker_id)) corners_of[corner.marker_id] = {nullptr, nullptr, nullptr, nullptr};
       corners_of[corner.marker_id][corner.corner] = corner.xyz.data();

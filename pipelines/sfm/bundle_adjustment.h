@@ -22,6 +22,7 @@ struct BundleAdjustmentOptions {
   bool virtual_camera_error = false;  // else the exact reprojection error
   double sigma_px = 1.0;              // residuals in units of this
   bool scale_weighting = true;        // sigma grows with the keypoint's scale (above 2 px)
+  double marker_sigma_px = 1.0;       // of an ArUco marker corner (edge-refined)
   double loss_scale = 1.0;            // Cauchy loss scale, in sigma; <= 0: no robust loss
   int max_num_iterations = 100;
   double function_tolerance = 1e-8;  // relative cost change that ends the solve
