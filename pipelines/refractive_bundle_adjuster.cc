@@ -104,8 +104,35 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
                     "is arbitrary, so a flat port's distance and a dome's decentering are not in metres "
                     "(refraction observes the scale only weakly)";
   }
+  // With the intrinsics refined too, the housing is first adjusted under the
+  // mapper's intrinsics: started jointly from an untilted guess, the focal
+  // length and the port distance trade off and the solve can slide into the
+  // distance's lower bound with a wrong focal length (measured on own flat
+  // renders: 4 of 10 seeds, normal off by up to 2.5 deg; staged: see
+  // docs/auto_calibration.md).
+  const bool joint = options.ba.refine_housing && (options.ba.refine_focal_length ||
+                                                   options.ba.refine_principal_point ||
+                                                   options.ba.refine_extra_params);
+  if (joint) {
+    BundleAdjustmentOptions housing_first = options.ba;
+    housing_first.refine_focal_length = false;
+    housing_first.refine_principal_point = false;
+    housing_first.refine_extra_params = false;
+    AdjustBundle(&r, housing_first, BundleAdjustmentScope(), &markers, options.marker_scale);
+  }
   // A first solve, outliers out, then the final solve with covariance.
+  const std::map<camera_t, SfmCamera> cameras_before = r.cameras();
   AdjustBundle(&r, options.ba, BundleAdjustmentScope(), &markers, options.marker_scale);
+  for (const auto& [id, camera] : r.cameras()) {
+    // Garbage must not pass for a calibration.
+    std::string why;
+    if (ImplausibleIntrinsics(cameras_before.at(id).camera, camera.camera, &why)) {
+      throw NumericalError(options.input_path + ": refining camera " + std::to_string(id) +
+                           " gave implausible intrinsics (" + why + "): the reconstruction is likely "
+                           "wrong (mean reprojection error " + std::to_string(r.MeanReprojectionError()) +
+                           " px); give the intrinsics (--ImageReader.camera_params) or more views");
+    }
+  }
   result.num_filtered = FilterObservations(&r, options.max_reproj_error_px);
   CalibrationStdDevs std_devs;
   AdjustBundle(&r, options.ba, BundleAdjustmentScope(), &markers, options.marker_scale, &std_devs);

@@ -22,6 +22,8 @@ static void AddMapperOptions(CommandLine* cli, IncrementalMapperOptions* o) {
   cli->Add("Mapper.ba_refine_focal_length", &o->ba_refine_focal_length, "0 | 1");
   cli->Add("Mapper.ba_refine_principal_point", &o->ba_refine_principal_point, "0 | 1");
   cli->Add("Mapper.ba_refine_extra_params", &o->ba_refine_extra_params, "0 | 1");
+  cli->Add("Mapper.ba_refine_housing", &o->ba_refine_housing,
+           "refine the housing with the intrinsics in global adjustments (0 | 1)");
   cli->Add("Mapper.ba_local_num_images", &o->ba_local_num_images, "images in a local adjustment");
   cli->Add("Mapper.ba_global_images_ratio", &o->ba_global_images_ratio, "global adjustment when the model grows by");
   cli->Add("Mapper.multiple_models", &o->multiple_models, "0 | 1");

@@ -2,11 +2,13 @@
 
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/housing/housing_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/string_utils.h"
 #include "pipelines/calibration/view_pose.h"
 #include "pipelines/sfm/bundle_costs.h"
 #include "pipelines/sfm/bundle_costs_fixed.h"
@@ -24,6 +26,22 @@ void BundleAdjustmentOptions::Check() const {
   if (!(function_tolerance > 0)) {
     throw OptionError("--BundleAdjustment.function_tolerance", std::to_string(function_tolerance), "> 0");
   }
+}
+
+bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::string* why) {
+  std::ostringstream text;
+  const double ratio = after.MeanFocalLength() / before.MeanFocalLength();
+  if (!(ratio > 0.5 && ratio < 2.0)) {
+    text << "focal length " << after.MeanFocalLength() << " px from " << before.MeanFocalLength() << " px";
+  }
+  const std::vector<std::string> names = SplitTokens(after.ParamsInfo(), ", ");
+  for (int idx : CameraModelExtraParamsIdxs(after.model_id)) {
+    if (!(std::abs(after.params[idx]) < 1.0)) {
+      text << (text.tellp() > 0 ? ", " : "") << names.at(idx) << " = " << after.params[idx];
+    }
+  }
+  if (why) *why = text.str();
+  return text.tellp() > 0;
 }
 
 std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconstruction, double max_error_px) {

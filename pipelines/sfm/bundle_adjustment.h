@@ -65,6 +65,10 @@ struct CalibrationStdDevs {
   int64_t num_residuals = 0;
 };
 
+// COLMAP's bogus-camera test (min/max_focal_length_ratio 0.5 / 2,
+// max_extra_param 1) of `after` against `before`; says why in `why`.
+bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::string* why = nullptr);
+
 // Adjusts in place. The gauge: the first registered image's pose is held,
 // and, without marker scale, one translation coordinate of the second.
 // Returns Ceres' summary; throws NumericalError if the solve fails.

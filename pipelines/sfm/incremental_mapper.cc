@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <sstream>
 #include <tuple>
 
 #include "colmap_ext/camera/camera_models.h"
@@ -40,15 +41,9 @@ namespace {
 constexpr double kDegree = M_PI / 180.0;
 constexpr int kMinImagesForIntrinsics = 5;
 
-// COLMAP's bogus-camera test (min/max_focal_length_ratio, max_extra_param),
-// against the intrinsics before the adjustment.
 bool BogusIntrinsics(const std::map<camera_t, SfmCamera>& before, const std::map<camera_t, SfmCamera>& after) {
   for (const auto& [id, camera] : after) {
-    const double ratio = camera.camera.MeanFocalLength() / before.at(id).camera.MeanFocalLength();
-    if (!(ratio > 0.5 && ratio < 2.0)) return true;
-    for (int idx : CameraModelExtraParamsIdxs(camera.camera.model_id)) {
-      if (!(std::abs(camera.camera.params[idx]) < 1.0)) return true;
-    }
+    if (ImplausibleIntrinsics(before.at(id).camera, camera.camera)) return true;
   }
   return false;
 }
@@ -485,6 +480,7 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   ba.refine_focal_length = refine_intrinsics && options_.ba_refine_focal_length;
   ba.refine_principal_point = refine_intrinsics && options_.ba_refine_principal_point;
   ba.refine_extra_params = refine_intrinsics && options_.ba_refine_extra_params;
+  ba.refine_housing = refine_intrinsics && options_.ba_refine_housing;
   ba.max_num_iterations = options_.ba_max_num_iterations;
   ba.num_threads = options_.num_threads;
   std::vector<MarkerCorner> markers;
@@ -496,16 +492,30 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   std::map<point3D_t, Eigen::Vector3d> points_before;
   for (const auto& [id, point] : r->points()) points_before[id] = point.xyz;
   const std::vector<MarkerCorner> markers_before = markers;
+  if (ba.refine_housing) {
+    // The housing first, under the held intrinsics (see
+    // RunRefractiveBundleAdjuster: jointly from a poor start, focal length
+    // and port distance trade off).
+    BundleAdjustmentOptions housing_first = ba;
+    housing_first.refine_focal_length = housing_first.refine_principal_point = false;
+    housing_first.refine_extra_params = false;
+    AdjustBundle(r, housing_first, BundleAdjustmentScope(), &markers, options_.marker_scale);
+  }
   AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
   if (refine_intrinsics && BogusIntrinsics(cameras_before, r->cameras())) {
+    std::ostringstream values;
+    for (const auto& [id, camera] : r->cameras()) {
+      for (const double p : camera.camera.params) values << " " << p;
+    }
     LOG(WARNING) << "refractive_mapper: intrinsics refined on " << r->poses().size()
-                 << " images came out implausible; held for now";
+                 << " images came out implausible (" << values.str() << " ); held for now";
     r->mutable_cameras() = cameras_before;
     r->mutable_poses() = poses_before;
     for (const auto& [id, xyz] : points_before) r->point(id).xyz = xyz;
     r->UpdateRays();
     markers = markers_before;
     ba.refine_focal_length = ba.refine_principal_point = ba.refine_extra_params = false;
+    ba.refine_housing = false;
     AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
   }
   Filter(r, nullptr);

@@ -32,6 +32,11 @@ struct IncrementalMapperOptions {
   bool ba_refine_focal_length = true;
   bool ba_refine_principal_point = false;
   bool ba_refine_extra_params = true;
+  // Self-calibrate the housing in the global adjustments that refine the
+  // intrinsics, so that structure and port co-evolve (a model built under an
+  // untilted guess absorbs the tilt into poses and points, and the final
+  // refinement may not climb out).
+  bool ba_refine_housing = false;
   int ba_local_num_images = 6;
   double ba_global_images_ratio = 1.1;
   int ba_max_num_iterations = 50;

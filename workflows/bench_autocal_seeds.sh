@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# Are auto-calibration's standard deviations honest? Renders N sets of the
+# same scene with different seeds (view poses, noise; portcal's renderer:
+# 960 x 540, 12 views of the two-face ArUco target behind a flat port
+# tilted 4 deg), auto-calibrates each with the intrinsics unknown, and
+# prints per seed and over all seeds the RMS of (estimate - truth) / sigma
+# for f, the normal's Nx and Ny, and the port distance (honest: 0.7-1.4).
+# Usage: workflows/bench_autocal_seeds.sh [N=10]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+[ -x build/portcal ] || bash workflows/setup.sh >/dev/null
+n="${1:-10}"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+cat > "$work/set.yaml" <<'YAML'
+name: seeds
+num_images: 12
+camera: {model: RADIAL, width: 960, height: 540, params: [650.0, 480.0, 270.0, 0.0, 0.0]}
+housing: {model: FLATPORT, params: [0.0697565, 0.0, 0.9975641, 0.015, 0.010, 1.0, 1.473, 1.334]}
+target:
+  type: target3d
+  num_faces: 2
+  fold_angle_deg: 120
+  face_width: 0.2
+  face_height: 0.25
+  aruco_dict: DICT_4X4_50
+  marker_ids: [0, 1]
+  marker_size: 0.06
+  quiet_zone_modules: 1
+  dots: {seed: 11, r_min: 0.0015, r_max: 0.009, coverage: 0.5, gray_min: 20, gray_max: 110, edge_margin: 0.004}
+poses: {distance: [0.4, 1.0], tilt_max_deg: 45, roll_max_deg: 180, visibility: markers, border_margin_px: 10, max_view_angle_deg: 70}
+render: {spp: 4, noise_sigma: 1.0, white: 220, black: 30, background: 110}
+YAML
+for seed in $(seq 1 "$n"); do
+  build/portcal synthesize --log_level warn --config "$work/set.yaml" --output_path "$work/s$seed" --seed "$seed"
+  if build/portcal auto_calibrator --log_level error --image_path "$work/s$seed/images" \
+       --output_path "$work/o$seed" --Housing.model FLATPORT \
+       --Housing.params 0,0,1,0.015,0.010,1,1.473,1.334 --Markers.side_length 0.06; then
+    echo "$seed $work/s$seed/ground_truth.yaml $work/o$seed/calibration.yaml"
+  else
+    echo "$seed failed"
+  fi
+done > "$work/runs.txt"
+/usr/bin/python3 - "$work/runs.txt" <<'PY'
+import math, sys, yaml
+names = ["f", "Nx", "Ny", "distance"]
+sums = [0.0] * 4
+count = 0
+for line in open(sys.argv[1]):
+    parts = line.split()
+    if parts[1] == "failed":
+        print(f"seed {parts[0]}: auto_calibrator failed")
+        continue
+    truth = yaml.safe_load(open(parts[1]))
+    result = yaml.safe_load(open(parts[2]))
+    t = [truth["camera"]["params"][0]] + truth["housing"]["params"][0:2] + [truth["housing"]["params"][3]]
+    e = [result["parameters"][0]] + result["non_svp_parameters"][0:2] + [result["non_svp_parameters"][3]]
+    s = [result["parameters_std_dev"][0]] + result["non_svp_parameters_std_dev"][0:2] + \
+        [result["non_svp_parameters_std_dev"][3]]
+    z = [(e[i] - t[i]) / s[i] if s[i] else float("nan") for i in range(4)]
+    print(f"seed {parts[0]}: " + ", ".join(f"{names[i]} {e[i] - t[i]:+.5g} (sd {s[i]:.3g}, z {z[i]:+.2f})"
+                                          for i in range(4)))
+    for i in range(4):
+        sums[i] += z[i] ** 2
+    count += 1
+if count:
+    print(f"RMS z over {count} seeds (honest: 0.7-1.4): " +
+          ", ".join(f"{names[i]} {math.sqrt(sums[i] / count):.2f}" for i in range(4)))
+PY
