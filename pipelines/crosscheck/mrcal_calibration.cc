@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "colmap_ext/io/mrcal_model.h"

@@ -4,6 +4,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iomanip>
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
@@ -143,31 +144,45 @@ double Step(const Eigen::MatrixXd& covariance, int i) {
   return 1e-2 * std::sqrt(covariance(i, i));
 }
 
-// Worst-direction projection standard deviation of a ray fixed in the camera
-// frame (what mrcal weighs its fit with), from the intrinsics covariance.
-std::vector<double> ProjectionStdDev(const CalibratedLens& lens, const Grid& grid) {
-  const size_t n = grid.pixels.size();
+using GridJacobian = Eigen::Matrix<double, 2, Eigen::Dynamic>;
+
+// Per grid point, the derivative of a 2-vector `evaluate` computes (for all
+// points at once) with respect to the lens parameters, by central
+// differences; zero columns for parameters without variance (held).
+std::vector<GridJacobian> GridJacobians(
+    const CalibratedLens& lens, size_t n,
+    const std::function<std::vector<Eigen::Vector2d>(const Camera&)>& evaluate) {
   const int p = static_cast<int>(lens.camera.params.size());
-  std::vector<Eigen::Matrix<double, 2, Eigen::Dynamic>> jacobians(
-      n, Eigen::Matrix<double, 2, Eigen::Dynamic>::Zero(2, p));
-  std::vector<std::optional<Eigen::Vector3d>> rays(n);
-  for (size_t k = 0; k < n; ++k) rays[k] = UnitRay(lens.camera, grid.pixels[k]);
+  std::vector<GridJacobian> jacobians(n, GridJacobian::Zero(2, p));
   for (int i = 0; i < p; ++i) {
     if (!(lens.covariance(i, i) > 0)) continue;
     const double h = Step(lens.covariance, i);
     Camera plus = lens.camera, minus = lens.camera;
     plus.params[i] += h;
     minus.params[i] -= h;
-    for (size_t k = 0; k < n; ++k) {
-      if (!rays[k]) continue;
-      const auto qp = plus.ImgFromCam(*rays[k]);
-      const auto qm = minus.ImgFromCam(*rays[k]);
-      if (qp && qm) jacobians[k].col(i) = (*qp - *qm) / (2 * h);
-    }
+    const std::vector<Eigen::Vector2d> vp = evaluate(plus), vm = evaluate(minus);
+    for (size_t k = 0; k < n; ++k) jacobians[k].col(i) = (vp[k] - vm[k]) / (2 * h);
   }
+  return jacobians;
+}
+
+// Worst-direction projection standard deviation of a ray fixed in the camera
+// frame (what mrcal weighs its fit with), from the intrinsics covariance.
+std::vector<double> ProjectionStdDev(const CalibratedLens& lens, const Grid& grid) {
+  const size_t n = grid.pixels.size();
+  std::vector<std::optional<Eigen::Vector3d>> rays(n);
+  for (size_t k = 0; k < n; ++k) rays[k] = UnitRay(lens.camera, grid.pixels[k]);
+  const std::vector<GridJacobian> jacobians = GridJacobians(lens, n, [&](const Camera& camera) {
+    std::vector<Eigen::Vector2d> pixels(n, Eigen::Vector2d::Constant(kNaN));
+    for (size_t k = 0; k < n; ++k) {
+      const auto q = rays[k] ? camera.ImgFromCam(*rays[k]) : std::nullopt;
+      if (q) pixels[k] = *q;
+    }
+    return pixels;
+  });
   std::vector<double> sigma(n, kNaN);
   for (size_t k = 0; k < n; ++k) {
-    if (!rays[k]) continue;
+    if (!rays[k] || !jacobians[k].allFinite()) continue;
     const Eigen::Matrix2d c = jacobians[k] * lens.covariance * jacobians[k].transpose();
     sigma[k] = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(c)
                                            .eigenvalues()
@@ -182,21 +197,9 @@ void AddPredictedVariance(const CalibratedLens& lens, bool lens_is_a, const Came
                           const Grid& grid, const std::vector<double>& weights,
                           std::vector<double>* variance) {
   const size_t n = grid.pixels.size();
-  const int p = static_cast<int>(lens.camera.params.size());
-  std::vector<Eigen::Matrix<double, 2, Eigen::Dynamic>> jacobians(
-      n, Eigen::Matrix<double, 2, Eigen::Dynamic>::Zero(2, p));
-  for (int i = 0; i < p; ++i) {
-    if (!(lens.covariance(i, i) > 0)) continue;
-    const double h = Step(lens.covariance, i);
-    Camera plus = lens.camera, minus = lens.camera;
-    plus.params[i] += h;
-    minus.params[i] -= h;
-    const Evaluation ep = lens_is_a ? Evaluate(plus, other, grid, weights)
-                                    : Evaluate(other, plus, grid, weights);
-    const Evaluation em = lens_is_a ? Evaluate(minus, other, grid, weights)
-                                    : Evaluate(other, minus, grid, weights);
-    for (size_t k = 0; k < n; ++k) jacobians[k].col(i) = (ep.diff[k] - em.diff[k]) / (2 * h);
-  }
+  const std::vector<GridJacobian> jacobians = GridJacobians(lens, n, [&](const Camera& camera) {
+    return (lens_is_a ? Evaluate(camera, other, grid, weights) : Evaluate(other, camera, grid, weights)).diff;
+  });
   for (size_t k = 0; k < n; ++k) {
     (*variance)[k] += (jacobians[k] * lens.covariance * jacobians[k].transpose()).trace();
   }
