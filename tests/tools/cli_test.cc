@@ -199,5 +199,22 @@ TEST(Cli, ModelConverterExportsAndImportsOneCamera) {
   EXPECT_DOUBLE_EQ(back.cameras.at(1).params[2], 731.9);
 }
 
+// cross_check: usage errors exit 2; a missing calibration file exits 1 and
+// names it.
+TEST(Cli, CrossCheckNamesWhatIsMissing) {
+  testing::TempDir dir;
+  auto result = RunCommand(Portcal("cross_check --database_path " + (dir / "db.db").string()));
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  result = RunCommand(Portcal("cross_check --database_path " + (dir / "db.db").string() +
+                              " --input_calibration " + (dir / "nope.yaml").string() + " --output_path " +
+                              (dir / "out").string()));
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_NE(result.output.find("nope.yaml"), std::string::npos) << result.output;
+  result = RunCommand(Portcal("cross_check --database_path a --input_calibration b --output_path c "
+                              "--CrossCheck.folds 1"));
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_NE(result.output.find("--CrossCheck.folds"), std::string::npos) << result.output;
+}
+
 }  // namespace
 }  // namespace portcal
