@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <numeric>
 #include <set>
 #include <sstream>
@@ -40,13 +41,13 @@ std::vector<ParameterComparison> CompareParameters(const Camera& portcal,
     p.name = kMrcalParamNames[i];
     const int s = sources[i];
     p.portcal = s >= 0 ? portcal.params[s] : 0.0;
-    p.portcal_std_dev = s >= 0 && s < static_cast<int>(portcal_std_dev.size())
-                            ? std::max(0.0, portcal_std_dev[s])
-                            : 0.0;
+    // -1: undetermined by portcal's views (rank-deficient covariance).
+    p.portcal_std_dev = s >= 0 && s < static_cast<int>(portcal_std_dev.size()) ? portcal_std_dev[s] : 0.0;
     p.mrcal = mrcal.camera.params[i];
     p.mrcal_std_dev = mrcal.params_std_dev[i];
-    const double combined = std::hypot(p.portcal_std_dev, p.mrcal_std_dev);
-    p.z = combined > 0 ? (p.mrcal - p.portcal) / combined : 0.0;
+    const double combined = std::hypot(std::max(0.0, p.portcal_std_dev), p.mrcal_std_dev);
+    p.z = p.portcal_std_dev < 0 ? std::numeric_limits<double>::quiet_NaN()
+                                : combined > 0 ? (p.mrcal - p.portcal) / combined : 0.0;
     out.push_back(p);
   }
   return out;

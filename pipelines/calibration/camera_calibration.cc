@@ -188,7 +188,12 @@ Solution Solve(const std::vector<const CalibrationView*>& views, const Camera& c
                                        std::sqrt(std::max(0.0, w[3] * variance)));
     }
   } else if (static_cast<int>(fixed.size()) < num_params) {
-    LOG(WARNING) << "camera calibration: the covariance is rank deficient; no standard deviations";
+    // Undetermined (-1, written as null), not 0, which means "held".
+    for (int i = 0; i < num_params; ++i) {
+      if (std::find(fixed.begin(), fixed.end(), i) == fixed.end()) s.params_std_dev[i] = -1.0;
+    }
+    LOG(WARNING) << "camera calibration: the covariance is rank deficient (a parameter the views do "
+                    "not determine); standard deviations undetermined";
   }
   return s;
 }

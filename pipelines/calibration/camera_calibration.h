@@ -51,7 +51,7 @@ struct CalibratedView {
 
 struct CameraCalibrationResult {
   Camera camera;
-  std::vector<double> params_std_dev;  // 0 for fixed parameters
+  std::vector<double> params_std_dev;  // 0 for fixed parameters, -1 undetermined
   // Full covariance of camera.params (px^2 ...), the residual variance
   // applied; zero rows and columns for fixed parameters, all zero when the
   // system is rank deficient.

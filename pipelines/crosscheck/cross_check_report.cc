@@ -1,5 +1,6 @@
 #include "pipelines/crosscheck/cross_check_report.h"
 
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -11,6 +12,12 @@ namespace {
 std::string Fixed(double value, int digits) {
   std::ostringstream out;
   out << std::fixed << std::setprecision(digits) << value;
+  return out.str();
+}
+
+std::string Number(double value) {
+  std::ostringstream out;
+  out << std::setprecision(12) << value;
   return out.str();
 }
 
@@ -28,13 +35,16 @@ std::string DiffLine(const ProjectionDiff& diff) {
 }
 
 void ParameterTable(std::ostream& out, const std::vector<ParameterComparison>& parameters) {
-  out << "  parameter        portcal     +-std dev          mrcal     +-std dev    difference     z\n";
+  out << "  parameter          portcal      +-std dev            mrcal      +-std dev      difference       z\n";
   for (const ParameterComparison& p : parameters) {
-    const bool held = p.portcal_std_dev == 0;
-    out << "  " << std::left << std::setw(8) << p.name << std::right << std::setw(15)
-        << Fixed(p.portcal, 6) << std::setw(14) << (held ? std::string("(held)") : Fixed(p.portcal_std_dev, 6))
-        << std::setw(15) << Fixed(p.mrcal, 6) << std::setw(14) << Fixed(p.mrcal_std_dev, 6)
-        << std::setw(14) << Fixed(p.mrcal - p.portcal, 6) << std::setw(7) << Fixed(p.z, 1) << "\n";
+    const std::string portcal_sd = p.portcal_std_dev == 0  ? std::string("(held)")
+                                   : p.portcal_std_dev < 0 ? std::string("(undetermined)")
+                                                           : Fixed(p.portcal_std_dev, 6);
+    out << "  " << std::left << std::setw(8) << p.name << std::right << " " << std::setw(16)
+        << Fixed(p.portcal, 6) << " " << std::setw(14) << portcal_sd << " " << std::setw(16)
+        << Fixed(p.mrcal, 6) << " " << std::setw(14) << Fixed(p.mrcal_std_dev, 6) << " "
+        << std::setw(15) << Fixed(p.mrcal - p.portcal, 6) << " " << std::setw(7)
+        << (std::isfinite(p.z) ? Fixed(p.z, 1) : std::string("-")) << "\n";
   }
 }
 
@@ -43,8 +53,9 @@ std::string YamlParameters(const std::vector<ParameterComparison>& parameters, c
   out << std::setprecision(12);
   for (const ParameterComparison& p : parameters) {
     out << indent << "- {name: " << p.name << ", portcal: " << p.portcal
-        << ", portcal_std_dev: " << p.portcal_std_dev << ", mrcal: " << p.mrcal
-        << ", mrcal_std_dev: " << p.mrcal_std_dev << ", z: " << p.z << "}\n";
+        << ", portcal_std_dev: " << (p.portcal_std_dev < 0 ? std::string("null") : Number(p.portcal_std_dev))
+        << ", mrcal: " << p.mrcal << ", mrcal_std_dev: " << p.mrcal_std_dev
+        << ", z: " << (std::isfinite(p.z) ? Number(p.z) : std::string("null")) << "}\n";
   }
   return out.str();
 }

@@ -14,9 +14,9 @@ namespace portcal {
 // One lens parameter in mrcal's parameterisation, COLMAP pixel convention.
 struct ParameterComparison {
   std::string name;
-  double portcal = 0, portcal_std_dev = 0;  // std dev 0: held by portcal's model
+  double portcal = 0, portcal_std_dev = 0;  // 0: held by portcal's model; -1: undetermined
   double mrcal = 0, mrcal_std_dev = 0;
-  double z = 0;  // (mrcal - portcal) / sqrt(both variances); 0 if both held
+  double z = 0;  // (mrcal - portcal) / sqrt(both variances); 0 if both held, NaN if undetermined
 };
 
 struct FoldComparison {
