@@ -84,8 +84,11 @@ AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   // normal 0.067 -> 0.012 deg, |df| 1.53 -> 0.58 px). A dome's centred
   // guess is close, and its axial decentering trades with the focal length
   // on a few views (shared set: |df| 0.26 -> 1.28 px when refined in the
-  // mapper), so it is left to the final refinement.
-  map.mapper.ba_refine_housing = options.housing.model == "FLATPORT";
+  // mapper), so it is left to the final refinement. Only with marker scale:
+  // without it the port distance is barely observed, and on a rendered
+  // survey (120 images, no markers) refining the port in the growing models
+  // split the reconstruction into 9 pieces instead of 3.
+  map.mapper.ba_refine_housing = options.housing.model == "FLATPORT" && options.marker_side_length_m > 0;
   const RefractiveMapperSummary mapped = RunRefractiveMapper(map, progress);
   result.num_registered = static_cast<int>(ReadSparseModel(mapped.model_paths.at(0)).images.size());
   lap("refractive_mapper");

@@ -35,7 +35,8 @@ struct IncrementalMapperOptions {
   // Self-calibrate the housing in the global adjustments that refine the
   // intrinsics, so that structure and port co-evolve (a model built under an
   // untilted guess absorbs the tilt into poses and points, and the final
-  // refinement may not climb out).
+  // refinement may not climb out). Wants a metric scale (markers): without
+  // one the port distance wanders and models split.
   bool ba_refine_housing = false;
   int ba_local_num_images = 6;
   double ba_global_images_ratio = 1.1;
