@@ -11,6 +11,7 @@
 #include "colmap_ext/io/mrcal_model.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/string_utils.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
@@ -21,14 +22,6 @@ namespace {
 
 const char* kMrcalParamNames[] = {"fx", "fy", "cx", "cy", "k1", "k2",
                                   "p1", "p2", "k3", "k4", "k5", "k6"};
-
-std::string Format(double value, int digits) {
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(digits);
-  out << value;
-  return out.str();
-}
 
 // Both calibrations in mrcal's parameterisation of the lens.
 std::vector<ParameterComparison> CompareParameters(const Camera& portcal,
@@ -130,8 +123,8 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views, const C
   out.verdict =
       out.worst_ratio <= 2.0
           ? "consistent: the folds differ by what their uncertainty predicts (worst ratio " +
-                Format(out.worst_ratio, 2) + ")"
-          : "NOT consistent: the folds differ by up to " + Format(out.worst_ratio, 2) +
+                FormatFixed(out.worst_ratio, 2) + ")"
+          : "NOT consistent: the folds differ by up to " + FormatFixed(out.worst_ratio, 2) +
                 "x what their uncertainty predicts; the lens model is too lean for this lens, "
                 "or the data carry a systematic error (board warp, outliers, rolling shutter)";
   return out;
@@ -208,7 +201,7 @@ CrossCheckResult CrossCheck(const CrossCheckerOptions& options) {
     if (resolve.mean_px > 0.01) {
       result.causes.push_back(
           "the input calibration is not portcal's solution of these observations (re-solving "
-          "from it moves the projection by " + Format(resolve.mean_px, 3) +
+          "from it moves the projection by " + FormatFixed(resolve.mean_px, 3) +
           " px on average): made from other views or settings?");
     }
   }
@@ -251,9 +244,9 @@ CrossCheckResult CrossCheck(const CrossCheckerOptions& options) {
   if (!result.pass || max_z > 3) {
     if (warp_cause) {
       result.causes.push_back(
-          "board warp: mrcal finds the board bent by x " + Format(mrcal.board_warp.x() * 1e3, 2) +
-          " +- " + Format(mrcal.board_warp_std_dev.x() * 1e3, 2) + " mm, y " +
-          Format(mrcal.board_warp.y() * 1e3, 2) + " +- " + Format(mrcal.board_warp_std_dev.y() * 1e3, 2) +
+          "board warp: mrcal finds the board bent by x " + FormatFixed(mrcal.board_warp.x() * 1e3, 2) +
+          " +- " + FormatFixed(mrcal.board_warp_std_dev.x() * 1e3, 2) + " mm, y " +
+          FormatFixed(mrcal.board_warp.y() * 1e3, 2) + " +- " + FormatFixed(mrcal.board_warp_std_dev.y() * 1e3, 2) +
           " mm, portcal holds it flat (camera_calibrator --Calibration.estimate_board_warp 1)");
     }
     if (outlier_cause) {

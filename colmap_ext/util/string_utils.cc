@@ -3,6 +3,8 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <iomanip>
+#include <sstream>
 
 #include "colmap_ext/util/error.h"
 
@@ -69,6 +71,12 @@ std::vector<double> ParseDoubleList(const std::string& s,
     values.push_back(ParseDouble(token, context));
   }
   return values;
+}
+
+std::string FormatFixed(double value, int digits) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(digits) << value;
+  return out.str();
 }
 
 }  // namespace portcal

@@ -18,5 +18,7 @@ long long ParseInteger(const std::string& token, const std::string& context,
 // "1.0, 2 3" -> {1, 2, 3}; throws InputError naming `context`.
 std::vector<double> ParseDoubleList(const std::string& s,
                                     const std::string& context);
+// `value` with `digits` digits after the point (std::fixed), for reports.
+std::string FormatFixed(double value, int digits);
 
 }  // namespace portcal

@@ -5,15 +5,10 @@
 #include <sstream>
 
 #include "colmap_ext/io/sparse_model.h"
+#include "colmap_ext/util/string_utils.h"
 
 namespace portcal {
 namespace {
-
-std::string Fixed(double value, int digits) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << value;
-  return out.str();
-}
 
 std::string Number(double value) {
   std::ostringstream out;
@@ -29,9 +24,9 @@ std::string Quoted(const std::string& text) {
 }
 
 std::string DiffLine(const ProjectionDiff& diff) {
-  return "mean " + Fixed(diff.mean_px, 3) + " px, p95 " + Fixed(diff.p95_px, 3) + " px, max " +
-         Fixed(diff.max_px, 3) + " px; worst: " + diff.worst_region + " (mean " +
-         Fixed(diff.worst_region_mean_px, 3) + " px)";
+  return "mean " + FormatFixed(diff.mean_px, 3) + " px, p95 " + FormatFixed(diff.p95_px, 3) + " px, max " +
+         FormatFixed(diff.max_px, 3) + " px; worst: " + diff.worst_region + " (mean " +
+         FormatFixed(diff.worst_region_mean_px, 3) + " px)";
 }
 
 void ParameterTable(std::ostream& out, const std::vector<ParameterComparison>& parameters) {
@@ -39,12 +34,12 @@ void ParameterTable(std::ostream& out, const std::vector<ParameterComparison>& p
   for (const ParameterComparison& p : parameters) {
     const std::string portcal_sd = p.portcal_std_dev == 0  ? std::string("(held)")
                                    : p.portcal_std_dev < 0 ? std::string("(undetermined)")
-                                                           : Fixed(p.portcal_std_dev, 6);
+                                                           : FormatFixed(p.portcal_std_dev, 6);
     out << "  " << std::left << std::setw(8) << p.name << std::right << " " << std::setw(16)
-        << Fixed(p.portcal, 6) << " " << std::setw(14) << portcal_sd << " " << std::setw(16)
-        << Fixed(p.mrcal, 6) << " " << std::setw(14) << Fixed(p.mrcal_std_dev, 6) << " "
-        << std::setw(15) << Fixed(p.mrcal - p.portcal, 6) << " " << std::setw(7)
-        << (std::isfinite(p.z) ? Fixed(p.z, 1) : std::string("-")) << "\n";
+        << FormatFixed(p.portcal, 6) << " " << std::setw(14) << portcal_sd << " " << std::setw(16)
+        << FormatFixed(p.mrcal, 6) << " " << std::setw(14) << FormatFixed(p.mrcal_std_dev, 6) << " "
+        << std::setw(15) << FormatFixed(p.mrcal - p.portcal, 6) << " " << std::setw(7)
+        << (std::isfinite(p.z) ? FormatFixed(p.z, 1) : std::string("-")) << "\n";
   }
 }
 
@@ -73,12 +68,12 @@ std::string YamlDiff(const ProjectionDiff& d, const std::string& indent) {
 
 std::string CrossCheckResult::Verdict() const {
   std::string line = std::string(pass ? "PASS" : "FAIL") + ": portcal vs mrcal projection diff p95 " +
-                     Fixed(diff.p95_px, 3) + " px " + (pass ? "<=" : ">") + " " +
-                     Fixed(max_diff_px, 3) + " px; worst region: " + diff.worst_region + " (mean " +
-                     Fixed(diff.worst_region_mean_px, 3) + " px)";
+                     FormatFixed(diff.p95_px, 3) + " px " + (pass ? "<=" : ">") + " " +
+                     FormatFixed(max_diff_px, 3) + " px; worst region: " + diff.worst_region + " (mean " +
+                     FormatFixed(diff.worst_region_mean_px, 3) + " px)";
   if (!pass && !causes.empty()) line += "; likely cause: " + causes.front();
   if (!pass && rerun_diff) {
-    line += "; " + rerun_description + ": p95 " + Fixed(rerun_diff->p95_px, 3) + " px (" +
+    line += "; " + rerun_description + ": p95 " + FormatFixed(rerun_diff->p95_px, 3) + " px (" +
             (rerun_diff->p95_px <= max_diff_px ? "agree" : "still disagree") + ")";
   }
   return line;
@@ -89,8 +84,8 @@ std::string CrossCheckText(const CrossCheckResult& r) {
   out << "portcal cross_check\n===================\n\n"
       << "Camera model " << r.camera_model << " (mrcal: " << r.mrcal_lensmodel << "), " << r.num_views
       << " views, " << r.num_points << " corners\n"
-      << "RMS reprojection error: portcal " << Fixed(r.portcal_rms_px, 4) << " px, mrcal "
-      << Fixed(r.mrcal_rms_px, 4) << " px (inliers)\n"
+      << "RMS reprojection error: portcal " << FormatFixed(r.portcal_rms_px, 4) << " px, mrcal "
+      << FormatFixed(r.mrcal_rms_px, 4) << " px (inliers)\n"
       << "mrcal rejected " << r.mrcal_outliers << " corners as outliers";
   if (!r.mrcal_outliers_per_view.empty()) {
     out << " (";
@@ -100,13 +95,13 @@ std::string CrossCheckText(const CrossCheckResult& r) {
     }
     out << ")";
   }
-  out << "\nBoard warp (parabolic sag, mm): mrcal x " << Fixed(r.mrcal_warp.x() * 1e3, 3) << " +- "
-      << Fixed(r.mrcal_warp_std_dev.x() * 1e3, 3) << ", y " << Fixed(r.mrcal_warp.y() * 1e3, 3)
-      << " +- " << Fixed(r.mrcal_warp_std_dev.y() * 1e3, 3);
+  out << "\nBoard warp (parabolic sag, mm): mrcal x " << FormatFixed(r.mrcal_warp.x() * 1e3, 3) << " +- "
+      << FormatFixed(r.mrcal_warp_std_dev.x() * 1e3, 3) << ", y " << FormatFixed(r.mrcal_warp.y() * 1e3, 3)
+      << " +- " << FormatFixed(r.mrcal_warp_std_dev.y() * 1e3, 3);
   if (r.portcal_warp) {
-    out << "; portcal x " << Fixed(r.portcal_warp->x() * 1e3, 3) << " +- "
-        << Fixed(r.portcal_warp_std_dev->x() * 1e3, 3) << ", y " << Fixed(r.portcal_warp->y() * 1e3, 3)
-        << " +- " << Fixed(r.portcal_warp_std_dev->y() * 1e3, 3);
+    out << "; portcal x " << FormatFixed(r.portcal_warp->x() * 1e3, 3) << " +- "
+        << FormatFixed(r.portcal_warp_std_dev->x() * 1e3, 3) << ", y " << FormatFixed(r.portcal_warp->y() * 1e3, 3)
+        << " +- " << FormatFixed(r.portcal_warp_std_dev->y() * 1e3, 3);
   } else {
     out << "; portcal: flat board";
   }
@@ -123,7 +118,7 @@ std::string CrossCheckText(const CrossCheckResult& r) {
     out << "\nRe-run: " << r.rerun_description << " (heat map projection_diff_rerun.png)\n  "
         << DiffLine(*r.rerun_diff) << "\n  "
         << (r.rerun_diff->p95_px <= r.max_diff_px ? "the two now agree" : "the two still disagree")
-        << " (threshold p95 " << Fixed(r.max_diff_px, 3) << " px)\n";
+        << " (threshold p95 " << FormatFixed(r.max_diff_px, 3) << " px)\n";
     ParameterTable(out, r.rerun_parameters);
   }
   for (const CrossValidation& cv : r.cross_validations) {
@@ -134,8 +129,8 @@ std::string CrossCheckText(const CrossCheckResult& r) {
     for (const FoldComparison& f : cv.pairs) {
       out << "  " << f.fold_a << " vs " << f.fold_b << "  " << std::setw(3) << f.views_a << "/"
           << std::left << std::setw(3) << f.views_b << std::right << std::setw(9)
-          << Fixed(f.mean_px, 3) << std::setw(7) << Fixed(f.p95_px, 3) << std::setw(17)
-          << Fixed(f.predicted_mean_px, 3) << std::setw(7) << Fixed(f.predicted_p95_px, 3) << "\n";
+          << FormatFixed(f.mean_px, 3) << std::setw(7) << FormatFixed(f.p95_px, 3) << std::setw(17)
+          << FormatFixed(f.predicted_mean_px, 3) << std::setw(7) << FormatFixed(f.predicted_p95_px, 3) << "\n";
     }
     out << "  " << cv.verdict << "\n";
   }
