@@ -95,6 +95,23 @@ void WriteDatabase(const fs::path& path, const Camera& camera, const std::vector
   }
 }
 
+// Stores the views, calibrates them with portcal's camera_calibrator (flat
+// board) and returns cross_check options on the result.
+CrossCheckerOptions CalibratedForCheck(const fs::path& dir, const std::vector<CalibrationView>& views,
+                                       bool drop_outlier_views = false) {
+  WriteDatabase(dir / "db.db", TruthCamera(), views);
+  CameraCalibratorOptions calibrate;
+  calibrate.database_path = (dir / "db.db").string();
+  calibrate.output_path = (dir / "cal").string();
+  calibrate.calibration.drop_outlier_views = drop_outlier_views;
+  CalibrateCameraStage(calibrate);
+  CrossCheckerOptions options;
+  options.database_path = calibrate.database_path;
+  options.input_calibration = (dir / "cal/calibration.yaml").string();
+  options.output_path = (dir / "check").string();
+  return options;
+}
+
 std::vector<Rigid3d> Poses(const CameraCalibrationResult& result) {
   std::vector<Rigid3d> poses;
   for (const CalibratedView& v : result.views) poses.push_back(v.cam_from_target);
@@ -207,17 +224,7 @@ TEST(CrossCheck, WarpedBoardIsCaughtAndExplained) {
   testing::TempDir dir;
   const Camera truth = TruthCamera();
   const Eigen::Vector2d warp(0.0, 0.5e-3);
-  const auto views = SyntheticViews(truth, warp, 0.1, 18, 4);
-  WriteDatabase(dir / "db.db", truth, views);
-  CameraCalibratorOptions calibrate;
-  calibrate.database_path = (dir / "db.db").string();
-  calibrate.output_path = (dir / "cal").string();
-  CalibrateCameraStage(calibrate);
-
-  CrossCheckerOptions options;
-  options.database_path = (dir / "db.db").string();
-  options.input_calibration = (dir / "cal/calibration.yaml").string();
-  options.output_path = (dir / "check").string();
+  CrossCheckerOptions options = CalibratedForCheck(dir.path(), SyntheticViews(truth, warp, 0.1, 18, 4));
   options.folds = 2;
   const CrossCheckResult result = CrossCheck(options);
   EXPECT_FALSE(result.pass) << result.Verdict();
@@ -253,17 +260,7 @@ TEST(CrossCheck, ViewsDroppedByTheInputStayOut) {
   std::mt19937 rng(8);
   std::normal_distribution<double> blur(0, 3.0);
   for (Eigen::Vector2d& pixel : views[4].pixels) pixel += Eigen::Vector2d(blur(rng), blur(rng));
-  WriteDatabase(dir / "db.db", truth, views);
-  CameraCalibratorOptions calibrate;
-  calibrate.database_path = (dir / "db.db").string();
-  calibrate.output_path = (dir / "cal").string();
-  calibrate.calibration.drop_outlier_views = true;
-  CalibrateCameraStage(calibrate);
-  CrossCheckerOptions options;
-  options.database_path = (dir / "db.db").string();
-  options.input_calibration = (dir / "cal/calibration.yaml").string();
-  options.output_path = (dir / "check").string();
-  const CrossCheckResult result = CrossCheck(options);
+  const CrossCheckResult result = CrossCheck(CalibratedForCheck(dir.path(), views, true));
   EXPECT_EQ(result.num_views, 11);
   EXPECT_TRUE(result.pass) << result.Verdict();
   EXPECT_TRUE(result.causes.empty()) << result.causes.front();
@@ -272,15 +269,8 @@ TEST(CrossCheck, ViewsDroppedByTheInputStayOut) {
 TEST(CrossCheck, BadOptionsAndModelsAreNamed) {
   testing::TempDir dir;
   const Camera truth = TruthCamera();
-  WriteDatabase(dir / "db.db", truth, SyntheticViews(truth, Eigen::Vector2d::Zero(), 0.1, 5, 5));
-  CameraCalibratorOptions calibrate;
-  calibrate.database_path = (dir / "db.db").string();
-  calibrate.output_path = (dir / "cal").string();
-  CalibrateCameraStage(calibrate);
-  CrossCheckerOptions options;
-  options.database_path = (dir / "db.db").string();
-  options.input_calibration = (dir / "cal/calibration.yaml").string();
-  options.output_path = (dir / "check").string();
+  CrossCheckerOptions options =
+      CalibratedForCheck(dir.path(), SyntheticViews(truth, Eigen::Vector2d::Zero(), 0.1, 5, 5));
   options.folds = 1;
   EXPECT_THROW(CrossCheck(options), OptionError);
   options.folds = 3;  // 5 views: folds of 2
