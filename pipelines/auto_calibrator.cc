@@ -4,6 +4,7 @@
 
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "database/database.h"
 
 namespace fs = std::filesystem;
 
@@ -25,6 +26,27 @@ void AutoCalibratorOptions::Check() const {
     throw OptionError("--Markers.side_length", std::to_string(marker_side_length_m), ">= 0 m");
   }
 }
+
+namespace {
+
+// Without given intrinsics the database camera starts at the image reader's
+// guess (1.2 x the larger image side). Two-view verification estimates E on
+// rays normalised with it, so a wrong guess shapes which pairs and inliers
+// the mapper gets (own renders: the same seed failed from 1152 px and
+// calibrated when verified with 609 px). The markers give a far better
+// start: it is written to the database camera before matching.
+void StartFocalFromMarkers(const std::string& database_path, const HousingOverride& housing) {
+  Database database(database_path, Database::OpenMode::kReadWrite);
+  const SfmInputs inputs = SfmInputs::Read(&database);
+  std::map<camera_t, SfmCamera> cameras = inputs.cameras;
+  ApplyHousingOverride(housing, &cameras);
+  InitializeFocalFromMarkers(inputs, 1, &cameras);
+  Transaction transaction = database.BeginTransaction();
+  for (const auto& [id, camera] : cameras) database.UpdateCamera(camera.camera);
+  transaction.Commit();
+}
+
+}  // namespace
 
 AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, ProgressSink& progress) {
   options.Check();
@@ -61,6 +83,8 @@ AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
     MaskFeatures(mask, progress);
     lap("feature_masker");
   }
+
+  if (!intrinsics_given) StartFocalFromMarkers(database_path, options.housing);
 
   FeatureMatcherOptions match;
   match.database_path = database_path;
