@@ -195,6 +195,8 @@ DatabaseImage ImageFromRow(const Statement& stmt) {
         QuaternionFromWxyz(Eigen::Vector4d(prior[0], prior[1], prior[2], prior[3]))
             .normalized(),
         Eigen::Vector3d(prior[4], prior[5], prior[6]));
+  } else if (std::isfinite(prior[4]) && std::isfinite(prior[5]) && std::isfinite(prior[6])) {
+    image.position_prior = Eigen::Vector3d(prior[4], prior[5], prior[6]);
   }
   return image;
 }
@@ -238,11 +240,32 @@ image_t Database::WriteImage(const DatabaseImage& image, bool use_image_id) {
     for (int i = 0; i < 3; ++i) {
       stmt.Bind(8 + i, image.cam_from_world_prior->translation[i]);
     }
+  } else if (image.position_prior) {
+    for (int i = 4; i <= 7; ++i) stmt.BindNull(i);
+    for (int i = 0; i < 3; ++i) stmt.Bind(8 + i, (*image.position_prior)[i]);
   } else {
     for (int i = 4; i <= 10; ++i) stmt.BindNull(i);
   }
   stmt.Execute();
   return static_cast<image_t>(sqlite3_last_insert_rowid(db_));
+}
+
+void Database::UpdatePositionPrior(image_t image_id, const std::optional<Eigen::Vector3d>& position) {
+  Statement& stmt = Prepare("update_position_prior",
+                            "UPDATE images SET prior_qw=NULL, prior_qx=NULL, prior_qy=NULL, "
+                            "prior_qz=NULL, prior_tx=?, prior_ty=?, prior_tz=? WHERE image_id=?;");
+  for (int i = 0; i < 3; ++i) {
+    if (position) {
+      stmt.Bind(1 + i, (*position)[i]);
+    } else {
+      stmt.BindNull(1 + i);
+    }
+  }
+  stmt.Bind(4, static_cast<int64_t>(image_id));
+  stmt.Execute();
+  if (sqlite3_changes(db_) != 1) {
+    throw InputError(path_ + ": no image with id " + std::to_string(image_id) + " for a position prior");
+  }
 }
 
 std::optional<DatabaseImage> Database::ReadImage(image_t image_id) {

@@ -53,6 +53,9 @@ class Database {
 
   image_t WriteImage(const DatabaseImage& image, bool use_image_id = false);
   std::optional<DatabaseImage> ReadImage(image_t image_id);
+  // Sets (or, with nullopt, clears) an image's position prior; clears any
+  // full pose prior.
+  void UpdatePositionPrior(image_t image_id, const std::optional<Eigen::Vector3d>& position);
   std::optional<DatabaseImage> ReadImageWithName(const std::string& name);
   std::vector<DatabaseImage> ReadAllImages();
 

@@ -54,4 +54,9 @@ void PairIdToImagePair(image_pair_t pair_id, image_t* image_id1,
   *image_id1 = static_cast<image_t>((pair_id - *image_id2) / kMaxNumImages);
 }
 
+std::optional<Eigen::Vector3d> DatabaseImage::PriorPosition() const {
+  if (cam_from_world_prior) return cam_from_world_prior->Inverse().translation;
+  return position_prior;
+}
+
 }  // namespace portcal

@@ -71,6 +71,14 @@ struct DatabaseImage {
   camera_t camera_id = kInvalidCameraId;
   // Optional pose prior (prior_qw..prior_tz); NULL columns when absent.
   std::optional<Rigid3d> cam_from_world_prior;
+  // Optional position prior, the camera centre in the world (navigation,
+  // GPS), metres: prior_tx..tz with prior_q NULL, as COLMAP 3.8 stores the
+  // positions it reads from EXIF GPS. Ignored when cam_from_world_prior is
+  // set (its centre is the position).
+  std::optional<Eigen::Vector3d> position_prior;
+
+  // The prior's camera centre, from either form.
+  std::optional<Eigen::Vector3d> PriorPosition() const;
 };
 
 // portcal_target_observations: a target point seen in an image.

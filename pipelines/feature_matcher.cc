@@ -77,6 +77,7 @@ std::string OptionsText(const FeatureMatcherOptions& o) {
   out << "SiftMatching.max_ratio=" << o.matching.max_ratio
       << "\nSiftMatching.max_distance=" << o.matching.max_distance
       << "\nSiftMatching.cross_check=" << o.matching.cross_check
+      << "\nSiftMatching.method=" << o.matching.method
       << "\nTwoViewGeometry.max_error=" << o.verification.max_error
       << "\nTwoViewGeometry.min_num_inliers=" << o.verification.min_num_inliers;
   if (o.mode == "sequential") {

@@ -4,6 +4,7 @@
 
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "pipelines/sfm/position_priors.h"
 
 namespace fs = std::filesystem;
 
@@ -20,6 +21,9 @@ void RefractiveBundleAdjusterOptions::Check() const {
   }
   if (!(marker_scale.sigma_m > 0)) {
     throw OptionError("--Markers.side_sigma", std::to_string(marker_scale.sigma_m), "> 0 m");
+  }
+  if (ba.position_prior_sigma_m > 0 && database_path.empty()) {
+    throw OptionError("--database_path", "''", "the database with the position priors (--PosePrior.position_sigma)");
   }
   if (!(max_reproj_error_px > 0)) {
     throw OptionError("--BundleAdjustment.max_reproj_error", std::to_string(max_reproj_error_px), "> 0 px");
@@ -73,6 +77,7 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
       const auto row = database.ReadImageWithName(image.name);
       if (!row) continue;
       image.markers = database.ReadMarkerDetections(row->image_id);
+      image.position_prior = row->PriorPosition();
       // The keypoints' scales, for weighting, when the model's points are
       // the database's keypoints.
       const FeatureKeypoints keypoints = database.ReadKeypoints(row->image_id);
@@ -88,6 +93,19 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
   }
   Reconstruction r = Reconstruction::FromSparseModel(&inputs, model);
   RefractiveBundleAdjusterResult result;
+  const bool use_priors = options.ba.position_prior_sigma_m > 0;
+  if (use_priors) {
+    const auto alignment = AlignToPositionPriors(&r, 5 * options.ba.position_prior_sigma_m);
+    if (!alignment) {
+      throw InputError(options.database_path + ": fewer than 3 registered images of " + options.input_path +
+                       " have position priors, or their positions are collinear; the scale cannot come "
+                       "from --PosePrior.position_sigma (run pose_prior_importer, or set it to 0)");
+    }
+    result.num_position_priors = alignment->num_inliers;
+    LOG(INFO) << "refractive_bundle_adjuster: aligned to " << alignment->num_inliers << " of "
+              << alignment->num_priors << " position priors (scale " << alignment->new_from_old.scale
+              << ", RMS " << alignment->rms_m << " m)";
+  }
   std::vector<MarkerCorner> markers;
   if (options.marker_scale.side_length_m > 0) {
     markers = TriangulateMarkerCorners(r, 4 * options.max_reproj_error_px);
@@ -99,7 +117,7 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
     LOG(INFO) << "refractive_bundle_adjuster: " << markers.size() << " marker corners give the scale";
   }
 
-  if (options.ba.refine_housing && options.marker_scale.side_length_m <= 0) {
+  if (options.ba.refine_housing && options.marker_scale.side_length_m <= 0 && !use_priors) {
     LOG(WARNING) << "refractive_bundle_adjuster: no marker scale (--Markers.side_length): the model's scale "
                     "is arbitrary, so a flat port's distance and a dome's decentering are not in metres "
                     "(refraction observes the scale only weakly)";
@@ -158,10 +176,13 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
   for (double& v : report.parameters_std_dev) if (!std::isfinite(v)) v = 0.0;
   for (double& v : report.housing_std_dev) if (!std::isfinite(v)) v = 0.0;
   report.residual_sigma_px = std_devs.sigma0;
-  report.target_description = options.marker_scale.side_length_m > 0
-                                  ? "auto-calibration (SIFT points, ArUco markers of side " +
-                                        std::to_string(options.marker_scale.side_length_m) + " m give the scale)"
-                                  : "auto-calibration (SIFT points; no metric scale)";
+  report.target_description =
+      options.marker_scale.side_length_m > 0
+          ? "auto-calibration (SIFT points, ArUco markers of side " +
+                std::to_string(options.marker_scale.side_length_m) + " m give the scale)"
+          : use_priors ? "self-calibration (SIFT points; position priors of sigma " +
+                             std::to_string(options.ba.position_prior_sigma_m) + " m give the scale)"
+                       : "auto-calibration (SIFT points; no metric scale)";
   double sum_sq = 0;
   int64_t count = 0;
   std::map<image_t, std::pair<double, int>> per_image;

@@ -6,7 +6,10 @@
 // database the markers were detected into, the marker corners join the
 // adjustment as points whose distances equal the known side, which fixes the
 // scale: the flat-port distance and dome decentering then come out in
-// metres. Writes the adjusted model and calibration.yaml / .txt.
+// metres. Or, with --PosePrior.position_sigma and the database holding
+// position priors (pose_prior_importer), the model is aligned to the priors
+// and they join the adjustment: a survey's scale from its navigation.
+// Writes the adjusted model and calibration.yaml / .txt.
 #pragma once
 
 #include <string>
@@ -38,6 +41,7 @@ struct RefractiveBundleAdjusterOptions {
 struct RefractiveBundleAdjusterResult {
   CalibrationReport report;  // of the first camera
   int num_marker_corners = 0;
+  int num_position_priors = 0;  // images whose priors fixed the frame
   int num_filtered = 0;
 };
 

@@ -4,6 +4,7 @@
 namespace portcal {
 
 int RunDatabaseCreator(int argc, char** argv);
+int RunPosePriorImporter(int argc, char** argv);
 int RunModelConverter(int argc, char** argv);
 int RunProjectPoints(int argc, char** argv);
 int RunSynthesize(int argc, char** argv);

@@ -1,4 +1,5 @@
 #include "pipelines/database_creator.h"
+#include "pipelines/pose_prior_importer.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 
@@ -13,6 +14,20 @@ int RunDatabaseCreator(int argc, char** argv) {
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
     CreateDatabase(database_path);
+  });
+}
+
+int RunPosePriorImporter(int argc, char** argv) {
+  PosePriorImporterOptions options;
+  CommandLine cli("pose_prior_importer",
+                  "Stores navigation positions (camera centres, metres, a local Cartesian frame) as the "
+                  "images' position priors, from a file of 'NAME X Y Z' lines. The refractive bundle "
+                  "adjuster takes the scale from them (--PosePrior.position_sigma).");
+  cli.AddRequired("database_path", &options.database_path, "database with the images");
+  cli.AddRequired("input_path", &options.input_path, "file of 'NAME X Y Z' lines");
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    ImportPosePriors(options);
   });
 }
 

@@ -60,6 +60,10 @@ void AddMatchingOptions(CommandLine* cli, FeatureMatcherOptions* options) {
   cli->Add("SiftMatching.max_distance", &options->matching.max_distance, "max descriptor angle, radians");
   cli->Add("SiftMatching.cross_check", &options->matching.cross_check, "mutual matches only (0 | 1)");
   cli->Add("SiftMatching.max_num_matches", &options->matching.max_num_matches, "per pair");
+  cli->Add("SiftMatching.method", &options->matching.method,
+           "brute_force (exact) | kdtree (approximate, FLANN)");
+  cli->Add("SiftMatching.kdtree_num_trees", &options->matching.kdtree_num_trees, "randomized k-d trees");
+  cli->Add("SiftMatching.kdtree_num_checks", &options->matching.kdtree_num_checks, "leaves visited per query");
   cli->Add("TwoViewGeometry.max_error", &options->verification.max_error, "RANSAC threshold, pixels");
   cli->Add("TwoViewGeometry.confidence", &options->verification.confidence, "RANSAC confidence");
   cli->Add("TwoViewGeometry.max_num_trials", &options->verification.max_num_trials, "RANSAC iterations");

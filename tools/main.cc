@@ -22,6 +22,8 @@ const std::vector<Command>& Commands() {
   static const std::vector<Command> kCommands = {
       {"database_creator", portcal::RunDatabaseCreator,
        "create a COLMAP 3.8 database with portcal's tables"},
+      {"pose_prior_importer", portcal::RunPosePriorImporter,
+       "store navigation positions as the images' position priors"},
       {"model_converter", portcal::RunModelConverter,
        "convert sparse models between BIN and TXT (and import the refractive "
        "fork's cameras.txt)"},

@@ -82,16 +82,18 @@ int RunRefractiveBundleAdjuster(int argc, char** argv) {
                   "Bundle adjustment of a sparse model that self-calibrates the housing (flat: "
                   "normal + distance; dome: decentering) and optionally the intrinsics, with "
                   "standard deviations. --Markers.side_length (with --database_path) fixes the "
-                  "scale by the ArUco markers. Writes the model and calibration.yaml/.txt.");
+                  "scale by the ArUco markers, --PosePrior.position_sigma by the images' position priors. Writes the model and calibration.yaml/.txt.");
   cli.AddRequired("input_path", &options.input_path, "sparse model (+ housings.txt)");
   cli.AddRequired("output_path", &options.output_path, "directory for the model and reports");
-  cli.Add("database_path", &options.database_path, "database with marker detections (for the scale)");
+  cli.Add("database_path", &options.database_path, "database with marker detections or position priors (scale)");
   cli.Add("Housing.model", &options.housing.model, "FLATPORT | DOMEPORT replacing the model's housings");
   cli.Add("Housing.params", &options.housing.params, "housing parameters (first guess)");
   cli.Add("Markers.side_length", &options.marker_scale.side_length_m, "ArUco marker side, metres (0: no scale)");
   cli.Add("Markers.side_sigma", &options.marker_scale.sigma_m, "uncertainty of a marker side, metres");
   cli.Add("Markers.corner_sigma", &options.ba.marker_sigma_px, "uncertainty of a marker corner, px");
   cli.Add("BundleAdjustment.max_reproj_error", &options.max_reproj_error_px, "observations beyond are dropped");
+  cli.Add("PosePrior.position_sigma", &options.ba.position_prior_sigma_m,
+          "position priors' uncertainty, metres (0: unused); they give the scale");
   AddBundleOptions(&cli, &options.ba);
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;

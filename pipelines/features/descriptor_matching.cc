@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include <opencv2/core.hpp>
+#include <opencv2/flann.hpp>
+
 #include "colmap_ext/util/error.h"
 
 namespace portcal {
@@ -17,6 +20,15 @@ void DescriptorMatchingOptions::Check() const {
   }
   if (max_num_matches < 1) {
     throw OptionError("--SiftMatching.max_num_matches", std::to_string(max_num_matches), ">= 1");
+  }
+  if (method != "brute_force" && method != "kdtree") {
+    throw OptionError("--SiftMatching.method", method, "brute_force or kdtree");
+  }
+  if (kdtree_num_trees < 1) {
+    throw OptionError("--SiftMatching.kdtree_num_trees", std::to_string(kdtree_num_trees), ">= 1");
+  }
+  if (kdtree_num_checks < 1) {
+    throw OptionError("--SiftMatching.kdtree_num_checks", std::to_string(kdtree_num_checks), ">= 1");
   }
 }
 
@@ -36,25 +48,18 @@ struct Nearest {
   float best = -2, second = -2;  // dot products (larger is closer)
 };
 
-}  // namespace
-
-FeatureMatches MatchDescriptors(const UnitDescriptors& descriptors1,
-                                const UnitDescriptors& descriptors2,
-                                const DescriptorMatchingOptions& options) {
+void NearestBruteForce(const UnitDescriptors& descriptors1, const UnitDescriptors& descriptors2,
+                       std::vector<Nearest>* nearest1, std::vector<Nearest>* nearest2) {
   const Eigen::Index n1 = descriptors1.rows(), n2 = descriptors2.rows();
-  FeatureMatches matches;
-  if (n1 == 0 || n2 == 0) return matches;
   // Dot products in blocks of rows so that memory stays bounded for large
   // feature counts; columns' best rows are tracked for the cross check.
-  std::vector<Nearest> nearest1(static_cast<size_t>(n1));
-  std::vector<Nearest> nearest2(static_cast<size_t>(n2));
   constexpr Eigen::Index kBlock = 1024;
   Eigen::MatrixXf dots;
   for (Eigen::Index start = 0; start < n1; start += kBlock) {
     const Eigen::Index rows = std::min(kBlock, n1 - start);
     dots.noalias() = descriptors1.middleRows(start, rows) * descriptors2.transpose();
     for (Eigen::Index r = 0; r < rows; ++r) {
-      Nearest& a = nearest1[static_cast<size_t>(start + r)];
+      Nearest& a = (*nearest1)[static_cast<size_t>(start + r)];
       for (Eigen::Index c = 0; c < n2; ++c) {
         const float d = dots(r, c);
         if (d > a.best) {
@@ -64,7 +69,7 @@ FeatureMatches MatchDescriptors(const UnitDescriptors& descriptors1,
         } else if (d > a.second) {
           a.second = d;
         }
-        Nearest& b = nearest2[static_cast<size_t>(c)];
+        Nearest& b = (*nearest2)[static_cast<size_t>(c)];
         if (d > b.best) {
           b.second = b.best;
           b.best = d;
@@ -74,6 +79,43 @@ FeatureMatches MatchDescriptors(const UnitDescriptors& descriptors1,
         }
       }
     }
+  }
+}
+
+// The two nearest rows of `data` for each row of `queries`, by k-d trees.
+// FLANN's L2 distances are squared; for unit vectors dot = 1 - d^2 / 2.
+void NearestKdTree(const UnitDescriptors& data, const UnitDescriptors& queries,
+                   const DescriptorMatchingOptions& options, std::vector<Nearest>* nearest) {
+  const cv::Mat data_mat(static_cast<int>(data.rows()), 128, CV_32F, const_cast<float*>(data.data()));
+  const cv::Mat query_mat(static_cast<int>(queries.rows()), 128, CV_32F, const_cast<float*>(queries.data()));
+  const int k = data.rows() > 1 ? 2 : 1;
+  cv::flann::Index index(data_mat, cv::flann::KDTreeIndexParams(options.kdtree_num_trees));
+  cv::Mat indices, distances;
+  index.knnSearch(query_mat, indices, distances, k, cv::flann::SearchParams(options.kdtree_num_checks));
+  for (int q = 0; q < query_mat.rows; ++q) {
+    Nearest& n = (*nearest)[static_cast<size_t>(q)];
+    n.index = indices.at<int>(q, 0);
+    if (n.index < 0) continue;
+    n.best = 1.0f - 0.5f * distances.at<float>(q, 0);
+    if (k == 2 && indices.at<int>(q, 1) >= 0) n.second = 1.0f - 0.5f * distances.at<float>(q, 1);
+  }
+}
+
+}  // namespace
+
+FeatureMatches MatchDescriptors(const UnitDescriptors& descriptors1,
+                                const UnitDescriptors& descriptors2,
+                                const DescriptorMatchingOptions& options) {
+  const Eigen::Index n1 = descriptors1.rows(), n2 = descriptors2.rows();
+  FeatureMatches matches;
+  if (n1 == 0 || n2 == 0) return matches;
+  std::vector<Nearest> nearest1(static_cast<size_t>(n1));
+  std::vector<Nearest> nearest2(static_cast<size_t>(n2));
+  if (options.method == "kdtree") {
+    NearestKdTree(descriptors2, descriptors1, options, &nearest1);
+    if (options.cross_check) NearestKdTree(descriptors1, descriptors2, options, &nearest2);
+  } else {
+    NearestBruteForce(descriptors1, descriptors2, &nearest1, &nearest2);
   }
   const auto angle = [](float dot) { return std::acos(std::min(1.0f, std::max(-1.0f, dot))); };
   for (Eigen::Index i = 0; i < n1; ++i) {

@@ -118,6 +118,9 @@ void SurveyOptions::Check() const {
     throw OptionError("survey.relief_wavelength", std::to_string(relief_wavelength_m), "> 0 m");
   }
   if (!(texel_m > 0)) throw OptionError("survey.texel", std::to_string(texel_m), "> 0 m");
+  if (!(navigation_sigma_m >= 0)) {
+    throw OptionError("survey.navigation_sigma", std::to_string(navigation_sigma_m), ">= 0 m");
+  }
 }
 
 SurveyPath PlanSurvey(const Camera& camera, const Housing* housing, const SurveyOptions& options) {

@@ -47,6 +47,9 @@ struct SurveyOptions {
   double relief_wavelength_m = 2.0;  // > 0
   double texel_m = 0.004;       // seabed texture resolution, > 0
   uint64_t texture_seed = 21;
+  // Noise of the navigation positions written beside the images
+  // (navigation.txt, per axis), metres: a DVL-aided INS over a short survey.
+  double navigation_sigma_m = 0.02;
   void Check() const;
 };
 

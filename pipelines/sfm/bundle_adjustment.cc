@@ -13,6 +13,7 @@
 #include "pipelines/sfm/bundle_costs.h"
 #include "pipelines/sfm/bundle_costs_fixed.h"
 #include "pipelines/sfm/calibration_covariance.h"
+#include "pipelines/sfm/position_priors.h"
 #include "pipelines/sfm/ray_geometry.h"
 
 namespace portcal {
@@ -23,6 +24,9 @@ void BundleAdjustmentOptions::Check() const {
     throw OptionError("--BundleAdjustment.max_num_iterations", std::to_string(max_num_iterations), ">= 1");
   }
   if (!(loss_scale >= 0)) throw OptionError("--BundleAdjustment.loss_scale", std::to_string(loss_scale), ">= 0");
+  if (!(position_prior_sigma_m >= 0)) {
+    throw OptionError("--PosePrior.position_sigma", std::to_string(position_prior_sigma_m), ">= 0 m");
+  }
   if (!(function_tolerance > 0)) {
     throw OptionError("--BundleAdjustment.function_tolerance", std::to_string(function_tolerance), "> 0");
   }
@@ -239,6 +243,20 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
     }
   }
 
+  // Position priors: residuals on the camera centres, robust (a navigation
+  // fix can jump) at 3 sigma.
+  const bool use_priors = !local && options.position_prior_sigma_m > 0 &&
+                          NumUsablePositionPriors(*reconstruction) > 0;
+  if (use_priors) {
+    for (auto& [id, block] : pose_blocks) {
+      const auto& prior = reconstruction->inputs().images.at(id).position_prior;
+      if (!prior || !problem.HasParameterBlock(block.data())) continue;
+      problem.AddResidualBlock(CreatePositionPriorCost(*prior, options.position_prior_sigma_m),
+                               new ceres::HuberLoss(3.0), block.data());
+      num_residuals += 3;
+    }
+  }
+
   // Poses: manifold; constant outside the local scope; the gauge.
   // Gauge: the first registered image is held. The scale is held by the
   // markers, or by a second held image (a local adjustment's neighbours), or
@@ -264,10 +282,10 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
       scale_image = id;
     }
   }
-  const bool hold_scale = !use_markers && num_held < 2 && scale_image != first;
+  const bool hold_scale = !use_priors && !use_markers && num_held < 2 && scale_image != first;
   for (auto& [id, block] : pose_blocks) {
     if (!problem.HasParameterBlock(block.data())) continue;
-    if (!is_variable(id) || id == first) {
+    if (!is_variable(id) || (id == first && !use_priors)) {
       problem.SetParameterBlockConstant(block.data());
       continue;
     }

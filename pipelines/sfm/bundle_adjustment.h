@@ -24,6 +24,10 @@ struct BundleAdjustmentOptions {
   bool scale_weighting = true;        // sigma grows with the keypoint's scale (above 2 px)
   double marker_sigma_px = 1.0;       // of an ArUco marker corner (edge-refined)
   double loss_scale = 1.0;            // Cauchy loss scale, in sigma; <= 0: no robust loss
+  // > 0: in global adjustments, the registered images' position priors are
+  // residuals with this standard deviation (metres) and hold the gauge
+  // (align the model to them first: AlignToPositionPriors).
+  double position_prior_sigma_m = 0;
   int max_num_iterations = 100;
   double function_tolerance = 1e-8;  // relative cost change that ends the solve
   int num_threads = 2;
@@ -69,8 +73,10 @@ struct CalibrationStdDevs {
 // max_extra_param 1) of `after` against `before`; says why in `why`.
 bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::string* why = nullptr);
 
-// Adjusts in place. The gauge: the first registered image's pose is held,
-// and, without marker scale, one translation coordinate of the second.
+// Adjusts in place. The gauge: the position priors (global adjustments with
+// position_prior_sigma_m > 0 and priors spanning a plane), else the first
+// registered image's pose is held, and, without marker scale, one
+// translation coordinate of the second.
 // Returns Ceres' summary; throws NumericalError if the solve fails.
 ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const BundleAdjustmentOptions& options,
                                     const BundleAdjustmentScope& scope, std::vector<MarkerCorner>* markers,

@@ -27,6 +27,7 @@ SfmInputs SfmInputs::Read(Database* database) {
     }
     image.correspondences.resize(image.keypoints.size());
     image.markers = database->ReadMarkerDetections(row.image_id);
+    image.position_prior = row.PriorPosition();
   }
   for (const auto& [pair_id, geometry] : database->ReadTwoViewGeometries()) {
     if (geometry.inlier_matches.empty()) continue;

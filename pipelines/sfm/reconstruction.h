@@ -36,6 +36,8 @@ struct SfmImage {
   std::vector<float> scales;                            // SIFT scale per keypoint (empty: unknown)
   std::vector<std::vector<Correspondence>> correspondences;  // per keypoint
   std::vector<MarkerDetection> markers;
+  // Where navigation says the camera centre was (world frame, metres).
+  std::optional<Eigen::Vector3d> position_prior;
   int num_correspondences = 0;  // keypoints with at least one
 };
 

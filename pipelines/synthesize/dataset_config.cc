@@ -220,6 +220,7 @@ DatasetConfig ReadDatasetConfig(const std::filesystem::path& path) {
     reader.Optional(s, "survey.", "roughness", &o.roughness_m);
     reader.Optional(s, "survey.", "relief_wavelength", &o.relief_wavelength_m);
     reader.Optional(s, "survey.", "texel", &o.texel_m);
+    reader.Optional(s, "survey.", "navigation_sigma", &o.navigation_sigma_m);
     int64_t texture_seed = static_cast<int64_t>(o.texture_seed);
     reader.Optional(s, "survey.", "seed", &texture_seed);
     o.texture_seed = static_cast<uint64_t>(texture_seed);

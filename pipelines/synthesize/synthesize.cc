@@ -203,6 +203,30 @@ std::string ExtraYaml(const DatasetConfig& config, const Clutter* clutter, const
   return out.str();
 }
 
+// A survey's navigation: each image's camera centre plus Gaussian noise per
+// axis, as pose_prior_importer reads it (names relative to images/).
+std::string NavigationText(const GroundTruth& truth, double sigma_m, uint64_t seed) {
+  std::mt19937_64 rng(seed * 7919ULL + 17ULL);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::ostringstream out;
+  out << "# NAME X Y Z: camera centres in the seabed frame (z up), metres, with noise of sigma "
+      << sigma_m << " m per axis\n";
+  out.precision(9);
+  const auto line = [&](const std::string& file, const Rigid3d& cam_from_world) {
+    const Eigen::Vector3d centre = cam_from_world.Inverse().translation;
+    const std::string prefix = "images/";
+    const std::string name = file.rfind(prefix, 0) == 0 ? file.substr(prefix.size()) : file;
+    out << name;
+    for (int k = 0; k < 3; ++k) out << " " << centre[k] + sigma_m * noise(rng);
+    out << "\n";
+  };
+  for (const FrameTruth& frame : truth.images) {
+    line(frame.cam1.file, frame.cam1.cam_from_target);
+    if (frame.cam2) line(frame.cam2->file, frame.cam2->cam_from_target);
+  }
+  return out.str();
+}
+
 void WriteImage(const fs::path& path, const cv::Mat& image) {
   if (!cv::imwrite(path.string(), image)) throw InputError(path.string() + ": cannot write image");
 }
@@ -338,6 +362,10 @@ SynthesizeSummary Synthesize(const SynthesizeOptions& options, ProgressSink& pro
 
   WriteGroundTruth(truth, staging / "ground_truth.yaml",
                    ExtraYaml(config, clutter ? &*clutter : nullptr, config.survey ? &survey : nullptr));
+  if (config.survey) {
+    const std::string navigation = NavigationText(truth, config.survey_options.navigation_sigma_m, config.seed);
+    WriteFileAtomically(staging / "navigation.txt", false, [&](std::ostream& out) { out << navigation; });
+  }
   if (!config.survey && config.target.type == "target3d") {
     const std::string csv = DotsCsv(target.dots);
     WriteFileAtomically(staging / "target_dots.csv", false, [&](std::ostream& out) { out << csv; });
@@ -345,7 +373,7 @@ SynthesizeSummary Synthesize(const SynthesizeOptions& options, ProgressSink& pro
   fs::copy_file(options.config_path, staging / "config_used.yaml", fs::copy_options::overwrite_existing);
 
   // Move the finished set into place.
-  for (const char* entry : {"images", "ground_truth.yaml", "target_dots.csv", "config_used.yaml"}) {
+  for (const char* entry : {"images", "ground_truth.yaml", "target_dots.csv", "config_used.yaml", "navigation.txt"}) {
     if (!fs::exists(staging / entry)) continue;
     fs::remove_all(output / entry);
     fs::rename(staging / entry, output / entry);

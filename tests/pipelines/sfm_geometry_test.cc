@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "colmap_ext/util/error.h"
 #include "colmap_ext/util/parallel.h"
 #include "pipelines/feature_masker.h"
 #include "pipelines/features/descriptor_matching.h"
@@ -74,13 +75,19 @@ TEST(DescriptorMatching, FindsMutualNearestNeighboursAndRejectsAmbiguousOnes) {
   for (int i = 0; i < 50; ++i) {
     for (int c = 0; c < 128; ++c) b(perm[i], c) = static_cast<uint8_t>(std::min(255, a(i, c) + (c % 3 == 0)));
   }
-  const FeatureMatches matches = MatchDescriptors(ToUnitDescriptors(a), ToUnitDescriptors(b),
-                                                  DescriptorMatchingOptions());
-  EXPECT_EQ(matches.size(), 48u);
-  for (const FeatureMatch& m : matches) {
-    EXPECT_GE(m.point2D_idx1, 2u);
-    EXPECT_EQ(static_cast<int>(m.point2D_idx2), perm[m.point2D_idx1]);
+  for (const char* method : {"brute_force", "kdtree"}) {
+    DescriptorMatchingOptions options;
+    options.method = method;
+    const FeatureMatches matches = MatchDescriptors(ToUnitDescriptors(a), ToUnitDescriptors(b), options);
+    EXPECT_EQ(matches.size(), 48u) << method;
+    for (const FeatureMatch& m : matches) {
+      EXPECT_GE(m.point2D_idx1, 2u) << method;
+      EXPECT_EQ(static_cast<int>(m.point2D_idx2), perm[m.point2D_idx1]) << method;
+    }
   }
+  DescriptorMatchingOptions bad;
+  bad.method = "flann";
+  EXPECT_THROW(bad.Check(), OptionError);
 }
 
 // Rays of a camera behind a tilted flat port, for generalized pose tests.

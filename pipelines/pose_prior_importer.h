@@ -1,0 +1,30 @@
+// `portcal pose_prior_importer`: stores where navigation (DVL/INS, USBL,
+// GPS) says each image's camera centre was, as position priors in the
+// images table (prior_tx..tz, prior_q NULL: the way COLMAP 3.8 stores the
+// positions it reads from EXIF GPS). The refractive bundle adjuster takes
+// a survey's metric scale from them (--PosePrior.position_sigma).
+//
+// The file has one image per line, "NAME X Y Z" (metres, a local Cartesian
+// frame such as the survey's ENU or NED; not latitude/longitude), blank
+// lines and lines starting with '#' ignored. One transaction: a malformed
+// line or an unknown image name stores nothing.
+#pragma once
+
+#include <string>
+
+namespace portcal {
+
+struct PosePriorImporterOptions {
+  std::string database_path;
+  std::string input_path;  // the positions file
+  void Check() const;      // throws OptionError naming the option
+};
+
+struct PosePriorImporterSummary {
+  int num_imported = 0;
+  int num_images_without = 0;  // database images the file does not list
+};
+
+PosePriorImporterSummary ImportPosePriors(const PosePriorImporterOptions& options);
+
+}  // namespace portcal

@@ -1,0 +1,248 @@
+// Position priors: stored as COLMAP 3.8 stores GPS positions, imported from
+// a navigation file in one transaction, and, in the bundle adjustment, the
+// metric scale that lets a survey without markers self-calibrate a flat
+// port's distance.
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <fstream>
+#include <random>
+
+#include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/housing/housing_models.h"
+#include "colmap_ext/util/error.h"
+#include "database/database.h"
+#include "pipelines/pose_prior_importer.h"
+#include "pipelines/sfm/bundle_adjustment.h"
+#include "pipelines/sfm/position_priors.h"
+#include "tests/test_utils.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+namespace {
+
+// prior_q* and prior_t* of an image, as SQL text ("NULL" for NULL).
+std::string RawPriorColumns(const fs::path& path, const std::string& name) {
+  sqlite3* db = nullptr;
+  EXPECT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* stmt = nullptr;
+  const std::string sql = "SELECT prior_qw, prior_qx, prior_qy, prior_qz, prior_tx, prior_ty, prior_tz "
+                          "FROM images WHERE name='" + name + "';";
+  EXPECT_EQ(sqlite3_prepare_v2(db, sql.c_str(), -1, &stmt, nullptr), SQLITE_OK);
+  std::string out;
+  if (sqlite3_step(stmt) == SQLITE_ROW) {
+    for (int i = 0; i < 7; ++i) {
+      out += sqlite3_column_type(stmt, i) == SQLITE_NULL ? "NULL" : std::to_string(sqlite3_column_double(stmt, i));
+      out += i < 6 ? " " : "";
+    }
+  }
+  sqlite3_finalize(stmt);
+  sqlite3_close(db);
+  return out;
+}
+
+// A database with images a.png, b.png, c.png.
+fs::path ThreeImageDatabase(const testing::TempDir& dir) {
+  const fs::path path = dir / "db.db";
+  Database database(path, Database::OpenMode::kCreate);
+  Camera camera = Camera::FromModelName("PINHOLE", 700, 960, 540);
+  camera.camera_id = database.WriteCamera(camera);
+  for (const char* name : {"a.png", "b.png", "c.png"}) {
+    DatabaseImage image;
+    image.name = name;
+    image.camera_id = camera.camera_id;
+    database.WriteImage(image);
+  }
+  return path;
+}
+
+TEST(PositionPrior, StoredAsColmapStoresGpsPositions) {
+  testing::TempDir dir;
+  const fs::path path = ThreeImageDatabase(dir);
+  {
+    Database database(path, Database::OpenMode::kReadWrite);
+    database.UpdatePositionPrior(database.ReadImageWithName("b.png")->image_id, Eigen::Vector3d(1.5, -2, 3.25));
+    EXPECT_THROW(database.UpdatePositionPrior(99, Eigen::Vector3d::Zero()), InputError);
+  }
+  // prior_q NULL, prior_t the position (COLMAP 3.8's EXIF GPS import).
+  EXPECT_EQ(RawPriorColumns(path, "b.png"), "NULL NULL NULL NULL 1.500000 -2.000000 3.250000");
+  EXPECT_EQ(RawPriorColumns(path, "a.png"), "NULL NULL NULL NULL NULL NULL NULL");
+  Database database(path, Database::OpenMode::kReadOnly);
+  const DatabaseImage b = *database.ReadImageWithName("b.png");
+  EXPECT_FALSE(b.cam_from_world_prior.has_value());
+  ASSERT_TRUE(b.PriorPosition().has_value());
+  EXPECT_EQ(*b.PriorPosition(), Eigen::Vector3d(1.5, -2, 3.25));
+  EXPECT_FALSE(database.ReadImageWithName("a.png")->PriorPosition().has_value());
+  // A full pose prior's position is its camera centre.
+  DatabaseImage posed;
+  posed.cam_from_world_prior = Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ())),
+                                       Eigen::Vector3d(1, 2, 3));
+  EXPECT_LT((*posed.PriorPosition() - posed.cam_from_world_prior->Inverse().translation).norm(), 1e-15);
+}
+
+TEST(PosePriorImporter, ImportsAllOrNothingAndNamesTheFault) {
+  testing::TempDir dir;
+  const fs::path path = ThreeImageDatabase(dir);
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    PosePriorImporterOptions options;
+    options.database_path = path.string();
+    options.input_path = (dir / name).string();
+    return options;
+  };
+  const auto message = [](const PosePriorImporterOptions& options) {
+    try {
+      ImportPosePriors(options);
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  // An unknown image, after a good line: nothing stored.
+  const std::string unknown = message(write("unknown.txt", "a.png 1 2 3\nzzz.png 4 5 6\n"));
+  EXPECT_NE(unknown.find("zzz.png"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("unknown.txt"), std::string::npos) << unknown;
+  EXPECT_EQ(RawPriorColumns(path, "a.png"), "NULL NULL NULL NULL NULL NULL NULL");
+  // A malformed line names the file and line.
+  const std::string malformed = message(write("bad.txt", "# nav\n\na.png 1 2\n"));
+  EXPECT_NE(malformed.find("bad.txt:3"), std::string::npos) << malformed;
+  EXPECT_NE(message(write("nan.txt", "a.png 1 nan 2\n")).find("nan.txt:1"), std::string::npos);
+  EXPECT_NE(message(write("twice.txt", "a.png 1 2 3\na.png 1 2 3\n")).find("twice"), std::string::npos);
+
+  const PosePriorImporterSummary summary = ImportPosePriors(write("nav.txt", "# NAME X Y Z\na.png 1 2 3\nc.png -1 0.5 2\n"));
+  EXPECT_EQ(summary.num_imported, 2);
+  EXPECT_EQ(summary.num_images_without, 1);
+  EXPECT_EQ(RawPriorColumns(path, "c.png"), "NULL NULL NULL NULL -1.000000 0.500000 2.000000");
+  // Rerunning is safe.
+  EXPECT_EQ(ImportPosePriors(write("nav.txt", "a.png 1 2 3\nc.png -1 0.5 2\n")).num_imported, 2);
+}
+
+// A lawnmower survey 2 m over a rough seabed behind a flat port tilted
+// 3 deg, observed exactly plus Gaussian pixel noise; the reconstruction is
+// handed over in an arbitrary frame (scaled, turned, shifted) under an
+// untilted port guess with half the distance.
+struct SyntheticSurvey {
+  SfmInputs inputs;
+  std::map<image_t, Rigid3d> true_cam_from_world;
+  std::vector<std::pair<Eigen::Vector3d, std::vector<TrackElement>>> true_points;
+  Housing true_housing = Housing::FromName("FLATPORT", {0.0523360, 0.0, 0.9986295, 0.02, 0.01, 1.0, 1.473, 1.334}, "t");
+  Camera camera = Camera::FromModelName("PINHOLE", 700, 960, 540);
+
+  SyntheticSurvey(double pixel_sigma, double navigation_sigma, std::mt19937* rng) {
+    camera.camera_id = 1;
+    inputs.cameras[1] = SfmCamera{camera, true_housing};
+    std::normal_distribution<double> noise(0.0, 1.0);
+    image_t id = 1;
+    const Eigen::Quaterniond down(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
+    for (int line = 0; line < 3; ++line) {
+      for (int k = 0; k < 8; ++k, ++id) {
+        const Eigen::Vector3d centre(0.5 * k, 0.45 * line, 2.0 + 0.05 * std::sin(k));
+        true_cam_from_world[id] = Rigid3d(down, -(down * centre));
+        SfmImage& image = inputs.images[id];
+        image.image_id = id;
+        image.name = "img_" + std::to_string(id) + ".png";
+        image.camera_id = 1;
+        image.position_prior = centre + navigation_sigma * Eigen::Vector3d(noise(*rng), noise(*rng), noise(*rng));
+      }
+    }
+    std::uniform_real_distribution<double> x(-1.0, 4.5), y(-0.8, 1.7);
+    for (int p = 0; p < 2500; ++p) {
+      const double px = x(*rng), py = y(*rng);
+      const Eigen::Vector3d world(px, py, 0.15 * std::sin(2 * px) * std::cos(1.5 * py));
+      std::vector<TrackElement> track;
+      for (auto& [image_id, pose] : true_cam_from_world) {
+        const auto pixel = ProjectPoint(camera, &true_housing, pose * world);
+        if (!pixel || pixel->x() < 0 || pixel->y() < 0 || pixel->x() > 960 || pixel->y() > 540) continue;
+        SfmImage& image = inputs.images.at(image_id);
+        track.push_back({image_id, static_cast<point2D_t>(image.keypoints.size())});
+        image.keypoints.push_back(*pixel + pixel_sigma * Eigen::Vector2d(noise(*rng), noise(*rng)));
+      }
+      if (track.size() >= 2) true_points.emplace_back(world, track);
+    }
+    for (auto& [image_id, image] : inputs.images) image.correspondences.resize(image.keypoints.size());
+  }
+
+  Reconstruction InArbitraryFrame(const Similarity3d& arbitrary_from_true) const {
+    std::map<camera_t, SfmCamera> guess = inputs.cameras;
+    guess.at(1).housing->params = {0, 0, 1, 0.01, 0.01, 1.0, 1.473, 1.334};
+    Reconstruction r(&inputs, guess);
+    const Similarity3d& s = arbitrary_from_true;
+    for (const auto& [id, pose] : true_cam_from_world) {
+      const Eigen::Quaterniond rotation = pose.rotation * s.rotation.conjugate();
+      r.Register(id, Rigid3d(rotation, s.scale * pose.translation - rotation * s.translation));
+    }
+    for (const auto& [xyz, track] : true_points) r.AddPoint(s.scale * (s.rotation * xyz) + s.translation, track);
+    return r;
+  }
+};
+
+Similarity3d ArbitraryFrame() {
+  Similarity3d s;
+  s.scale = 0.6;
+  s.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 3).normalized()));
+  s.translation = Eigen::Vector3d(5, -3, 10);
+  return s;
+}
+
+TEST(PositionPriors, AlignmentUndoesTheArbitraryFrameAndIgnoresAJump) {
+  std::mt19937 rng(5);
+  SyntheticSurvey survey(0.0, 0.0, &rng);
+  survey.inputs.images.at(7).position_prior->x() += 3.0;  // a navigation jump
+  Reconstruction r = survey.InArbitraryFrame(ArbitraryFrame());
+  const auto alignment = AlignToPositionPriors(&r, 0.05);
+  ASSERT_TRUE(alignment.has_value());
+  EXPECT_EQ(alignment->num_priors, 24);
+  EXPECT_EQ(alignment->num_inliers, 23);
+  EXPECT_NEAR(alignment->new_from_old.scale, 1 / 0.6, 1e-9);
+  EXPECT_LT(alignment->rms_m, 1e-9);
+  for (const auto& [id, pose] : r.poses()) {
+    EXPECT_LT((pose.Inverse().translation - survey.true_cam_from_world.at(id).Inverse().translation).norm(), 1e-9);
+    EXPECT_LT(pose.rotation.angularDistance(survey.true_cam_from_world.at(id).rotation), 1e-9);
+  }
+  size_t k = 0;
+  for (const auto& [point_id, point] : r.points()) EXPECT_LT((point.xyz - survey.true_points[k++].first).norm(), 1e-9);
+  // Collinear priors fix no similarity: nothing changes.
+  SyntheticSurvey line(0.0, 0.0, &rng);
+  for (auto& [id, image] : line.inputs.images) {
+    image.position_prior->y() = 0;
+    image.position_prior->z() = 2;
+  }
+  Reconstruction r2 = line.InArbitraryFrame(ArbitraryFrame());
+  const Rigid3d before = r2.poses().begin()->second;
+  EXPECT_FALSE(AlignToPositionPriors(&r2, 0.05).has_value());
+  EXPECT_EQ(r2.poses().begin()->second.translation, before.translation);
+}
+
+TEST(PositionPriors, GiveTheScaleThatSelfCalibratesTheFlatPortDistance) {
+  std::mt19937 rng(11);
+  const double navigation_sigma = 0.02;
+  SyntheticSurvey survey(0.1, navigation_sigma, &rng);
+  Reconstruction r = survey.InArbitraryFrame(ArbitraryFrame());
+  ASSERT_TRUE(AlignToPositionPriors(&r, 5 * navigation_sigma).has_value());
+  BundleAdjustmentOptions ba;
+  ba.refine_housing = true;
+  ba.sigma_px = 0.1;
+  ba.position_prior_sigma_m = navigation_sigma;
+  ba.max_num_iterations = 200;
+  AdjustBundle(&r, ba, BundleAdjustmentScope(), nullptr, MarkerScale());
+  CalibrationStdDevs std_devs;
+  AdjustBundle(&r, ba, BundleAdjustmentScope(), nullptr, MarkerScale(), &std_devs);
+  const std::vector<double>& h = r.cameras().at(1).housing->params;
+  const std::vector<double>& sd = std_devs.housing.at(1);
+  const std::vector<double>& t = survey.true_housing.params;
+  // Errors within 4 standard deviations, and the deviations small enough to
+  // mean something (the guess was 10 mm and 3 deg off): refraction observes
+  // the port distance only through how the rays' virtual centres move with
+  // the angle, a fraction of a pixel here, so a survey needs many points.
+  for (int k : {0, 1, 3}) EXPECT_LT(std::abs(h[k] - t[k]), 4 * sd[k]) << "parameter " << k;
+  EXPECT_LT(sd[3], 0.005);
+  EXPECT_LT(sd[0], 0.0015);
+  for (const auto& [id, pose] : r.poses()) {
+    const Eigen::Vector3d error = pose.Inverse().translation - survey.true_cam_from_world.at(id).Inverse().translation;
+    EXPECT_LT(error.norm(), 4 * navigation_sigma) << "image " << id;
+  }
+}
+
+}  // namespace
+}  // namespace portcal
