@@ -30,11 +30,23 @@ void SequentialPairingOptions::Check() const {
   }
 }
 
+void SpatialPairingOptions::Check() const {
+  if (max_num_neighbors < 1) {
+    throw OptionError("--SpatialMatching.max_num_neighbors", std::to_string(max_num_neighbors), ">= 1");
+  }
+  if (!(max_distance_m > 0)) {
+    throw OptionError("--SpatialMatching.max_distance", std::to_string(max_distance_m), "> 0 m");
+  }
+}
+
 void FeatureMatcherOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
-  if (mode != "exhaustive" && mode != "sequential") throw OptionError("mode", mode, "exhaustive or sequential");
+  if (mode != "exhaustive" && mode != "sequential" && mode != "spatial") {
+    throw OptionError("mode", mode, "exhaustive, sequential or spatial");
+  }
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
   sequential.Check();
+  spatial.Check();
   matching.Check();
   verification.Check();
 }
@@ -64,6 +76,26 @@ std::vector<std::pair<image_t, image_t>> SequentialPairs(const std::vector<image
   return pairs;
 }
 
+std::vector<std::pair<image_t, image_t>> SpatialPairs(const std::vector<std::pair<image_t, Eigen::Vector3d>>& positions,
+                                                      const SpatialPairingOptions& options) {
+  std::vector<std::pair<image_t, image_t>> pairs;
+  std::vector<std::pair<double, size_t>> nearest;
+  for (size_t i = 0; i < positions.size(); ++i) {
+    nearest.clear();
+    for (size_t j = 0; j < positions.size(); ++j) {
+      if (j == i) continue;
+      Eigen::Vector3d d = positions[j].second - positions[i].second;
+      if (options.ignore_z) d.z() = 0;
+      const double distance = d.norm();
+      if (distance <= options.max_distance_m) nearest.emplace_back(distance, j);
+    }
+    const size_t k = std::min(nearest.size(), static_cast<size_t>(options.max_num_neighbors));
+    std::partial_sort(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(k), nearest.end());
+    for (size_t n = 0; n < k; ++n) pairs.emplace_back(positions[i].first, positions[nearest[n].second].first);
+  }
+  return pairs;
+}
+
 namespace {
 
 struct ImageFeatures {
@@ -80,6 +112,11 @@ std::string OptionsText(const FeatureMatcherOptions& o) {
       << "\nSiftMatching.method=" << o.matching.method
       << "\nTwoViewGeometry.max_error=" << o.verification.max_error
       << "\nTwoViewGeometry.min_num_inliers=" << o.verification.min_num_inliers;
+  if (o.mode == "spatial") {
+    out << "\nSpatialMatching.max_num_neighbors=" << o.spatial.max_num_neighbors
+        << "\nSpatialMatching.max_distance=" << o.spatial.max_distance_m
+        << "\nSpatialMatching.ignore_z=" << o.spatial.ignore_z;
+  }
   if (o.mode == "sequential") {
     out << "\nSequentialMatching.overlap=" << o.sequential.overlap
         << "\nSequentialMatching.quadratic_overlap=" << o.sequential.quadratic_overlap
@@ -151,8 +188,26 @@ FeatureMatchingSummary MatchFeatures(const FeatureMatcherOptions& options, Progr
   for (const Camera& camera : database.ReadAllCameras()) cameras[camera.camera_id] = camera;
 
   FeatureMatchingSummary summary;
-  std::vector<std::pair<image_t, image_t>> candidates =
-      options.mode == "exhaustive" ? ExhaustivePairs(ids) : SequentialPairs(ids, options.sequential);
+  std::vector<std::pair<image_t, image_t>> candidates;
+  if (options.mode == "exhaustive") {
+    candidates = ExhaustivePairs(ids);
+  } else if (options.mode == "sequential") {
+    candidates = SequentialPairs(ids, options.sequential);
+  } else {
+    std::vector<std::pair<image_t, Eigen::Vector3d>> positions;
+    for (const DatabaseImage& image : images) {
+      if (const auto position = image.PriorPosition()) positions.emplace_back(image.image_id, *position);
+    }
+    if (positions.size() < 2) {
+      throw InputError(options.database_path + ": " + std::to_string(positions.size()) +
+                       " image(s) with a position prior; spatial matching needs them (run pose_prior_importer)");
+    }
+    if (positions.size() < images.size()) {
+      LOG(WARNING) << stage << ": " << images.size() - positions.size()
+                   << " image(s) without a position prior are not matched";
+    }
+    candidates = SpatialPairs(positions, options.spatial);
+  }
   if (options.mode == "sequential" && options.sequential.loop_detection) {
     const auto loops = LoopPairs(&database, ids, options.sequential, progress);
     summary.num_loop_pairs = static_cast<int64_t>(loops.size());

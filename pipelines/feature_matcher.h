@@ -1,4 +1,5 @@
-// `portcal exhaustive_matcher` and `portcal sequential_matcher`: descriptor
+// `portcal exhaustive_matcher`, `sequential_matcher` and `spatial_matcher`
+// (pairs from the images' position priors, as COLMAP's): descriptor
 // matching of image pairs and geometric verification, written to COLMAP's
 // `matches` and `two_view_geometries` tables in one transaction. Pairs that
 // already have a two-view geometry are skipped (rerunning is safe and
@@ -28,10 +29,20 @@ struct SequentialPairingOptions {
   void Check() const;         // throws OptionError naming --SequentialMatching.*
 };
 
+// COLMAP's spatial matcher: each image with its nearest images by position
+// prior (navigation), for surveys whose lines pass beside each other.
+struct SpatialPairingOptions {
+  int max_num_neighbors = 20;
+  double max_distance_m = 3.0;  // between camera positions
+  bool ignore_z = true;         // distances in the horizontal plane (z up or down)
+  void Check() const;           // throws OptionError naming --SpatialMatching.*
+};
+
 struct FeatureMatcherOptions {
   std::string database_path;
-  std::string mode = "exhaustive";  // exhaustive | sequential
+  std::string mode = "exhaustive";  // exhaustive | sequential | spatial
   SequentialPairingOptions sequential;
+  SpatialPairingOptions spatial;
   DescriptorMatchingOptions matching;
   TwoViewVerificationOptions verification;
   bool overwrite = false;
@@ -51,6 +62,10 @@ struct FeatureMatchingSummary {
 std::vector<std::pair<image_t, image_t>> ExhaustivePairs(const std::vector<image_t>& images);
 std::vector<std::pair<image_t, image_t>> SequentialPairs(const std::vector<image_t>& images,
                                                          const SequentialPairingOptions& options);
+
+// Images without a position have no spatial pairs.
+std::vector<std::pair<image_t, image_t>> SpatialPairs(const std::vector<std::pair<image_t, Eigen::Vector3d>>& positions,
+                                                      const SpatialPairingOptions& options);
 
 FeatureMatchingSummary MatchFeatures(const FeatureMatcherOptions& options, ProgressSink& progress);
 

@@ -16,6 +16,7 @@ int RunFeatureExtractor(int argc, char** argv);
 int RunFeatureMasker(int argc, char** argv);
 int RunExhaustiveMatcher(int argc, char** argv);
 int RunSequentialMatcher(int argc, char** argv);
+int RunSpatialMatcher(int argc, char** argv);
 int RunRefractiveMapper(int argc, char** argv);
 int RunRefractiveBundleAdjuster(int argc, char** argv);
 int RunAutoCalibrator(int argc, char** argv);

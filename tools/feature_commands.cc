@@ -116,4 +116,22 @@ int RunSequentialMatcher(int argc, char** argv) {
   });
 }
 
+int RunSpatialMatcher(int argc, char** argv) {
+  FeatureMatcherOptions options;
+  options.mode = "spatial";
+  CommandLine cli("spatial_matcher",
+                  "Matches each image with its nearest images by position prior (navigation; "
+                  "pose_prior_importer), as COLMAP's spatial_matcher, then verifies each pair "
+                  "geometrically. Safe to rerun.");
+  AddMatchingOptions(&cli, &options);
+  cli.Add("SpatialMatching.max_num_neighbors", &options.spatial.max_num_neighbors, "nearest images matched");
+  cli.Add("SpatialMatching.max_distance", &options.spatial.max_distance_m, "metres between positions");
+  cli.Add("SpatialMatching.ignore_z", &options.spatial.ignore_z, "horizontal distances only (0 | 1)");
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    StderrProgress progress;
+    MatchFeatures(options, progress);
+  });
+}
+
 }  // namespace portcal

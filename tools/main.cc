@@ -46,6 +46,8 @@ const std::vector<Command>& Commands() {
        "match and verify every image pair"},
       {"sequential_matcher", portcal::RunSequentialMatcher,
        "match and verify neighbouring images (and loop candidates)"},
+      {"spatial_matcher", portcal::RunSpatialMatcher,
+       "match and verify images near each other by position prior"},
       {"refractive_mapper", portcal::RunRefractiveMapper,
        "incremental structure-from-motion on refracted rays"},
       {"refractive_bundle_adjuster", portcal::RunRefractiveBundleAdjuster,

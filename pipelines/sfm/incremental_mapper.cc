@@ -1,6 +1,7 @@
 #include "pipelines/sfm/incremental_mapper.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -74,6 +75,19 @@ class Mapper {
   const IncrementalMapperOptions& options_;
   std::set<image_t> used_;    // registered in an earlier model
   std::set<image_t> failed_;  // failed to register since the model last grew
+  // Seconds spent per step, for the debug log.
+  std::map<std::string, double> seconds_;
+  template <typename F>
+  auto Timed(const char* step, F&& f) {
+    const auto start = std::chrono::steady_clock::now();
+    struct Add {
+      std::map<std::string, double>* seconds;
+      const char* step;
+      std::chrono::steady_clock::time_point start;
+      ~Add() { (*seconds)[step] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
+    } add{&seconds_, step, start};
+    return f();
+  }
 };
 
 std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
@@ -90,21 +104,21 @@ std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
     while (true) {
       CancelFlag::ThrowIfRequested();
       bool added = false;
-      for (image_t image_id : NextImages(r)) {
-        if (!Register(&r, image_id)) {
+      for (image_t image_id : Timed("next", [&] { return NextImages(r); })) {
+        if (!Timed("register", [&] { return Register(&r, image_id); })) {
           failed_.insert(image_id);
           continue;
         }
         failed_.clear();
-        Triangulate(&r, image_id);
-        LocalAdjust(&r, image_id);
+        Timed("triangulate", [&] { return Triangulate(&r, image_id); });
+        Timed("local", [&] { LocalAdjust(&r, image_id); return 0; });
         progress.Advance(1);
         if (r.poses().size() >= options_.ba_global_images_ratio * last_global) {
           // Intrinsics move the rays of every image (and need the exact,
           // slower error): refine them while the model is small and then
           // whenever it has grown by a third.
           const bool refine = r.poses().size() <= 8 || r.poses().size() >= 1.33 * last_refine;
-          GlobalAdjust(&r, refine);
+          Timed("global", [&] { GlobalAdjust(&r, refine); return 0; });
           if (refine) last_refine = r.poses().size();
           last_global = r.poses().size();
         }
@@ -122,6 +136,9 @@ std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
     LOG(INFO) << "refractive_mapper: model " << models.size() << ": " << r.poses().size() << " images, "
               << r.points().size() << " points, mean reprojection error " << r.MeanReprojectionError()
               << " px";
+    VLOG(1) << "refractive_mapper: seconds in next " << seconds_["next"] << ", register " << seconds_["register"]
+            << ", triangulate " << seconds_["triangulate"] << ", local " << seconds_["local"] << ", global "
+            << seconds_["global"];
     const bool keep = static_cast<int>(r.poses().size()) >= options_.min_model_size;
     for (const auto& [id, pose] : r.poses()) used_.insert(id);
     if (keep) models.push_back(std::move(r));

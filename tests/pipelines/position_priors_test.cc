@@ -7,11 +7,13 @@
 
 #include <fstream>
 #include <random>
+#include <set>
 
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/housing/housing_models.h"
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
+#include "pipelines/feature_matcher.h"
 #include "pipelines/pose_prior_importer.h"
 #include "pipelines/sfm/bundle_adjustment.h"
 #include "pipelines/sfm/position_priors.h"
@@ -116,6 +118,33 @@ TEST(PosePriorImporter, ImportsAllOrNothingAndNamesTheFault) {
   EXPECT_EQ(RawPriorColumns(path, "c.png"), "NULL NULL NULL NULL -1.000000 0.500000 2.000000");
   // Rerunning is safe.
   EXPECT_EQ(ImportPosePriors(write("nav.txt", "a.png 1 2 3\nc.png -1 0.5 2\n")).num_imported, 2);
+}
+
+TEST(SpatialMatching, PairsTheNearestImagesWithinTheDistance) {
+  // Two survey lines 0.45 m apart, frames every 0.5 m; the vehicle bobs 1 m
+  // in z on the second, which ignore_z discards.
+  std::vector<std::pair<image_t, Eigen::Vector3d>> positions;
+  for (int k = 0; k < 10; ++k) {
+    positions.emplace_back(1 + k, Eigen::Vector3d(0.5 * k, 0, 2));
+    positions.emplace_back(11 + k, Eigen::Vector3d(0.5 * k, 0.45, 2 + (k % 2)));
+  }
+  SpatialPairingOptions options;
+  options.max_num_neighbors = 3;
+  options.max_distance_m = 0.6;
+  const auto pairs = SpatialPairs(positions, options);
+  std::set<std::pair<image_t, image_t>> unique;
+  for (const auto& [a, b] : pairs) unique.insert({std::min(a, b), std::max(a, b)});
+  // Each image: its along-track neighbours (0.5 m) and the one beside it
+  // (0.45 m); the diagonal (0.67 m) is too far.
+  EXPECT_TRUE(unique.count({1, 11}));
+  EXPECT_TRUE(unique.count({1, 2}));
+  EXPECT_FALSE(unique.count({1, 12}));
+  EXPECT_EQ(unique.size(), 9u + 9u + 10u);
+  for (const auto& [a, b] : pairs) EXPECT_NE(a, b);
+  options.ignore_z = false;
+  std::set<std::pair<image_t, image_t>> with_z;
+  for (const auto& [a, b] : SpatialPairs(positions, options)) with_z.insert({std::min(a, b), std::max(a, b)});
+  EXPECT_FALSE(with_z.count({12, 13}));  // 1 m apart in z
 }
 
 // A lawnmower survey 2 m over a rough seabed behind a flat port tilted
