@@ -1,5 +1,7 @@
 #include "pipelines/refractive_mapper.h"
 
+#include <algorithm>
+
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
@@ -73,6 +75,12 @@ RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& optio
   }
   if (inputs.pair_inliers.empty()) {
     throw InputError(options.database_path + ": no verified image pairs; run a matcher first");
+  }
+  if (options.mapper.position_prior_sigma_m > 0 &&
+      std::none_of(inputs.images.begin(), inputs.images.end(),
+                   [](const auto& entry) { return entry.second.position_prior.has_value(); })) {
+    throw InputError(options.database_path + ": no image has a position prior, so --PosePrior.position_sigma "
+                     "has nothing to use (run pose_prior_importer, or set it to 0)");
   }
   std::map<camera_t, SfmCamera> cameras = inputs.cameras;
   ApplyHousingOverride(options.housing, &cameras);

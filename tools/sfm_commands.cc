@@ -32,6 +32,8 @@ static void AddMapperOptions(CommandLine* cli, IncrementalMapperOptions* o) {
   cli->Add("Markers.side_length", &o->marker_scale.side_length_m,
            "ArUco marker side, metres: markers then fix the scale (0: off)");
   cli->Add("Markers.side_sigma", &o->marker_scale.sigma_m, "uncertainty of a marker side, metres");
+  cli->Add("PosePrior.position_sigma", &o->position_prior_sigma_m,
+           "position priors' uncertainty, metres (0: unused); global adjustments take the scale from them");
   cli->Add("num_threads", &o->num_threads, "threads");
 }
 

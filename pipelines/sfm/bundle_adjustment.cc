@@ -367,6 +367,9 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
   if (!summary.IsSolutionUsable()) throw NumericalError("bundle adjustment failed: " + summary.BriefReport());
+  VLOG(1) << "bundle adjustment: " << num_free_poses << " free poses, " << point_blocks.size() << " points, "
+          << num_residuals << " residuals, " << summary.iterations.size() << " iterations, "
+          << summary.total_time_in_seconds << " s (" << summary.BriefReport() << ")";
 
   if (std_devs) {
     std_devs->num_residuals = num_residuals;

@@ -13,6 +13,7 @@
 #include "pipelines/sfm/bundle_costs.h"
 #include "pipelines/sfm/bundle_costs_fixed.h"
 #include "pipelines/calibration/view_pose.h"
+#include "pipelines/sfm/position_priors.h"
 #include "pipelines/sfm/ray_geometry.h"
 
 namespace portcal {
@@ -28,6 +29,9 @@ void IncrementalMapperOptions::Check() const {
   positive(filter_max_reproj_error_px, "filter_max_reproj_error");
   positive(ba_global_images_ratio, "ba_global_images_ratio");
   positive(max_num_models, "max_num_models");
+  if (!(position_prior_sigma_m >= 0)) {
+    throw OptionError("--PosePrior.position_sigma", std::to_string(position_prior_sigma_m), ">= 0 m");
+  }
   if (abs_pose_min_num_inliers < 6) {
     throw OptionError("--Mapper.abs_pose_min_num_inliers", std::to_string(abs_pose_min_num_inliers), ">= 6");
   }
@@ -500,6 +504,11 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   ba.refine_housing = refine_intrinsics && options_.ba_refine_housing;
   ba.max_num_iterations = options_.ba_max_num_iterations;
   ba.num_threads = options_.num_threads;
+  if (options_.position_prior_sigma_m > 0 && options_.marker_scale.side_length_m <= 0 &&
+      AlignToPositionPriors(r, 5 * options_.position_prior_sigma_m)) {
+    // The model in the priors' metric frame, the priors as residuals.
+    ba.position_prior_sigma_m = options_.position_prior_sigma_m;
+  }
   std::vector<MarkerCorner> markers;
   if (options_.marker_scale.side_length_m > 0) {
     markers = TriangulateMarkerCorners(*r, options_.filter_max_reproj_error_px * 4);
@@ -509,7 +518,7 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   std::map<point3D_t, Eigen::Vector3d> points_before;
   for (const auto& [id, point] : r->points()) points_before[id] = point.xyz;
   const std::vector<MarkerCorner> markers_before = markers;
-  if (ba.refine_housing) {
+  if (ba.refine_housing && (ba.refine_focal_length || ba.refine_principal_point || ba.refine_extra_params)) {
     // The housing first, under the held intrinsics (see
     // RunRefractiveBundleAdjuster: jointly from a poor start, focal length
     // and port distance trade off).

@@ -45,6 +45,10 @@ struct IncrementalMapperOptions {
   int max_num_models = 50;
   int min_model_size = 3;
   MarkerScale marker_scale;  // side_length_m > 0: markers fix the scale
+  // > 0: global adjustments align the model to the images' position priors
+  // and keep them as residuals of this sigma (metres): the scale of a
+  // survey, so that ba_refine_housing can estimate the port distance.
+  double position_prior_sigma_m = 0;
   int num_threads = 2;
   void Check() const;  // throws OptionError naming --Mapper.*
 };

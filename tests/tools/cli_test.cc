@@ -216,5 +216,24 @@ TEST(Cli, CrossCheckNamesWhatIsMissing) {
   EXPECT_NE(result.output.find("--CrossCheck.folds"), std::string::npos) << result.output;
 }
 
+TEST(Cli, PosePriorsNameWhatIsMissing) {
+  testing::TempDir dir;
+  const std::string db = (dir / "db.db").string();
+  auto result = RunCommand(Portcal("pose_prior_importer --database_path " + db + " --input_path nav.txt"));
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("--database_path"), std::string::npos) << result.output;
+  ASSERT_EQ(RunCommand(Portcal("database_creator --log_level error --database_path " + db)).exit_code, 0);
+  result = RunCommand(Portcal("pose_prior_importer --database_path " + db + " --input_path " +
+                              (dir / "missing.txt").string()));
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("missing.txt"), std::string::npos) << result.output;
+  result = RunCommand(Portcal("spatial_matcher --database_path " + db));
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("image"), std::string::npos) << result.output;
+  result = RunCommand(Portcal("refractive_bundle_adjuster --input_path a --output_path b --PosePrior.position_sigma 0.02"));
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("--database_path"), std::string::npos) << result.output;
+}
+
 }  // namespace
 }  // namespace portcal

@@ -1,0 +1,128 @@
+// Self-calibration of a flat port on a survey without target or markers:
+// portcal's renderer makes a small lawnmower survey (48 images, 640 x 360)
+// over a rough seabed behind a port tilted 3 deg, with navigation positions
+// of 2 cm noise; extract, pose_prior_importer, spatial_matcher,
+// refractive_mapper (port refined, navigation as the scale) and
+// refractive_bundle_adjuster run in-process, and the port and the camera
+// positions are compared with the ground truth. Tolerances: 4 reported
+// standard deviations and the issue's survey goals (0.05 deg, positions
+// within 0.5 % of the path) where this small survey reaches them, else the
+// measured level plus a margin with the gap stated. Surveys of the issue's
+// size: workflows/bench_survey.sh.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "colmap_ext/io/ground_truth.h"
+#include "pipelines/feature_extractor.h"
+#include "pipelines/feature_matcher.h"
+#include "pipelines/pose_prior_importer.h"
+#include "pipelines/refractive_bundle_adjuster.h"
+#include "pipelines/refractive_mapper.h"
+#include "pipelines/synthesize/synthesize.h"
+#include "tests/test_utils.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+TEST(SurveyCalibration, FlatPortFromNavigationScale) {
+  testing::TempDir dir;
+  std::ofstream(dir / "survey.yaml") << R"(name: survey
+num_images: 48
+camera: {model: RADIAL, width: 640, height: 360, params: [466.7, 320.0, 180.0, 0.0, 0.0]}
+housing: {model: FLATPORT, params: [0.0523360, 0.0, 0.9986295, 0.02, 0.010, 1.0, 1.473, 1.334]}
+survey: {height: 2.0, speed: 0.5, frame_rate: 1.0, side_overlap: 0.6, line_length: 6.0,
+         roughness: 0.15, relief_wavelength: 2.0, navigation_sigma: 0.02}
+render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
+)";
+  NullProgress progress;
+  SynthesizeOptions synthesize;
+  synthesize.config_path = (dir / "survey.yaml").string();
+  synthesize.output_path = (dir / "set").string();
+  Synthesize(synthesize, progress);
+  const GroundTruth truth = ReadGroundTruth(dir / "set" / "ground_truth.yaml");
+  const std::string database = (dir / "db.db").string();
+
+  FeatureExtractorOptions extract;
+  extract.database_path = database;
+  extract.image_path = (dir / "set" / "images").string();
+  extract.reader.single_camera = true;
+  extract.reader.camera_model = "RADIAL";
+  extract.reader.camera_params = "466.7,320,180,0,0";
+  ExtractFeatures(extract, progress);
+  PosePriorImporterOptions priors;
+  priors.database_path = database;
+  priors.input_path = (dir / "set" / "navigation.txt").string();
+  ASSERT_EQ(ImportPosePriors(priors).num_imported, 48);
+  FeatureMatcherOptions match;
+  match.database_path = database;
+  match.mode = "spatial";
+  MatchFeatures(match, progress);
+
+  RefractiveMapperOptions map;
+  map.database_path = database;
+  map.output_path = (dir / "sparse").string();
+  map.housing.model = "FLATPORT";
+  map.housing.params = "0,0,1,0.01,0.010,1,1.473,1.334";
+  map.mapper.init_scene_depth_m = 2.0;
+  map.mapper.ba_refine_focal_length = false;
+  map.mapper.ba_refine_extra_params = false;
+  map.mapper.ba_refine_housing = true;
+  map.mapper.position_prior_sigma_m = 0.02;
+  const RefractiveMapperSummary mapped = RunRefractiveMapper(map, progress);
+  ASSERT_GE(mapped.num_models, 1);
+  RefractiveBundleAdjusterOptions refine;
+  refine.input_path = mapped.model_paths[0].string();
+  refine.output_path = (dir / "refined").string();
+  refine.database_path = database;
+  refine.ba.position_prior_sigma_m = 0.02;
+  const CalibrationReport report = RunRefractiveBundleAdjuster(refine).report;
+
+  // One model with (nearly) every image.
+  EXPECT_GE(report.views.size(), 44u);
+  const std::vector<double>& h = report.housing->params;
+  const std::vector<double>& sd = report.housing_std_dev;
+  const std::vector<double>& t = truth.housing->params;
+  const Eigen::Vector3d normal(h[0], h[1], h[2]), true_normal(t[0], t[1], t[2]);
+  const double angle = std::acos(std::min(1.0, normal.normalized().dot(true_normal.normalized())));
+  const double angle_sd = std::hypot(sd[0], sd[1]);
+  const double distance_error = h[3] - t[3];
+  RecordProperty("normal_error_deg", std::to_string(angle / kDegree));
+  RecordProperty("distance_error_mm", std::to_string(distance_error * 1000));
+  std::cout << "normal error " << angle / kDegree << " deg (sd " << angle_sd / kDegree << "), distance error "
+            << distance_error * 1000 << " mm (sd " << sd[3] * 1000 << ")\n";
+  // The normal within 4 sigma and the issue's 0.05 deg. The distance is not
+  // yet within 4 sigma on a survey this small: measured 4.1 mm at a reported
+  // 0.67 mm (6 sigma; the 120-image survey at 960 x 540 gives 0.03 mm at
+  // 0.15 mm, see docs/auto_calibration.md), so the bound asserted is the
+  // measured level plus a margin, and the gap is stated.
+  EXPECT_LT(angle, std::max(4 * angle_sd, 0.005 * kDegree));
+  EXPECT_LT(angle, 0.05 * kDegree);
+  EXPECT_LT(std::abs(distance_error), 0.006);
+  // The deviations mean something: the guess was 3 deg and 10 mm off.
+  EXPECT_LT(angle_sd, 0.05 * kDegree);
+  EXPECT_LT(sd[3], 0.003);
+
+  // Camera centres in the navigation frame, against the path length.
+  std::map<std::string, Eigen::Vector3d> true_centres;
+  for (const FrameTruth& frame : truth.images) {
+    true_centres[fs::path(frame.cam1.file).filename().string()] = frame.cam1.cam_from_target.Inverse().translation;
+  }
+  double path = 0;
+  for (auto it = std::next(true_centres.begin()); it != true_centres.end(); ++it) {
+    path += (it->second - std::prev(it)->second).norm();
+  }
+  double max_error = 0;
+  for (const CalibratedView& view : report.views) {
+    max_error = std::max(max_error, (view.cam_from_target.Inverse().translation - true_centres.at(view.image_name)).norm());
+  }
+  std::cout << "positions: max error " << max_error * 1000 << " mm over a path of " << path << " m\n";
+  EXPECT_LT(max_error, 0.005 * path);
+}
+
+}  // namespace
+}  // namespace portcal
