@@ -74,6 +74,14 @@ void AddMatchingOptions(CommandLine* cli, FeatureMatcherOptions* options) {
   cli->Add("num_threads", &options->num_threads, "threads");
 }
 
+int ParseAndMatch(CommandLine* cli, const FeatureMatcherOptions& options, int argc, char** argv) {
+  return ReportErrors([&] {
+    if (!cli->Parse(argc, argv)) return;
+    StderrProgress progress;
+    MatchFeatures(options, progress);
+  });
+}
+
 }  // namespace
 
 int RunExhaustiveMatcher(int argc, char** argv) {
@@ -84,11 +92,7 @@ int RunExhaustiveMatcher(int argc, char** argv) {
                   "verifies each geometrically (E, F, H by RANSAC, COLMAP's configurations). "
                   "Pairs already verified are skipped; safe to rerun.");
   AddMatchingOptions(&cli, &options);
-  return ReportErrors([&] {
-    if (!cli.Parse(argc, argv)) return;
-    StderrProgress progress;
-    MatchFeatures(options, progress);
-  });
+  return ParseAndMatch(&cli, options, argc, argv);
 }
 
 int RunSequentialMatcher(int argc, char** argv) {
@@ -109,11 +113,7 @@ int RunSequentialMatcher(int argc, char** argv) {
   cli.Add("SequentialMatching.loop_detection_num_images", &options.sequential.loop_detection_num_images,
           "most similar images matched per query");
   cli.Add("SequentialMatching.vocabulary_size", &options.sequential.vocabulary_size, "visual words");
-  return ReportErrors([&] {
-    if (!cli.Parse(argc, argv)) return;
-    StderrProgress progress;
-    MatchFeatures(options, progress);
-  });
+  return ParseAndMatch(&cli, options, argc, argv);
 }
 
 int RunSpatialMatcher(int argc, char** argv) {
@@ -127,11 +127,7 @@ int RunSpatialMatcher(int argc, char** argv) {
   cli.Add("SpatialMatching.max_num_neighbors", &options.spatial.max_num_neighbors, "nearest images matched");
   cli.Add("SpatialMatching.max_distance", &options.spatial.max_distance_m, "metres between positions");
   cli.Add("SpatialMatching.ignore_z", &options.spatial.ignore_z, "horizontal distances only (0 | 1)");
-  return ReportErrors([&] {
-    if (!cli.Parse(argc, argv)) return;
-    StderrProgress progress;
-    MatchFeatures(options, progress);
-  });
+  return ParseAndMatch(&cli, options, argc, argv);
 }
 
 }  // namespace portcal
