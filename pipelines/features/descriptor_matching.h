@@ -6,8 +6,11 @@
 // Brute force compares every pair of descriptors (COLMAP's CPU matcher);
 // "kdtree" finds the two nearest neighbours by FLANN's randomized k-d trees
 // (Muja and Lowe, "Fast approximate nearest neighbors with automatic
-// algorithm configuration", VISAPP 2009), which on a survey's pairs keeps
-// nearly all verified inliers for a fraction of the time (docs/benchmarks.md).
+// algorithm configuration", VISAPP 2009). At 128 dimensions and ~4500
+// features per image the trees gain little (measured on two survey images:
+// 0.16 s at 32 checks, 99 % of the matches, against 0.24 s brute force;
+// slower from 64 checks on), so brute force is the default
+// (docs/auto_calibration.md).
 #pragma once
 
 #include <string>
