@@ -101,6 +101,7 @@ std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
   while (static_cast<int>(models.size()) < options_.max_num_models) {
     Reconstruction r(&inputs_, cameras_);
     failed_.clear();
+    seconds_.clear();  // per model
     if (!Initialize(&r, &tried)) break;
     progress.Advance(2);
     size_t last_global = r.poses().size();
