@@ -32,6 +32,11 @@ struct AutoCalibratorOptions {
   SiftExtractionOptions sift;
   // Refine the intrinsics with the housing; -1: when camera_params is empty.
   int refine_intrinsics = -1;
+  // With the intrinsics refined: -1 refines the principal point but holds it
+  // at the image centre again unless it moves beyond 3 sigma (see
+  // RefractiveBundleAdjusterOptions::principal_point_test_sigmas); 0 holds
+  // it; 1 refines it.
+  int refine_principal_point = -1;
   int num_threads = 2;
   void Check() const;  // throws OptionError naming the option
 };

@@ -1,7 +1,10 @@
 #include "pipelines/refractive_bundle_adjuster.h"
 
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
+#include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "pipelines/sfm/position_priors.h"
@@ -28,10 +31,58 @@ void RefractiveBundleAdjusterOptions::Check() const {
   if (!(max_reproj_error_px > 0)) {
     throw OptionError("--BundleAdjustment.max_reproj_error", std::to_string(max_reproj_error_px), "> 0 px");
   }
+  if (!(principal_point_test_sigmas >= 0)) {
+    throw OptionError("--BundleAdjustment.principal_point_test_sigmas", std::to_string(principal_point_test_sigmas),
+                      ">= 0 (0: no test)");
+  }
   ba.Check();
 }
 
 namespace {
+
+std::string FormatSigmas(double sigmas) {
+  std::ostringstream out;
+  out << sigmas << " sigma";
+  return out.str();
+}
+
+// Whether any camera's refined principal point lies more than `sigmas`
+// standard deviations (per axis) from the image centre; describes each
+// camera's offset in `offset`.
+bool PrincipalPointOffCentre(const std::map<camera_t, SfmCamera>& cameras, const CalibrationStdDevs& std_devs,
+                             double sigmas, std::ostringstream* offset) {
+  bool significant = false;
+  *offset << std::fixed << std::setprecision(2);
+  for (const auto& [id, camera] : cameras) {
+    const std::vector<int> idxs = CameraModelPrincipalPointIdxs(camera.camera.model_id);
+    const auto sd = std_devs.intrinsics.find(id);
+    if (idxs.size() != 2 || sd == std_devs.intrinsics.end()) continue;
+    const double centre[2] = {camera.camera.width / 2.0, camera.camera.height / 2.0};
+    const char* axis = "xy";
+    if (offset->tellp() > 0) *offset << "; ";
+    if (cameras.size() > 1) *offset << "camera " << id << ": ";
+    for (size_t k = 0; k < 2; ++k) {
+      const double delta = camera.camera.params[idxs[k]] - centre[k];
+      const double sigma = sd->second[idxs[k]];
+      // No finite standard deviation: the data cannot tell, so not significant.
+      const bool beyond = sigma > 0 && std::isfinite(sigma) && std::abs(delta) > sigmas * sigma;
+      significant |= beyond;
+      *offset << (k ? ", " : "") << axis[k] << " " << std::showpos << delta << std::noshowpos << " px (sd "
+              << sigma << ")";
+    }
+  }
+  return significant;
+}
+
+// Sets every camera's principal point to its image centre.
+void CentrePrincipalPoints(Reconstruction* r) {
+  for (auto& [id, camera] : r->mutable_cameras()) {
+    const std::vector<int> idxs = CameraModelPrincipalPointIdxs(camera.camera.model_id);
+    if (idxs.size() != 2) continue;
+    camera.camera.params[idxs[0]] = camera.camera.width / 2.0;
+    camera.camera.params[idxs[1]] = camera.camera.height / 2.0;
+  }
+}
 
 // Drops observations whose exact reprojection error exceeds the limit.
 int FilterObservations(Reconstruction* r, double max_error_px) {
@@ -140,20 +191,40 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
   }
   // A first solve, outliers out, then the final solve with covariance.
   const std::map<camera_t, SfmCamera> cameras_before = r.cameras();
-  AdjustBundle(&r, options.ba, BundleAdjustmentScope(), &markers, options.marker_scale);
-  for (const auto& [id, camera] : r.cameras()) {
-    // Garbage must not pass for a calibration.
-    std::string why;
-    if (ImplausibleIntrinsics(cameras_before.at(id).camera, camera.camera, &why)) {
-      throw NumericalError(options.input_path + ": refining camera " + std::to_string(id) +
-                           " gave implausible intrinsics (" + why + "): the reconstruction is likely "
-                           "wrong (mean reprojection error " + std::to_string(r.MeanReprojectionError()) +
-                           " px); give the intrinsics (--ImageReader.camera_params) or more views");
+  const auto solve = [&](const BundleAdjustmentOptions& ba, CalibrationStdDevs* std_devs) {
+    AdjustBundle(&r, ba, BundleAdjustmentScope(), &markers, options.marker_scale);
+    for (const auto& [id, camera] : r.cameras()) {
+      // Garbage must not pass for a calibration.
+      std::string why;
+      if (ImplausibleIntrinsics(cameras_before.at(id).camera, camera.camera, &why)) {
+        throw NumericalError(options.input_path + ": refining camera " + std::to_string(id) +
+                             " gave implausible intrinsics (" + why + "): the reconstruction is likely "
+                             "wrong (mean reprojection error " + std::to_string(r.MeanReprojectionError()) +
+                             " px); give the intrinsics (--ImageReader.camera_params) or more views");
+      }
     }
-  }
-  result.num_filtered = FilterObservations(&r, options.max_reproj_error_px);
+    result.num_filtered += FilterObservations(&r, options.max_reproj_error_px);
+    AdjustBundle(&r, ba, BundleAdjustmentScope(), &markers, options.marker_scale, std_devs);
+  };
   CalibrationStdDevs std_devs;
-  AdjustBundle(&r, options.ba, BundleAdjustmentScope(), &markers, options.marker_scale, &std_devs);
+  solve(options.ba, &std_devs);
+  std::vector<std::string> notes;
+  if (options.ba.refine_principal_point && options.principal_point_test_sigmas > 0) {
+    std::ostringstream offset;
+    if (!PrincipalPointOffCentre(r.cameras(), std_devs, options.principal_point_test_sigmas, &offset)) {
+      CentrePrincipalPoints(&r);
+      BundleAdjustmentOptions held = options.ba;
+      held.refine_principal_point = false;
+      std_devs = CalibrationStdDevs();
+      solve(held, &std_devs);
+      result.principal_point_held = true;
+      notes.push_back("principal point held at the image centre: refined, it was off by " + offset.str() +
+                      ", within " + FormatSigmas(options.principal_point_test_sigmas));
+    } else {
+      notes.push_back("principal point refined: off the image centre by " + offset.str());
+    }
+    LOG(INFO) << "refractive_bundle_adjuster: " << notes.back();
+  }
 
   // Report: the first camera, RMS of the exact reprojection error.
   const camera_t camera_id = r.cameras().begin()->first;
@@ -176,6 +247,7 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
   for (double& v : report.parameters_std_dev) if (!std::isfinite(v)) v = 0.0;
   for (double& v : report.housing_std_dev) if (!std::isfinite(v)) v = 0.0;
   report.residual_sigma_px = std_devs.sigma0;
+  report.notes = notes;
   report.target_description =
       options.marker_scale.side_length_m > 0
           ? "auto-calibration (SIFT points, ArUco markers of side " +

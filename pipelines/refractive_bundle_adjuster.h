@@ -28,6 +28,15 @@ struct RefractiveBundleAdjusterOptions {
   BundleAdjustmentOptions ba;  // refine_housing on, exact reprojection error
   MarkerScale marker_scale;
   double max_reproj_error_px = 4.0;  // observations beyond are dropped before the final solve
+  // With ba.refine_principal_point and a value > 0: after the final solve the
+  // principal point is set to the image centre and held there (the solve
+  // redone) unless the refined one lies more than this many standard
+  // deviations from the centre in x or y. Refined when the data cannot tell
+  // it from the centre, it only trades with a flat port's tilt (1 px ~ 0.04
+  // deg at f = 1300 px; shared flat set: normal 0.015 -> 0.048 deg); held at
+  // the centre when it is elsewhere, it wrecks the housing (own render with
+  // the principal point 5 px off: port distance 3 mm instead of 30 mm).
+  double principal_point_test_sigmas = 0;
   RefractiveBundleAdjusterOptions() {
     ba.refine_housing = true;
     // The virtual-camera error biased the dome's Cz by 1.1 mm on the shared
@@ -43,6 +52,7 @@ struct RefractiveBundleAdjusterResult {
   int num_marker_corners = 0;
   int num_position_priors = 0;  // images whose priors fixed the frame
   int num_filtered = 0;
+  bool principal_point_held = false;  // by principal_point_test_sigmas
 };
 
 RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options);

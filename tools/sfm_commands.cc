@@ -94,6 +94,8 @@ int RunRefractiveBundleAdjuster(int argc, char** argv) {
   cli.Add("Markers.side_sigma", &options.marker_scale.sigma_m, "uncertainty of a marker side, metres");
   cli.Add("Markers.corner_sigma", &options.ba.marker_sigma_px, "uncertainty of a marker corner, px");
   cli.Add("BundleAdjustment.max_reproj_error", &options.max_reproj_error_px, "observations beyond are dropped");
+  cli.Add("BundleAdjustment.principal_point_test_sigmas", &options.principal_point_test_sigmas,
+          "with refine_principal_point: hold it at the image centre unless it lies more sigmas than this from it (0: no test)");
   cli.Add("PosePrior.position_sigma", &options.ba.position_prior_sigma_m,
           "position priors' uncertainty, metres (0: unused); they give the scale");
   AddBundleOptions(&cli, &options.ba);
@@ -122,6 +124,8 @@ int RunAutoCalibrator(int argc, char** argv) {
   cli.Add("AutoCalibration.matcher", &options.matcher, "exhaustive | sequential");
   cli.Add("AutoCalibration.refine_intrinsics", &options.refine_intrinsics,
           "-1: when --ImageReader.camera_params is empty; 0; 1");
+  cli.Add("AutoCalibration.refine_principal_point", &options.refine_principal_point,
+          "-1: with the intrinsics, held at the image centre unless the data move it beyond 3 sigma; 0; 1");
   cli.Add("SiftExtraction.max_num_features", &options.sift.max_num_features, "per image");
   cli.Add("SiftExtraction.max_image_size", &options.sift.max_image_size, "pixels");
   cli.Add("num_threads", &options.num_threads, "threads");

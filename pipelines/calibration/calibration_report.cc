@@ -29,6 +29,13 @@ std::string List(const std::vector<double>& values) {
 }
 
 // Standard deviations: negative means undetermined, written as null.
+// A YAML single-quoted scalar: a quote inside is doubled.
+std::string SingleQuoted(const std::string& text) {
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("''") : std::string(1, c);
+  return out + "'";
+}
+
 std::string StdDevList(const std::vector<double>& values) {
   std::string text = "[";
   for (size_t i = 0; i < values.size(); ++i) {
@@ -61,10 +68,14 @@ std::string Yaml(const CalibrationReport& r) {
       << "residual_sigma_px: " << Num(r.residual_sigma_px) << "\n"
       << "num_views: " << std::count_if(r.views.begin(), r.views.end(), [](const CalibratedView& v) { return !v.dropped; })
       << "\nnum_points: " << r.num_points << "\n"
-      << "target: '" << r.target_description << "'\n";
+      << "target: " << SingleQuoted(r.target_description) << "\n";
   if (r.board_warp) {
     out << "board_warp: " << List({r.board_warp->x(), r.board_warp->y()}) << "\n"
         << "board_warp_std_dev: " << List({r.board_warp_std_dev->x(), r.board_warp_std_dev->y()}) << "\n";
+  }
+  if (!r.notes.empty()) {
+    out << "notes:\n";
+    for (const std::string& note : r.notes) out << "- " << SingleQuoted(note) << "\n";
   }
   out << "per_view:\n";
   for (const CalibratedView& v : r.views) {
@@ -109,6 +120,7 @@ std::string Text(const CalibrationReport& r) {
         << r.board_warp_std_dev->x() * 1000 << " mm, y " << r.board_warp->y() * 1000 << " +- "
         << r.board_warp_std_dev->y() * 1000 << " mm\n";
   }
+  for (const std::string& note : r.notes) out << "\nNote: " << note << "\n";
   out << std::setprecision(4) << "\nRMS reprojection error " << r.overall_rms_px << " px over "
       << r.num_points << " points (residual sigma " << r.residual_sigma_px << " px)\n\n"
       << "  view                                  rms (px)  points\n";
@@ -243,6 +255,7 @@ CalibrationReport ReadCalibrationReport(const fs::path& path) {
       report.board_warp = Eigen::Vector2d(warp[0], warp[1]);
       report.board_warp_std_dev = Eigen::Vector2d(warp_std_dev[0], warp_std_dev[1]);
     }
+    if (root["notes"]) report.notes = root["notes"].as<std::vector<std::string>>();
   } catch (const YAML::Exception& e) {
     throw InputError(path.string() + ": " + e.what());
   }

@@ -26,6 +26,9 @@ struct CalibrationReport {
   std::vector<CalibratedView> views;
   std::string target_description;  // e.g. "chessboard 10x7, square 0.02 m"
   std::optional<Eigen::Vector2d> board_warp, board_warp_std_dev;
+  // Decisions a reader needs to weigh the numbers (e.g. a parameter held
+  // because the data could not tell it from its default).
+  std::vector<std::string> notes;
 };
 
 // Writes calibration.yaml and calibration.txt into `dir` (created),
