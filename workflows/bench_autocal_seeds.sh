@@ -2,9 +2,10 @@
 # Are auto-calibration's standard deviations honest? Renders N sets of the
 # same scene with different seeds (view poses, noise; portcal's renderer:
 # 960 x 540, 12 views of the two-face ArUco target behind a flat port
-# tilted 4 deg), auto-calibrates each with the intrinsics unknown, and
+# tilted 4 deg; principal point 4 and 3.5 px off the centre), auto-calibrates each with the intrinsics unknown, and
 # prints per seed and over all seeds the RMS of (estimate - truth) / sigma
-# for f, the normal's Nx and Ny, and the port distance (honest: 0.7-1.4).
+# for f, the principal point, the normal's Nx and Ny, and the port distance
+# (honest: 0.7-1.4).
 # Usage: workflows/bench_autocal_seeds.sh [N=10]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,7 +16,7 @@ trap 'rm -rf "$work"' EXIT
 cat > "$work/set.yaml" <<'YAML'
 name: seeds
 num_images: 12
-camera: {model: RADIAL, width: 960, height: 540, params: [650.0, 480.0, 270.0, 0.0, 0.0]}
+camera: {model: RADIAL, width: 960, height: 540, params: [650.0, 484.0, 266.5, 0.0, 0.0]}
 housing: {model: FLATPORT, params: [0.0697565, 0.0, 0.9975641, 0.015, 0.010, 1.0, 1.473, 1.334]}
 target:
   type: target3d
@@ -43,8 +44,9 @@ for seed in $(seq 1 "$n"); do
 done > "$work/runs.txt"
 /usr/bin/python3 - "$work/runs.txt" <<'PY'
 import math, sys, yaml
-names = ["f", "Nx", "Ny", "distance"]
-sums = [0.0] * 4
+names = ["f", "cx", "cy", "Nx", "Ny", "distance"]
+n = len(names)
+sums = [0.0] * n
 count = 0
 for line in open(sys.argv[1]):
     parts = line.split()
@@ -53,17 +55,17 @@ for line in open(sys.argv[1]):
         continue
     truth = yaml.safe_load(open(parts[1]))
     result = yaml.safe_load(open(parts[2]))
-    t = [truth["camera"]["params"][0]] + truth["housing"]["params"][0:2] + [truth["housing"]["params"][3]]
-    e = [result["parameters"][0]] + result["non_svp_parameters"][0:2] + [result["non_svp_parameters"][3]]
-    s = [result["parameters_std_dev"][0]] + result["non_svp_parameters_std_dev"][0:2] + \
+    t = truth["camera"]["params"][0:3] + truth["housing"]["params"][0:2] + [truth["housing"]["params"][3]]
+    e = result["parameters"][0:3] + result["non_svp_parameters"][0:2] + [result["non_svp_parameters"][3]]
+    s = result["parameters_std_dev"][0:3] + result["non_svp_parameters_std_dev"][0:2] + \
         [result["non_svp_parameters_std_dev"][3]]
-    z = [(e[i] - t[i]) / s[i] if s[i] else float("nan") for i in range(4)]
+    z = [(e[i] - t[i]) / s[i] if s[i] else float("nan") for i in range(n)]
     print(f"seed {parts[0]}: " + ", ".join(f"{names[i]} {e[i] - t[i]:+.5g} (sd {s[i]:.3g}, z {z[i]:+.2f})"
-                                          for i in range(4)))
-    for i in range(4):
+                                          for i in range(n)))
+    for i in range(n):
         sums[i] += z[i] ** 2
     count += 1
 if count:
     print(f"RMS z over {count} seeds (honest: 0.7-1.4): " +
-          ", ".join(f"{names[i]} {math.sqrt(sums[i] / count):.2f}" for i in range(4)))
+          ", ".join(f"{names[i]} {math.sqrt(sums[i] / count):.2f}" for i in range(n)))
 PY

@@ -92,6 +92,10 @@ namespace {
 // Smallest flat-port interface distance an adjustment may reach, metres.
 constexpr double kMinPortDistance = 1e-4;
 
+// Largest dome decentering an adjustment may reach, in dome radii: the
+// camera centre stays inside the dome.
+constexpr double kMaxDomeDecentering = 0.9;
+
 // Largest reduced (Schur) system whose covariance is computed.
 constexpr int kMaxReducedSystem = 6000;
 
@@ -121,6 +125,15 @@ std::vector<int> ConstantIntrinsics(const Camera& camera, const BundleAdjustment
 }
 
 }  // namespace
+
+bool HousingAtBound(const Housing& housing) {
+  if (housing.model_id == 0) return housing.params[3] <= 1.5 * kMinPortDistance;
+  const double bound = kMaxDomeDecentering * housing.params[3];
+  for (int k = 0; k < 3; ++k) {
+    if (std::abs(housing.params[k]) >= 0.99 * bound) return true;
+  }
+  return false;
+}
 
 ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const BundleAdjustmentOptions& options,
                                     const BundleAdjustmentScope& scope, std::vector<MarkerCorner>* markers,
@@ -329,8 +342,7 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
     } else {
       // DOMEPORT: the decentering (Cx, Cy, Cz) only.
       problem.SetManifold(housing, new ceres::SubsetManifold(8, {3, 4, 5, 6, 7}));
-      // The camera centre stays inside the dome.
-      const double bound = 0.9 * camera.housing->params[3];
+      const double bound = kMaxDomeDecentering * camera.housing->params[3];
       for (int k = 0; k < 3; ++k) {
         problem.SetParameterLowerBound(housing, k, -bound);
         problem.SetParameterUpperBound(housing, k, bound);

@@ -73,6 +73,12 @@ struct CalibrationStdDevs {
 // max_extra_param 1) of `after` against `before`; says why in `why`.
 bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::string* why = nullptr);
 
+// Whether a refined housing ended at a bound the adjustment imposes (a flat
+// port's distance at its floor of 0.1 mm, a dome's decentering at 90 % of
+// its radius): not an estimate but a sign that the data traded the housing
+// against something else (e.g. the focal length).
+bool HousingAtBound(const Housing& housing);
+
 // Adjusts in place. The gauge: the position priors (global adjustments with
 // position_prior_sigma_m > 0 and priors spanning a plane), else the first
 // registered image's pose is held, and, without marker scale, one

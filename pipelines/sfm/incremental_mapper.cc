@@ -545,6 +545,18 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
     ba.refine_housing = false;
     AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
   }
+  if (VLOG_IS_ON(1) && (ba.refine_housing || ba.refine_focal_length)) {
+    std::ostringstream values;
+    for (const auto& [id, camera] : r->cameras()) {
+      values << " camera";
+      for (const double p : camera.camera.params) values << " " << p;
+      if (camera.housing) {
+        values << " housing";
+        for (const double p : camera.housing->params) values << " " << p;
+      }
+    }
+    VLOG(1) << "global adjustment of " << r->poses().size() << " images:" << values.str();
+  }
   Filter(r, nullptr);
 }
 
