@@ -12,6 +12,7 @@
 #include "pipelines/feature_masker.h"
 #include "pipelines/features/descriptor_matching.h"
 #include "pipelines/features/sift.h"
+#include "pipelines/sfm/bundle_adjustment.h"
 #include "pipelines/sfm/calibration_covariance.h"
 #include "pipelines/sfm/ray_geometry.h"
 #include "pipelines/target/marker_edge_refinement.h"
@@ -251,6 +252,20 @@ TEST(CalibrationCovariance, MarginalMatchesTheFullCovariance) {
   covariance.GetCovarianceBlock(&b, &b, &vb);
   EXPECT_NEAR(marginal.at(&a)[0], std::sqrt(va), 1e-9);
   EXPECT_NEAR(marginal.at(&b)[0], std::sqrt(vb), 1e-9);
+}
+
+TEST(BundleAdjustment, HousingAtBoundIsTheAdjustmentsFloorOrWall) {
+  // A flat port at the 0.1 mm floor of its distance, a dome decentred to
+  // 90 % of its radius: bounds, not estimates.
+  const auto flat = [](double distance) {
+    return Housing::FromName("FLATPORT", {0.05, 0.0, std::sqrt(1 - 0.0025), distance, 0.01, 1, 1.473, 1.334}, "test");
+  };
+  EXPECT_TRUE(HousingAtBound(flat(1e-4)));
+  EXPECT_FALSE(HousingAtBound(flat(0.015)));
+  EXPECT_FALSE(HousingAtBound(flat(1e-3)));
+  const auto dome = [](double cz) { return Housing::FromName("DOMEPORT", {0.01, 0.0, cz, 0.05, 0.006, 1, 1.473, 1.334}, "test"); };
+  EXPECT_TRUE(HousingAtBound(dome(-0.045)));
+  EXPECT_FALSE(HousingAtBound(dome(0.02)));
 }
 
 TEST(Parallel, OrderedParallelForConsumesInOrderAndPropagatesErrors) {
