@@ -28,7 +28,6 @@ std::string List(const std::vector<double>& values) {
   return text + "]";
 }
 
-// Standard deviations: negative means undetermined, written as null.
 // A YAML single-quoted scalar: a quote inside is doubled.
 std::string SingleQuoted(const std::string& text) {
   std::string out = "'";
@@ -36,6 +35,7 @@ std::string SingleQuoted(const std::string& text) {
   return out + "'";
 }
 
+// Standard deviations: negative means undetermined, written as null.
 std::string StdDevList(const std::vector<double>& values) {
   std::string text = "[";
   for (size_t i = 0; i < values.size(); ++i) {
@@ -255,6 +255,7 @@ CalibrationReport ReadCalibrationReport(const fs::path& path) {
       report.board_warp = Eigen::Vector2d(warp[0], warp[1]);
       report.board_warp_std_dev = Eigen::Vector2d(warp_std_dev[0], warp_std_dev[1]);
     }
+    if (root["target"]) report.target_description = root["target"].as<std::string>();
     if (root["notes"]) report.notes = root["notes"].as<std::vector<std::string>>();
   } catch (const YAML::Exception& e) {
     throw InputError(path.string() + ": " + e.what());

@@ -43,7 +43,7 @@ void WriteStereoCalibrationReport(const StereoCalibrationResult& result, const R
                                   const std::filesystem::path& dir);
 
 // Reads the camera (and housing) of a calibration.yaml written by portcal or
-// calibmar, and portcal's standard deviations, board warp and per-view table
+// calibmar, and portcal's standard deviations, board warp, target, notes and per-view table
 // (names, RMS, outlier/dropped flags; poses are not read back) when present.
 // Throws InputError naming the file and key.
 CalibrationReport ReadCalibrationReport(const std::filesystem::path& path);

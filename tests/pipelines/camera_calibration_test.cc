@@ -152,5 +152,21 @@ TEST(CameraCalibration, StageWritesBothReports) {
   EXPECT_NE(text.find("img_025.png"), std::string::npos);
 }
 
+TEST(CalibrationReport, NotesAndTargetSurviveQuotesThroughYaml) {
+  testing::TempDir dir;
+  CalibrationReport report;
+  report.camera = Camera::FromModelName("RADIAL", 1000, 1600, 1200);
+  report.parameters_std_dev = {1, 0, 0, 0.01, 0.01};
+  report.target_description = "the diver's board: 'A3'";
+  report.notes = {"principal point held at the image centre: refined, it was off by x +0.50 px (sd 0.20)",
+                  "it's quoted"};
+  WriteCalibrationReport(report, dir / "out");
+  const CalibrationReport read = ReadCalibrationReport(dir / "out/calibration.yaml");
+  EXPECT_EQ(read.notes, report.notes);
+  EXPECT_EQ(read.target_description, report.target_description);
+  const std::string text = testing::ReadFileToString(dir / "out/calibration.txt");
+  EXPECT_NE(text.find("Note: it's quoted"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace portcal
