@@ -94,6 +94,38 @@ housing: {model: FLATPORT, params: [0.0697565, 0.0, 0.9975641, 0.015, 0.010, 1.0
   EXPECT_TRUE(fs::exists(dir / "out" / "calibration.yaml"));
 }
 
+TEST(AutoCalibration, OwnRenderDomePortPrincipalPointOffCentre) {
+  // A dome's lateral decentering and the principal point move the rays
+  // alike (only depth tells them apart): with the principal point held at
+  // the image centre 4 px away, the decentering (and the focal length)
+  // would take up the offset.
+  testing::TempDir dir;
+  const GroundTruth truth = Render(dir.path(), R"(camera: {model: RADIAL, width: 960, height: 540, params: [650.0, 476.0, 273.0, -0.05, 0.0]}
+housing: {model: DOMEPORT, params: [-0.004, 0.006, -0.008, 0.05, 0.006, 1.0, 1.473, 1.334]}
+)");
+  const AutoCalibrationResult result =
+      Calibrate(dir / "set" / "images", dir / "out", "DOMEPORT", "0,0,0,0.05,0.006,1,1.473,1.334");
+  EXPECT_EQ(result.num_registered, 15);
+  const CalibrationReport& r = result.refined.report;
+  ASSERT_TRUE(r.housing);
+  const double df = std::abs(r.camera.params[0] - truth.camera.params[0]);
+  std::cout << "own dome: |df| " << df << " px (sd " << r.parameters_std_dev[0] << "), dc ("
+            << r.camera.params[1] - truth.camera.params[1] << ", " << r.camera.params[2] - truth.camera.params[2]
+            << ") px, dC (" << (r.housing->params[0] - truth.housing->params[0]) * 1000 << ", "
+            << (r.housing->params[1] - truth.housing->params[1]) * 1000 << ", "
+            << (r.housing->params[2] - truth.housing->params[2]) * 1000 << ") mm\n";
+  EXPECT_LT(df, 4 * r.parameters_std_dev[0]);
+  for (int i : {1, 2}) {
+    EXPECT_GT(r.parameters_std_dev[i], 0.0) << "the principal point was held";
+    EXPECT_LT(std::abs(r.camera.params[i] - truth.camera.params[i]), 4 * r.parameters_std_dev[i]);
+  }
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_LT(std::abs(r.housing->params[k] - truth.housing->params[k]), 4 * r.housing_std_dev[k]) << "C" << k;
+  }
+  ASSERT_EQ(r.notes.size(), 1u);
+  EXPECT_NE(r.notes[0].find("principal point refined"), std::string::npos) << r.notes[0];
+}
+
 TEST(AutoCalibration, OwnRenderInAirWithoutIntrinsics) {
   // The published tool fails outright here ("can not estimate pose of image
   // 0"); the markers pre-calibrate the focal length.
