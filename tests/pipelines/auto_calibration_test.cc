@@ -48,6 +48,21 @@ AutoCalibrationResult Calibrate(const fs::path& images, const fs::path& out, con
   return RunAutoCalibrator(options, progress);
 }
 
+// An own render of 15 views in `dir`, auto-calibrated; all views register.
+struct OwnRun {
+  GroundTruth truth;
+  AutoCalibrationResult result;
+};
+
+OwnRun RenderAndCalibrate(const fs::path& dir, const std::string& camera_and_housing,
+                          const std::string& housing_model, const std::string& housing_guess) {
+  OwnRun run;
+  run.truth = Render(dir, camera_and_housing);
+  run.result = Calibrate(dir / "set" / "images", dir / "out", housing_model, housing_guess);
+  EXPECT_EQ(run.result.num_registered, 15);
+  return run;
+}
+
 double NormalAngle(const std::vector<double>& a, const std::vector<double>& b) {
   const Eigen::Vector3d na(a[0], a[1], a[2]), nb(b[0], b[1], b[2]);
   return std::acos(std::min(1.0, na.normalized().dot(nb.normalized())));
@@ -74,13 +89,11 @@ TEST(AutoCalibration, OwnRenderFlatPortIntrinsicsUnknown) {
   // The principal point 4 px and 3.5 px off the image centre: held at the
   // centre it would be absorbed by the port's tilt and distance.
   testing::TempDir dir;
-  const GroundTruth truth = Render(dir.path(), R"(camera: {model: RADIAL, width: 960, height: 540, params: [650.0, 484.0, 266.5, 0.0, 0.0]}
+  const OwnRun run = RenderAndCalibrate(dir.path(), R"(camera: {model: RADIAL, width: 960, height: 540, params: [650.0, 484.0, 266.5, 0.0, 0.0]}
 housing: {model: FLATPORT, params: [0.0697565, 0.0, 0.9975641, 0.015, 0.010, 1.0, 1.473, 1.334]}
-)");
-  const AutoCalibrationResult result =
-      Calibrate(dir / "set" / "images", dir / "out", "FLATPORT", "0,0,1,0.015,0.010,1,1.473,1.334");
-  EXPECT_EQ(result.num_registered, 15);
-  const CalibrationReport& r = result.refined.report;
+)", "FLATPORT", "0,0,1,0.015,0.010,1,1.473,1.334");
+  const GroundTruth& truth = run.truth;
+  const CalibrationReport& r = run.result.refined.report;
   ASSERT_TRUE(r.housing);
   const double df = std::abs(r.camera.params[0] - truth.camera.params[0]);
   const double angle = NormalAngle(r.housing->params, truth.housing->params);
@@ -106,13 +119,11 @@ TEST(AutoCalibration, OwnRenderDomePortPrincipalPointOffCentre) {
   // the image centre 4 px away, the decentering (and the focal length)
   // would take up the offset.
   testing::TempDir dir;
-  const GroundTruth truth = Render(dir.path(), R"(camera: {model: RADIAL, width: 960, height: 540, params: [650.0, 476.0, 273.0, -0.05, 0.0]}
+  const OwnRun run = RenderAndCalibrate(dir.path(), R"(camera: {model: RADIAL, width: 960, height: 540, params: [650.0, 476.0, 273.0, -0.05, 0.0]}
 housing: {model: DOMEPORT, params: [-0.004, 0.006, -0.008, 0.05, 0.006, 1.0, 1.473, 1.334]}
-)");
-  const AutoCalibrationResult result =
-      Calibrate(dir / "set" / "images", dir / "out", "DOMEPORT", "0,0,0,0.05,0.006,1,1.473,1.334");
-  EXPECT_EQ(result.num_registered, 15);
-  const CalibrationReport& r = result.refined.report;
+)", "DOMEPORT", "0,0,0,0.05,0.006,1,1.473,1.334");
+  const GroundTruth& truth = run.truth;
+  const CalibrationReport& r = run.result.refined.report;
   ASSERT_TRUE(r.housing);
   const double df = std::abs(r.camera.params[0] - truth.camera.params[0]);
   std::cout << "own dome: |df| " << df << " px (sd " << r.parameters_std_dev[0] << "), dc ("
@@ -131,12 +142,11 @@ TEST(AutoCalibration, OwnRenderInAirWithoutIntrinsics) {
   // The published tool fails outright here ("can not estimate pose of image
   // 0"); the markers pre-calibrate the focal length.
   testing::TempDir dir;
-  const GroundTruth truth = Render(dir.path(), R"(camera: {model: RADIAL, width: 960, height: 540, params: [700.0, 480.0, 270.0, -0.04, 0.0]}
+  const OwnRun run = RenderAndCalibrate(dir.path(), R"(camera: {model: RADIAL, width: 960, height: 540, params: [700.0, 480.0, 270.0, -0.04, 0.0]}
 housing: null
-)");
-  const AutoCalibrationResult result = Calibrate(dir / "set" / "images", dir / "out", "", "");
-  EXPECT_EQ(result.num_registered, 15);
-  const CalibrationReport& r = result.refined.report;
+)", "", "");
+  const GroundTruth& truth = run.truth;
+  const CalibrationReport& r = run.result.refined.report;
   EXPECT_FALSE(r.housing);
   const double df = std::abs(r.camera.params[0] - truth.camera.params[0]);
   const double dk1 = std::abs(r.camera.params[3] - truth.camera.params[3]);
