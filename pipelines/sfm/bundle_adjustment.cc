@@ -165,7 +165,9 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
       !local && (options.refine_focal_length || options.refine_principal_point || options.refine_extra_params);
   const bool refine_housing = !local && options.refine_housing;
   const auto blocks_of = [&](const SfmCamera& camera) {
-    if (refine_housing && camera.housing) return CostBlocks::kAll;
+    if (refine_housing && camera.housing) {
+      return refine_intrinsics || options.virtual_camera_error ? CostBlocks::kAll : CostBlocks::kPosePointHousing;
+    }
     if (refine_intrinsics || (options.virtual_camera_error && camera.housing)) {
       return camera.housing && options.virtual_camera_error ? CostBlocks::kAll : CostBlocks::kPosePointIntrinsics;
     }
@@ -187,8 +189,12 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
             ? CreateVirtualCameraCost(camera.camera.model_id, camera.housing->model_id, pixel, sigma)
             : CreateReprojectionCost(model, kind, pixel, sigma);
     std::vector<double*> blocks = {pose_blocks.at(image_id).data(), xyz};
-    if (kind != CostBlocks::kPosePoint) blocks.push_back(intrinsics.at(image.camera_id).data());
-    if (kind == CostBlocks::kAll && camera.housing) blocks.push_back(housings.at(image.camera_id).data());
+    if (kind == CostBlocks::kPosePointIntrinsics || kind == CostBlocks::kAll) {
+      blocks.push_back(intrinsics.at(image.camera_id).data());
+    }
+    if ((kind == CostBlocks::kAll || kind == CostBlocks::kPosePointHousing) && camera.housing) {
+      blocks.push_back(housings.at(image.camera_id).data());
+    }
     problem.AddResidualBlock(cost, loss, blocks);
     used_cameras.insert(image.camera_id);
     num_residuals += 2;
@@ -334,8 +340,10 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
     } else if (camera.housing->model_id == 0) {
       // FLATPORT: normal on the unit sphere, distance free; thickness and
       // refractive indices are the user's constants.
+      const std::vector<int> held = options.refine_port_distance ? std::vector<int>{1, 2, 3, 4}
+                                                                  : std::vector<int>{0, 1, 2, 3, 4};
       problem.SetManifold(housing, new ceres::ProductManifold<ceres::SphereManifold<3>, ceres::SubsetManifold>(
-                                       ceres::SphereManifold<3>(), ceres::SubsetManifold(5, {1, 2, 3, 4})));
+                                       ceres::SphereManifold<3>(), ceres::SubsetManifold(5, held)));
       // The interface is in front of the lens: a distance the data cannot
       // fix (no scale) must not wander through zero.
       problem.SetParameterLowerBound(housing, 3, kMinPortDistance);
@@ -449,14 +457,24 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
       others.clear();
       wanted.clear();
     }
-    const auto marginal = wanted.empty() ? std::map<const double*, std::vector<double>>()
-                                         : MarginalStdDevs(&problem, points, others, wanted, scale, describe);
-    for (camera_t id : used_cameras) {
-      const auto it = marginal.find(intrinsics.at(id).data());
-      if (it != marginal.end()) std_devs->intrinsics[id] = it->second;
-      if (!housings.count(id)) continue;
-      const auto ith = marginal.find(housings.at(id).data());
-      if (ith != marginal.end()) std_devs->housing[id] = ith->second;
+    if (!wanted.empty()) {
+      const MarginalCovariance marginal = ComputeMarginalCovariance(&problem, points, others, wanted, scale, describe);
+      for (camera_t id : used_cameras) {
+        const double* intrinsics_block = intrinsics.at(id).data();
+        const bool free_intrinsics = marginal.offset.count(intrinsics_block) > 0;
+        if (free_intrinsics) std_devs->intrinsics[id] = marginal.StdDevs(intrinsics_block);
+        if (!housings.count(id) || !marginal.offset.count(housings.at(id).data())) continue;
+        const double* housing_block = housings.at(id).data();
+        std_devs->housing[id] = marginal.StdDevs(housing_block);
+        if (!free_intrinsics) continue;
+        Eigen::MatrixXd& correlation = std_devs->intrinsics_housing_correlation[id];
+        correlation.resize(marginal.size.at(intrinsics_block), marginal.size.at(housing_block));
+        for (int i = 0; i < correlation.rows(); ++i) {
+          for (int j = 0; j < correlation.cols(); ++j) {
+            correlation(i, j) = marginal.Correlation(intrinsics_block, i, housing_block, j);
+          }
+        }
+      }
     }
   }
 

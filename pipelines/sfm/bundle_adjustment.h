@@ -19,6 +19,8 @@ struct BundleAdjustmentOptions {
   bool refine_principal_point = false;
   bool refine_extra_params = false;
   bool refine_housing = false;
+  // With refine_housing: a flat port's distance too (else only its normal).
+  bool refine_port_distance = true;
   bool virtual_camera_error = false;  // else the exact reprojection error
   double sigma_px = 1.0;              // residuals in units of this
   bool scale_weighting = true;        // sigma grows with the keypoint's scale (above 2 px)
@@ -65,6 +67,10 @@ struct BundleAdjustmentScope {
 struct CalibrationStdDevs {
   std::map<camera_t, std::vector<double>> intrinsics;
   std::map<camera_t, std::vector<double>> housing;
+  // Correlation of each intrinsic parameter (row) with each housing
+  // parameter (column), 0 where either is held: near +-1 the data cannot
+  // tell the two apart.
+  std::map<camera_t, Eigen::MatrixXd> intrinsics_housing_correlation;
   double sigma0 = 0;  // estimated pixel noise (residual RMS corrected for the degrees of freedom)
   int64_t num_residuals = 0;
 };

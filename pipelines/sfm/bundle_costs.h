@@ -8,7 +8,9 @@
 //                         intrinsics and housing are constants.
 //   kPosePointIntrinsics: + intrinsics (the camera model's count); the
 //                         housing is a constant.
-//   kAll:                 + the housing parameters (port model's count)
+//   kPosePointHousing:    + the housing parameters (port model's count);
+//                         the intrinsics are constants. Needs a housing.
+//   kAll:                 + the intrinsics and the housing parameters
 //                         when there is a housing.
 // cam_from_world is quaternion x,y,z,w + translation.
 //
@@ -25,7 +27,7 @@ namespace portcal {
 
 constexpr int kNoHousing = -1;
 
-enum class CostBlocks { kPosePoint, kPosePointIntrinsics, kAll };
+enum class CostBlocks { kPosePoint, kPosePointIntrinsics, kPosePointHousing, kAll };
 
 struct ObservationModel {
   int camera_model_id = 0;

@@ -1,6 +1,7 @@
 #include "pipelines/sfm/calibration_covariance.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <unordered_map>
@@ -9,7 +10,21 @@
 
 namespace portcal {
 
-std::map<const double*, std::vector<double>> MarginalStdDevs(
+std::vector<double> MarginalCovariance::StdDevs(const double* block) const {
+  const int start = offset.at(block);
+  std::vector<double> std_dev;
+  for (int i = 0; i < size.at(block); ++i) std_dev.push_back(std::sqrt(std::max(0.0, covariance(start + i, start + i))));
+  return std_dev;
+}
+
+double MarginalCovariance::Correlation(const double* a, int i, const double* b, int j) const {
+  const int row = offset.at(a) + i;
+  const int col = offset.at(b) + j;
+  const double denominator = std::sqrt(covariance(row, row) * covariance(col, col));
+  return denominator > 0 ? covariance(row, col) / denominator : 0.0;
+}
+
+MarginalCovariance ComputeMarginalCovariance(
     ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others,
     const std::vector<const double*>& wanted, double scale,
     const std::function<std::string(const double*, int)>& describe) {
@@ -107,21 +122,33 @@ std::map<const double*, std::vector<double>> MarginalStdDevs(
                                      values.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose() *
                                      d_inv_sqrt.asDiagonal();
 
-  std::map<const double*, std::vector<double>> result;
+  // Each wanted block's tangent covariance mapped to its ambient
+  // coordinates by the manifold's plus Jacobian: C_ab = P_a C'_ab P_b^T.
+  MarginalCovariance result;
+  std::vector<Eigen::MatrixXd> plus;
+  int total = 0;
   for (const double* block : wanted) {
-    double* mutable_block = const_cast<double*>(block);
-    const int start = offset.at(mutable_block);
     const int tangent = problem->ParameterBlockTangentSize(block);
     const int ambient = problem->ParameterBlockSize(block);
-    Eigen::MatrixXd plus = Eigen::MatrixXd::Identity(ambient, tangent);
+    Eigen::MatrixXd p = Eigen::MatrixXd::Identity(ambient, tangent);
     if (const ceres::Manifold* manifold = problem->GetManifold(block)) {
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> J(ambient, tangent);
       manifold->PlusJacobian(block, J.data());
-      plus = J;
+      p = J;
     }
-    const Eigen::MatrixXd ambient_cov = plus * covariance.block(start, start, tangent, tangent) * plus.transpose();
-    std::vector<double>& std_dev = result[block];
-    for (int i = 0; i < ambient; ++i) std_dev.push_back(std::sqrt(std::max(0.0, ambient_cov(i, i))) * scale);
+    plus.push_back(p);
+    result.offset[block] = total;
+    result.size[block] = ambient;
+    total += ambient;
+  }
+  result.covariance = Eigen::MatrixXd::Zero(total, total);
+  for (size_t a = 0; a < wanted.size(); ++a) {
+    const int ta = offset.at(const_cast<double*>(wanted[a]));
+    for (size_t b = 0; b < wanted.size(); ++b) {
+      const int tb = offset.at(const_cast<double*>(wanted[b]));
+      result.covariance.block(result.offset[wanted[a]], result.offset[wanted[b]], plus[a].rows(), plus[b].rows()) =
+          scale * scale * plus[a] * covariance.block(ta, tb, plus[a].cols(), plus[b].cols()) * plus[b].transpose();
+    }
   }
   return result;
 }

@@ -10,6 +10,8 @@
 
 #include <ceres/ceres.h>
 
+#include <Eigen/Core>
+
 #include <functional>
 #include <map>
 #include <string>
@@ -17,16 +19,29 @@
 
 namespace portcal {
 
+// The covariance of some parameter blocks (the "wanted" ones), in their
+// ambient coordinates: held coordinates of a manifold have zero variance.
+struct MarginalCovariance {
+  std::map<const double*, int> offset;  // row of each wanted block's first parameter
+  std::map<const double*, int> size;    // its ambient size
+  Eigen::MatrixXd covariance;           // the wanted blocks in order, scaled
+
+  // Standard deviation of every ambient parameter of `block`.
+  std::vector<double> StdDevs(const double* block) const;
+  // Correlation of parameter i of block a with parameter j of block b; 0
+  // where either is held.
+  double Correlation(const double* a, int i, const double* b, int j) const;
+};
+
 // `points`: 3-parameter blocks to marginalise (each residual may touch at
 // most one of them); `others`: the remaining variable blocks (poses,
 // intrinsics, housings, points shared by several-point residuals). Returns
-// for each of `wanted` (a subset of `others`) the standard deviation of
-// every ambient parameter (0 where held by its manifold), scaled by
-// `scale`. Residuals are taken without the loss function. Throws
-// NumericalError when the reduced system is rank deficient, naming the
-// parameter that dominates the unobservable direction by `describe(block,
-// tangent index)`.
-std::map<const double*, std::vector<double>> MarginalStdDevs(
+// the covariance of `wanted` (a subset of `others`), scaled by `scale`^2
+// (standard deviations by `scale`). Residuals are taken without the loss
+// function. Throws NumericalError when the reduced system is rank
+// deficient, naming the parameter that dominates the unobservable direction
+// by `describe(block, tangent index)`.
+MarginalCovariance ComputeMarginalCovariance(
     ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others,
     const std::vector<const double*>& wanted, double scale,
     const std::function<std::string(const double*, int)>& describe);

@@ -1,18 +1,21 @@
 // The building blocks of auto-calibration: SIFT keypoints in COLMAP's pixel
 // convention, descriptor matching, ray triangulation, generalized absolute
 // pose on refracted rays, focal length from markers, marker corners by edge
-// fits, the marginal covariance and the ordered parallel loop.
+// fits, the bundle adjustment's cost widths, the marginal covariance and the
+// ordered parallel loop.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/parallel.h"
 #include "pipelines/feature_masker.h"
 #include "pipelines/features/descriptor_matching.h"
 #include "pipelines/features/sift.h"
 #include "pipelines/sfm/bundle_adjustment.h"
+#include "pipelines/sfm/bundle_costs.h"
 #include "pipelines/sfm/calibration_covariance.h"
 #include "pipelines/sfm/ray_geometry.h"
 #include "pipelines/target/marker_edge_refinement.h"
@@ -212,6 +215,55 @@ TEST(MarkerEdgeRefinement, FindsTheCornersOfABlurredMarker) {
   }
 }
 
+// The housing-only width (intrinsics captured) is the full error with the
+// intrinsics held: same residuals, same derivatives by pose, point and
+// housing, for a flat and a dome port.
+TEST(BundleCosts, HousingBlockCostEqualsTheFullCostWithIntrinsicsHeld) {
+  const std::vector<double> intrinsics = {700, 484, 266, -0.05, 0.01};
+  const std::vector<std::pair<int, std::vector<double>>> housings = {
+      {0, {0.0523, 0.02, std::sqrt(1 - 0.0523 * 0.0523 - 0.0004), 0.02, 0.01, 1, 1.473, 1.334}},
+      {1, {0.004, -0.003, 0.006, 0.05, 0.006, 1, 1.473, 1.334}}};
+  for (const auto& [housing_id, housing] : housings) {
+    ObservationModel model;
+    model.camera_model_id = CameraModelNameToId("RADIAL");
+    model.intrinsics = intrinsics;
+    model.housing_model_id = housing_id;
+    model.housing = housing;
+    const Eigen::Vector2d observed(610.2, 180.7);
+    std::unique_ptr<ceres::CostFunction> narrow(
+        CreateReprojectionCost(model, CostBlocks::kPosePointHousing, observed, 0.5));
+    std::unique_ptr<ceres::CostFunction> full(CreateReprojectionCost(model, CostBlocks::kAll, observed, 0.5));
+    ASSERT_EQ(narrow->parameter_block_sizes(), (std::vector<int32_t>{7, 3, 8}));
+    ASSERT_EQ(full->parameter_block_sizes(), (std::vector<int32_t>{7, 3, 5, 8}));
+    const Eigen::Quaterniond rotation(Eigen::AngleAxisd(0.2, Eigen::Vector3d(0.3, -1, 0.2).normalized()));
+    double pose[7] = {rotation.x(), rotation.y(), rotation.z(), rotation.w(), 0.1, -0.05, 0.3};
+    double point[3] = {0.3, -0.2, 1.4};
+    double housing_params[8];
+    std::copy(housing.begin(), housing.end(), housing_params);
+    std::vector<double> camera = intrinsics;
+    double r_narrow[2], r_full[2];
+    double j_narrow[3][2 * 8], j_full[4][2 * 8];
+    double* narrow_jacobians[3] = {j_narrow[0], j_narrow[1], j_narrow[2]};
+    double* full_jacobians[4] = {j_full[0], j_full[1], j_full[2], j_full[3]};
+    const double* narrow_blocks[3] = {pose, point, housing_params};
+    const double* full_blocks[4] = {pose, point, camera.data(), housing_params};
+    ASSERT_TRUE(narrow->Evaluate(narrow_blocks, r_narrow, narrow_jacobians)) << housing_id;
+    ASSERT_TRUE(full->Evaluate(full_blocks, r_full, full_jacobians)) << housing_id;
+    // The point is seen: the residual is not zero (a zero would hide a
+    // cost that returns without computing).
+    EXPECT_GT(std::hypot(r_full[0], r_full[1]), 1.0) << housing_id;
+    for (int k = 0; k < 2; ++k) EXPECT_DOUBLE_EQ(r_narrow[k], r_full[k]) << housing_id;
+    const int sizes[3] = {7, 3, 8};
+    const int full_index[3] = {0, 1, 3};
+    for (int b = 0; b < 3; ++b) {
+      for (int k = 0; k < 2 * sizes[b]; ++k) {
+        EXPECT_NEAR(narrow_jacobians[b][k], full_jacobians[full_index[b]][k], 1e-9 * (1 + std::abs(full_jacobians[full_index[b]][k])))
+            << housing_id << " block " << b << " entry " << k;
+      }
+    }
+  }
+}
+
 // y = a x + b fitted to points, a and b each a 1-block, points marginalised:
 // the marginal std devs must equal those of ceres::Covariance on the full
 // problem.
@@ -242,16 +294,22 @@ TEST(CalibrationCovariance, MarginalMatchesTheFullCovariance) {
   ceres::Solve(options, &problem, &summary);
   std::vector<double*> points;
   for (auto& q : p) points.push_back(q.data());
-  const auto marginal = MarginalStdDevs(&problem, points, {&a, &b}, {&a, &b}, 1.0,
-                                        [](const double*, int) { return std::string("?"); });
+  const MarginalCovariance marginal = ComputeMarginalCovariance(
+      &problem, points, {&a, &b}, {&a, &b}, 1.0, [](const double*, int) { return std::string("?"); });
   ceres::Covariance::Options covariance_options;
   ceres::Covariance covariance(covariance_options);
-  ASSERT_TRUE(covariance.Compute({{&a, &a}, {&b, &b}}, &problem));
-  double va, vb;
+  ASSERT_TRUE(covariance.Compute({{&a, &a}, {&b, &b}, {&a, &b}}, &problem));
+  double va, vb, vab;
   covariance.GetCovarianceBlock(&a, &a, &va);
   covariance.GetCovarianceBlock(&b, &b, &vb);
-  EXPECT_NEAR(marginal.at(&a)[0], std::sqrt(va), 1e-9);
-  EXPECT_NEAR(marginal.at(&b)[0], std::sqrt(vb), 1e-9);
+  covariance.GetCovarianceBlock(&a, &b, &vab);
+  EXPECT_NEAR(marginal.StdDevs(&a)[0], std::sqrt(va), 1e-9);
+  EXPECT_NEAR(marginal.StdDevs(&b)[0], std::sqrt(vb), 1e-9);
+  // A line's slope and intercept, both fitted from x >= 0: negatively
+  // correlated.
+  EXPECT_LT(vab, 0);
+  EXPECT_NEAR(marginal.Correlation(&a, 0, &b, 0), vab / std::sqrt(va * vb), 1e-9);
+  EXPECT_NEAR(marginal.Correlation(&b, 0, &a, 0), marginal.Correlation(&a, 0, &b, 0), 1e-12);
 }
 
 TEST(BundleAdjustment, HousingAtBoundIsTheAdjustmentsFloorOrWall) {
