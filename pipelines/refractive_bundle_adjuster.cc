@@ -1,5 +1,6 @@
 #include "pipelines/refractive_bundle_adjuster.h"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -40,6 +41,11 @@ void RefractiveBundleAdjusterOptions::Check() const {
 
 namespace {
 
+// |correlation| of an intrinsic with a housing parameter from which the
+// report warns: the housing's standard deviation is then at least 3.2 times
+// what it would be with the intrinsic known.
+constexpr double kTradeOffCorrelation = 0.95;
+
 std::string FormatSigmas(double sigmas) {
   std::ostringstream out;
   out << sigmas << " sigma";
@@ -72,6 +78,48 @@ bool PrincipalPointOffCentre(const std::map<camera_t, SfmCamera>& cameras, const
     }
   }
   return significant;
+}
+
+std::vector<std::string> SplitParamsInfo(const std::string& info) {
+  std::vector<std::string> names;
+  std::istringstream in(info);
+  for (std::string name; std::getline(in, name, ',');) {
+    name.erase(0, name.find_first_not_of(' '));
+    names.push_back(name);
+  }
+  return names;
+}
+
+// The strongest correlation of an intrinsic with a housing parameter, per
+// camera, as a note when it reaches `limit`. Near +-1 the data tell the two
+// apart only through small higher-order effects: a dome decentred along its
+// axis magnifies like a longer focal length (own render, dome r 60 mm
+// decentred 12 mm along the axis, intrinsics unknown: f 14.5 px and Cz
+// 2.3 mm off, each ~1.2 sd; with the in-air intrinsics given Cz 0.05 mm).
+// The housing's variance is then at least 1 / (1 - rho^2) times what it
+// would be with that intrinsic known.
+std::vector<std::string> TradeOffNotes(const std::map<camera_t, SfmCamera>& cameras,
+                                       const CalibrationStdDevs& std_devs, double limit) {
+  std::vector<std::string> notes;
+  for (const auto& [id, correlation] : std_devs.intrinsics_housing_correlation) {
+    if (correlation.size() == 0) continue;
+    Eigen::Index i, j;
+    const double strongest = correlation.cwiseAbs().maxCoeff(&i, &j);
+    if (!(strongest >= limit)) continue;
+    const SfmCamera& camera = cameras.at(id);
+    const std::vector<std::string> intrinsic = SplitParamsInfo(camera.camera.ParamsInfo());
+    const std::vector<std::string> housing = SplitParamsInfo(camera.housing->ParamsInfo());
+    std::ostringstream note;
+    note << std::fixed << std::setprecision(4) << (cameras.size() > 1 ? "camera " + std::to_string(id) + ": " : "")
+         << intrinsic.at(static_cast<size_t>(i)) << " and " << housing.at(static_cast<size_t>(j))
+         << " are correlated at " << std::showpos << correlation(i, j) << std::noshowpos
+         << ": the views hardly tell them apart (the housing's standard deviation is at least "
+         << std::setprecision(1) << 1.0 / std::sqrt(std::max(1e-12, 1.0 - strongest * strongest))
+         << " times what it would be with the intrinsics known); give in-air intrinsics "
+            "(--ImageReader.camera_params) or views with more depth and angle";
+    notes.push_back(note.str());
+  }
+  return notes;
 }
 
 // Sets every camera's principal point to its image centre.
@@ -266,6 +314,11 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
                     "), not an estimate; the data traded it against the intrinsics: give the intrinsics, more "
                     "views or a closer housing guess");
     LOG(WARNING) << "refractive_bundle_adjuster: " << notes.back();
+  }
+
+  for (const std::string& note : TradeOffNotes(r.cameras(), std_devs, kTradeOffCorrelation)) {
+    notes.push_back(note);
+    LOG(WARNING) << "refractive_bundle_adjuster: " << note;
   }
 
   // Report: the first camera, RMS of the exact reprojection error.
