@@ -70,24 +70,41 @@ template <typename Port, typename T>
     internal::PerpendicularBasis(base, &e1, &e2);
     internal::PerpendicularBasis(water_dir0, &b1, &b2);
 
-    using Jet2 = ceres::Jet<double, 2>;
-    Jet2 port_jet[Port::kNumParams];
-    for (int i = 0; i < Port::kNumParams; ++i) port_jet[i] = Jet2(port_value[i]);
-    Jet2 miss_jet[2];
-    if (!internal::WaterRayMiss<Port, Jet2>(port_jet, point_value.cast<Jet2>(),
-                                            base, e1, e2, b1, b2, Jet2(0.0, 0),
-                                            Jet2(0.0, 1), miss_jet)) {
+    // One evaluation of the miss with a Jet over just (alpha, beta, port,
+    // point) -- 13 wide for the flat port and the dome -- gives J and the
+    // miss's derivatives by port and point; they are then chained into T
+    // (whose width counts the pose's and intrinsics' parameters too), so
+    // the refraction itself never runs in T's wider Jets.
+    constexpr int kPortOffset = 2;
+    constexpr int kPointOffset = 2 + Port::kNumParams;
+    using Inner = ceres::Jet<double, kPointOffset + 3>;
+    Inner port_inner[Port::kNumParams];
+    for (int i = 0; i < Port::kNumParams; ++i) {
+      port_inner[i] = Inner(port_value[i], kPortOffset + i);
+    }
+    VectorT<Inner, 3> point_inner;
+    for (int k = 0; k < 3; ++k) point_inner[k] = Inner(point_value[k], kPointOffset + k);
+    Inner miss_inner[2];
+    if (!internal::WaterRayMiss<Port, Inner>(port_inner, point_inner, base, e1,
+                                             e2, b1, b2, Inner(0.0, 0),
+                                             Inner(0.0, 1), miss_inner)) {
       return false;
     }
-    const double j00 = miss_jet[0].v[0], j01 = miss_jet[0].v[1];
-    const double j10 = miss_jet[1].v[0], j11 = miss_jet[1].v[1];
+    const double j00 = miss_inner[0].v[0], j01 = miss_inner[0].v[1];
+    const double j10 = miss_inner[1].v[0], j11 = miss_inner[1].v[1];
     const double det = j00 * j11 - j01 * j10;
     if (!(std::abs(det) > 0) || !std::isfinite(det)) return false;
 
+    // miss(port, point) to first order about the values, in T.
     T miss[2];
-    if (!internal::WaterRayMiss<Port, T>(port, point, base, e1, e2, b1, b2,
-                                         T(0.0), T(0.0), miss)) {
-      return false;
+    for (int r = 0; r < 2; ++r) {
+      miss[r] = T(miss_inner[r].a);
+      for (int i = 0; i < Port::kNumParams; ++i) {
+        miss[r] += miss_inner[r].v[kPortOffset + i] * (port[i] - T(port_value[i]));
+      }
+      for (int k = 0; k < 3; ++k) {
+        miss[r] += miss_inner[r].v[kPointOffset + k] * (point[k] - T(point_value[k]));
+      }
     }
     const T alpha = -(j11 * miss[0] - j01 * miss[1]) / det;
     const T beta = -(-j10 * miss[0] + j00 * miss[1]) / det;

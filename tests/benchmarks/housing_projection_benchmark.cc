@@ -5,13 +5,19 @@
 // same camera; read the two times as a ratio. The `max_diff_px` counter is
 // the largest pixel difference between the two methods on the benchmark's
 // points (equal accuracy), `max_error_px` each method's round-trip error.
+// Last, the exact error as bundle adjustment evaluates it, with Jacobians.
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Dense>
 
+#include <memory>
 #include <random>
 
 #include "colmap_ext/camera/camera.h"
+#include "colmap_ext/camera/models/radial.h"
+#include "colmap_ext/cost/refractive_reproj_error.h"
+#include "colmap_ext/housing/dome_port.h"
+#include "colmap_ext/housing/flat_port.h"
 #include "colmap_ext/housing/housing.h"
 
 namespace portcal {
@@ -124,6 +130,34 @@ void ProjectReference(benchmark::State& state, bool dome) {
   state.counters["max_error_px"] = max_error;
 }
 
+// The bundle adjustment's inner loop: the exact refractive reprojection
+// error (pose, point, intrinsics, housing all blocks: 23-wide Jets) with
+// its Jacobians, on the same points seen from the identity pose.
+void ReprojectionErrorWithJacobians(benchmark::State& state, bool dome) {
+  const Camera camera = BenchCamera();
+  const Housing housing = BenchHousing(dome);
+  const std::vector<Sample> samples = Samples(camera, housing);
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs;
+  for (const Sample& s : samples) {
+    if (dome) {
+      costs.emplace_back(RefractiveReprojError<RadialModel, DomePort>::Create(s.pixel, 1.0));
+    } else {
+      costs.emplace_back(RefractiveReprojError<RadialModel, FlatPort>::Create(s.pixel, 1.0));
+    }
+  }
+  double pose[7] = {0, 0, 0, 1, 0, 0, 0};
+  std::vector<double> intrinsics = camera.params, port = housing.params;
+  double jacobian_storage[4][2 * 8];
+  double* jacobians[4] = {jacobian_storage[0], jacobian_storage[1], jacobian_storage[2], jacobian_storage[3]};
+  double residual[2];
+  size_t i = 0;
+  for (auto _ : state) {
+    const size_t k = i++ % samples.size();
+    const double* blocks[4] = {pose, samples[k].point.data(), intrinsics.data(), port.data()};
+    benchmark::DoNotOptimize(costs[k]->Evaluate(blocks, residual, jacobians));
+  }
+}
+
 void BM_FlatPortProjectExact(benchmark::State& state) { ProjectExact(state, false); }
 void BM_FlatPortProjectIterative(benchmark::State& state) { ProjectReference(state, false); }
 void BM_DomePortProjectExact(benchmark::State& state) { ProjectExact(state, true); }
@@ -133,6 +167,10 @@ BENCHMARK(BM_FlatPortProjectExact);
 BENCHMARK(BM_FlatPortProjectIterative);
 BENCHMARK(BM_DomePortProjectExact);
 BENCHMARK(BM_DomePortProjectIterative);
+void BM_FlatPortErrorWithJacobians(benchmark::State& state) { ReprojectionErrorWithJacobians(state, false); }
+void BM_DomePortErrorWithJacobians(benchmark::State& state) { ReprojectionErrorWithJacobians(state, true); }
+BENCHMARK(BM_FlatPortErrorWithJacobians);
+BENCHMARK(BM_DomePortErrorWithJacobians);
 
 }  // namespace
 }  // namespace portcal
