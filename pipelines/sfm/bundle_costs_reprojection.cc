@@ -3,9 +3,9 @@
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/cost/refractive_reproj_error.h"
 #include "colmap_ext/housing/housing_models.h"
+#include "colmap_ext/util/error.h"
 #include "pipelines/sfm/bundle_costs.h"
 #include "pipelines/sfm/bundle_costs_fixed.h"
-#include "colmap_ext/util/error.h"
 
 namespace portcal {
 namespace {
