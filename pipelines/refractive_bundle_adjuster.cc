@@ -256,11 +256,7 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
       AdjustBundle(&r, intrinsics, BundleAdjustmentScope(), &markers, options.marker_scale);
     }
     if (joint) {
-      BundleAdjustmentOptions housing_first = options.ba;
-      housing_first.refine_focal_length = false;
-      housing_first.refine_principal_point = false;
-      housing_first.refine_extra_params = false;
-      AdjustBundle(&r, housing_first, BundleAdjustmentScope(), &markers, options.marker_scale);
+      AdjustBundle(&r, options.ba.WithIntrinsicsHeld(), BundleAdjustmentScope(), &markers, options.marker_scale);
     }
     solve(options.ba, std_devs);
     if (options.ba.refine_principal_point && options.principal_point_test_sigmas > 0) {
@@ -283,10 +279,7 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
     return notes;
   };
   const auto housing_at_bound = [&] {
-    for (const auto& [id, camera] : r.cameras()) {
-      if (options.ba.refine_housing && camera.housing && HousingAtBound(*camera.housing)) return id;
-    }
-    return kInvalidCameraId;
+    return options.ba.refine_housing ? CameraWithHousingAtBound(r.cameras()) : kInvalidCameraId;
   };
   const Reconstruction start = r;
   const std::vector<MarkerCorner> markers_start = markers;

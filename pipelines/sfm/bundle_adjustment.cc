@@ -32,6 +32,12 @@ void BundleAdjustmentOptions::Check() const {
   }
 }
 
+BundleAdjustmentOptions BundleAdjustmentOptions::WithIntrinsicsHeld() const {
+  BundleAdjustmentOptions held = *this;
+  held.refine_focal_length = held.refine_principal_point = held.refine_extra_params = false;
+  return held;
+}
+
 bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::string* why) {
   std::ostringstream text;
   const double ratio = after.MeanFocalLength() / before.MeanFocalLength();
@@ -133,6 +139,13 @@ bool HousingAtBound(const Housing& housing) {
     if (std::abs(housing.params[k]) >= 0.99 * bound) return true;
   }
   return false;
+}
+
+camera_t CameraWithHousingAtBound(const std::map<camera_t, SfmCamera>& cameras) {
+  for (const auto& [id, camera] : cameras) {
+    if (camera.housing && HousingAtBound(*camera.housing)) return id;
+  }
+  return kInvalidCameraId;
 }
 
 ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const BundleAdjustmentOptions& options,

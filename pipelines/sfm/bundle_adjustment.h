@@ -34,6 +34,9 @@ struct BundleAdjustmentOptions {
   double function_tolerance = 1e-8;  // relative cost change that ends the solve
   int num_threads = 2;
   void Check() const;  // throws OptionError naming --BundleAdjustment.*
+  // These options with focal length, principal point and extra parameters
+  // held (a stage that adjusts the housing under the current intrinsics).
+  BundleAdjustmentOptions WithIntrinsicsHeld() const;
 };
 
 // A physical marker corner: its point and where it was seen.
@@ -84,6 +87,8 @@ bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::strin
 // its radius): not an estimate but a sign that the data traded the housing
 // against something else (e.g. the focal length).
 bool HousingAtBound(const Housing& housing);
+// The first camera whose housing is at such a bound, or kInvalidCameraId.
+camera_t CameraWithHousingAtBound(const std::map<camera_t, SfmCamera>& cameras);
 
 // Adjusts in place. The gauge: the position priors (global adjustments with
 // position_prior_sigma_m > 0 and priors spanning a plane), else the first

@@ -538,10 +538,8 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
     // 3 deg: at 5 to 30 images each of 8 adjustments ended at 50 iterations,
     // cost 711 -> 470 at 5 images, 144 s in all; normal first: 711 -> 85 in
     // 19 iterations, the joint step then 10, 50 s in all, the port within
-    // 0.02 deg and 2 mm from 5 images on, the same refined result).
-    BundleAdjustmentOptions normal_first = ba;
-    normal_first.refine_focal_length = normal_first.refine_principal_point = false;
-    normal_first.refine_extra_params = false;
+    // 0.02 deg and 2.2 mm from 5 images on, the same refined result).
+    BundleAdjustmentOptions normal_first = ba.WithIntrinsicsHeld();
     normal_first.refine_port_distance = false;
     AdjustBundle(r, normal_first, BundleAdjustmentScope(), &markers, options_.marker_scale);
   }
@@ -549,10 +547,7 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
     // The housing first, under the held intrinsics (see
     // RunRefractiveBundleAdjuster: jointly from a poor start, focal length
     // and port distance trade off).
-    BundleAdjustmentOptions housing_first = ba;
-    housing_first.refine_focal_length = housing_first.refine_principal_point = false;
-    housing_first.refine_extra_params = false;
-    AdjustBundle(r, housing_first, BundleAdjustmentScope(), &markers, options_.marker_scale);
+    AdjustBundle(r, ba.WithIntrinsicsHeld(), BundleAdjustmentScope(), &markers, options_.marker_scale);
   }
   const ceres::Solver::Summary summary =
       AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
@@ -568,14 +563,12 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
     for (const auto& [id, xyz] : points_before) r->point(id).xyz = xyz;
     r->UpdateRays();
     markers = markers_before;
-    ba.refine_focal_length = ba.refine_principal_point = ba.refine_extra_params = false;
+    ba = ba.WithIntrinsicsHeld();
     ba.refine_housing = false;
     AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
   }
   if (ba.refine_housing && summary.termination_type == ceres::CONVERGENCE) {
-    port_converged_ = std::none_of(r->cameras().begin(), r->cameras().end(), [](const auto& entry) {
-      return entry.second.housing && HousingAtBound(*entry.second.housing);
-    });
+    port_converged_ = CameraWithHousingAtBound(r->cameras()) == kInvalidCameraId;
   }
   if (VLOG_IS_ON(1) && (ba.refine_housing || ba.refine_focal_length)) {
     std::ostringstream values;
