@@ -332,6 +332,13 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
                                  ? std_devs.housing.at(camera_id)
                                  : std::vector<double>(camera.housing->params.size(), 0.0);
   }
+  const auto of_camera = [camera_id](const std::map<camera_t, std::vector<double>>& std_dev) {
+    return std_dev.count(camera_id) ? std_dev.at(camera_id) : std::vector<double>{};
+  };
+  report.parameters_std_dev_by_noise = of_camera(std_devs.intrinsics_by_noise);
+  report.parameters_std_dev_by_image = of_camera(std_devs.intrinsics_by_image);
+  report.housing_std_dev_by_noise = of_camera(std_devs.housing_by_noise);
+  report.housing_std_dev_by_image = of_camera(std_devs.housing_by_image);
   for (double& v : report.parameters_std_dev) if (!std::isfinite(v)) v = 0.0;
   for (double& v : report.housing_std_dev) if (!std::isfinite(v)) v = 0.0;
   report.residual_sigma_px = std_devs.sigma0;

@@ -52,6 +52,14 @@ std::string StdDevText(const std::vector<double>& values, size_t i) {
   return out.str();
 }
 
+// The two estimates behind a std dev, when there are two.
+std::string StdDevSourcesText(const std::vector<double>& by_noise, const std::vector<double>& by_image, size_t i) {
+  if (i >= by_noise.size() || i >= by_image.size() || by_noise[i] <= 0) return "";
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(6) << std::setw(17) << by_noise[i] << std::setw(17) << by_image[i];
+  return out.str();
+}
+
 std::string Yaml(const CalibrationReport& r) {
   std::ostringstream out;
   out << "# portcal calibration report (calibmar-compatible keys first)\n"
@@ -63,8 +71,16 @@ std::string Yaml(const CalibrationReport& r) {
       << "height: " << r.camera.height << "\n"
       << "parameter_names: [" << r.camera.ParamsInfo() << "]\n"
       << "parameters_std_dev: " << StdDevList(r.parameters_std_dev) << "\n"
-      << "non_svp_parameters_std_dev: " << StdDevList(r.housing_std_dev) << "\n"
-      << "overall_rms: " << Num(r.overall_rms_px) << "\n"
+      << "non_svp_parameters_std_dev: " << StdDevList(r.housing_std_dev) << "\n";
+  const std::pair<const char*, const std::vector<double>*> estimates[] = {
+      {"parameters_std_dev_by_noise", &r.parameters_std_dev_by_noise},
+      {"parameters_std_dev_by_image", &r.parameters_std_dev_by_image},
+      {"non_svp_parameters_std_dev_by_noise", &r.housing_std_dev_by_noise},
+      {"non_svp_parameters_std_dev_by_image", &r.housing_std_dev_by_image}};
+  for (const auto& [key, values] : estimates) {
+    if (!values->empty()) out << key << ": " << StdDevList(*values) << "\n";
+  }
+  out << "overall_rms: " << Num(r.overall_rms_px) << "\n"
       << "residual_sigma_px: " << Num(r.residual_sigma_px) << "\n"
       << "num_views: " << std::count_if(r.views.begin(), r.views.end(), [](const CalibratedView& v) { return !v.dropped; })
       << "\nnum_points: " << r.num_points << "\n"
@@ -98,10 +114,15 @@ std::string Text(const CalibrationReport& r) {
       << "Camera model " << r.camera.ModelName() << ", " << r.camera.width << " x " << r.camera.height
       << " px\nTarget: " << r.target_description << "\n\n";
   const std::vector<std::string> names = SplitTokens(r.camera.ParamsInfo(), ", ");
-  out << "  parameter          value          std dev\n";
+  out << "  parameter          value          std dev"
+      << (r.parameters_std_dev_by_image.empty() && r.housing_std_dev_by_image.empty()
+              ? ""
+              : "   (by the noise, by the images' spread)")
+      << "\n";
   for (size_t i = 0; i < r.camera.params.size(); ++i) {
     out << "  " << std::left << std::setw(10) << names[i] << std::right << std::setw(17)
-        << std::setprecision(6) << r.camera.params[i] << StdDevText(r.parameters_std_dev, i) << "\n";
+        << std::setprecision(6) << r.camera.params[i] << StdDevText(r.parameters_std_dev, i)
+        << StdDevSourcesText(r.parameters_std_dev_by_noise, r.parameters_std_dev_by_image, i) << "\n";
   }
   if (r.housing) {
     const std::vector<std::string> housing_names = SplitTokens(r.housing->ParamsInfo(), ", ");
@@ -111,7 +132,8 @@ std::string Text(const CalibrationReport& r) {
           << std::setprecision(6) << r.housing->params[i]
           << (i < r.housing_std_dev.size() && r.housing_std_dev[i] == 0 && i >= 3
                   ? std::string("       (constant)")
-                  : StdDevText(r.housing_std_dev, i))
+                  : StdDevText(r.housing_std_dev, i) +
+                        StdDevSourcesText(r.housing_std_dev_by_noise, r.housing_std_dev_by_image, i))
           << "\n";
     }
   }

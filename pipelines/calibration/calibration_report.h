@@ -20,6 +20,12 @@ struct CalibrationReport {
   std::vector<double> parameters_std_dev;
   std::optional<Housing> housing;
   std::vector<double> housing_std_dev;
+  // Auto-calibration: the two estimates behind the std devs above, which
+  // are the larger of them: by the noise model (the covariance, every
+  // residual independent) and by the images' spread (the covariance
+  // clustered by image). Empty elsewhere.
+  std::vector<double> parameters_std_dev_by_noise, parameters_std_dev_by_image;
+  std::vector<double> housing_std_dev_by_noise, housing_std_dev_by_image;
   double overall_rms_px = 0;
   double residual_sigma_px = 0;
   int num_points = 0;

@@ -471,14 +471,32 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
       wanted.clear();
     }
     if (!wanted.empty()) {
-      const MarginalCovariance marginal = ComputeMarginalCovariance(&problem, points, others, wanted, scale, describe);
+      ResidualClusters clusters;
+      for (const auto& [id, block] : pose_blocks) {
+        clusters.cluster_of_block[block.data()] = static_cast<int>(clusters.cluster_of_block.size());
+      }
+      clusters.residuals_per_dof = summary.num_residuals_reduced / dof;
+      const MarginalCovariance marginal =
+          ComputeMarginalCovariance(&problem, points, others, wanted, scale, describe, &clusters);
+      const auto larger = [](std::vector<double> by_noise, const std::vector<double>& by_image) {
+        for (size_t i = 0; i < by_image.size() && i < by_noise.size(); ++i) {
+          by_noise[i] = std::max(by_noise[i], by_image[i]);
+        }
+        return by_noise;
+      };
       for (camera_t id : used_cameras) {
         const double* intrinsics_block = intrinsics.at(id).data();
         const bool free_intrinsics = marginal.offset.count(intrinsics_block) > 0;
-        if (free_intrinsics) std_devs->intrinsics[id] = marginal.StdDevs(intrinsics_block);
+        if (free_intrinsics) {
+          std_devs->intrinsics_by_noise[id] = marginal.StdDevs(intrinsics_block);
+          std_devs->intrinsics_by_image[id] = marginal.ClusteredStdDevs(intrinsics_block);
+          std_devs->intrinsics[id] = larger(std_devs->intrinsics_by_noise[id], std_devs->intrinsics_by_image[id]);
+        }
         if (!housings.count(id) || !marginal.offset.count(housings.at(id).data())) continue;
         const double* housing_block = housings.at(id).data();
-        std_devs->housing[id] = marginal.StdDevs(housing_block);
+        std_devs->housing_by_noise[id] = marginal.StdDevs(housing_block);
+        std_devs->housing_by_image[id] = marginal.ClusteredStdDevs(housing_block);
+        std_devs->housing[id] = larger(std_devs->housing_by_noise[id], std_devs->housing_by_image[id]);
         if (!free_intrinsics) continue;
         Eigen::MatrixXd& correlation = std_devs->intrinsics_housing_correlation[id];
         correlation.resize(marginal.size.at(intrinsics_block), marginal.size.at(housing_block));

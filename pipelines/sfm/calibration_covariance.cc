@@ -17,6 +17,16 @@ std::vector<double> MarginalCovariance::StdDevs(const double* block) const {
   return std_dev;
 }
 
+std::vector<double> MarginalCovariance::ClusteredStdDevs(const double* block) const {
+  std::vector<double> std_dev;
+  if (clustered_covariance.size() == 0) return std_dev;
+  const int start = offset.at(block);
+  for (int i = 0; i < size.at(block); ++i) {
+    std_dev.push_back(std::sqrt(std::max(0.0, clustered_covariance(start + i, start + i))));
+  }
+  return std_dev;
+}
+
 double MarginalCovariance::Correlation(const double* a, int i, const double* b, int j) const {
   const int row = offset.at(a) + i;
   const int col = offset.at(b) + j;
@@ -27,11 +37,12 @@ double MarginalCovariance::Correlation(const double* a, int i, const double* b, 
 MarginalCovariance ComputeMarginalCovariance(
     ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others,
     const std::vector<const double*>& wanted, double scale,
-    const std::function<std::string(const double*, int)>& describe) {
+    const std::function<std::string(const double*, int)>& describe, const ResidualClusters* clusters) {
   ceres::Problem::EvaluateOptions evaluate;
   evaluate.apply_loss_function = false;
   evaluate.parameter_blocks = others;
   evaluate.parameter_blocks.insert(evaluate.parameter_blocks.end(), points.begin(), points.end());
+  problem->GetResidualBlocks(&evaluate.residual_blocks);
   std::map<const double*, int> offset;  // tangent column of each other block
   int nc = 0;
   for (double* block : others) {
@@ -43,12 +54,48 @@ MarginalCovariance ComputeMarginalCovariance(
   if (!problem->Evaluate(evaluate, nullptr, &residuals, nullptr, &jacobian)) {
     throw NumericalError("covariance: the residuals cannot be evaluated at the solution");
   }
+  // Each row's cluster, and the weight of its gradient: the loss's
+  // derivative rho'(|r|^2) of its block (at the solution the robust
+  // gradient, rho' J'r, is what balances).
+  std::vector<int> row_cluster;
+  std::vector<double> row_weight;
+  int num_clusters = 0;
+  if (clusters) {
+    std::map<int, int> index_of_cluster;
+    int next_own = -1;  // blocks in no listed cluster: each its own
+    std::vector<double*> blocks;
+    for (const ceres::ResidualBlockId id : evaluate.residual_blocks) {
+      problem->GetParameterBlocksForResidualBlock(id, &blocks);
+      int cluster = next_own--;
+      for (double* block : blocks) {
+        const auto it = clusters->cluster_of_block.find(block);
+        if (it != clusters->cluster_of_block.end()) {
+          cluster = it->second;
+          break;
+        }
+      }
+      auto [it, inserted] = index_of_cluster.emplace(cluster, num_clusters);
+      if (inserted) ++num_clusters;
+      const int rows = problem->GetCostFunctionForResidualBlock(id)->num_residuals();
+      double squared_norm = 0;
+      for (int k = 0; k < rows; ++k) squared_norm += residuals[row_cluster.size() + k] * residuals[row_cluster.size() + k];
+      double rho[3] = {squared_norm, 1, 0};
+      if (const ceres::LossFunction* loss = problem->GetLossFunctionForResidualBlock(id)) loss->Evaluate(squared_norm, rho);
+      row_cluster.insert(row_cluster.end(), rows, it->second);
+      row_weight.insert(row_weight.end(), rows, rho[1]);
+    }
+    PORTCAL_CHECK_MSG(static_cast<int>(row_cluster.size()) == jacobian.num_rows, "residual rows and blocks disagree");
+  }
+  // Reduced gradient of each cluster's residuals: u_k = g_c,k - H_cp
+  // H_pp^+ g_p,k (the points' share removed as in the Schur complement).
+  Eigen::MatrixXd cluster_gradients = Eigen::MatrixXd::Zero(clusters ? nc : 0, num_clusters);
 
   // Accumulate H_cc, and per point H_pp and H_pc (sparse in c).
   Eigen::MatrixXd Hcc = Eigen::MatrixXd::Zero(nc, nc);
   struct PointBlocks {
     Eigen::Matrix3d Hpp = Eigen::Matrix3d::Zero();
-    std::unordered_map<int, Eigen::Vector3d> Hpc;  // column -> 3-vector
+    std::unordered_map<int, Eigen::Vector3d> Hpc;       // column -> 3-vector
+    std::unordered_map<int, Eigen::Vector3d> gradient;  // cluster -> its residuals' g_p
   };
   std::vector<PointBlocks> point_blocks(points.size());
   std::vector<std::pair<int, double>> camera_entries;
@@ -71,9 +118,18 @@ MarginalCovariance ComputeMarginalCovariance(
     for (const auto& [i, vi] : camera_entries) {
       for (const auto& [j, vj] : camera_entries) Hcc(i, j) += vi * vj;
     }
+    const double weighted_residual = clusters ? row_weight[row] * residuals[row] : 0.0;
+    if (clusters) {
+      for (const auto& [i, vi] : camera_entries) cluster_gradients(i, row_cluster[row]) += vi * weighted_residual;
+    }
     if (point < 0) continue;
     PointBlocks& pb = point_blocks[static_cast<size_t>(point)];
     pb.Hpp += b * b.transpose();
+    if (clusters) {
+      auto it = pb.gradient.find(row_cluster[row]);
+      if (it == pb.gradient.end()) it = pb.gradient.emplace(row_cluster[row], Eigen::Vector3d::Zero()).first;
+      it->second += b * weighted_residual;
+    }
     for (const auto& [i, vi] : camera_entries) {
       auto it = pb.Hpc.find(i);
       if (it == pb.Hpc.end()) it = pb.Hpc.emplace(i, Eigen::Vector3d::Zero()).first;
@@ -92,6 +148,10 @@ MarginalCovariance ComputeMarginalCovariance(
     for (const auto& [i, hi] : pb.Hpc) {
       const Eigen::Vector3d w = Hpp_pinv * hi;
       for (const auto& [j, hj] : pb.Hpc) Hcc(i, j) -= w.dot(hj);
+    }
+    for (const auto& [k, g] : pb.gradient) {
+      const Eigen::Vector3d w = Hpp_pinv * g;
+      for (const auto& [i, hi] : pb.Hpc) cluster_gradients(i, k) -= hi.dot(w);
     }
   }
   // Jacobi scaling: rotations (radians), translations (metres), focal
@@ -149,6 +209,22 @@ MarginalCovariance ComputeMarginalCovariance(
       result.covariance.block(result.offset[wanted[a]], result.offset[wanted[b]], plus[a].rows(), plus[b].rows()) =
           scale * scale * plus[a] * covariance.block(ta, tb, plus[a].cols(), plus[b].cols()) * plus[b].transpose();
     }
+  }
+  if (clusters && num_clusters > 1) {
+    // Each cluster's linearised effect on the wanted blocks, S^-1 u_k, in
+    // ambient coordinates; their outer products summed, with the small-
+    // sample factors: G / (G - 1) (the "CR1" correction for few clusters)
+    // and N / (N - K) for the share of the residuals' spread the fitted
+    // parameters absorbed (as the model covariance's sigma0^2 has).
+    Eigen::MatrixXd effects(total, num_clusters);
+    for (size_t a = 0; a < wanted.size(); ++a) {
+      const int ta = offset.at(const_cast<double*>(wanted[a]));
+      effects.middleRows(result.offset[wanted[a]], plus[a].rows()) =
+          plus[a] * (covariance.middleRows(ta, plus[a].cols()) * cluster_gradients);
+    }
+    const double factor = num_clusters / (num_clusters - 1.0) * clusters->residuals_per_dof;
+    result.clustered_covariance = factor * effects * effects.transpose();
+    result.num_clusters = num_clusters;
   }
   return result;
 }

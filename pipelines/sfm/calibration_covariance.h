@@ -25,12 +25,35 @@ struct MarginalCovariance {
   std::map<const double*, int> offset;  // row of each wanted block's first parameter
   std::map<const double*, int> size;    // its ambient size
   Eigen::MatrixXd covariance;           // the wanted blocks in order, scaled
+  // The same blocks' cluster-robust ("sandwich") covariance, clustered by
+  // image (Liang & Zeger, Biometrika 1986; Cameron & Miller, "A
+  // practitioner's guide to cluster-robust inference", 2015):
+  // S^-1 (sum_k u_k u_k') S^-1 with u_k the reduced gradient of image k's
+  // residuals, times G / (G - 1) * N / (N - K). It does not assume the
+  // residuals independent: an image's errors that share a cause (blur, a
+  // keypoint bias that depends on the view) show up in it, where the model
+  // covariance, which counts every residual as independent information,
+  // stays small. Empty unless clusters were given.
+  Eigen::MatrixXd clustered_covariance;
+  int num_clusters = 0;
 
-  // Standard deviation of every ambient parameter of `block`.
+  // Standard deviation of every ambient parameter of `block` by the model
+  // covariance.
   std::vector<double> StdDevs(const double* block) const;
+  // By the clustered covariance (empty when there is none).
+  std::vector<double> ClusteredStdDevs(const double* block) const;
   // Correlation of parameter i of block a with parameter j of block b; 0
   // where either is held.
   double Correlation(const double* a, int i, const double* b, int j) const;
+};
+
+// How the residuals fall into clusters for the clustered covariance: a
+// residual block belongs to the cluster of the first of its parameter
+// blocks listed here (an image's pose, held or free), else it is a cluster
+// of its own (a marker's side length).
+struct ResidualClusters {
+  std::map<const double*, int> cluster_of_block;
+  double residuals_per_dof = 1;  // N / (N - K) of the whole adjustment
 };
 
 // `points`: 3-parameter blocks to marginalise (each residual may touch at
@@ -38,12 +61,13 @@ struct MarginalCovariance {
 // intrinsics, housings, points shared by several-point residuals). Returns
 // the covariance of `wanted` (a subset of `others`), scaled by `scale`^2
 // (standard deviations by `scale`). Residuals are taken without the loss
-// function. Throws NumericalError when the reduced system is rank
-// deficient, naming the parameter that dominates the unobservable direction
-// by `describe(block, tangent index)`.
+// function (the clustered covariance weighs each block's gradient by the
+// loss's derivative, as the solve did). Throws NumericalError when the
+// reduced system is rank deficient, naming the parameter that dominates the
+// unobservable direction by `describe(block, tangent index)`.
 MarginalCovariance ComputeMarginalCovariance(
     ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others,
     const std::vector<const double*>& wanted, double scale,
-    const std::function<std::string(const double*, int)>& describe);
+    const std::function<std::string(const double*, int)>& describe, const ResidualClusters* clusters = nullptr);
 
 }  // namespace portcal

@@ -312,6 +312,112 @@ TEST(CalibrationCovariance, MarginalMatchesTheFullCovariance) {
   EXPECT_NEAR(marginal.Correlation(&b, 0, &a, 0), marginal.Correlation(&a, 0, &b, 0), 1e-12);
 }
 
+// A sample of the line, y = a x + b + p[0] + c, seen in one cluster (c: the
+// cluster's held offset, as an image's held pose), its point's p[0] seen
+// again in another cluster (p[0] = z); p[1], p[2] pinned. Linear, so the
+// effect of a cluster's residuals on (a, b) is exact.
+struct ClusterSample {
+  ClusterSample(double x, const double* y) : x_(x), y_(y) {}
+  template <typename T>
+  bool operator()(const T* a, const T* b, const T* p, const T* c, T* r) const {
+    r[0] = a[0] * T(x_) + b[0] + p[0] + c[0] - T(*y_);
+    r[1] = p[1] - T(0.1 * x_);
+    r[2] = p[2] - T(0.2);
+    return true;
+  }
+  double x_;
+  const double* y_;
+};
+struct ClusterSecondLook {
+  explicit ClusterSecondLook(const double* z) : z_(z) {}
+  template <typename T>
+  bool operator()(const T* p, const T* c, T* r) const {
+    r[0] = p[0] + c[0] - T(*z_);
+    return true;
+  }
+  const double* z_;
+};
+
+TEST(CalibrationCovariance, ClusteredCovarianceSumsEachClustersExactEffect) {
+  // Linear least squares: moving cluster k's observations onto their fitted
+  // values (its residuals to zero) moves the solution by exactly the
+  // effect S^-1 u_k the clustered covariance sums; so the clustered
+  // covariance must equal G / (G - 1) * (N / (N - K)) * sum_k d_k d_k'.
+  constexpr int kSamples = 24, kClusters = 4;
+  std::vector<double> y(kSamples), z(kSamples);
+  for (int i = 0; i < kSamples; ++i) {
+    // Errors that share a sign within a cluster: what the clustered
+    // covariance is for.
+    y[i] = 2.0 * i * 0.1 + 0.3 + 0.02 * ((i % kClusters) - 1.5) + 0.01 * std::sin(3.0 * i);
+    z[i] = 0.05 * std::cos(1.7 * i);
+  }
+  double a = 0, b = 0;
+  std::vector<std::array<double, 3>> p(kSamples, {0, 0, 0});
+  std::array<double, kClusters> offsets{};
+  ceres::Problem problem;
+  for (int i = 0; i < kSamples; ++i) {
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ClusterSample, 3, 1, 1, 3, 1>(
+                                 new ClusterSample(i * 0.1, &y[i])),
+                             nullptr, &a, &b, p[i].data(), &offsets[i % kClusters]);
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ClusterSecondLook, 1, 3, 1>(new ClusterSecondLook(&z[i])),
+                             nullptr, p[i].data(), &offsets[(i + 1) % kClusters]);
+  }
+  for (double& offset : offsets) problem.SetParameterBlockConstant(&offset);
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.function_tolerance = options.gradient_tolerance = options.parameter_tolerance = 1e-16;
+  ceres::Solver::Summary summary;
+  const auto solve = [&] {
+    ceres::Solve(options, &problem, &summary);
+    ASSERT_TRUE(summary.IsSolutionUsable());
+  };
+  solve();
+  const double a_hat = a, b_hat = b;
+  std::vector<double*> points;
+  for (auto& q : p) points.push_back(q.data());
+  ResidualClusters clusters;
+  for (int k = 0; k < kClusters; ++k) clusters.cluster_of_block[&offsets[k]] = k;
+  clusters.residuals_per_dof = 1.25;
+  const MarginalCovariance marginal = ComputeMarginalCovariance(
+      &problem, points, {&a, &b}, {&a, &b}, 1.0, [](const double*, int) { return std::string("?"); }, &clusters);
+  ASSERT_EQ(marginal.num_clusters, kClusters);
+  ASSERT_EQ(marginal.clustered_covariance.rows(), 2);
+
+  Eigen::Matrix2d expected = Eigen::Matrix2d::Zero();
+  const std::vector<double> y_observed = y, z_observed = z;
+  for (int k = 0; k < kClusters; ++k) {
+    for (int i = 0; i < kSamples; ++i) {
+      // Fitted values at the first solution; the points as solved then.
+      if (i % kClusters == k) y[i] = a_hat * i * 0.1 + b_hat + p[i][0];
+      if ((i + 1) % kClusters == k) z[i] = p[i][0];
+    }
+    const std::vector<std::array<double, 3>> p_hat = p;
+    solve();
+    const Eigen::Vector2d effect(a - a_hat, b - b_hat);
+    expected += effect * effect.transpose();
+    // Back to the first solution and observations for the next cluster.
+    y = y_observed;
+    z = z_observed;
+    a = a_hat;
+    b = b_hat;
+    p = p_hat;
+  }
+  expected *= kClusters / (kClusters - 1.0) * 1.25;
+  // Not trivially zero: the clusters' errors moved the line.
+  ASSERT_GT(expected(0, 0), 1e-8);
+  for (int i = 0; i < 2; ++i) {
+    for (int j = 0; j < 2; ++j) {
+      EXPECT_NEAR(marginal.clustered_covariance(i, j), expected(i, j), 1e-6 * expected.norm()) << i << "," << j;
+    }
+  }
+  EXPECT_NEAR(marginal.ClusteredStdDevs(&a)[0], std::sqrt(expected(0, 0)), 1e-6 * std::sqrt(expected(0, 0)));
+  // Without clusters there is no clustered covariance.
+  const MarginalCovariance plain = ComputeMarginalCovariance(
+      &problem, points, {&a, &b}, {&a, &b}, 1.0, [](const double*, int) { return std::string("?"); });
+  EXPECT_EQ(plain.clustered_covariance.size(), 0);
+  EXPECT_TRUE(plain.ClusteredStdDevs(&a).empty());
+}
+
 TEST(BundleAdjustment, HousingAtBoundIsTheAdjustmentsFloorOrWall) {
   // A flat port at the 0.1 mm floor of its distance, a dome decentred to
   // 90 % of its radius: bounds, not estimates.

@@ -96,17 +96,20 @@ render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
   RecordProperty("distance_error_mm", std::to_string(distance_error * 1000));
   std::cout << "normal error " << angle / kDegree << " deg (sd " << angle_sd / kDegree << "), distance error "
             << distance_error * 1000 << " mm (sd " << sd[3] * 1000 << ")\n";
-  // The normal within the 0.05 deg. On a survey this small neither
-  // error is safely within 4 reported sigma: measured normal 0.035 deg at
-  // 0.009 (3.8 sigma), distance 4.5 mm at 0.74 mm (6 sigma), where the
-  // 120-image survey at 960 x 540 gives 0.0009 deg at 0.002 and 0.03 mm at
-  // 0.15 mm (docs/auto_calibration.md). So the bounds asserted are the goal
-  // and the measured level plus a margin, and the gap is stated.
+  // The normal within the 0.05 deg, the distance within 6 mm (the
+  // measured level, 4.5 mm, plus a margin: the 2 mm is met on the
+  // larger surveys, docs/auto_calibration.md), and both within 4 reported
+  // sigma. Sigma by the noise alone said 0.009 deg and 0.74 mm here (3.8 and
+  // 6 sigma off); by the images' spread, which the report now takes when it
+  // is larger, 0.040 deg and 4.8 mm.
   EXPECT_LT(angle, 0.05 * kDegree);
   EXPECT_LT(std::abs(distance_error), 0.006);
-  // The deviations mean something: the guess was 3 deg and 10 mm off.
-  EXPECT_LT(angle_sd, 0.05 * kDegree);
-  EXPECT_LT(sd[3], 0.003);
+  EXPECT_LT(angle, 4 * angle_sd);
+  EXPECT_LT(std::abs(distance_error), 4 * sd[3]);
+  // The deviations mean something: smaller than the guess's errors (3 deg,
+  // 10 mm).
+  EXPECT_LT(angle_sd, 0.1 * kDegree);
+  EXPECT_LT(sd[3], 0.008);
 
   // Camera centres in the navigation frame, against the path length.
   std::map<std::string, Eigen::Vector3d> true_centres;
