@@ -26,6 +26,8 @@ static void AddMapperOptions(CommandLine* cli, IncrementalMapperOptions* o) {
            "refine the housing with the intrinsics in global adjustments (0 | 1)");
   cli->Add("Mapper.ba_local_num_images", &o->ba_local_num_images, "images in a local adjustment");
   cli->Add("Mapper.ba_global_images_ratio", &o->ba_global_images_ratio, "global adjustment when the model grows by");
+  cli->Add("Mapper.ba_global_function_tolerance", &o->ba_global_function_tolerance,
+           "a global adjustment ends when an iteration lowers the cost by less than this fraction");
   cli->Add("Mapper.multiple_models", &o->multiple_models, "0 | 1");
   cli->Add("Mapper.max_num_models", &o->max_num_models, "models at most");
   cli->Add("Mapper.min_model_size", &o->min_model_size, "images a model needs to be kept");

@@ -40,6 +40,10 @@ void IncrementalMapperOptions::Check() const {
   if (ba_local_num_images < 1) {
     throw OptionError("--Mapper.ba_local_num_images", std::to_string(ba_local_num_images), ">= 1");
   }
+  if (!(ba_global_function_tolerance > 0 && ba_global_function_tolerance < 1)) {
+    throw OptionError("--Mapper.ba_global_function_tolerance", std::to_string(ba_global_function_tolerance),
+                      "in (0, 1)");
+  }
 }
 
 namespace {
@@ -515,6 +519,7 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   ba.refine_extra_params = refine_intrinsics && options_.ba_refine_extra_params;
   ba.refine_housing = refine_intrinsics && options_.ba_refine_housing;
   ba.max_num_iterations = options_.ba_max_num_iterations;
+  ba.function_tolerance = options_.ba_global_function_tolerance;
   ba.num_threads = options_.num_threads;
   if (options_.position_prior_sigma_m > 0 && options_.marker_scale.side_length_m <= 0 &&
       AlignToPositionPriors(r, 5 * options_.position_prior_sigma_m)) {

@@ -17,6 +17,7 @@
 #include "pipelines/sfm/bundle_adjustment.h"
 #include "pipelines/sfm/bundle_costs.h"
 #include "pipelines/sfm/calibration_covariance.h"
+#include "pipelines/sfm/incremental_mapper.h"
 #include "pipelines/sfm/ray_geometry.h"
 #include "pipelines/target/marker_edge_refinement.h"
 
@@ -416,6 +417,20 @@ TEST(CalibrationCovariance, ClusteredCovarianceSumsEachClustersExactEffect) {
       &problem, points, {&a, &b}, {&a, &b}, 1.0, [](const double*, int) { return std::string("?"); });
   EXPECT_EQ(plain.clustered_covariance.size(), 0);
   EXPECT_TRUE(plain.ClusteredStdDevs(&a).empty());
+}
+
+TEST(IncrementalMapperOptions, GlobalFunctionToleranceIsAFractionAndNamedWhenBad) {
+  IncrementalMapperOptions options;
+  EXPECT_NO_THROW(options.Check());
+  for (const double bad : {0.0, -1e-5, 1.0, std::nan("")}) {
+    options.ba_global_function_tolerance = bad;
+    try {
+      options.Check();
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const OptionError& e) {
+      EXPECT_NE(std::string(e.what()).find("--Mapper.ba_global_function_tolerance"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(BundleAdjustment, HousingAtBoundIsTheAdjustmentsFloorOrWall) {
