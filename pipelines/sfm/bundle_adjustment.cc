@@ -472,9 +472,8 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
     }
     if (!wanted.empty()) {
       ResidualClusters clusters;
-      for (const auto& [id, block] : pose_blocks) {
-        clusters.cluster_of_block[block.data()] = static_cast<int>(clusters.cluster_of_block.size());
-      }
+      int image_index = 0;
+      for (const auto& [id, block] : pose_blocks) clusters.cluster_of_block[block.data()] = image_index++;
       clusters.residuals_per_dof = summary.num_residuals_reduced / dof;
       const MarginalCovariance marginal =
           ComputeMarginalCovariance(&problem, points, others, wanted, scale, describe, &clusters);

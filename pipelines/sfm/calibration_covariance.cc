@@ -10,21 +10,24 @@
 
 namespace portcal {
 
-std::vector<double> MarginalCovariance::StdDevs(const double* block) const {
-  const int start = offset.at(block);
+namespace {
+
+// Square roots of a diagonal stretch, negatives (round-off) as 0.
+std::vector<double> DiagonalStdDevs(const Eigen::MatrixXd& covariance, int start, int size) {
   std::vector<double> std_dev;
-  for (int i = 0; i < size.at(block); ++i) std_dev.push_back(std::sqrt(std::max(0.0, covariance(start + i, start + i))));
+  for (int i = 0; i < size; ++i) std_dev.push_back(std::sqrt(std::max(0.0, covariance(start + i, start + i))));
   return std_dev;
 }
 
+}  // namespace
+
+std::vector<double> MarginalCovariance::StdDevs(const double* block) const {
+  return DiagonalStdDevs(covariance, offset.at(block), size.at(block));
+}
+
 std::vector<double> MarginalCovariance::ClusteredStdDevs(const double* block) const {
-  std::vector<double> std_dev;
-  if (clustered_covariance.size() == 0) return std_dev;
-  const int start = offset.at(block);
-  for (int i = 0; i < size.at(block); ++i) {
-    std_dev.push_back(std::sqrt(std::max(0.0, clustered_covariance(start + i, start + i))));
-  }
-  return std_dev;
+  if (clustered_covariance.size() == 0) return {};
+  return DiagonalStdDevs(clustered_covariance, offset.at(block), size.at(block));
 }
 
 double MarginalCovariance::Correlation(const double* a, int i, const double* b, int j) const {
