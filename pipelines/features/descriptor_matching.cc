@@ -53,14 +53,18 @@ void NearestBruteForce(const UnitDescriptors& descriptors1, const UnitDescriptor
   const Eigen::Index n1 = descriptors1.rows(), n2 = descriptors2.rows();
   // Dot products in blocks of rows so that memory stays bounded for large
   // feature counts; columns' best rows are tracked for the cross check.
+  // The scan walks each column down (Eigen stores them contiguously; a
+  // block's 1024 row entries stay in cache), visiting rows and columns in
+  // the same increasing order as a row-wise scan, so ties resolve alike.
   constexpr Eigen::Index kBlock = 1024;
   Eigen::MatrixXf dots;
   for (Eigen::Index start = 0; start < n1; start += kBlock) {
     const Eigen::Index rows = std::min(kBlock, n1 - start);
     dots.noalias() = descriptors1.middleRows(start, rows) * descriptors2.transpose();
-    for (Eigen::Index r = 0; r < rows; ++r) {
-      Nearest& a = (*nearest1)[static_cast<size_t>(start + r)];
-      for (Eigen::Index c = 0; c < n2; ++c) {
+    for (Eigen::Index c = 0; c < n2; ++c) {
+      Nearest& b = (*nearest2)[static_cast<size_t>(c)];
+      for (Eigen::Index r = 0; r < rows; ++r) {
+        Nearest& a = (*nearest1)[static_cast<size_t>(start + r)];
         const float d = dots(r, c);
         if (d > a.best) {
           a.second = a.best;
@@ -69,7 +73,6 @@ void NearestBruteForce(const UnitDescriptors& descriptors1, const UnitDescriptor
         } else if (d > a.second) {
           a.second = d;
         }
-        Nearest& b = (*nearest2)[static_cast<size_t>(c)];
         if (d > b.best) {
           b.second = b.best;
           b.best = d;
