@@ -61,8 +61,10 @@ for line in open(sys.argv[1]):
     t = truth["camera"]["params"][0:3] + truth["housing"]["params"][0:2] + [truth["housing"]["params"][3]]
     e = result["parameters"][0:3] + result["non_svp_parameters"][0:2] + [result["non_svp_parameters"][3]]
     for kind, suffix in kinds.items():
-        cam = result.get("parameters_std_dev" + suffix) or result["parameters_std_dev"]
-        hou = result.get("non_svp_parameters_std_dev" + suffix) or result["non_svp_parameters_std_dev"]
+        cam = result.get("parameters_std_dev" + suffix)
+        hou = result.get("non_svp_parameters_std_dev" + suffix)
+        if cam is None or hou is None:
+            sys.exit(f"{parts[2]}: no parameters_std_dev{suffix} / non_svp_parameters_std_dev{suffix}")
         s = cam[0:3] + hou[0:2] + [hou[3]]
         z = [(e[i] - t[i]) / s[i] if s[i] else float("nan") for i in range(n)]
         if kind == "reported":
