@@ -136,6 +136,7 @@ AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   refine.output_path = (fs::path(options.output_path) / "refined").string();
   refine.database_path = database_path;
   refine.marker_scale.side_length_m = options.marker_side_length_m;
+  refine.housing_guess = options.housing;
   refine.ba.refine_housing = !options.housing.model.empty();
   refine.ba.refine_focal_length = refine_intrinsics;
   refine.ba.refine_extra_params = refine_intrinsics;

@@ -25,6 +25,14 @@ struct RefractiveBundleAdjusterOptions {
   std::string output_path;    // adjusted model and reports
   std::string database_path;  // for marker detections (optional)
   HousingOverride housing;    // replaces the model's housings
+  // The first guess of the housing, for one case only: the model's own
+  // housing lies at a bound of the adjustment (a flat port's distance at its
+  // 0.1 mm floor, a dome decentred to 90 % of its radius; the mapper can
+  // slide it there). With intrinsics and housing refined, the adjustment
+  // then starts its bound parameters (flat: distance; dome: centre) from
+  // this guess, the rest (a flat port's normal) from the model, and adjusts
+  // the intrinsics first. auto_calibrator passes its --Housing.*.
+  HousingOverride housing_guess;
   BundleAdjustmentOptions ba;  // refine_housing on, exact reprojection error
   MarkerScale marker_scale;
   double max_reproj_error_px = 4.0;  // observations beyond are dropped before the final solve

@@ -12,6 +12,8 @@ static void AddMapperOptions(CommandLine* cli, IncrementalMapperOptions* o) {
   cli->Add("Mapper.init_min_num_inliers", &o->init_min_num_inliers, "inlier matches of the initial pair");
   cli->Add("Mapper.init_min_tri_angle", &o->init_min_tri_angle_deg, "median triangulation angle, degrees");
   cli->Add("Mapper.init_max_error", &o->init_max_error_px, "initial pair inlier threshold, pixels");
+  cli->Add("Mapper.init_max_restarts", &o->init_max_restarts,
+           "models started again from another initial pair when their intrinsics keep coming out implausible");
   cli->Add("Mapper.init_scene_depth", &o->init_scene_depth_m,
            "scale when no marker size is given: median depth of the initial pair, metres");
   cli->Add("Mapper.abs_pose_max_error", &o->abs_pose_max_error_px, "registration threshold, pixels");

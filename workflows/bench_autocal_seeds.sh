@@ -6,7 +6,8 @@
 # prints per seed and over all seeds the RMS of (estimate - truth) / sigma
 # for f, the principal point, the normal's Nx and Ny, and the port distance
 # (honest: 0.7-1.4), with the reported std devs and with each of the two
-# estimates they are the larger of (by the noise, by the images' spread).
+# estimates they are the larger of (by the noise, by the clusters' spread:
+# images and tracks).
 # Usage: workflows/bench_autocal_seeds.sh [N=10]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -48,7 +49,7 @@ import math, sys, yaml
 names = ["f", "cx", "cy", "Nx", "Ny", "distance"]
 n = len(names)
 # The reported std devs, and the two estimates they are the larger of.
-kinds = {"reported": "", "by the noise": "_by_noise", "by the images": "_by_image"}
+kinds = {"reported": "", "by the noise": "_by_noise", "by the clusters": "_by_clusters"}
 sums = {kind: [0.0] * n for kind in kinds}
 count = 0
 for line in open(sys.argv[1]):

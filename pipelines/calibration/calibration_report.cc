@@ -53,10 +53,10 @@ std::string StdDevText(const std::vector<double>& values, size_t i) {
 }
 
 // The two estimates behind a std dev, when there are two.
-std::string StdDevSourcesText(const std::vector<double>& by_noise, const std::vector<double>& by_image, size_t i) {
-  if (i >= by_noise.size() || i >= by_image.size() || by_noise[i] <= 0) return "";
+std::string StdDevSourcesText(const std::vector<double>& by_noise, const std::vector<double>& by_clusters, size_t i) {
+  if (i >= by_noise.size() || i >= by_clusters.size() || by_noise[i] <= 0) return "";
   std::ostringstream out;
-  out << std::fixed << std::setprecision(6) << std::setw(17) << by_noise[i] << std::setw(17) << by_image[i];
+  out << std::fixed << std::setprecision(6) << std::setw(17) << by_noise[i] << std::setw(17) << by_clusters[i];
   return out.str();
 }
 
@@ -74,9 +74,9 @@ std::string Yaml(const CalibrationReport& r) {
       << "non_svp_parameters_std_dev: " << StdDevList(r.housing_std_dev) << "\n";
   const std::pair<const char*, const std::vector<double>*> estimates[] = {
       {"parameters_std_dev_by_noise", &r.parameters_std_dev_by_noise},
-      {"parameters_std_dev_by_image", &r.parameters_std_dev_by_image},
+      {"parameters_std_dev_by_clusters", &r.parameters_std_dev_by_clusters},
       {"non_svp_parameters_std_dev_by_noise", &r.housing_std_dev_by_noise},
-      {"non_svp_parameters_std_dev_by_image", &r.housing_std_dev_by_image}};
+      {"non_svp_parameters_std_dev_by_clusters", &r.housing_std_dev_by_clusters}};
   for (const auto& [key, values] : estimates) {
     if (!values->empty()) out << key << ": " << StdDevList(*values) << "\n";
   }
@@ -115,14 +115,14 @@ std::string Text(const CalibrationReport& r) {
       << " px\nTarget: " << r.target_description << "\n\n";
   const std::vector<std::string> names = SplitTokens(r.camera.ParamsInfo(), ", ");
   out << "  parameter          value          std dev"
-      << (r.parameters_std_dev_by_image.empty() && r.housing_std_dev_by_image.empty()
+      << (r.parameters_std_dev_by_clusters.empty() && r.housing_std_dev_by_clusters.empty()
               ? ""
-              : "   (by the noise, by the images' spread)")
+              : "   (by the noise, by the clusters' spread)")
       << "\n";
   for (size_t i = 0; i < r.camera.params.size(); ++i) {
     out << "  " << std::left << std::setw(10) << names[i] << std::right << std::setw(17)
         << std::setprecision(6) << r.camera.params[i] << StdDevText(r.parameters_std_dev, i)
-        << StdDevSourcesText(r.parameters_std_dev_by_noise, r.parameters_std_dev_by_image, i) << "\n";
+        << StdDevSourcesText(r.parameters_std_dev_by_noise, r.parameters_std_dev_by_clusters, i) << "\n";
   }
   if (r.housing) {
     const std::vector<std::string> housing_names = SplitTokens(r.housing->ParamsInfo(), ", ");
@@ -133,7 +133,7 @@ std::string Text(const CalibrationReport& r) {
           << (i < r.housing_std_dev.size() && r.housing_std_dev[i] == 0 && i >= 3
                   ? std::string("       (constant)")
                   : StdDevText(r.housing_std_dev, i) +
-                        StdDevSourcesText(r.housing_std_dev_by_noise, r.housing_std_dev_by_image, i))
+                        StdDevSourcesText(r.housing_std_dev_by_noise, r.housing_std_dev_by_clusters, i))
           << "\n";
     }
   }

@@ -22,10 +22,10 @@ struct CalibrationReport {
   std::vector<double> housing_std_dev;
   // Auto-calibration: the two estimates behind the std devs above, which
   // are the larger of them: by the noise model (the covariance, every
-  // residual independent) and by the images' spread (the covariance
-  // clustered by image). Empty elsewhere.
-  std::vector<double> parameters_std_dev_by_noise, parameters_std_dev_by_image;
-  std::vector<double> housing_std_dev_by_noise, housing_std_dev_by_image;
+  // residual independent) and by the clusters' spread (the covariance
+  // clustered by image and by track). Empty elsewhere.
+  std::vector<double> parameters_std_dev_by_noise, parameters_std_dev_by_clusters;
+  std::vector<double> housing_std_dev_by_noise, housing_std_dev_by_clusters;
   double overall_rms_px = 0;
   double residual_sigma_px = 0;
   int num_points = 0;

@@ -473,13 +473,19 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
     if (!wanted.empty()) {
       ResidualClusters clusters;
       int image_index = 0;
-      for (const auto& [id, block] : pose_blocks) clusters.cluster_of_block[block.data()] = image_index++;
+      for (const auto& [id, block] : pose_blocks) clusters.image_of_block[block.data()] = image_index++;
+      // The marginalised points are tracks by themselves; a marker's
+      // corner, seen in several images, is one too.
+      if (use_markers) {
+        int corner_index = 0;
+        for (MarkerCorner& corner : *markers) clusters.track_of_block[corner.xyz.data()] = corner_index++;
+      }
       clusters.residuals_per_dof = summary.num_residuals_reduced / dof;
       const MarginalCovariance marginal =
           ComputeMarginalCovariance(&problem, points, others, wanted, scale, describe, &clusters);
-      const auto larger = [](std::vector<double> by_noise, const std::vector<double>& by_image) {
-        for (size_t i = 0; i < by_image.size() && i < by_noise.size(); ++i) {
-          by_noise[i] = std::max(by_noise[i], by_image[i]);
+      const auto larger = [](std::vector<double> by_noise, const std::vector<double>& by_clusters) {
+        for (size_t i = 0; i < by_clusters.size() && i < by_noise.size(); ++i) {
+          by_noise[i] = std::max(by_noise[i], by_clusters[i]);
         }
         return by_noise;
       };
@@ -488,14 +494,14 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
         const bool free_intrinsics = marginal.offset.count(intrinsics_block) > 0;
         if (free_intrinsics) {
           std_devs->intrinsics_by_noise[id] = marginal.StdDevs(intrinsics_block);
-          std_devs->intrinsics_by_image[id] = marginal.ClusteredStdDevs(intrinsics_block);
-          std_devs->intrinsics[id] = larger(std_devs->intrinsics_by_noise[id], std_devs->intrinsics_by_image[id]);
+          std_devs->intrinsics_by_clusters[id] = marginal.ClusteredStdDevs(intrinsics_block);
+          std_devs->intrinsics[id] = larger(std_devs->intrinsics_by_noise[id], std_devs->intrinsics_by_clusters[id]);
         }
         if (!housings.count(id) || !marginal.offset.count(housings.at(id).data())) continue;
         const double* housing_block = housings.at(id).data();
         std_devs->housing_by_noise[id] = marginal.StdDevs(housing_block);
-        std_devs->housing_by_image[id] = marginal.ClusteredStdDevs(housing_block);
-        std_devs->housing[id] = larger(std_devs->housing_by_noise[id], std_devs->housing_by_image[id]);
+        std_devs->housing_by_clusters[id] = marginal.ClusteredStdDevs(housing_block);
+        std_devs->housing[id] = larger(std_devs->housing_by_noise[id], std_devs->housing_by_clusters[id]);
         if (!free_intrinsics) continue;
         Eigen::MatrixXd& correlation = std_devs->intrinsics_housing_correlation[id];
         correlation.resize(marginal.size.at(intrinsics_block), marginal.size.at(housing_block));

@@ -67,17 +67,18 @@ struct BundleAdjustmentScope {
 // Standard deviations of the cameras' and housings' parameters (0 for
 // parameters held fixed): each the larger of two estimates, by the noise
 // (the covariance of the solution scaled by the residual variance: every
-// residual independent) and by the images' spread (the covariance clustered
-// by image, calibration_covariance.h: it grows when an image's errors share
-// a cause, as a view-dependent keypoint bias does). The first is the better
-// estimate when the noise is what the model says, and the second, from a
-// dozen images, is itself uncertain by ~20 %; the larger is wrong in the
-// safe direction.
+// residual independent) and by the clusters' spread (the covariance
+// clustered two ways, by image and by track, calibration_covariance.h: it
+// grows when an image's errors share a cause, as a view-dependent keypoint
+// bias does, or a track's, as the same texture seen from nearby views
+// does). The first is the better estimate when the noise is what the model
+// says, and the second, from a dozen images, is itself uncertain by ~20 %;
+// the larger is wrong in the safe direction.
 struct CalibrationStdDevs {
   std::map<camera_t, std::vector<double>> intrinsics;
   std::map<camera_t, std::vector<double>> housing;
-  std::map<camera_t, std::vector<double>> intrinsics_by_noise, intrinsics_by_image;
-  std::map<camera_t, std::vector<double>> housing_by_noise, housing_by_image;
+  std::map<camera_t, std::vector<double>> intrinsics_by_noise, intrinsics_by_clusters;
+  std::map<camera_t, std::vector<double>> housing_by_noise, housing_by_clusters;
   // Correlation of each intrinsic parameter (row) with each housing
   // parameter (column), 0 where either is held: near +-1 the data cannot
   // tell the two apart.

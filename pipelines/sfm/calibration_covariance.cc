@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 #include <unordered_map>
 
@@ -18,6 +19,153 @@ std::vector<double> DiagonalStdDevs(const Eigen::MatrixXd& covariance, int start
   for (int i = 0; i < size; ++i) std_dev.push_back(std::sqrt(std::max(0.0, covariance(start + i, start + i))));
   return std_dev;
 }
+
+// A residual block's place in the clusterings.
+struct BlockClusters {
+  int image = 0;   // its image cluster
+  int track = -1;  // its track cluster (-1: clustered by image only)
+  int both = -1;   // its (image, track) cluster
+  int rows = 0;
+  double weight = 1;  // rho'(|r|^2) of the block's loss
+};
+
+// Dense cluster indices of every residual block (see ResidualClusters).
+std::vector<BlockClusters> AssignClusters(ceres::Problem* problem, const std::vector<ceres::ResidualBlockId>& ids,
+                                          const std::vector<double*>& points, const std::vector<double>& residuals,
+                                          const ResidualClusters& clusters) {
+  std::unordered_map<const double*, int> point_index;
+  for (size_t p = 0; p < points.size(); ++p) point_index[points[p]] = static_cast<int>(p);
+  // Listed clusters by their given id, points by index; the rest their own.
+  std::map<int, int> image_index, listed_track_index;
+  std::unordered_map<int, int> point_track_index;
+  std::unordered_map<int64_t, int> both_index;
+  int num_images = 0, num_tracks = 0, num_both = 0;
+  const auto dense = [](auto& index, auto key, int* count) {
+    const auto [it, inserted] = index.emplace(key, *count);
+    if (inserted) ++*count;
+    return it->second;
+  };
+  std::vector<BlockClusters> result;
+  std::vector<double*> blocks;
+  size_t row = 0;
+  for (const ceres::ResidualBlockId id : ids) {
+    problem->GetParameterBlocksForResidualBlock(id, &blocks);
+    BlockClusters b;
+    b.image = -1;
+    for (double* block : blocks) {
+      const auto it = clusters.image_of_block.find(block);
+      if (it != clusters.image_of_block.end()) {
+        b.image = dense(image_index, it->second, &num_images);
+        break;
+      }
+    }
+    if (b.image < 0) b.image = num_images++;
+    if (clusters.by_track) {
+      for (double* block : blocks) {
+        if (const auto it = point_index.find(block); it != point_index.end()) {
+          b.track = dense(point_track_index, it->second, &num_tracks);
+          break;
+        }
+      }
+      for (double* block : blocks) {
+        if (b.track >= 0) break;
+        if (const auto it = clusters.track_of_block.find(block); it != clusters.track_of_block.end()) {
+          b.track = dense(listed_track_index, it->second, &num_tracks);
+        }
+      }
+      if (b.track < 0) b.track = num_tracks++;
+      const int64_t key = (static_cast<int64_t>(b.image) << 32) | static_cast<uint32_t>(b.track);
+      b.both = dense(both_index, key, &num_both);
+    }
+    b.rows = problem->GetCostFunctionForResidualBlock(id)->num_residuals();
+    double squared_norm = 0;
+    for (int k = 0; k < b.rows; ++k) squared_norm += residuals[row + k] * residuals[row + k];
+    double rho[3] = {squared_norm, 1, 0};
+    if (const ceres::LossFunction* loss = problem->GetLossFunctionForResidualBlock(id)) loss->Evaluate(squared_norm, rho);
+    b.weight = rho[1];
+    row += static_cast<size_t>(b.rows);
+    result.push_back(b);
+  }
+  PORTCAL_CHECK_MSG(row == residuals.size(), "residual rows and blocks disagree");
+  return result;
+}
+
+// The clusters' summed effects and, from them, the two-way covariance.
+class ClusterEffects {
+ public:
+  ClusterEffects(int size, const std::vector<BlockClusters>& blocks) : blocks_(blocks), both_(size, size) {
+    int num_images = 0, num_tracks = 0;
+    std::unordered_map<int, int> blocks_of_both;
+    for (const BlockClusters& b : blocks) {
+      num_images = std::max(num_images, b.image + 1);
+      num_tracks = std::max(num_tracks, b.track + 1);
+      if (b.both >= 0) ++blocks_of_both[b.both];
+    }
+    images_ = Eigen::MatrixXd::Zero(size, num_images);
+    tracks_ = Eigen::MatrixXd::Zero(size, num_tracks);
+    both_.setZero();
+    num_both_ = static_cast<int>(blocks_of_both.size());
+    // An (image, track) pair is nearly always one residual block: its
+    // outer product is taken at once, the few others are summed first.
+    for (const auto& [both, count] : blocks_of_both) {
+      if (count > 1) shared_both_.emplace(both, Eigen::VectorXd::Zero(size));
+    }
+  }
+
+  void Add(size_t block, const Eigen::VectorXd& effect) {
+    const BlockClusters& b = blocks_[block];
+    images_.col(b.image) += effect;
+    if (b.track < 0) return;
+    tracks_.col(b.track) += effect;
+    if (const auto it = shared_both_.find(b.both); it != shared_both_.end()) {
+      it->second += effect;
+    } else {
+      both_.noalias() += effect * effect.transpose();
+    }
+  }
+
+  // V_image (+ V_track - V_both), each the sum of its clusters' outer
+  // products times the small-sample factors G / (G - 1) (the "CR1"
+  // correction for few clusters) and N / (N - K) (the share of the
+  // residuals' spread the fitted parameters absorbed, as the model
+  // covariance's sigma0^2 has); empty with fewer than two images. Negative
+  // eigenvalues of the two-way sum (possible in finite samples) are set to
+  // zero, as Cameron, Gelbach & Miller propose.
+  Eigen::MatrixXd Covariance(double residuals_per_dof, int* num_images, int* num_tracks) const {
+    const auto factor = [&](Eigen::Index g) { return g / (g - 1.0) * residuals_per_dof; };
+    *num_images = static_cast<int>(images_.cols());
+    if (images_.cols() < 2) return {};
+    Eigen::MatrixXd covariance = factor(images_.cols()) * images_ * images_.transpose();
+    if (tracks_.cols() < 2 || num_both_ < 2) return covariance;
+    *num_tracks = static_cast<int>(tracks_.cols());
+    Eigen::MatrixXd both = both_;
+    for (const auto& [index, effect] : shared_both_) both.noalias() += effect * effect.transpose();
+    covariance += factor(tracks_.cols()) * tracks_ * tracks_.transpose() - factor(num_both_) * both;
+    // Clipped on the coordinates that vary: held ones stay exactly zero.
+    std::vector<Eigen::Index> varying;
+    for (Eigen::Index i = 0; i < covariance.rows(); ++i) {
+      if (images_.row(i).any() || tracks_.row(i).any()) varying.push_back(i);
+    }
+    Eigen::MatrixXd sub(varying.size(), varying.size());
+    for (size_t i = 0; i < varying.size(); ++i) {
+      for (size_t j = 0; j < varying.size(); ++j) sub(i, j) = covariance(varying[i], varying[j]);
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (sub + sub.transpose()));
+    sub = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+    covariance.setZero();
+    for (size_t i = 0; i < varying.size(); ++i) {
+      for (size_t j = 0; j < varying.size(); ++j) covariance(varying[i], varying[j]) = sub(i, j);
+    }
+    return covariance;
+  }
+
+ private:
+  const std::vector<BlockClusters>& blocks_;
+  Eigen::MatrixXd images_, tracks_;  // summed effect of each cluster
+  Eigen::MatrixXd both_;             // sum of the (image, track) clusters' outer products
+  int num_both_ = 0;
+  std::unordered_map<int, Eigen::VectorXd> shared_both_;
+};
 
 }  // namespace
 
@@ -57,48 +205,18 @@ MarginalCovariance ComputeMarginalCovariance(
   if (!problem->Evaluate(evaluate, nullptr, &residuals, nullptr, &jacobian)) {
     throw NumericalError("covariance: the residuals cannot be evaluated at the solution");
   }
-  // Each row's cluster, and the weight of its gradient: the loss's
-  // derivative rho'(|r|^2) of its block (at the solution the robust
-  // gradient, rho' J'r, is what balances).
-  std::vector<int> row_cluster;
-  std::vector<double> row_weight;
-  int num_clusters = 0;
-  if (clusters) {
-    std::map<int, int> index_of_cluster;
-    int next_own = -1;  // blocks in no listed cluster: each its own
-    std::vector<double*> blocks;
-    for (const ceres::ResidualBlockId id : evaluate.residual_blocks) {
-      problem->GetParameterBlocksForResidualBlock(id, &blocks);
-      int cluster = next_own--;
-      for (double* block : blocks) {
-        const auto it = clusters->cluster_of_block.find(block);
-        if (it != clusters->cluster_of_block.end()) {
-          cluster = it->second;
-          break;
-        }
-      }
-      auto [it, inserted] = index_of_cluster.emplace(cluster, num_clusters);
-      if (inserted) ++num_clusters;
-      const int rows = problem->GetCostFunctionForResidualBlock(id)->num_residuals();
-      double squared_norm = 0;
-      for (int k = 0; k < rows; ++k) squared_norm += residuals[row_cluster.size() + k] * residuals[row_cluster.size() + k];
-      double rho[3] = {squared_norm, 1, 0};
-      if (const ceres::LossFunction* loss = problem->GetLossFunctionForResidualBlock(id)) loss->Evaluate(squared_norm, rho);
-      row_cluster.insert(row_cluster.end(), rows, it->second);
-      row_weight.insert(row_weight.end(), rows, rho[1]);
-    }
-    PORTCAL_CHECK_MSG(static_cast<int>(row_cluster.size()) == jacobian.num_rows, "residual rows and blocks disagree");
-  }
-  // Reduced gradient of each cluster's residuals: u_k = g_c,k - H_cp
-  // H_pp^+ g_p,k (the points' share removed as in the Schur complement).
-  Eigen::MatrixXd cluster_gradients = Eigen::MatrixXd::Zero(clusters ? nc : 0, num_clusters);
+  // Each residual block's clusters and the weight of its gradient: the
+  // loss's derivative rho'(|r|^2) (at the solution the robust gradient,
+  // rho' J'r, is what balances).
+  std::vector<BlockClusters> block_clusters;
+  if (clusters) block_clusters = AssignClusters(problem, evaluate.residual_blocks, points, residuals, *clusters);
 
   // Accumulate H_cc, and per point H_pp and H_pc (sparse in c).
   Eigen::MatrixXd Hcc = Eigen::MatrixXd::Zero(nc, nc);
   struct PointBlocks {
     Eigen::Matrix3d Hpp = Eigen::Matrix3d::Zero();
-    std::unordered_map<int, Eigen::Vector3d> Hpc;       // column -> 3-vector
-    std::unordered_map<int, Eigen::Vector3d> gradient;  // cluster -> its residuals' g_p
+    Eigen::Matrix3d Hpp_pinv = Eigen::Matrix3d::Zero();
+    std::unordered_map<int, Eigen::Vector3d> Hpc;  // column -> 3-vector
   };
   std::vector<PointBlocks> point_blocks(points.size());
   std::vector<std::pair<int, double>> camera_entries;
@@ -121,18 +239,9 @@ MarginalCovariance ComputeMarginalCovariance(
     for (const auto& [i, vi] : camera_entries) {
       for (const auto& [j, vj] : camera_entries) Hcc(i, j) += vi * vj;
     }
-    const double weighted_residual = clusters ? row_weight[row] * residuals[row] : 0.0;
-    if (clusters) {
-      for (const auto& [i, vi] : camera_entries) cluster_gradients(i, row_cluster[row]) += vi * weighted_residual;
-    }
     if (point < 0) continue;
     PointBlocks& pb = point_blocks[static_cast<size_t>(point)];
     pb.Hpp += b * b.transpose();
-    if (clusters) {
-      auto it = pb.gradient.find(row_cluster[row]);
-      if (it == pb.gradient.end()) it = pb.gradient.emplace(row_cluster[row], Eigen::Vector3d::Zero()).first;
-      it->second += b * weighted_residual;
-    }
     for (const auto& [i, vi] : camera_entries) {
       auto it = pb.Hpc.find(i);
       if (it == pb.Hpc.end()) it = pb.Hpc.emplace(i, Eigen::Vector3d::Zero()).first;
@@ -140,21 +249,17 @@ MarginalCovariance ComputeMarginalCovariance(
     }
   }
   // Schur complement S = Hcc - sum_p Hcp Hpp^+ Hpc.
-  for (const PointBlocks& pb : point_blocks) {
+  for (PointBlocks& pb : point_blocks) {
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(pb.Hpp);
     const Eigen::Vector3d values = eig.eigenvalues();
     Eigen::Vector3d inverse = Eigen::Vector3d::Zero();
     for (int k = 0; k < 3; ++k) {
       if (values(k) > 1e-12 * values(2)) inverse(k) = 1.0 / values(k);
     }
-    const Eigen::Matrix3d Hpp_pinv = eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
+    pb.Hpp_pinv = eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
     for (const auto& [i, hi] : pb.Hpc) {
-      const Eigen::Vector3d w = Hpp_pinv * hi;
+      const Eigen::Vector3d w = pb.Hpp_pinv * hi;
       for (const auto& [j, hj] : pb.Hpc) Hcc(i, j) -= w.dot(hj);
-    }
-    for (const auto& [k, g] : pb.gradient) {
-      const Eigen::Vector3d w = Hpp_pinv * g;
-      for (const auto& [i, hi] : pb.Hpc) cluster_gradients(i, k) -= hi.dot(w);
     }
   }
   // Jacobi scaling: rotations (radians), translations (metres), focal
@@ -213,22 +318,47 @@ MarginalCovariance ComputeMarginalCovariance(
           scale * scale * plus[a] * covariance.block(ta, tb, plus[a].cols(), plus[b].cols()) * plus[b].transpose();
     }
   }
-  if (clusters && num_clusters > 1) {
-    // Each cluster's linearised effect on the wanted blocks, S^-1 u_k, in
-    // ambient coordinates; their outer products summed, with the small-
-    // sample factors: G / (G - 1) (the "CR1" correction for few clusters)
-    // and N / (N - K) for the share of the residuals' spread the fitted
-    // parameters absorbed (as the model covariance's sigma0^2 has).
-    Eigen::MatrixXd effects(total, num_clusters);
-    for (size_t a = 0; a < wanted.size(); ++a) {
-      const int ta = offset.at(const_cast<double*>(wanted[a]));
-      effects.middleRows(result.offset[wanted[a]], plus[a].rows()) =
-          plus[a] * (covariance.middleRows(ta, plus[a].cols()) * cluster_gradients);
-    }
-    const double factor = num_clusters / (num_clusters - 1.0) * clusters->residuals_per_dof;
-    result.clustered_covariance = factor * effects * effects.transpose();
-    result.num_clusters = num_clusters;
+  if (!clusters) return result;
+
+  // Each residual's linearised effect on the wanted blocks (ambient
+  // coordinates): the gain S^-1 (wanted rows) applied to its reduced
+  // gradient w r (J_c' - H_cp H_pp^+ J_p'), w = rho' -- the points' share
+  // removed as in the Schur complement. A cluster's effect S^-1 u_k is the
+  // sum of its residuals' effects.
+  Eigen::MatrixXd gain(total, nc);
+  for (size_t a = 0; a < wanted.size(); ++a) {
+    const int ta = offset.at(const_cast<double*>(wanted[a]));
+    gain.middleRows(result.offset[wanted[a]], plus[a].rows()) = plus[a] * covariance.middleRows(ta, plus[a].cols());
   }
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, 3>> point_gain(point_blocks.size());  // S^-1 H_cp H_pp^+
+  for (size_t p = 0; p < point_blocks.size(); ++p) {
+    Eigen::Matrix<double, Eigen::Dynamic, 3> through = Eigen::MatrixXd::Zero(total, 3);
+    for (const auto& [i, hi] : point_blocks[p].Hpc) through.noalias() += gain.col(i) * hi.transpose();
+    point_gain[p] = through * point_blocks[p].Hpp_pinv;
+  }
+  ClusterEffects effects(total, block_clusters);
+  size_t block = 0;
+  int block_start = 0;
+  Eigen::VectorXd block_effect = Eigen::VectorXd::Zero(total);
+  for (int row = 0; row < jacobian.num_rows; ++row) {
+    const double weighted_residual = block_clusters[block].weight * residuals[static_cast<size_t>(row)];
+    for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
+      const int col = jacobian.cols[k];
+      const double value = jacobian.values[k] * weighted_residual;
+      if (col < nc) {
+        block_effect += gain.col(col) * value;
+      } else {
+        block_effect -= point_gain[static_cast<size_t>((col - nc) / 3)].col((col - nc) % 3) * value;
+      }
+    }
+    if (row + 1 == block_start + block_clusters[block].rows) {
+      effects.Add(block, block_effect);
+      block_start = row + 1;
+      ++block;
+      block_effect.setZero();
+    }
+  }
+  result.clustered_covariance = effects.Covariance(clusters->residuals_per_dof, &result.num_clusters, &result.num_tracks);
   return result;
 }
 

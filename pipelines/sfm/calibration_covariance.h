@@ -25,17 +25,21 @@ struct MarginalCovariance {
   std::map<const double*, int> offset;  // row of each wanted block's first parameter
   std::map<const double*, int> size;    // its ambient size
   Eigen::MatrixXd covariance;           // the wanted blocks in order, scaled
-  // The same blocks' cluster-robust ("sandwich") covariance, clustered by
-  // image (Liang & Zeger, Biometrika 1986; Cameron & Miller, "A
-  // practitioner's guide to cluster-robust inference", 2015):
-  // S^-1 (sum_k u_k u_k') S^-1 with u_k the reduced gradient of image k's
-  // residuals, times G / (G - 1) * N / (N - K). It does not assume the
-  // residuals independent: an image's errors that share a cause (blur, a
-  // keypoint bias that depends on the view) show up in it, where the model
-  // covariance, which counts every residual as independent information,
-  // stays small. Empty unless clusters were given.
+  // The same blocks' cluster-robust ("sandwich") covariance, clustered two
+  // ways, by image and by track (Cameron, Gelbach & Miller, "Robust
+  // inference with multiway clustering", J. Bus. Econ. Stat. 2011):
+  // V_image + V_track - V_image&track, each V_g = G/(G-1) * N/(N-K) *
+  // S^-1 (sum_k u_k u_k') S^-1 with u_k the reduced gradient of cluster k's
+  // residuals (Liang & Zeger, Biometrika 1986), negative eigenvalues of the
+  // sum set to zero. It does not assume the residuals independent: errors
+  // an image's observations share (blur, a view-dependent keypoint bias)
+  // and errors a track's observations share (the same texture seen from
+  // nearby views, biased alike beyond what the point absorbs) show up in
+  // it, where the model covariance, which counts every residual as
+  // independent information, stays small. Empty unless clusters were given.
   Eigen::MatrixXd clustered_covariance;
-  int num_clusters = 0;
+  int num_clusters = 0;  // images
+  int num_tracks = 0;    // 0 when clustered by image only
 
   // Standard deviation of every ambient parameter of `block` by the model
   // covariance.
@@ -47,12 +51,16 @@ struct MarginalCovariance {
   double Correlation(const double* a, int i, const double* b, int j) const;
 };
 
-// How the residuals fall into clusters for the clustered covariance: a
-// residual block belongs to the cluster of the first of its parameter
-// blocks listed here (an image's pose, held or free), else it is a cluster
-// of its own (a marker's side length).
+// How the residuals fall into clusters for the clustered covariance. A
+// residual block's image is the cluster of the first of its parameter
+// blocks in `image_of_block` (an image's pose, held or free); its track is
+// the marginalised point it observes, else the first of its parameter
+// blocks in `track_of_block` (a marker corner). A block with neither is a
+// cluster of its own in that dimension (a marker's side length).
 struct ResidualClusters {
-  std::map<const double*, int> cluster_of_block;
+  std::map<const double*, int> image_of_block;
+  bool by_track = true;  // false: one-way, by image only
+  std::map<const double*, int> track_of_block;
   double residuals_per_dof = 1;  // N / (N - K) of the whole adjustment
 };
 

@@ -36,6 +36,7 @@ void IncrementalMapperOptions::Check() const {
   if (abs_pose_min_num_inliers < 6) {
     throw OptionError("--Mapper.abs_pose_min_num_inliers", std::to_string(abs_pose_min_num_inliers), ">= 6");
   }
+  if (init_max_restarts < 0) throw OptionError("--Mapper.init_max_restarts", std::to_string(init_max_restarts), ">= 0");
   if (min_model_size < 2) throw OptionError("--Mapper.min_model_size", std::to_string(min_model_size), ">= 2");
   if (ba_local_num_images < 1) {
     throw OptionError("--Mapper.ba_local_num_images", std::to_string(ba_local_num_images), ">= 1");
@@ -76,7 +77,8 @@ class Mapper {
   double FocalOf(image_t image_id) const {
     return cameras_.at(inputs_.images.at(image_id).camera_id).camera.MeanFocalLength();
   }
-  bool Initialize(Reconstruction* r, std::set<image_pair_t>* tried);
+  // The pair it started from in `start`.
+  bool Initialize(Reconstruction* r, std::set<image_pair_t>* tried, image_pair_t* start);
   bool TryInitialPair(Reconstruction* r, image_t a, image_t b);
   bool Register(Reconstruction* r, image_t image_id);
   int Triangulate(Reconstruction* r, image_t image_id);
@@ -93,6 +95,10 @@ class Mapper {
   // A global adjustment refining the housing has converged (off its bounds)
   // in the current model.
   bool port_converged_ = false;
+  // Whether the last global adjustment that refined the intrinsics found
+  // them implausible (and held them).
+  bool intrinsics_implausible_ = false;
+  int num_implausible_in_a_row_ = 0;
   // Seconds spent per step, for the debug log.
   std::map<std::string, double> seconds_;
   template <typename F>
@@ -112,16 +118,38 @@ std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
   std::vector<Reconstruction> models;
   std::set<image_pair_t> tried;
   progress.Begin("refractive_mapper: images registered", inputs_.images.size());
+  // Initial pairs of the current model whose growth was abandoned because
+  // the intrinsics kept coming out implausible (a wrong start, see
+  // IncrementalMapperOptions::init_max_restarts). With no other pair left,
+  // the first is built again to the end, its intrinsics held where
+  // implausible, as before there were restarts.
+  std::vector<image_pair_t> abandoned;
+  bool may_abandon = true;
   while (static_cast<int>(models.size()) < options_.max_num_models) {
     Reconstruction r(&inputs_, cameras_);
     port_converged_ = false;
+    intrinsics_implausible_ = false;
+    num_implausible_in_a_row_ = 0;
     failed_.clear();
     seconds_.clear();  // per model
-    if (!Initialize(&r, &tried)) break;
+    image_pair_t start = 0;
+    if (!Initialize(&r, &tried, &start)) {
+      if (abandoned.empty() || !may_abandon) break;
+      LOG(WARNING) << "refractive_mapper: no other initial pair; building model " << models.size()
+                   << " from the first one again, to the end";
+      tried.erase(abandoned.front());
+      may_abandon = false;
+      continue;
+    }
+    const bool abandon_allowed = may_abandon && static_cast<int>(abandoned.size()) < options_.init_max_restarts;
+    // Implausible at this many refinements in a row, the model is given up
+    // (own render: from 5 images on at every one).
+    constexpr int kImplausibleInARowToAbandon = 3;
+    const auto abandon = [&] { return abandon_allowed && num_implausible_in_a_row_ >= kImplausibleInARowToAbandon; };
     progress.Advance(2);
     size_t last_global = r.poses().size();
     size_t last_refine = r.poses().size();
-    while (true) {
+    while (!abandon()) {
       CancelFlag::ThrowIfRequested();
       bool added = false;
       for (image_t image_id : Timed("next", [&] { return NextImages(r); })) {
@@ -147,15 +175,28 @@ std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
       }
       if (!added) break;
     }
-    // Rays may have moved with the intrinsics: triangulate what is left,
-    // adjust once more and filter.
-    for (const auto& [id, pose] : std::map<image_t, Rigid3d>(r.poses())) Triangulate(&r, id);
-    GlobalAdjust(&r, true);
-    Filter(&r, nullptr);
-    GlobalAdjust(&r, true);
-    LOG(INFO) << "refractive_mapper: model " << models.size() << ": " << r.poses().size() << " images, "
-              << r.points().size() << " points, mean reprojection error " << r.MeanReprojectionError()
-              << " px";
+    if (!abandon()) {
+      // Rays may have moved with the intrinsics: triangulate what is left,
+      // adjust once more and filter.
+      for (const auto& [id, pose] : std::map<image_t, Rigid3d>(r.poses())) Triangulate(&r, id);
+      GlobalAdjust(&r, true);
+      Filter(&r, nullptr);
+      GlobalAdjust(&r, true);
+      LOG(INFO) << "refractive_mapper: model " << models.size() << ": " << r.poses().size() << " images, "
+                << r.points().size() << " points, mean reprojection error " << r.MeanReprojectionError()
+                << " px";
+    }
+    if (abandon() || (abandon_allowed && intrinsics_implausible_)) {
+      LOG(WARNING) << "refractive_mapper: the intrinsics refined on " << r.poses().size() << " images of model "
+                   << models.size() << " came out implausible " << num_implausible_in_a_row_
+                   << " time(s) in a row: its initial pair was likely wrong; starting it again from another";
+      abandoned.push_back(start);
+      progress.Begin("refractive_mapper: images registered (another initial pair)", inputs_.images.size());
+      progress.Advance(used_.size());
+      continue;
+    }
+    abandoned.clear();
+    may_abandon = true;
     VLOG(1) << "refractive_mapper: seconds in next " << seconds_["next"] << ", register " << seconds_["register"]
             << ", triangulate " << seconds_["triangulate"] << ", local " << seconds_["local"] << ", global "
             << seconds_["global"];
@@ -172,7 +213,7 @@ std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
   return models;
 }
 
-bool Mapper::Initialize(Reconstruction* r, std::set<image_pair_t>* tried) {
+bool Mapper::Initialize(Reconstruction* r, std::set<image_pair_t>* tried, image_pair_t* start) {
   // Most inlier matches first, but pairs whose geometry is a homography
   // last: a relative pose from a plane seen twice is ambiguous (two
   // decompositions), and a wrong start warps the model and sends the
@@ -197,6 +238,7 @@ bool Mapper::Initialize(Reconstruction* r, std::set<image_pair_t>* tried) {
       LOG(INFO) << "refractive_mapper: initial pair '" << inputs_.images.at(a).name << "' + '"
                 << inputs_.images.at(b).name << "' (" << count << " inlier matches), " << r->points().size()
                 << " points";
+      *start = pair_id;
       return true;
     }
   }
@@ -556,7 +598,11 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   }
   const ceres::Solver::Summary summary =
       AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
-  if (refine_intrinsics && BogusIntrinsics(cameras_before, r->cameras())) {
+  if (refine_intrinsics) {
+    intrinsics_implausible_ = BogusIntrinsics(cameras_before, r->cameras());
+    num_implausible_in_a_row_ = intrinsics_implausible_ ? num_implausible_in_a_row_ + 1 : 0;
+  }
+  if (refine_intrinsics && intrinsics_implausible_) {
     std::ostringstream values;
     for (const auto& [id, camera] : r->cameras()) {
       for (const double p : camera.camera.params) values << " " << p;

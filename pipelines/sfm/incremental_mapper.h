@@ -20,6 +20,14 @@ struct IncrementalMapperOptions {
   int init_min_num_inliers = 50;
   double init_min_tri_angle_deg = 4.0;  // median over the initial points
   int init_max_num_trials = 20;         // candidate initial pairs tried per model
+  // A model whose intrinsics come out implausible at three refinements in a
+  // row, or at the last one, grew from a wrong start (own render: a
+  // low-parallax pair of nearly frontal views whose relative pose took the
+  // other side of the bas-relief ambiguity; from 5 images on every
+  // adjustment sent the focal length to ~1300 px for 650): it is started
+  // again from the next candidate pair, at most this many times; with no
+  // pair left, the first start is built to the end, its intrinsics held.
+  int init_max_restarts = 2;
   double init_max_error_px = 4.0;
   // Scale of a model when markers do not give it: the initial pair's median
   // scene depth, metres.

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
+#include <functional>
 #include <random>
 
 #include "colmap_ext/camera/camera_models.h"
@@ -342,26 +343,31 @@ struct ClusterSecondLook {
 TEST(CalibrationCovariance, ClusteredCovarianceSumsEachClustersExactEffect) {
   // Linear least squares: moving cluster k's observations onto their fitted
   // values (its residuals to zero) moves the solution by exactly the
-  // effect S^-1 u_k the clustered covariance sums; so the clustered
-  // covariance must equal G / (G - 1) * (N / (N - K)) * sum_k d_k d_k'.
-  constexpr int kSamples = 24, kClusters = 4;
+  // effect d_k = S^-1 u_k the clustered covariance sums; so clustered by
+  // image it must equal V_image = G / (G - 1) * (N / (N - K)) * sum_k d_k
+  // d_k', and clustered two ways V_image + V_track - V_image&track, each
+  // with its own G. Sample i is seen in image i % 4 and again in image
+  // (i + 1) % 4; its point is the track.
+  constexpr int kSamples = 24, kImages = 4;
   std::vector<double> y(kSamples), z(kSamples);
   for (int i = 0; i < kSamples; ++i) {
-    // Errors that share a sign within a cluster: what the clustered
-    // covariance is for.
-    y[i] = 2.0 * i * 0.1 + 0.3 + 0.02 * ((i % kClusters) - 1.5) + 0.01 * std::sin(3.0 * i);
-    z[i] = 0.05 * std::cos(1.7 * i);
+    // Errors that share a sign within an image and within a track (the
+    // second look repeats part of the first one's error): what the
+    // clustered covariance is for.
+    const double shared = 0.01 * std::sin(3.0 * i);
+    y[i] = 2.0 * i * 0.1 + 0.3 + 0.02 * ((i % kImages) - 1.5) + shared;
+    z[i] = 0.05 * std::cos(1.7 * i) + 0.5 * shared;
   }
   double a = 0, b = 0;
   std::vector<std::array<double, 3>> p(kSamples, {0, 0, 0});
-  std::array<double, kClusters> offsets{};
+  std::array<double, kImages> offsets{};
   ceres::Problem problem;
   for (int i = 0; i < kSamples; ++i) {
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ClusterSample, 3, 1, 1, 3, 1>(
                                  new ClusterSample(i * 0.1, &y[i])),
-                             nullptr, &a, &b, p[i].data(), &offsets[i % kClusters]);
+                             nullptr, &a, &b, p[i].data(), &offsets[i % kImages]);
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ClusterSecondLook, 1, 3, 1>(new ClusterSecondLook(&z[i])),
-                             nullptr, p[i].data(), &offsets[(i + 1) % kClusters]);
+                             nullptr, p[i].data(), &offsets[(i + 1) % kImages]);
   }
   for (double& offset : offsets) problem.SetParameterBlockConstant(&offset);
   ceres::Solver::Options options;
@@ -374,47 +380,66 @@ TEST(CalibrationCovariance, ClusteredCovarianceSumsEachClustersExactEffect) {
   };
   solve();
   const double a_hat = a, b_hat = b;
+  const std::vector<double> y_observed = y, z_observed = z;
+  const std::vector<std::array<double, 3>> p_hat = p;
+  // The factor times the sum of d_k d_k' over `num_clusters` clusters, where
+  // `in(k, i, second_look)` says whether an observation is in cluster k.
+  constexpr double kResidualsPerDof = 1.25;
+  const auto exact = [&](int num_clusters, const std::function<bool(int, int, bool)>& in) {
+    Eigen::Matrix2d sum = Eigen::Matrix2d::Zero();
+    for (int k = 0; k < num_clusters; ++k) {
+      for (int i = 0; i < kSamples; ++i) {
+        // Fitted values at the first solution.
+        if (in(k, i, false)) y[i] = a_hat * i * 0.1 + b_hat + p_hat[i][0];
+        if (in(k, i, true)) z[i] = p_hat[i][0];
+      }
+      solve();
+      const Eigen::Vector2d effect(a - a_hat, b - b_hat);
+      sum += effect * effect.transpose();
+      // Back to the first solution and observations for the next cluster.
+      y = y_observed;
+      z = z_observed;
+      a = a_hat;
+      b = b_hat;
+      p = p_hat;
+    }
+    return Eigen::Matrix2d(num_clusters / (num_clusters - 1.0) * kResidualsPerDof * sum);
+  };
+  const Eigen::Matrix2d by_image = exact(kImages, [](int k, int i, bool second) {
+    return (second ? (i + 1) % kImages : i % kImages) == k;
+  });
+  const Eigen::Matrix2d by_track = exact(kSamples, [](int k, int i, bool) { return i == k; });
+  const Eigen::Matrix2d by_both = exact(2 * kSamples, [](int k, int i, bool second) { return k == 2 * i + second; });
+  const Eigen::Matrix2d two_way = by_image + by_track - by_both;
+  // Not trivially zero: the clusters' errors moved the line; and positive
+  // definite, so no eigenvalue is clipped.
+  ASSERT_GT(by_image(0, 0), 1e-8);
+  ASSERT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(two_way).eigenvalues().minCoeff(), 0.0);
+  ASSERT_GT((two_way - by_image).norm(), 0.1 * by_image.norm());
+
   std::vector<double*> points;
   for (auto& q : p) points.push_back(q.data());
   ResidualClusters clusters;
-  for (int k = 0; k < kClusters; ++k) clusters.cluster_of_block[&offsets[k]] = k;
-  clusters.residuals_per_dof = 1.25;
-  const MarginalCovariance marginal = ComputeMarginalCovariance(
-      &problem, points, {&a, &b}, {&a, &b}, 1.0, [](const double*, int) { return std::string("?"); }, &clusters);
-  ASSERT_EQ(marginal.num_clusters, kClusters);
-  ASSERT_EQ(marginal.clustered_covariance.rows(), 2);
-
-  Eigen::Matrix2d expected = Eigen::Matrix2d::Zero();
-  const std::vector<double> y_observed = y, z_observed = z;
-  for (int k = 0; k < kClusters; ++k) {
-    for (int i = 0; i < kSamples; ++i) {
-      // Fitted values at the first solution; the points as solved then.
-      if (i % kClusters == k) y[i] = a_hat * i * 0.1 + b_hat + p[i][0];
-      if ((i + 1) % kClusters == k) z[i] = p[i][0];
+  for (int k = 0; k < kImages; ++k) clusters.image_of_block[&offsets[k]] = k;
+  clusters.residuals_per_dof = kResidualsPerDof;
+  const auto describe = [](const double*, int) { return std::string("?"); };
+  for (const bool two : {true, false}) {
+    SCOPED_TRACE(two ? "two-way" : "by image");
+    clusters.by_track = two;
+    const MarginalCovariance marginal = ComputeMarginalCovariance(&problem, points, {&a, &b}, {&a, &b}, 1.0, describe, &clusters);
+    const Eigen::Matrix2d& expected = two ? two_way : by_image;
+    EXPECT_EQ(marginal.num_clusters, kImages);
+    EXPECT_EQ(marginal.num_tracks, two ? kSamples : 0);
+    ASSERT_EQ(marginal.clustered_covariance.rows(), 2);
+    for (int i = 0; i < 2; ++i) {
+      for (int j = 0; j < 2; ++j) {
+        EXPECT_NEAR(marginal.clustered_covariance(i, j), expected(i, j), 1e-6 * expected.norm()) << i << "," << j;
+      }
     }
-    const std::vector<std::array<double, 3>> p_hat = p;
-    solve();
-    const Eigen::Vector2d effect(a - a_hat, b - b_hat);
-    expected += effect * effect.transpose();
-    // Back to the first solution and observations for the next cluster.
-    y = y_observed;
-    z = z_observed;
-    a = a_hat;
-    b = b_hat;
-    p = p_hat;
+    EXPECT_NEAR(marginal.ClusteredStdDevs(&a)[0], std::sqrt(expected(0, 0)), 1e-6 * std::sqrt(expected(0, 0)));
   }
-  expected *= kClusters / (kClusters - 1.0) * 1.25;
-  // Not trivially zero: the clusters' errors moved the line.
-  ASSERT_GT(expected(0, 0), 1e-8);
-  for (int i = 0; i < 2; ++i) {
-    for (int j = 0; j < 2; ++j) {
-      EXPECT_NEAR(marginal.clustered_covariance(i, j), expected(i, j), 1e-6 * expected.norm()) << i << "," << j;
-    }
-  }
-  EXPECT_NEAR(marginal.ClusteredStdDevs(&a)[0], std::sqrt(expected(0, 0)), 1e-6 * std::sqrt(expected(0, 0)));
   // Without clusters there is no clustered covariance.
-  const MarginalCovariance plain = ComputeMarginalCovariance(
-      &problem, points, {&a, &b}, {&a, &b}, 1.0, [](const double*, int) { return std::string("?"); });
+  const MarginalCovariance plain = ComputeMarginalCovariance(&problem, points, {&a, &b}, {&a, &b}, 1.0, describe);
   EXPECT_EQ(plain.clustered_covariance.size(), 0);
   EXPECT_TRUE(plain.ClusteredStdDevs(&a).empty());
 }
@@ -430,6 +455,19 @@ TEST(IncrementalMapperOptions, GlobalFunctionToleranceIsAFractionAndNamedWhenBad
     } catch (const OptionError& e) {
       EXPECT_NE(std::string(e.what()).find("--Mapper.ba_global_function_tolerance"), std::string::npos) << e.what();
     }
+  }
+}
+
+TEST(IncrementalMapperOptions, NegativeRestartsAreNamed) {
+  IncrementalMapperOptions options;
+  options.init_max_restarts = 0;
+  EXPECT_NO_THROW(options.Check());
+  options.init_max_restarts = -1;
+  try {
+    options.Check();
+    ADD_FAILURE() << "accepted -1";
+  } catch (const OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("--Mapper.init_max_restarts"), std::string::npos) << e.what();
   }
 }
 

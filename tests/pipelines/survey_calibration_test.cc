@@ -100,8 +100,8 @@ render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
   // measured level, 4.5 mm, plus a margin: the 2 mm is met on the
   // larger surveys, docs/auto_calibration.md), and both within 4 reported
   // sigma. Sigma by the noise alone said 0.009 deg and 0.74 mm here (3.8 and
-  // 6 sigma off); by the images' spread, which the report now takes when it
-  // is larger, 0.040 deg and 4.8 mm.
+  // 6 sigma off); by the clusters' spread (images and tracks), which the
+  // report takes when it is larger, 0.040 deg and 4.8 mm.
   EXPECT_LT(angle, 0.05 * kDegree);
   EXPECT_LT(std::abs(distance_error), 0.006);
   EXPECT_LT(angle, 4 * angle_sd);
