@@ -95,9 +95,8 @@ class Mapper {
   // A global adjustment refining the housing has converged (off its bounds)
   // in the current model.
   bool port_converged_ = false;
-  // Whether the last global adjustment that refined the intrinsics found
-  // them implausible (and held them).
-  bool intrinsics_implausible_ = false;
+  // How many global adjustments that refined the intrinsics found them
+  // implausible (and held them) in a row, up to the last one.
   int num_implausible_in_a_row_ = 0;
   // Seconds spent per step, for the debug log.
   std::map<std::string, double> seconds_;
@@ -128,7 +127,6 @@ std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
   while (static_cast<int>(models.size()) < options_.max_num_models) {
     Reconstruction r(&inputs_, cameras_);
     port_converged_ = false;
-    intrinsics_implausible_ = false;
     num_implausible_in_a_row_ = 0;
     failed_.clear();
     seconds_.clear();  // per model
@@ -186,7 +184,7 @@ std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
                 << r.points().size() << " points, mean reprojection error " << r.MeanReprojectionError()
                 << " px";
     }
-    if (abandon() || (abandon_allowed && intrinsics_implausible_)) {
+    if (abandon() || (abandon_allowed && num_implausible_in_a_row_ > 0)) {
       LOG(WARNING) << "refractive_mapper: the intrinsics refined on " << r.poses().size() << " images of model "
                    << models.size() << " came out implausible " << num_implausible_in_a_row_
                    << " time(s) in a row: its initial pair was likely wrong; starting it again from another";
@@ -598,11 +596,9 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   }
   const ceres::Solver::Summary summary =
       AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
-  if (refine_intrinsics) {
-    intrinsics_implausible_ = BogusIntrinsics(cameras_before, r->cameras());
-    num_implausible_in_a_row_ = intrinsics_implausible_ ? num_implausible_in_a_row_ + 1 : 0;
-  }
-  if (refine_intrinsics && intrinsics_implausible_) {
+  const bool implausible = refine_intrinsics && BogusIntrinsics(cameras_before, r->cameras());
+  if (refine_intrinsics) num_implausible_in_a_row_ = implausible ? num_implausible_in_a_row_ + 1 : 0;
+  if (implausible) {
     std::ostringstream values;
     for (const auto& [id, camera] : r->cameras()) {
       for (const double p : camera.camera.params) values << " " << p;
