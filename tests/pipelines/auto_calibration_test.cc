@@ -131,8 +131,8 @@ TEST(AutoCalibration, OwnRenderWhoseBestPairStartsAWrongModel) {
   // model grown from it had implausible intrinsics at every refinement
   // (f ~1300 px for 650); refining it threw. The mapper now builds the
   // model again from the next pair. Its port then sat at the distance's
-  // floor, where the refinement's second attempt restarts it from the
-  // guess.
+  // floor, from where the refinement now starts it at the guess's
+  // distance, the intrinsics first.
   testing::TempDir dir;
   std::ofstream(dir.path() / "set.yaml") << "name: seed11\nnum_images: 12\n"
                                          << R"(camera: {model: RADIAL, width: 960, height: 540, params: [650.0, 484.0, 266.5, 0.0, 0.0]}
