@@ -1,5 +1,6 @@
 #include "pipelines/sfm/bundle_adjustment.h"
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -101,9 +102,6 @@ constexpr double kMinPortDistance = 1e-4;
 // Largest dome decentering an adjustment may reach, in dome radii: the
 // camera centre stays inside the dome.
 constexpr double kMaxDomeDecentering = 0.9;
-
-// Largest reduced (Schur) system whose covariance is computed.
-constexpr int kMaxReducedSystem = 6000;
 
 // Keypoints up to this scale (pixels) get sigma_px; coarser ones more.
 constexpr double kReferenceScale = 2.0;
@@ -460,16 +458,6 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
       }
       return "a marker corner";
     };
-    // The reduced system is dense: 6 x images columns. Beyond ~1000 images
-    // its inversion costs minutes and gigabytes; the std devs are skipped.
-    int reduced = 0;
-    for (double* block : others) reduced += problem.ParameterBlockTangentSize(block);
-    if (reduced > kMaxReducedSystem) {
-      LOG(WARNING) << "bundle adjustment: " << reduced << " pose and calibration parameters; standard "
-                   << "deviations are computed up to " << kMaxReducedSystem << " and are not reported";
-      others.clear();
-      wanted.clear();
-    }
     if (!wanted.empty()) {
       ResidualClusters clusters;
       int image_index = 0;
@@ -481,8 +469,13 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
         for (MarkerCorner& corner : *markers) clusters.track_of_block[corner.xyz.data()] = corner_index++;
       }
       clusters.residuals_per_dof = summary.num_residuals_reduced / dof;
+      const auto start = std::chrono::steady_clock::now();
       const MarginalCovariance marginal =
           ComputeMarginalCovariance(&problem, points, others, wanted, scale, describe, &clusters);
+      LOG(INFO) << "bundle adjustment: covariance of " << others.size() << " pose and calibration blocks, "
+                << points.size() << " points marginalised, clustered by " << marginal.num_clusters << " images and "
+                << marginal.num_tracks << " tracks: "
+                << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() << " s";
       const auto larger = [](std::vector<double> by_noise, const std::vector<double>& by_clusters) {
         for (size_t i = 0; i < by_clusters.size() && i < by_noise.size(); ++i) {
           by_noise[i] = std::max(by_noise[i], by_clusters[i]);

@@ -1,6 +1,7 @@
 #include "pipelines/sfm/calibration_covariance.h"
 
 #include <Eigen/Dense>
+#include <Eigen/Sparse>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -167,6 +168,133 @@ class ClusterEffects {
   std::unordered_map<int, Eigen::VectorXd> shared_both_;
 };
 
+// The error for a singular reduced system; `measure` says which ratio
+// (smallest to largest eigenvalue, or pivot) showed it.
+NumericalError RankDeficient(const std::string& name, const char* measure, double ratio) {
+  std::ostringstream text;
+  text << ratio;
+  return NumericalError("covariance: the views do not determine " + name + " (reduced system rank deficient: " +
+                        measure + " ratio " + text.str() + "); hold it fixed or add views");
+}
+
+// The Gauss-Newton system reduced over the points: S = H_cc - H_cp H_pp^+
+// H_pc, sparse (two cameras couple only through points both see), and
+// W = H_pp^+ H_pc, each point's least-squares response to the cameras.
+struct PointSchur {
+  Eigen::SparseMatrix<double> reduced;             // S, nc x nc
+  Eigen::SparseMatrix<double> point_from_cameras;  // W, 3 points x nc
+};
+
+// From the Jacobian's columns: the first `nc` are the other blocks', the
+// rest three per point. Each point's 3x3 block is pseudo-inverted.
+PointSchur ReduceOverPoints(const ceres::CRSMatrix& jacobian, int nc, size_t num_points) {
+  using RowMajor = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+  const int np = static_cast<int>(3 * num_points);
+  RowMajor camera_jacobian(jacobian.num_rows, nc), point_jacobian(jacobian.num_rows, np);
+  camera_jacobian.reserve(static_cast<Eigen::Index>(jacobian.values.size()));
+  point_jacobian.reserve(static_cast<Eigen::Index>(3 * jacobian.num_rows));
+  std::vector<std::pair<int, double>> entries;
+  for (int row = 0; row < jacobian.num_rows; ++row) {
+    camera_jacobian.startVec(row);
+    point_jacobian.startVec(row);
+    entries.clear();
+    for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
+      entries.emplace_back(jacobian.cols[k], jacobian.values[k]);
+    }
+    std::sort(entries.begin(), entries.end());  // Ceres orders a row's columns by block, not index
+    int point = -1;
+    for (const auto& [col, value] : entries) {
+      if (col < nc) {
+        camera_jacobian.insertBack(row, col) = value;
+        continue;
+      }
+      PORTCAL_CHECK_MSG(point == -1 || point == (col - nc) / 3, "a residual touches two marginalised points");
+      point = (col - nc) / 3;
+      point_jacobian.insertBack(row, col - nc) = value;
+    }
+  }
+  camera_jacobian.finalize();
+  point_jacobian.finalize();
+  const Eigen::SparseMatrix<double> jc = camera_jacobian, jp = point_jacobian;
+  const Eigen::SparseMatrix<double> point_camera = jp.transpose() * jc;  // H_pc
+  const Eigen::SparseMatrix<double> point_point = jp.transpose() * jp;   // block diagonal H_pp
+  std::vector<Eigen::Triplet<double>> pinv;
+  pinv.reserve(static_cast<size_t>(3 * np));
+  for (int p = 0; p < np; p += 3) {
+    const Eigen::Matrix3d hpp = Eigen::MatrixXd(point_point.block(p, p, 3, 3));
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(hpp);
+    const Eigen::Vector3d values = eig.eigenvalues();
+    Eigen::Vector3d inverse = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      if (values(k) > 1e-12 * values(2)) inverse(k) = 1.0 / values(k);
+    }
+    const Eigen::Matrix3d block = eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) pinv.emplace_back(p + i, p + j, block(i, j));
+    }
+  }
+  Eigen::SparseMatrix<double> point_point_pinv(np, np);
+  point_point_pinv.setFromTriplets(pinv.begin(), pinv.end());
+  PointSchur schur;
+  schur.point_from_cameras = point_point_pinv * point_camera;
+  schur.reduced = Eigen::SparseMatrix<double>(jc.transpose() * jc) -
+                  Eigen::SparseMatrix<double>(point_camera.transpose() * schur.point_from_cameras);
+  return schur;
+}
+
+// Rows of S^-1 at `wanted` by a dense eigen-decomposition of the scaled
+// system, whose smallest eigenvector names the parameter that dominates an
+// unobservable direction.
+Eigen::MatrixXd DenseInverseRows(const Eigen::SparseMatrix<double>& reduced, const Eigen::VectorXd& d_inv_sqrt,
+                                 const std::vector<int>& wanted,
+                                 const std::function<std::string(Eigen::Index)>& name_of) {
+  const Eigen::MatrixXd s = Eigen::MatrixXd(reduced);
+  const Eigen::MatrixXd scaled = d_inv_sqrt.asDiagonal() * (0.5 * (s + s.transpose())) * d_inv_sqrt.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaled);
+  const Eigen::VectorXd values = eig.eigenvalues();
+  const Eigen::Index n = values.size();
+  if (!(values(0) > 1e-12 * values(n - 1))) {
+    Eigen::Index column;
+    eig.eigenvectors().col(0).cwiseAbs().maxCoeff(&column);
+    throw RankDeficient(name_of(column), "eigenvalue", values(0) / values(n - 1));
+  }
+  Eigen::MatrixXd rows(wanted.size(), n);
+  for (size_t k = 0; k < wanted.size(); ++k) {
+    rows.row(static_cast<Eigen::Index>(k)) =
+        (eig.eigenvectors().row(wanted[k]) * values.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose())
+            .cwiseProduct(d_inv_sqrt.transpose()) * d_inv_sqrt(wanted[k]);
+  }
+  return rows;
+}
+
+// The same by a sparse LDL' factorisation of the scaled system (fill-
+// reducing AMD order): a survey's S couples each image with its
+// neighbours only, and its dense decomposition costs n^3. Rank deficiency
+// shows as a vanishing pivot; the parameter at that pivot is named.
+Eigen::MatrixXd SparseInverseRows(const Eigen::SparseMatrix<double>& reduced, const Eigen::VectorXd& d_inv_sqrt,
+                                  const std::vector<int>& wanted,
+                                  const std::function<std::string(Eigen::Index)>& name_of) {
+  const Eigen::SparseMatrix<double> symmetric = 0.5 * (reduced + Eigen::SparseMatrix<double>(reduced.transpose()));
+  const Eigen::SparseMatrix<double> scaled = d_inv_sqrt.asDiagonal() * symmetric * d_inv_sqrt.asDiagonal();
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(scaled);
+  if (ldlt.info() != Eigen::Success) {
+    // An exactly zero pivot stops the factorisation where it is; a shift
+    // far below the rank test's threshold lets it finish so that the
+    // pivot can be found and named (the shifted factor gives no numbers).
+    ldlt.setShift(1e-15);
+    ldlt.factorize(scaled);
+    if (ldlt.info() != Eigen::Success) throw NumericalError("covariance: the reduced system cannot be factorised");
+  }
+  const Eigen::VectorXd pivots = ldlt.vectorD();
+  Eigen::Index smallest;
+  const double ratio = pivots.minCoeff(&smallest) / pivots.cwiseAbs().maxCoeff();
+  if (!(ratio > 1e-12)) throw RankDeficient(name_of(ldlt.permutationPinv().indices()(smallest)), "pivot", ratio);
+  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(scaled.rows(), static_cast<Eigen::Index>(wanted.size()));
+  for (size_t k = 0; k < wanted.size(); ++k) unit(wanted[k], static_cast<Eigen::Index>(k)) = d_inv_sqrt(wanted[k]);
+  const Eigen::MatrixXd solved = ldlt.solve(unit);
+  return (d_inv_sqrt.asDiagonal() * solved).transpose();
+}
+
 }  // namespace
 
 std::vector<double> MarginalCovariance::StdDevs(const double* block) const {
@@ -188,7 +316,8 @@ double MarginalCovariance::Correlation(const double* a, int i, const double* b, 
 MarginalCovariance ComputeMarginalCovariance(
     ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others,
     const std::vector<const double*>& wanted, double scale,
-    const std::function<std::string(const double*, int)>& describe, const ResidualClusters* clusters) {
+    const std::function<std::string(const double*, int)>& describe, const ResidualClusters* clusters,
+    int max_dense_size) {
   ceres::Problem::EvaluateOptions evaluate;
   evaluate.apply_loss_function = false;
   evaluate.parameter_blocks = others;
@@ -200,6 +329,7 @@ MarginalCovariance ComputeMarginalCovariance(
     offset[block] = nc;
     nc += problem->ParameterBlockTangentSize(block);
   }
+  if (nc == 0) throw NumericalError("covariance: no free parameters");
   ceres::CRSMatrix jacobian;
   std::vector<double> residuals;
   if (!problem->Evaluate(evaluate, nullptr, &residuals, nullptr, &jacobian)) {
@@ -211,90 +341,44 @@ MarginalCovariance ComputeMarginalCovariance(
   std::vector<BlockClusters> block_clusters;
   if (clusters) block_clusters = AssignClusters(problem, evaluate.residual_blocks, points, residuals, *clusters);
 
-  // Accumulate H_cc, and per point H_pp and H_pc (sparse in c).
-  Eigen::MatrixXd Hcc = Eigen::MatrixXd::Zero(nc, nc);
-  struct PointBlocks {
-    Eigen::Matrix3d Hpp = Eigen::Matrix3d::Zero();
-    Eigen::Matrix3d Hpp_pinv = Eigen::Matrix3d::Zero();
-    std::unordered_map<int, Eigen::Vector3d> Hpc;  // column -> 3-vector
-  };
-  std::vector<PointBlocks> point_blocks(points.size());
-  std::vector<std::pair<int, double>> camera_entries;
-  for (int row = 0; row < jacobian.num_rows; ++row) {
-    camera_entries.clear();
-    int point = -1;
-    Eigen::Vector3d b = Eigen::Vector3d::Zero();
-    for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
-      const int col = jacobian.cols[k];
-      const double value = jacobian.values[k];
-      if (col < nc) {
-        camera_entries.emplace_back(col, value);
-      } else {
-        const int p = (col - nc) / 3;
-        PORTCAL_CHECK_MSG(point == -1 || point == p, "a residual touches two marginalised points");
-        point = p;
-        b((col - nc) % 3) = value;
-      }
-    }
-    for (const auto& [i, vi] : camera_entries) {
-      for (const auto& [j, vj] : camera_entries) Hcc(i, j) += vi * vj;
-    }
-    if (point < 0) continue;
-    PointBlocks& pb = point_blocks[static_cast<size_t>(point)];
-    pb.Hpp += b * b.transpose();
-    for (const auto& [i, vi] : camera_entries) {
-      auto it = pb.Hpc.find(i);
-      if (it == pb.Hpc.end()) it = pb.Hpc.emplace(i, Eigen::Vector3d::Zero()).first;
-      it->second += b * vi;
-    }
-  }
-  // Schur complement S = Hcc - sum_p Hcp Hpp^+ Hpc.
-  for (PointBlocks& pb : point_blocks) {
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(pb.Hpp);
-    const Eigen::Vector3d values = eig.eigenvalues();
-    Eigen::Vector3d inverse = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 3; ++k) {
-      if (values(k) > 1e-12 * values(2)) inverse(k) = 1.0 / values(k);
-    }
-    pb.Hpp_pinv = eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
-    for (const auto& [i, hi] : pb.Hpc) {
-      const Eigen::Vector3d w = pb.Hpp_pinv * hi;
-      for (const auto& [j, hj] : pb.Hpc) Hcc(i, j) -= w.dot(hj);
-    }
-  }
+  const PointSchur schur = ReduceOverPoints(jacobian, nc, points.size());
   // Jacobi scaling: rotations (radians), translations (metres), focal
   // lengths (pixels) and distortion differ by many orders of magnitude in
   // their information; the rank test and the inverse work on the scaled
   // system S' = D^-1/2 S D^-1/2 (D = diag S), whose diagonal is 1.
   Eigen::VectorXd d_inv_sqrt(nc);
-  for (int i = 0; i < nc; ++i) d_inv_sqrt(i) = Hcc(i, i) > 0 ? 1.0 / std::sqrt(Hcc(i, i)) : 0.0;
-  const Eigen::MatrixXd scaled = d_inv_sqrt.asDiagonal() * (0.5 * (Hcc + Hcc.transpose())) * d_inv_sqrt.asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaled);
-  const Eigen::VectorXd values = eig.eigenvalues();
-  if (nc == 0) throw NumericalError("covariance: no free parameters");
-  if (!(values(0) > 1e-12 * values(nc - 1))) {
-    Eigen::Index column;
-    eig.eigenvectors().col(0).cwiseAbs().maxCoeff(&column);
-    std::string name = "parameter " + std::to_string(column);
+  for (int i = 0; i < nc; ++i) {
+    const double d = schur.reduced.coeff(i, i);
+    d_inv_sqrt(i) = d > 0 ? 1.0 / std::sqrt(d) : 0.0;
+  }
+  const auto name_of = [&](Eigen::Index column) {
     for (const auto& [block, start] : offset) {
       const int size = problem->ParameterBlockTangentSize(block);
-      if (column >= start && column < start + size) name = describe(block, static_cast<int>(column) - start) + " [tangent " + std::to_string(column - start) + "]";
+      if (column >= start && column < start + size) {
+        return describe(block, static_cast<int>(column) - start) + " [tangent " + std::to_string(column - start) + "]";
+      }
     }
-    std::ostringstream ratio;
-    ratio << values(0) / values(nc - 1);
-    throw NumericalError("covariance: the views do not determine " + name +
-                         " (reduced system rank deficient: eigenvalue ratio " + ratio.str() +
-                         "); hold it fixed or add views");
+    return "parameter " + std::to_string(column);
+  };
+
+  // The wanted blocks' tangent coordinates, in order.
+  std::vector<int> wanted_tangent;
+  for (const double* block : wanted) {
+    const int start = offset.at(const_cast<double*>(block));
+    const int size = problem->ParameterBlockTangentSize(const_cast<double*>(block));
+    for (int k = 0; k < size; ++k) wanted_tangent.push_back(start + k);
   }
-  const Eigen::MatrixXd covariance = d_inv_sqrt.asDiagonal() * eig.eigenvectors() *
-                                     values.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose() *
-                                     d_inv_sqrt.asDiagonal();
+  // The rows of S^-1 at the wanted coordinates.
+  const Eigen::MatrixXd inverse_rows = nc <= max_dense_size
+      ? DenseInverseRows(schur.reduced, d_inv_sqrt, wanted_tangent, name_of)
+      : SparseInverseRows(schur.reduced, d_inv_sqrt, wanted_tangent, name_of);
 
   // Each wanted block's tangent covariance mapped to its ambient
   // coordinates by the manifold's plus Jacobian: C_ab = P_a C'_ab P_b^T.
   MarginalCovariance result;
   std::vector<Eigen::MatrixXd> plus;
-  int total = 0;
+  std::vector<int> tangent_row;  // each wanted block's first row in inverse_rows
+  int total = 0, tangent_total = 0;
   for (const double* block : wanted) {
     const int tangent = problem->ParameterBlockTangentSize(block);
     const int ambient = problem->ParameterBlockSize(block);
@@ -305,17 +389,19 @@ MarginalCovariance ComputeMarginalCovariance(
       p = J;
     }
     plus.push_back(p);
+    tangent_row.push_back(tangent_total);
+    tangent_total += tangent;
     result.offset[block] = total;
     result.size[block] = ambient;
     total += ambient;
   }
   result.covariance = Eigen::MatrixXd::Zero(total, total);
   for (size_t a = 0; a < wanted.size(); ++a) {
-    const int ta = offset.at(const_cast<double*>(wanted[a]));
     for (size_t b = 0; b < wanted.size(); ++b) {
       const int tb = offset.at(const_cast<double*>(wanted[b]));
       result.covariance.block(result.offset[wanted[a]], result.offset[wanted[b]], plus[a].rows(), plus[b].rows()) =
-          scale * scale * plus[a] * covariance.block(ta, tb, plus[a].cols(), plus[b].cols()) * plus[b].transpose();
+          scale * scale * plus[a] * inverse_rows.block(tangent_row[a], tb, plus[a].cols(), plus[b].cols()) *
+          plus[b].transpose();
     }
   }
   if (!clusters) return result;
@@ -327,15 +413,11 @@ MarginalCovariance ComputeMarginalCovariance(
   // sum of its residuals' effects.
   Eigen::MatrixXd gain(total, nc);
   for (size_t a = 0; a < wanted.size(); ++a) {
-    const int ta = offset.at(const_cast<double*>(wanted[a]));
-    gain.middleRows(result.offset[wanted[a]], plus[a].rows()) = plus[a] * covariance.middleRows(ta, plus[a].cols());
+    gain.middleRows(result.offset[wanted[a]], plus[a].rows()) =
+        plus[a] * inverse_rows.middleRows(tangent_row[a], plus[a].cols());
   }
-  std::vector<Eigen::Matrix<double, Eigen::Dynamic, 3>> point_gain(point_blocks.size());  // S^-1 H_cp H_pp^+
-  for (size_t p = 0; p < point_blocks.size(); ++p) {
-    Eigen::Matrix<double, Eigen::Dynamic, 3> through = Eigen::MatrixXd::Zero(total, 3);
-    for (const auto& [i, hi] : point_blocks[p].Hpc) through.noalias() += gain.col(i) * hi.transpose();
-    point_gain[p] = through * point_blocks[p].Hpp_pinv;
-  }
+  // S^-1 H_cp H_pp^+ for every point coordinate (total x 3 points).
+  const Eigen::MatrixXd point_gain = gain * schur.point_from_cameras.transpose();
   ClusterEffects effects(total, block_clusters);
   size_t block = 0;
   int block_start = 0;
@@ -348,7 +430,7 @@ MarginalCovariance ComputeMarginalCovariance(
       if (col < nc) {
         block_effect += gain.col(col) * value;
       } else {
-        block_effect -= point_gain[static_cast<size_t>((col - nc) / 3)].col((col - nc) % 3) * value;
+        block_effect -= point_gain.col(col - nc) * value;
       }
     }
     if (row + 1 == block_start + block_clusters[block].rows) {

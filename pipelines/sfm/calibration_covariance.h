@@ -1,11 +1,11 @@
 // Covariance of a bundle adjustment's calibration parameters with the 3-D
 // points marginalised out: the Schur complement of the Gauss-Newton
 // information matrix J'J on the non-point blocks (Triggs et al., "Bundle
-// adjustment -- a modern synthesis", 2000, sec. 6), inverted densely. Each
-// point's 3x3 block is pseudo-inverted, so a point whose depth the views do
-// not fix (nearly parallel rays) adds no information instead of making the
-// whole covariance rank deficient, as it does for Ceres' Covariance on the
-// full problem.
+// adjustment -- a modern synthesis", 2000, sec. 6). Each point's 3x3 block
+// is pseudo-inverted, so a point whose depth the views do not fix (nearly
+// parallel rays) adds no information instead of making the whole covariance
+// rank deficient, as it does for Ceres' Covariance on the full problem.
+// Only the rows of the inverse at the wanted parameters are formed.
 #pragma once
 
 #include <ceres/ceres.h>
@@ -72,10 +72,15 @@ struct ResidualClusters {
 // function (the clustered covariance weighs each block's gradient by the
 // loss's derivative, as the solve did). Throws NumericalError when the
 // reduced system is rank deficient, naming the parameter that dominates the
-// unobservable direction by `describe(block, tangent index)`.
+// unobservable direction by `describe(block, tangent index)`. The reduced
+// system is decomposed densely up to `max_dense_size` tangent parameters
+// (the rank test then finds the unobservable direction itself), beyond it
+// by a sparse LDL' factorisation (a survey of thousands of images: the
+// test names the parameter at the vanishing pivot).
 MarginalCovariance ComputeMarginalCovariance(
     ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others,
     const std::vector<const double*>& wanted, double scale,
-    const std::function<std::string(const double*, int)>& describe, const ResidualClusters* clusters = nullptr);
+    const std::function<std::string(const double*, int)>& describe, const ResidualClusters* clusters = nullptr,
+    int max_dense_size = 1200);
 
 }  // namespace portcal

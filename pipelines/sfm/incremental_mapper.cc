@@ -5,7 +5,6 @@
 #include <cmath>
 #include <set>
 #include <sstream>
-#include <tuple>
 
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/housing/flat_port.h"
@@ -13,6 +12,7 @@
 #include "colmap_ext/util/logging.h"
 #include "pipelines/sfm/bundle_costs.h"
 #include "pipelines/sfm/bundle_costs_fixed.h"
+#include "pipelines/sfm/initial_pair.h"
 #include "pipelines/calibration/view_pose.h"
 #include "pipelines/sfm/position_priors.h"
 #include "pipelines/sfm/ray_geometry.h"
@@ -212,30 +212,16 @@ std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
 }
 
 bool Mapper::Initialize(Reconstruction* r, std::set<image_pair_t>* tried, image_pair_t* start) {
-  // Most inlier matches first, but pairs whose geometry is a homography
-  // last: a relative pose from a plane seen twice is ambiguous (two
-  // decompositions), and a wrong start warps the model and sends the
-  // intrinsics astray (measured: focal length 16600 px for 650 on a render
-  // whose best pair saw one face of the target).
-  std::vector<std::tuple<bool, int, image_pair_t>> candidates;
-  for (const auto& [pair_id, count] : inputs_.pair_inliers) {
-    image_t a, b;
-    PairIdToImagePair(pair_id, &a, &b);
-    if (used_.count(a) || used_.count(b) || tried->count(pair_id)) continue;
-    if (count < options_.init_min_num_inliers) continue;
-    candidates.emplace_back(inputs_.planar_pairs.count(pair_id) == 0, count, pair_id);
-  }
-  std::sort(candidates.rbegin(), candidates.rend());
   int trials = 0;
-  for (const auto& [general, count, pair_id] : candidates) {
+  for (const image_pair_t pair_id : RankInitialPairs(inputs_, options_, used_, *tried)) {
     if (trials++ >= options_.init_max_num_trials) break;
     tried->insert(pair_id);
     image_t a, b;
     PairIdToImagePair(pair_id, &a, &b);
     if (TryInitialPair(r, a, b)) {
       LOG(INFO) << "refractive_mapper: initial pair '" << inputs_.images.at(a).name << "' + '"
-                << inputs_.images.at(b).name << "' (" << count << " inlier matches), " << r->points().size()
-                << " points";
+                << inputs_.images.at(b).name << "' (" << inputs_.pair_inliers.at(pair_id) << " inlier matches), "
+                << r->points().size() << " points";
       *start = pair_id;
       return true;
     }
@@ -244,89 +230,7 @@ bool Mapper::Initialize(Reconstruction* r, std::set<image_pair_t>* tried, image_
 }
 
 bool Mapper::TryInitialPair(Reconstruction* r, image_t a, image_t b) {
-  const SfmImage& image_a = inputs_.images.at(a);
-  std::vector<std::pair<point2D_t, point2D_t>> pairs;
-  std::vector<Eigen::Vector3d> dirs_a, dirs_b;
-  for (point2D_t k = 0; k < image_a.correspondences.size(); ++k) {
-    for (const Correspondence& c : image_a.correspondences[k]) {
-      if (c.image_id != b) continue;
-      const auto& ra = r->RayOf(a, k);
-      const auto& rb = r->RayOf(b, c.point2D_idx);
-      if (!ra || !rb) continue;
-      pairs.emplace_back(k, c.point2D_idx);
-      dirs_a.push_back(ra->direction);
-      dirs_b.push_back(rb->direction);
-    }
-  }
-  if (static_cast<int>(pairs.size()) < options_.init_min_num_inliers) return false;
-  std::vector<char> inliers;
-  const double angle = options_.init_max_error_px / std::min(FocalOf(a), FocalOf(b));
-  const auto b_from_a = EstimateRelativePose(dirs_a, dirs_b, angle, &inliers);
-  if (!b_from_a) return false;
-  const auto triangulate = [&](const Rigid3d& pose_b, std::vector<Eigen::Vector3d>* points,
-                               std::vector<double>* angles) {
-    points->assign(pairs.size(), Eigen::Vector3d::Constant(std::nan("")));
-    angles->clear();
-    for (size_t i = 0; i < pairs.size(); ++i) {
-      if (!inliers[i]) continue;
-      const std::vector<Ray3d> rays = {*r->RayOf(a, pairs[i].first),
-                                       RayInWorld(*r->RayOf(b, pairs[i].second), pose_b)};
-      const auto x = TriangulateRays(rays);
-      if (!x || (*x).z() <= 0 || (pose_b * *x).z() <= 0) continue;
-      (*points)[i] = *x;
-      angles->push_back(MaxTriangulationAngle(rays, *x));
-    }
-  };
-  std::vector<Eigen::Vector3d> points;
-  std::vector<double> angles;
-  Rigid3d pose_b = *b_from_a;
-  triangulate(pose_b, &points, &angles);
-  if (static_cast<int>(angles.size()) < options_.init_min_num_inliers) return false;
-  std::nth_element(angles.begin(), angles.begin() + angles.size() / 2, angles.end());
-  if (angles[angles.size() / 2] < options_.init_min_tri_angle_deg * kDegree) return false;
-  // Scale: the rays' origins are in metres, so the baseline must be too
-  // before the exact rays are triangulated again.
-  std::vector<double> depths;
-  for (const Eigen::Vector3d& x : points) {
-    if (x.allFinite()) depths.push_back(x.z());
-  }
-  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
-  pose_b.translation *= options_.init_scene_depth_m / depths[depths.size() / 2];
-  r->Register(a, Rigid3d());
-  r->Register(b, pose_b);
-  if (options_.marker_scale.side_length_m > 0) {
-    // Markers seen by both: their measured side against the known one.
-    const std::vector<MarkerCorner> corners = TriangulateMarkerCorners(*r, 1e9);
-    std::map<int, std::map<int, Eigen::Vector3d>> by_marker;
-    for (const MarkerCorner& c : corners) by_marker[c.marker_id][c.corner] = c.xyz;
-    std::vector<double> ratios;
-    for (const auto& [id, c] : by_marker) {
-      for (int k = 0; k < 4; ++k) {
-        if (c.count(k) && c.count((k + 1) % 4)) {
-          ratios.push_back(options_.marker_scale.side_length_m / (c.at(k) - c.at((k + 1) % 4)).norm());
-        }
-      }
-    }
-    if (!ratios.empty()) {
-      std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
-      pose_b.translation *= ratios[ratios.size() / 2];
-      r->Register(b, pose_b);
-    }
-  }
-  triangulate(pose_b, &points, &angles);
-  for (size_t i = 0; i < pairs.size(); ++i) {
-    if (!points[i].allFinite()) continue;
-    if (r->ReprojectionError(a, pairs[i].first, points[i]) > options_.init_max_error_px ||
-        r->ReprojectionError(b, pairs[i].second, points[i]) > options_.init_max_error_px) {
-      continue;
-    }
-    r->AddPoint(points[i], {{a, pairs[i].first}, {b, pairs[i].second}});
-  }
-  if (static_cast<int>(r->points().size()) < options_.init_min_num_inliers) {
-    r->Deregister(b);
-    r->Deregister(a);
-    return false;
-  }
+  if (!StartFromPair(options_, a, b, r)) return false;
   GlobalAdjust(r, false);
   Filter(r, nullptr);
   if (static_cast<int>(r->points().size()) < options_.init_min_num_inliers) {

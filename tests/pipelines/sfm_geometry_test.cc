@@ -296,8 +296,6 @@ TEST(CalibrationCovariance, MarginalMatchesTheFullCovariance) {
   ceres::Solve(options, &problem, &summary);
   std::vector<double*> points;
   for (auto& q : p) points.push_back(q.data());
-  const MarginalCovariance marginal = ComputeMarginalCovariance(
-      &problem, points, {&a, &b}, {&a, &b}, 1.0, [](const double*, int) { return std::string("?"); });
   ceres::Covariance::Options covariance_options;
   ceres::Covariance covariance(covariance_options);
   ASSERT_TRUE(covariance.Compute({{&a, &a}, {&b, &b}, {&a, &b}}, &problem));
@@ -305,13 +303,58 @@ TEST(CalibrationCovariance, MarginalMatchesTheFullCovariance) {
   covariance.GetCovarianceBlock(&a, &a, &va);
   covariance.GetCovarianceBlock(&b, &b, &vb);
   covariance.GetCovarianceBlock(&a, &b, &vab);
-  EXPECT_NEAR(marginal.StdDevs(&a)[0], std::sqrt(va), 1e-9);
-  EXPECT_NEAR(marginal.StdDevs(&b)[0], std::sqrt(vb), 1e-9);
-  // A line's slope and intercept, both fitted from x >= 0: negatively
-  // correlated.
-  EXPECT_LT(vab, 0);
-  EXPECT_NEAR(marginal.Correlation(&a, 0, &b, 0), vab / std::sqrt(va * vb), 1e-9);
-  EXPECT_NEAR(marginal.Correlation(&b, 0, &a, 0), marginal.Correlation(&a, 0, &b, 0), 1e-12);
+  // The dense decomposition (2 parameters <= 1200) and the sparse one.
+  for (const int max_dense_size : {1200, 0}) {
+    SCOPED_TRACE(max_dense_size == 0 ? "sparse" : "dense");
+    const MarginalCovariance marginal = ComputeMarginalCovariance(
+        &problem, points, {&a, &b}, {&a, &b}, 1.0, [](const double*, int) { return std::string("?"); }, nullptr,
+        max_dense_size);
+    EXPECT_NEAR(marginal.StdDevs(&a)[0], std::sqrt(va), 1e-9);
+    EXPECT_NEAR(marginal.StdDevs(&b)[0], std::sqrt(vb), 1e-9);
+    // A line's slope and intercept, both fitted from x >= 0: negatively
+    // correlated.
+    EXPECT_LT(vab, 0);
+    EXPECT_NEAR(marginal.Correlation(&a, 0, &b, 0), vab / std::sqrt(va * vb), 1e-9);
+    EXPECT_NEAR(marginal.Correlation(&b, 0, &a, 0), marginal.Correlation(&a, 0, &b, 0), 1e-12);
+  }
+}
+
+// Only a + b is seen: the reduced system is singular, and both
+// decompositions say so, naming a parameter of the unobservable direction,
+// instead of returning an enormous or NaN standard deviation.
+struct SumResidual {
+  explicit SumResidual(double y) : y_(y) {}
+  template <typename T>
+  bool operator()(const T* a, const T* b, const T* p, T* r) const {
+    r[0] = a[0] + b[0] + p[0] - T(y_);
+    r[1] = p[0] - T(0.1 * y_);
+    return true;
+  }
+  double y_;
+};
+
+TEST(CalibrationCovariance, UnobservableDirectionIsNamedByBothDecompositions) {
+  double a = 1, b = 0;
+  std::vector<std::array<double, 3>> p(10, {0, 0, 0});
+  ceres::Problem problem;
+  std::vector<double*> points;
+  for (int i = 0; i < 10; ++i) {
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SumResidual, 2, 1, 1, 3>(new SumResidual(i)), nullptr,
+                             &a, &b, p[i].data());
+    points.push_back(p[i].data());
+  }
+  const auto describe = [&](const double* block, int) { return std::string(block == &a ? "block a" : "block b"); };
+  for (const int max_dense_size : {1200, 0}) {
+    SCOPED_TRACE(max_dense_size == 0 ? "sparse" : "dense");
+    try {
+      ComputeMarginalCovariance(&problem, points, {&a, &b}, {&a, &b}, 1.0, describe, nullptr, max_dense_size);
+      ADD_FAILURE() << "a singular reduced system gave a covariance";
+    } catch (const NumericalError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("do not determine block"), std::string::npos) << message;
+      EXPECT_NE(message.find("hold it fixed or add views"), std::string::npos) << message;
+    }
+  }
 }
 
 // A sample of the line, y = a x + b + p[0] + c, seen in one cluster (c: the
@@ -423,20 +466,23 @@ TEST(CalibrationCovariance, ClusteredCovarianceSumsEachClustersExactEffect) {
   for (int k = 0; k < kImages; ++k) clusters.image_of_block[&offsets[k]] = k;
   clusters.residuals_per_dof = kResidualsPerDof;
   const auto describe = [](const double*, int) { return std::string("?"); };
-  for (const bool two : {true, false}) {
-    SCOPED_TRACE(two ? "two-way" : "by image");
-    clusters.by_track = two;
-    const MarginalCovariance marginal = ComputeMarginalCovariance(&problem, points, {&a, &b}, {&a, &b}, 1.0, describe, &clusters);
-    const Eigen::Matrix2d& expected = two ? two_way : by_image;
-    EXPECT_EQ(marginal.num_clusters, kImages);
-    EXPECT_EQ(marginal.num_tracks, two ? kSamples : 0);
-    ASSERT_EQ(marginal.clustered_covariance.rows(), 2);
-    for (int i = 0; i < 2; ++i) {
-      for (int j = 0; j < 2; ++j) {
-        EXPECT_NEAR(marginal.clustered_covariance(i, j), expected(i, j), 1e-6 * expected.norm()) << i << "," << j;
+  for (const int max_dense_size : {1200, 0}) {
+    for (const bool two : {true, false}) {
+      SCOPED_TRACE(std::string(two ? "two-way" : "by image") + (max_dense_size == 0 ? ", sparse" : ", dense"));
+      clusters.by_track = two;
+      const MarginalCovariance marginal =
+          ComputeMarginalCovariance(&problem, points, {&a, &b}, {&a, &b}, 1.0, describe, &clusters, max_dense_size);
+      const Eigen::Matrix2d& expected = two ? two_way : by_image;
+      EXPECT_EQ(marginal.num_clusters, kImages);
+      EXPECT_EQ(marginal.num_tracks, two ? kSamples : 0);
+      ASSERT_EQ(marginal.clustered_covariance.rows(), 2);
+      for (int i = 0; i < 2; ++i) {
+        for (int j = 0; j < 2; ++j) {
+          EXPECT_NEAR(marginal.clustered_covariance(i, j), expected(i, j), 1e-6 * expected.norm()) << i << "," << j;
+        }
       }
+      EXPECT_NEAR(marginal.ClusteredStdDevs(&a)[0], std::sqrt(expected(0, 0)), 1e-6 * std::sqrt(expected(0, 0)));
     }
-    EXPECT_NEAR(marginal.ClusteredStdDevs(&a)[0], std::sqrt(expected(0, 0)), 1e-6 * std::sqrt(expected(0, 0)));
   }
   // Without clusters there is no clustered covariance.
   const MarginalCovariance plain = ComputeMarginalCovariance(&problem, points, {&a, &b}, {&a, &b}, 1.0, describe);

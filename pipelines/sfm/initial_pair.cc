@@ -1,0 +1,130 @@
+#include "pipelines/sfm/initial_pair.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <tuple>
+
+#include "pipelines/sfm/bundle_adjustment.h"
+#include "pipelines/sfm/ray_geometry.h"
+
+namespace portcal {
+
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+}  // namespace
+
+std::vector<image_pair_t> RankInitialPairs(const SfmInputs& inputs, const IncrementalMapperOptions& options,
+                                           const std::set<image_t>& used, const std::set<image_pair_t>& tried) {
+  // Most inlier matches first, but pairs whose geometry is a homography
+  // last: a relative pose from a plane seen twice is ambiguous (two
+  // decompositions), and a wrong start warps the model and sends the
+  // intrinsics astray (measured: focal length 16600 px for 650 on a render
+  // whose best pair saw one face of the target).
+  std::vector<std::tuple<bool, int, image_pair_t>> candidates;
+  for (const auto& [pair_id, count] : inputs.pair_inliers) {
+    image_t a, b;
+    PairIdToImagePair(pair_id, &a, &b);
+    if (used.count(a) || used.count(b) || tried.count(pair_id)) continue;
+    if (count < options.init_min_num_inliers) continue;
+    candidates.emplace_back(inputs.planar_pairs.count(pair_id) == 0, count, pair_id);
+  }
+  std::sort(candidates.rbegin(), candidates.rend());
+  std::vector<image_pair_t> ranked;
+  for (const auto& candidate : candidates) ranked.push_back(std::get<2>(candidate));
+  return ranked;
+}
+
+bool StartFromPair(const IncrementalMapperOptions& options, image_t a, image_t b, Reconstruction* r) {
+  const auto focal_of = [&](image_t id) {
+    return r->cameras().at(r->inputs().images.at(id).camera_id).camera.MeanFocalLength();
+  };
+  const SfmImage& image_a = r->inputs().images.at(a);
+  std::vector<std::pair<point2D_t, point2D_t>> pairs;
+  std::vector<Eigen::Vector3d> dirs_a, dirs_b;
+  for (point2D_t k = 0; k < image_a.correspondences.size(); ++k) {
+    for (const Correspondence& c : image_a.correspondences[k]) {
+      if (c.image_id != b) continue;
+      const auto& ra = r->RayOf(a, k);
+      const auto& rb = r->RayOf(b, c.point2D_idx);
+      if (!ra || !rb) continue;
+      pairs.emplace_back(k, c.point2D_idx);
+      dirs_a.push_back(ra->direction);
+      dirs_b.push_back(rb->direction);
+    }
+  }
+  if (static_cast<int>(pairs.size()) < options.init_min_num_inliers) return false;
+  std::vector<char> inliers;
+  const double angle = options.init_max_error_px / std::min(focal_of(a), focal_of(b));
+  const auto b_from_a = EstimateRelativePose(dirs_a, dirs_b, angle, &inliers);
+  if (!b_from_a) return false;
+  const auto triangulate = [&](const Rigid3d& pose_b, std::vector<Eigen::Vector3d>* points,
+                               std::vector<double>* angles) {
+    points->assign(pairs.size(), Eigen::Vector3d::Constant(std::nan("")));
+    angles->clear();
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      if (!inliers[i]) continue;
+      const std::vector<Ray3d> rays = {*r->RayOf(a, pairs[i].first),
+                                       RayInWorld(*r->RayOf(b, pairs[i].second), pose_b)};
+      const auto x = TriangulateRays(rays);
+      if (!x || (*x).z() <= 0 || (pose_b * *x).z() <= 0) continue;
+      (*points)[i] = *x;
+      angles->push_back(MaxTriangulationAngle(rays, *x));
+    }
+  };
+  std::vector<Eigen::Vector3d> points;
+  std::vector<double> angles;
+  Rigid3d pose_b = *b_from_a;
+  triangulate(pose_b, &points, &angles);
+  if (static_cast<int>(angles.size()) < options.init_min_num_inliers) return false;
+  std::nth_element(angles.begin(), angles.begin() + angles.size() / 2, angles.end());
+  if (angles[angles.size() / 2] < options.init_min_tri_angle_deg * kDegree) return false;
+  // Scale: the rays' origins are in metres, so the baseline must be too
+  // before the exact rays are triangulated again.
+  std::vector<double> depths;
+  for (const Eigen::Vector3d& x : points) {
+    if (x.allFinite()) depths.push_back(x.z());
+  }
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  pose_b.translation *= options.init_scene_depth_m / depths[depths.size() / 2];
+  r->Register(a, Rigid3d());
+  r->Register(b, pose_b);
+  if (options.marker_scale.side_length_m > 0) {
+    // Markers seen by both: their measured side against the known one.
+    const std::vector<MarkerCorner> corners = TriangulateMarkerCorners(*r, 1e9);
+    std::map<int, std::map<int, Eigen::Vector3d>> by_marker;
+    for (const MarkerCorner& c : corners) by_marker[c.marker_id][c.corner] = c.xyz;
+    std::vector<double> ratios;
+    for (const auto& [id, c] : by_marker) {
+      for (int k = 0; k < 4; ++k) {
+        if (c.count(k) && c.count((k + 1) % 4)) {
+          ratios.push_back(options.marker_scale.side_length_m / (c.at(k) - c.at((k + 1) % 4)).norm());
+        }
+      }
+    }
+    if (!ratios.empty()) {
+      std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+      pose_b.translation *= ratios[ratios.size() / 2];
+      r->Register(b, pose_b);
+    }
+  }
+  triangulate(pose_b, &points, &angles);
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    if (!points[i].allFinite()) continue;
+    if (r->ReprojectionError(a, pairs[i].first, points[i]) > options.init_max_error_px ||
+        r->ReprojectionError(b, pairs[i].second, points[i]) > options.init_max_error_px) {
+      continue;
+    }
+    r->AddPoint(points[i], {{a, pairs[i].first}, {b, pairs[i].second}});
+  }
+  if (static_cast<int>(r->points().size()) < options.init_min_num_inliers) {
+    r->Deregister(b);
+    r->Deregister(a);
+    return false;
+  }
+  return true;
+}
+
+}  // namespace portcal
