@@ -1,6 +1,8 @@
 #include "pipelines/sfm/bundle_adjustment.h"
 
+#include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -117,6 +119,40 @@ struct DistanceError {
   }
   double length_, inv_sigma_;
 };
+
+// Beyond a thousand free poses the reduced camera system is factorised
+// sparsely only while it has at most this many 6x6 blocks (a survey's
+// images each see a few dozen neighbours: 5000 images x 40); more, it is
+// solved by preconditioned conjugate gradients.
+constexpr size_t kMaxSparseSchurBlocks = 200000;
+
+// The 6x6 blocks of the reduced camera system (the points eliminated): one
+// per free image and one per ordered pair of free images that see a common
+// point.
+size_t ReducedCameraSystemBlocks(const Reconstruction& reconstruction,
+                                 const std::map<point3D_t, Eigen::Vector3d>& point_blocks,
+                                 const std::function<bool(image_t)>& is_free) {
+  std::map<image_t, std::vector<image_t>> neighbours;
+  std::vector<image_t> track;
+  for (const auto& [point_id, xyz] : point_blocks) {
+    track.clear();
+    for (const TrackElement& e : reconstruction.points().at(point_id).track) {
+      if (is_free(e.image_id)) track.push_back(e.image_id);
+    }
+    for (const image_t a : track) {
+      std::vector<image_t>& of_a = neighbours[a];
+      for (const image_t b : track) {
+        if (b != a) of_a.push_back(b);
+      }
+    }
+  }
+  size_t blocks = 0;
+  for (auto& [image_id, of_image] : neighbours) {
+    std::sort(of_image.begin(), of_image.end());
+    blocks += 1 + static_cast<size_t>(std::unique(of_image.begin(), of_image.end()) - of_image.begin());
+  }
+  return blocks;
+}
 
 // The parameter indices of a camera that stay constant.
 std::vector<int> ConstantIntrinsics(const Camera& camera, const BundleAdjustmentOptions& o) {
@@ -373,18 +409,24 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
   // COLMAP's choice by the number of free poses: the reduced camera system
   // is small and dense for a few dozen images, sparse for a survey's
   // hundreds (each image sees its neighbours only), and beyond a thousand
-  // preconditioned conjugate gradients keep memory bounded. (On a
+  // preconditioned conjugate gradients keep memory bounded -- unless, as on
+  // a survey, the system stays sparse however many images there are. (On a
   // 120-image survey, one global adjustment at 114 images ran for over a
   // minute under iterative Schur; with sparse Schur the whole mapping took
   // 256 s.)
+  const auto free_pose = [&](image_t id) {
+    const auto it = pose_blocks.find(id);
+    return it != pose_blocks.end() && problem.HasParameterBlock(it->second.data()) &&
+           !problem.IsParameterBlockConstant(it->second.data());
+  };
   int num_free_poses = 0;
-  for (auto& [id, block] : pose_blocks) {
-    num_free_poses += problem.HasParameterBlock(block.data()) && !problem.IsParameterBlockConstant(block.data());
-  }
+  for (auto& [id, block] : pose_blocks) num_free_poses += free_pose(id);
   const bool sparse_available = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE);
   if (num_free_poses <= 50) {
     solver.linear_solver_type = ceres::DENSE_SCHUR;
-  } else if (num_free_poses <= 1000 && sparse_available) {
+  } else if (sparse_available &&
+             (num_free_poses <= 1000 ||
+              ReducedCameraSystemBlocks(*reconstruction, point_blocks, free_pose) <= kMaxSparseSchurBlocks)) {
     solver.linear_solver_type = ceres::SPARSE_SCHUR;
     solver.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
   } else {
