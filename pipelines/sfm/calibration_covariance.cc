@@ -361,24 +361,13 @@ MarginalCovariance ComputeMarginalCovariance(
     return "parameter " + std::to_string(column);
   };
 
-  // The wanted blocks' tangent coordinates, in order.
-  std::vector<int> wanted_tangent;
-  for (const double* block : wanted) {
-    const int start = offset.at(const_cast<double*>(block));
-    const int size = problem->ParameterBlockTangentSize(const_cast<double*>(block));
-    for (int k = 0; k < size; ++k) wanted_tangent.push_back(start + k);
-  }
-  // The rows of S^-1 at the wanted coordinates.
-  const Eigen::MatrixXd inverse_rows = nc <= max_dense_size
-      ? DenseInverseRows(schur.reduced, d_inv_sqrt, wanted_tangent, name_of)
-      : SparseInverseRows(schur.reduced, d_inv_sqrt, wanted_tangent, name_of);
-
-  // Each wanted block's tangent covariance mapped to its ambient
-  // coordinates by the manifold's plus Jacobian: C_ab = P_a C'_ab P_b^T.
+  // Each wanted block's plus Jacobian (tangent to ambient coordinates), its
+  // rows in the result, and its tangent coordinates in the reduced system.
   MarginalCovariance result;
   std::vector<Eigen::MatrixXd> plus;
-  std::vector<int> tangent_row;  // each wanted block's first row in inverse_rows
-  int total = 0, tangent_total = 0;
+  std::vector<int> wanted_tangent;  // in order; block a's start at tangent_row[a]
+  std::vector<int> tangent_row;
+  int total = 0;
   for (const double* block : wanted) {
     const int tangent = problem->ParameterBlockTangentSize(block);
     const int ambient = problem->ParameterBlockSize(block);
@@ -389,12 +378,20 @@ MarginalCovariance ComputeMarginalCovariance(
       p = J;
     }
     plus.push_back(p);
-    tangent_row.push_back(tangent_total);
-    tangent_total += tangent;
+    tangent_row.push_back(static_cast<int>(wanted_tangent.size()));
+    const int start = offset.at(const_cast<double*>(block));
+    for (int k = 0; k < tangent; ++k) wanted_tangent.push_back(start + k);
     result.offset[block] = total;
     result.size[block] = ambient;
     total += ambient;
   }
+  // The rows of S^-1 at the wanted coordinates.
+  const Eigen::MatrixXd inverse_rows = nc <= max_dense_size
+      ? DenseInverseRows(schur.reduced, d_inv_sqrt, wanted_tangent, name_of)
+      : SparseInverseRows(schur.reduced, d_inv_sqrt, wanted_tangent, name_of);
+
+  // Each wanted block's tangent covariance mapped to its ambient
+  // coordinates: C_ab = P_a C'_ab P_b^T.
   result.covariance = Eigen::MatrixXd::Zero(total, total);
   for (size_t a = 0; a < wanted.size(); ++a) {
     for (size_t b = 0; b < wanted.size(); ++b) {
