@@ -77,6 +77,7 @@ void AddBundleOptions(CommandLine* cli, BundleAdjustmentOptions* ba) {
            "virtual-camera error (1) or exact reprojection error (0)");
   cli->Add("BundleAdjustment.loss_scale", &ba->loss_scale, "Cauchy loss scale in pixels (0: none)");
   cli->Add("BundleAdjustment.max_num_iterations", &ba->max_num_iterations, "iterations");
+  cli->Add("BundleAdjustment.function_tolerance", &ba->function_tolerance, "relative cost change that ends the solve");
   cli->Add("num_threads", &ba->num_threads, "threads");
 }
 
