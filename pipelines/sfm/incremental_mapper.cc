@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -12,6 +13,7 @@
 #include "colmap_ext/util/logging.h"
 #include "pipelines/sfm/bundle_costs.h"
 #include "pipelines/sfm/bundle_costs_fixed.h"
+#include "pipelines/sfm/camera_change.h"
 #include "pipelines/sfm/initial_pair.h"
 #include "pipelines/calibration/view_pose.h"
 #include "pipelines/sfm/position_priors.h"
@@ -45,12 +47,20 @@ void IncrementalMapperOptions::Check() const {
     throw OptionError("--Mapper.ba_global_function_tolerance", std::to_string(ba_global_function_tolerance),
                       "in (0, 1)");
   }
+  if (!(ba_calibration_settled_px >= 0)) {
+    throw OptionError("--Mapper.ba_calibration_settled_px", std::to_string(ba_calibration_settled_px), ">= 0");
+  }
 }
 
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
 constexpr int kMinImagesForIntrinsics = 5;
+// Below this many images the intrinsics and housing are refined whenever the
+// model has grown by a third, however little they move: such adjustments
+// take seconds, and from a few dozen views the estimate still moves with
+// each image (the 25-view target sets).
+constexpr int kMinImagesToSettle = 50;
 
 bool BogusIntrinsics(const std::map<camera_t, SfmCamera>& before, const std::map<camera_t, SfmCamera>& after) {
   for (const auto& [id, camera] : after) {
@@ -98,6 +108,11 @@ class Mapper {
   // How many global adjustments that refined the intrinsics found them
   // implausible (and held them) in a row, up to the last one.
   int num_implausible_in_a_row_ = 0;
+  // How many global adjustments that refined the intrinsics or housing, on
+  // at least kMinImagesToSettle images, moved the image by less than
+  // ba_calibration_settled_px in a row, up to the last one.
+  int num_settled_in_a_row_ = 0;
+  bool CalibrationSettled() const { return options_.ba_calibration_settled_px > 0 && num_settled_in_a_row_ >= 2; }
   // Seconds spent per step, for the debug log.
   std::map<std::string, double> seconds_;
   template <typename F>
@@ -128,6 +143,7 @@ std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
     Reconstruction r(&inputs_, cameras_);
     port_converged_ = false;
     num_implausible_in_a_row_ = 0;
+    num_settled_in_a_row_ = 0;
     failed_.clear();
     seconds_.clear();  // per model
     image_pair_t start = 0;
@@ -162,8 +178,10 @@ std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
         if (r.poses().size() >= options_.ba_global_images_ratio * last_global) {
           // Intrinsics move the rays of every image (and need the exact,
           // slower error): refine them while the model is small and then
-          // whenever it has grown by a third.
-          const bool refine = r.poses().size() <= 8 || r.poses().size() >= 1.33 * last_refine;
+          // whenever it has grown by a third, until they have settled
+          // (IncrementalMapperOptions::ba_calibration_settled_px).
+          const bool refine =
+              (r.poses().size() <= 8 || r.poses().size() >= 1.33 * last_refine) && !CalibrationSettled();
           Timed("global", [&] { GlobalAdjust(&r, refine); return 0; });
           if (refine) last_refine = r.poses().size();
           last_global = r.poses().size();
@@ -248,15 +266,7 @@ std::vector<image_t> Mapper::NextImages(const Reconstruction& r) const {
   std::vector<std::pair<int, image_t>> ranked;
   for (const auto& [id, image] : inputs_.images) {
     if (r.IsRegistered(id) || used_.count(id) || failed_.count(id)) continue;
-    int visible = 0;
-    for (point2D_t k = 0; k < image.correspondences.size(); ++k) {
-      for (const Correspondence& c : image.correspondences[k]) {
-        if (r.PointOf(c.image_id, c.point2D_idx) != kInvalidPoint3DId) {
-          ++visible;
-          break;
-        }
-      }
-    }
+    const int visible = r.NumVisiblePoints(id);
     if (visible >= options_.abs_pose_min_num_inliers) ranked.emplace_back(visible, id);
   }
   std::sort(ranked.rbegin(), ranked.rend());
@@ -520,6 +530,21 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   }
   if (ba.refine_housing && summary.termination_type == ceres::CONVERGENCE) {
     port_converged_ = CameraWithHousingAtBound(r->cameras()) == kInvalidCameraId;
+  }
+  const bool refined = !implausible && (ba.refine_housing || ba.refine_focal_length ||
+                                        ba.refine_principal_point || ba.refine_extra_params);
+  if (refined && static_cast<int>(r->poses().size()) >= kMinImagesToSettle) {
+    const double depth = MedianSceneDepth(*r);
+    double shift = std::numeric_limits<double>::infinity();
+    if (depth > 0 && summary.termination_type == ceres::CONVERGENCE) {
+      shift = 0;
+      for (const auto& [id, camera] : r->cameras()) {
+        shift = std::max(shift, MaxImageShiftPx(cameras_before.at(id), camera, depth));
+      }
+    }
+    num_settled_in_a_row_ = shift < options_.ba_calibration_settled_px ? num_settled_in_a_row_ + 1 : 0;
+    VLOG(1) << "refractive_mapper: the refinement on " << r->poses().size() << " images moved the image by up to "
+            << shift << " px at the median depth " << depth << (CalibrationSettled() ? " (settled)" : "");
   }
   if (VLOG_IS_ON(1) && (ba.refine_housing || ba.refine_focal_length)) {
     std::ostringstream values;

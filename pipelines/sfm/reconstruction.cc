@@ -103,8 +103,22 @@ Eigen::Vector3d VirtualCenterOf(const SfmCamera& camera, const Ray3d& ray) {
 
 Reconstruction::Reconstruction(const SfmInputs* inputs, std::map<camera_t, SfmCamera> cameras)
     : inputs_(inputs), cameras_(std::move(cameras)) {
+  for (const auto& [id, image] : inputs_->images) {
+    num_observing_correspondences_[id].assign(image.keypoints.size(), 0);
+    num_visible_points_[id] = 0;
+  }
   UpdateRays();
 }
+
+void Reconstruction::UpdateVisibility(image_t image_id, point2D_t idx, int change) {
+  for (const Correspondence& c : inputs_->images.at(image_id).correspondences[idx]) {
+    int& count = num_observing_correspondences_.at(c.image_id)[c.point2D_idx];
+    if (change > 0 && count++ == 0) ++num_visible_points_.at(c.image_id);
+    if (change < 0 && --count == 0) --num_visible_points_.at(c.image_id);
+  }
+}
+
+int Reconstruction::NumVisiblePoints(image_t image_id) const { return num_visible_points_.at(image_id); }
 
 void Reconstruction::UpdateRays() {
   std::vector<const SfmImage*> images;
@@ -156,6 +170,7 @@ void Reconstruction::AddObservation(point3D_t id, const TrackElement& element) {
   PORTCAL_CHECK(slot == kInvalidPoint3DId);
   slot = id;
   points_.at(id).track.push_back(element);
+  UpdateVisibility(element.image_id, element.point2D_idx, +1);
 }
 
 void Reconstruction::DeleteObservation(image_t image_id, point2D_t idx) {
@@ -163,6 +178,7 @@ void Reconstruction::DeleteObservation(image_t image_id, point2D_t idx) {
   if (slot == kInvalidPoint3DId) return;
   const point3D_t id = slot;
   slot = kInvalidPoint3DId;
+  UpdateVisibility(image_id, idx, -1);
   SfmPoint& point = points_.at(id);
   for (size_t t = 0; t < point.track.size(); ++t) {
     if (point.track[t].image_id == image_id && point.track[t].point2D_idx == idx) {
@@ -176,7 +192,10 @@ void Reconstruction::DeleteObservation(image_t image_id, point2D_t idx) {
 void Reconstruction::DeletePoint(point3D_t id) {
   const auto it = points_.find(id);
   if (it == points_.end()) return;
-  for (const TrackElement& e : it->second.track) point_of_.at(e.image_id).at(e.point2D_idx) = kInvalidPoint3DId;
+  for (const TrackElement& e : it->second.track) {
+    point_of_.at(e.image_id).at(e.point2D_idx) = kInvalidPoint3DId;
+    UpdateVisibility(e.image_id, e.point2D_idx, -1);
+  }
   points_.erase(it);
 }
 

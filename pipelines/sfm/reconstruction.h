@@ -10,6 +10,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "colmap_ext/housing/housing.h"
@@ -91,6 +92,12 @@ class Reconstruction {
   void DeletePoint(point3D_t id);
   // Number of the image's keypoints that observe a point.
   int NumObservations(image_t image_id) const;
+  // Number of the image's keypoints with a correspondence that observes a
+  // point of the model: how many 2-D--3-D links registering it would find
+  // (COLMAP's num_visible_points3D). Kept up to date as observations come
+  // and go, so ranking the next images costs O(images), not a walk over
+  // every unregistered image's correspondences.
+  int NumVisiblePoints(image_t image_id) const;
 
   // Camera and housing of an image (the inputs' unless refined here).
   const SfmCamera& CameraOf(image_t image_id) const;
@@ -121,6 +128,13 @@ class Reconstruction {
   std::map<image_t, std::vector<point3D_t>> point_of_;
   std::map<image_t, std::vector<std::optional<Ray3d>>> rays_;  // per registered image, per keypoint
   point3D_t next_point_id_ = 1;
+  // Per image (all of the inputs'), per keypoint: how many of its
+  // correspondences observe a point; and per image, how many of its
+  // keypoints have at least one.
+  std::unordered_map<image_t, std::vector<int>> num_observing_correspondences_;
+  std::unordered_map<image_t, int> num_visible_points_;
+  // A keypoint started (+1) or stopped (-1) observing a point.
+  void UpdateVisibility(image_t image_id, point2D_t idx, int change);
 };
 
 }  // namespace portcal
