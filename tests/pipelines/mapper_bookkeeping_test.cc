@@ -31,8 +31,9 @@ int VisiblePointsByWalk(const Reconstruction& r, image_t image_id) {
 }
 
 TEST(Reconstruction, VisiblePointCountsFollowEveryObservationChange) {
-  // Six images of 40 keypoints; each keypoint matched to a keypoint of up to
-  // three other images (so a keypoint can see a point through several).
+  // Six images of 40 keypoints and 300 random matches between them: a
+  // keypoint has 2.5 correspondences on average, so it can see a point
+  // through several, and lose one of them without losing sight.
   std::mt19937 rng(7);
   SfmInputs inputs;
   inputs.cameras[1].camera = Camera::FromModelName("SIMPLE_PINHOLE", 500, 640, 480);
