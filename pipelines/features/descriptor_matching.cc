@@ -43,52 +43,10 @@ UnitDescriptors ToUnitDescriptors(const FeatureDescriptors& descriptors) {
 
 namespace {
 
-struct Nearest {
-  int index = -1;
-  float best = -2, second = -2;  // dot products (larger is closer)
-};
-
-void NearestBruteForce(const UnitDescriptors& descriptors1, const UnitDescriptors& descriptors2,
-                       std::vector<Nearest>* nearest1, std::vector<Nearest>* nearest2) {
-  const Eigen::Index n1 = descriptors1.rows(), n2 = descriptors2.rows();
-  // Dot products in blocks of rows so that memory stays bounded for large
-  // feature counts; columns' best rows are tracked for the cross check.
-  // The scan walks each column down (Eigen stores them contiguously; a
-  // block's 1024 row entries stay in cache), visiting rows and columns in
-  // the same increasing order as a row-wise scan, so ties resolve alike.
-  constexpr Eigen::Index kBlock = 1024;
-  Eigen::MatrixXf dots;
-  for (Eigen::Index start = 0; start < n1; start += kBlock) {
-    const Eigen::Index rows = std::min(kBlock, n1 - start);
-    dots.noalias() = descriptors1.middleRows(start, rows) * descriptors2.transpose();
-    for (Eigen::Index c = 0; c < n2; ++c) {
-      Nearest& b = (*nearest2)[static_cast<size_t>(c)];
-      for (Eigen::Index r = 0; r < rows; ++r) {
-        Nearest& a = (*nearest1)[static_cast<size_t>(start + r)];
-        const float d = dots(r, c);
-        if (d > a.best) {
-          a.second = a.best;
-          a.best = d;
-          a.index = static_cast<int>(c);
-        } else if (d > a.second) {
-          a.second = d;
-        }
-        if (d > b.best) {
-          b.second = b.best;
-          b.best = d;
-          b.index = static_cast<int>(start + r);
-        } else if (d > b.second) {
-          b.second = d;
-        }
-      }
-    }
-  }
-}
-
 // The two nearest rows of `data` for each row of `queries`, by k-d trees.
 // FLANN's L2 distances are squared; for unit vectors dot = 1 - d^2 / 2.
 void NearestKdTree(const UnitDescriptors& data, const UnitDescriptors& queries,
-                   const DescriptorMatchingOptions& options, std::vector<Nearest>* nearest) {
+                   const DescriptorMatchingOptions& options, std::vector<NearestDescriptors>* nearest) {
   const cv::Mat data_mat(static_cast<int>(data.rows()), 128, CV_32F, const_cast<float*>(data.data()));
   const cv::Mat query_mat(static_cast<int>(queries.rows()), 128, CV_32F, const_cast<float*>(queries.data()));
   const int k = data.rows() > 1 ? 2 : 1;
@@ -96,7 +54,7 @@ void NearestKdTree(const UnitDescriptors& data, const UnitDescriptors& queries,
   cv::Mat indices, distances;
   index.knnSearch(query_mat, indices, distances, k, cv::flann::SearchParams(options.kdtree_num_checks));
   for (int q = 0; q < query_mat.rows; ++q) {
-    Nearest& n = (*nearest)[static_cast<size_t>(q)];
+    NearestDescriptors& n = (*nearest)[static_cast<size_t>(q)];
     n.index = indices.at<int>(q, 0);
     if (n.index < 0) continue;
     n.best = 1.0f - 0.5f * distances.at<float>(q, 0);
@@ -112,17 +70,18 @@ FeatureMatches MatchDescriptors(const UnitDescriptors& descriptors1,
   const Eigen::Index n1 = descriptors1.rows(), n2 = descriptors2.rows();
   FeatureMatches matches;
   if (n1 == 0 || n2 == 0) return matches;
-  std::vector<Nearest> nearest1(static_cast<size_t>(n1));
-  std::vector<Nearest> nearest2(static_cast<size_t>(n2));
+  std::vector<NearestDescriptors> nearest1, nearest2;
   if (options.method == "kdtree") {
+    nearest1.resize(static_cast<size_t>(n1));
+    nearest2.resize(static_cast<size_t>(n2));
     NearestKdTree(descriptors2, descriptors1, options, &nearest1);
     if (options.cross_check) NearestKdTree(descriptors1, descriptors2, options, &nearest2);
   } else {
-    NearestBruteForce(descriptors1, descriptors2, &nearest1, &nearest2);
+    FindNearestDescriptors(descriptors1, descriptors2, &nearest1, &nearest2);
   }
   const auto angle = [](float dot) { return std::acos(std::min(1.0f, std::max(-1.0f, dot))); };
   for (Eigen::Index i = 0; i < n1; ++i) {
-    const Nearest& a = nearest1[static_cast<size_t>(i)];
+    const NearestDescriptors& a = nearest1[static_cast<size_t>(i)];
     if (a.index < 0) continue;
     const float best = angle(a.best);
     if (best > options.max_distance) continue;
@@ -130,7 +89,7 @@ FeatureMatches MatchDescriptors(const UnitDescriptors& descriptors1,
     if (n2 > 1 && best >= options.max_ratio * angle(a.second)) continue;
     if (options.cross_check) {
       // COLMAP's cross check: the reverse match passes the same tests.
-      const Nearest& b = nearest2[static_cast<size_t>(a.index)];
+      const NearestDescriptors& b = nearest2[static_cast<size_t>(a.index)];
       if (b.index != i) continue;
       if (n1 > 1 && angle(b.best) >= options.max_ratio * angle(b.second)) continue;
     }

@@ -3,19 +3,21 @@
 // a match needs angle <= max_distance, best < max_ratio x second best
 // (Lowe's ratio test) and, with cross_check, to be mutual.
 //
-// Brute force compares every pair of descriptors (COLMAP's CPU matcher);
+// Brute force compares every pair of descriptors (COLMAP's CPU matcher;
+// nearest_descriptors.h);
 // "kdtree" finds the two nearest neighbours by FLANN's randomized k-d trees
 // (Muja and Lowe, "Fast approximate nearest neighbors with automatic
 // algorithm configuration", VISAPP 2009). At 128 dimensions and ~4500
 // features per image the trees gain little (measured on two survey images:
-// 0.16 s at 32 checks, 99 % of the matches, against 0.24 s brute force;
-// slower from 64 checks on), so brute force is the default
-// (docs/auto_calibration.md).
+// 0.16 s at 32 checks, 99 % of the matches, against 0.24 s brute force
+// before its AVX2 kernel, ~0.05 s since; slower from 64 checks on), so
+// brute force is the default (docs/auto_calibration.md).
 #pragma once
 
 #include <string>
 
 #include "database/feature_types.h"
+#include "pipelines/features/nearest_descriptors.h"
 
 namespace portcal {
 
@@ -31,7 +33,7 @@ struct DescriptorMatchingOptions {
 };
 
 // Descriptors as unit float rows (uint8 / 512, renormalised).
-using UnitDescriptors = Eigen::Matrix<float, Eigen::Dynamic, 128, Eigen::RowMajor>;
+using UnitDescriptors = UnitDescriptorRows;
 UnitDescriptors ToUnitDescriptors(const FeatureDescriptors& descriptors);
 
 FeatureMatches MatchDescriptors(const UnitDescriptors& descriptors1,

@@ -65,16 +65,26 @@ TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& key
   std::vector<int> all(matches.size());
   for (size_t m = 0; m < all.size(); ++m) all[m] = static_cast<int>(m);
 
-  // F first, by RANSAC over all matches. E and H are then searched among
-  // F's inliers only: both models' inliers satisfy the epipolar constraint,
-  // so this loses nothing COLMAP's rules use (they compare the counts), and
-  // RANSAC on a clean set needs few iterations where the 5-point solver on
-  // the raw matches would need thousands.
+  // F first, by LO-RANSAC over all matches (two_view_verification.h). E
+  // and H are then searched among F's inliers only: both models' inliers
+  // satisfy the epipolar constraint, so this loses nothing COLMAP's rules
+  // use (they compare the counts), and RANSAC on a clean set needs few
+  // iterations where the 5-point solver on the raw matches would need
+  // thousands.
   cv::Mat f_mask, e_mask, h_mask;
-  const cv::Mat F = cv::findFundamentalMat(pixels1, pixels2, cv::FM_RANSAC, options.max_error,
+  const cv::Mat F = cv::findFundamentalMat(pixels1, pixels2, cv::USAC_DEFAULT, options.max_error,
                                            options.confidence, options.max_num_trials, f_mask);
   const FeatureMatches f_inliers = F.rows == 3 ? Inliers(matches, all, f_mask) : FeatureMatches();
-  if (static_cast<int>(f_inliers.size()) < options.min_num_inliers) return geometry;
+  // E's inliers are a subset of F's, so with fewer than the minimum here
+  // neither model can pass COLMAP's rules below: the pair is degenerate
+  // whatever E and H say, and their RANSAC (up to max_num_trials each on a
+  // pair of unrelated images) is skipped.
+  const double min_inliers = std::max<double>(options.min_num_inliers,
+                                              options.min_inlier_ratio * matches.size());
+  if (static_cast<double>(f_inliers.size()) < min_inliers) {
+    if (F.rows == 3) cv::cv2eigen(F, geometry.F);
+    return geometry;
+  }
   std::vector<int> f_index;  // match indices of F's inliers
   std::vector<cv::Point2d> f_pixels1, f_pixels2;
   for (size_t k = 0; k < all.size(); ++k) {
@@ -105,8 +115,6 @@ TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& key
   const double nf = static_cast<double>(f_inliers.size());
   const double ne = static_cast<double>(e_inliers.size());
   const double nh = static_cast<double>(h_inliers.size());
-  const double min_inliers = std::max<double>(options.min_num_inliers,
-                                              options.min_inlier_ratio * matches.size());
 
   if (F.rows == 3) cv::cv2eigen(F, geometry.F);
   if (E.rows == 3) cv::cv2eigen(E, geometry.E);
