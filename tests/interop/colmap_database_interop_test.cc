@@ -8,6 +8,7 @@
 //    mapper, which recovers the true camera centres.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <Eigen/Geometry>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -127,7 +128,10 @@ TEST(ColmapDatabaseInterop, SchemaIsCharacterForCharacterCOLMAPs) {
 
 // The database is created by portcal (true) or by colmap itself (false);
 // colmap fills and reconstructs it; portcal reads it all.
-class ColmapFillsDatabase : public ::testing::TestWithParam<bool> {};
+class ColmapFillsDatabase : public ::testing::TestWithParam<bool> {
+ protected:
+  static constexpr double kColmapMaxErrorPx = 4.0;  // colmap 3.8's default
+};
 
 TEST_P(ColmapFillsDatabase, PortcalReadsEverythingColmapWrote) {
   PORTCAL_REQUIRE_COLMAP(colmap);
@@ -167,8 +171,12 @@ TEST_P(ColmapFillsDatabase, PortcalReadsEverythingColmapWrote) {
       }
     }
     EXPECT_GT(db.NumMatchedImagePairs(), 5);
-    // The verified geometries read back as COLMAP meant them: inlier matches
-    // satisfy the stored fundamental matrix (Sampson distance, px).
+    // The verified geometries read back as COLMAP meant them: every inlier of
+    // an F-verified pair lies within colmap's inlier threshold
+    // (--SiftMatching.max_error, 4 px of Sampson distance) of the stored F.
+    // The median is no test: colmap's RANSAC is seeded by the clock, and its
+    // F's median distance ranged 0.04-1.05 px over runs, while F read
+    // transposed gave medians from 2.1 px but maxima of 11.6 px and more.
     int num_checked = 0;
     for (const auto& [pair_id, geometry] : db.ReadTwoViewGeometries()) {
       if (geometry.inlier_matches.empty()) continue;
@@ -192,8 +200,8 @@ TEST_P(ColmapFillsDatabase, PortcalReadsEverythingColmapWrote) {
         sampson.push_back(std::sqrt(e * e / (Fx1.head<2>().squaredNorm() +
                                              Ftx2.head<2>().squaredNorm())));
       }
-      std::nth_element(sampson.begin(), sampson.begin() + sampson.size() / 2, sampson.end());
-      EXPECT_LT(sampson[sampson.size() / 2], 1.0) << "pair " << id1 << "/" << id2;
+      EXPECT_LT(*std::max_element(sampson.begin(), sampson.end()), kColmapMaxErrorPx)
+          << "pair " << id1 << "/" << id2;
       ++num_checked;
     }
     EXPECT_GT(num_checked, 3);
