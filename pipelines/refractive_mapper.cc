@@ -85,7 +85,7 @@ RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& optio
   std::map<camera_t, SfmCamera> cameras = inputs.cameras;
   ApplyHousingOverride(options.housing, &cameras);
   InitializeFocalFromMarkers(inputs, options.init_focal_from_markers, &cameras);
-  const std::vector<Reconstruction> models = RunIncrementalMapper(inputs, cameras, options.mapper, progress);
+  const std::vector<MappedModel> models = RunIncrementalMapper(inputs, cameras, options.mapper, progress);
   if (models.empty()) {
     throw NumericalError("refractive_mapper: no model could be initialised from " +
                          std::to_string(inputs.pair_inliers.size()) +
@@ -96,9 +96,18 @@ RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& optio
   summary.num_images = static_cast<int>(inputs.images.size());
   for (size_t m = 0; m < models.size(); ++m) {
     const fs::path dir = fs::path(options.output_path) / std::to_string(m);
-    WriteSparseModel(models[m].ToSparseModel(), dir, ModelFormat::kBinary);
+    WriteSparseModel(models[m].reconstruction.ToSparseModel(), dir, ModelFormat::kBinary);
     summary.model_paths.push_back(dir);
-    summary.num_registered += static_cast<int>(models[m].poses().size());
+    summary.num_registered += static_cast<int>(models[m].reconstruction.poses().size());
+    const auto& refinements = models[m].calibration_refinements;
+    const auto held = std::find_if(refinements.begin(), refinements.end(),
+                                   [](const CalibrationRefinement& c) { return c.settled; });
+    summary.calibration_refinements.push_back(refinements);
+    if (held != refinements.end()) {
+      LOG(INFO) << "refractive_mapper: model " << m << ": intrinsics and housing held from " << held->num_images
+                << " images on (moved the image by " << held->image_shift_px
+                << " px at the last refinement), refined again at the end";
+    }
   }
   summary.num_models = static_cast<int>(models.size());
   LOG(INFO) << "refractive_mapper: " << summary.num_models << " model(s), " << summary.num_registered << " of "

@@ -35,6 +35,8 @@ struct RefractiveMapperSummary {
   int num_registered = 0;  // over all models
   int num_images = 0;
   std::vector<std::filesystem::path> model_paths;
+  // Per model: its global adjustments that refined the intrinsics or housing.
+  std::vector<std::vector<CalibrationRefinement>> calibration_refinements;
 };
 
 // Sets the housing of every camera when `override.model` is given.

@@ -31,8 +31,11 @@ static void AddMapperOptions(CommandLine* cli, IncrementalMapperOptions* o) {
   cli->Add("Mapper.ba_global_function_tolerance", &o->ba_global_function_tolerance,
            "a global adjustment ends when an iteration lowers the cost by less than this fraction");
   cli->Add("Mapper.ba_calibration_settled_px", &o->ba_calibration_settled_px,
-           "hold intrinsics and housing until the final adjustment once two refinements in a row (from 50 "
-           "images on) moved the image by less than this, pixels (0: refine to the end)");
+           "hold intrinsics and housing until the final adjustment once two refinements in a row (from "
+           "--Mapper.ba_calibration_settled_min_images on) moved the image by less than this, pixels (0: refine "
+           "to the end)");
+  cli->Add("Mapper.ba_calibration_settled_min_images", &o->ba_calibration_settled_min_images,
+           "images a model needs before its calibration may be held");
   cli->Add("Mapper.multiple_models", &o->multiple_models, "0 | 1");
   cli->Add("Mapper.max_num_models", &o->max_num_models, "models at most");
   cli->Add("Mapper.min_model_size", &o->min_model_size, "images a model needs to be kept");

@@ -50,18 +50,16 @@ void IncrementalMapperOptions::Check() const {
   if (!(ba_calibration_settled_px >= 0)) {
     throw OptionError("--Mapper.ba_calibration_settled_px", std::to_string(ba_calibration_settled_px), ">= 0");
   }
+  if (ba_calibration_settled_min_images < 2) {
+    throw OptionError("--Mapper.ba_calibration_settled_min_images",
+                      std::to_string(ba_calibration_settled_min_images), ">= 2");
+  }
 }
 
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
 constexpr int kMinImagesForIntrinsics = 5;
-// Below this many images the intrinsics and housing are refined whenever the
-// model has grown by a third, however little they move: such adjustments
-// take seconds, and from a few dozen views the estimate still moves with
-// each image (the 25-view target sets).
-constexpr int kMinImagesToSettle = 50;
-
 bool BogusIntrinsics(const std::map<camera_t, SfmCamera>& before, const std::map<camera_t, SfmCamera>& after) {
   for (const auto& [id, camera] : after) {
     if (ImplausibleIntrinsics(before.at(id).camera, camera.camera)) return true;
@@ -81,7 +79,7 @@ class Mapper {
          const IncrementalMapperOptions& options)
       : inputs_(inputs), cameras_(cameras), options_(options) {}
 
-  std::vector<Reconstruction> Run(ProgressSink& progress);
+  std::vector<MappedModel> Run(ProgressSink& progress);
 
  private:
   double FocalOf(image_t image_id) const {
@@ -109,9 +107,10 @@ class Mapper {
   // implausible (and held them) in a row, up to the last one.
   int num_implausible_in_a_row_ = 0;
   // How many global adjustments that refined the intrinsics or housing, on
-  // at least kMinImagesToSettle images, moved the image by less than
-  // ba_calibration_settled_px in a row, up to the last one.
+  // at least ba_calibration_settled_min_images images, moved the image by
+  // less than ba_calibration_settled_px in a row, up to the last one.
   int num_settled_in_a_row_ = 0;
+  std::vector<CalibrationRefinement> refinements_;  // of the current model
   bool CalibrationSettled() const { return options_.ba_calibration_settled_px > 0 && num_settled_in_a_row_ >= 2; }
   // Seconds spent per step, for the debug log.
   std::map<std::string, double> seconds_;
@@ -128,8 +127,8 @@ class Mapper {
   }
 };
 
-std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
-  std::vector<Reconstruction> models;
+std::vector<MappedModel> Mapper::Run(ProgressSink& progress) {
+  std::vector<MappedModel> models;
   std::set<image_pair_t> tried;
   progress.Begin("refractive_mapper: images registered", inputs_.images.size());
   // Initial pairs of the current model whose growth was abandoned because
@@ -144,6 +143,7 @@ std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
     port_converged_ = false;
     num_implausible_in_a_row_ = 0;
     num_settled_in_a_row_ = 0;
+    refinements_.clear();
     failed_.clear();
     seconds_.clear();  // per model
     image_pair_t start = 0;
@@ -218,13 +218,13 @@ std::vector<Reconstruction> Mapper::Run(ProgressSink& progress) {
             << seconds_["global"];
     const bool keep = static_cast<int>(r.poses().size()) >= options_.min_model_size;
     for (const auto& [id, pose] : r.poses()) used_.insert(id);
-    if (keep) models.push_back(std::move(r));
+    if (keep) models.push_back(MappedModel{std::move(r), std::move(refinements_)});
     if (!options_.multiple_models) break;
     if (inputs_.images.size() - used_.size() < 2) break;
   }
   progress.End();
-  std::stable_sort(models.begin(), models.end(), [](const Reconstruction& a, const Reconstruction& b) {
-    return a.poses().size() > b.poses().size();
+  std::stable_sort(models.begin(), models.end(), [](const MappedModel& a, const MappedModel& b) {
+    return a.reconstruction.poses().size() > b.reconstruction.poses().size();
   });
   return models;
 }
@@ -533,9 +533,10 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   }
   const bool refined = !implausible && (ba.refine_housing || ba.refine_focal_length ||
                                         ba.refine_principal_point || ba.refine_extra_params);
-  if (refined && static_cast<int>(r->poses().size()) >= kMinImagesToSettle) {
+  if (refined) refinements_.push_back({static_cast<int>(r->poses().size()), std::numeric_limits<double>::infinity()});
+  if (refined && static_cast<int>(r->poses().size()) >= options_.ba_calibration_settled_min_images) {
     const double depth = MedianSceneDepth(*r);
-    double shift = std::numeric_limits<double>::infinity();
+    double& shift = refinements_.back().image_shift_px;
     if (depth > 0 && summary.termination_type == ceres::CONVERGENCE) {
       shift = 0;
       for (const auto& [id, camera] : r->cameras()) {
@@ -543,6 +544,7 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
       }
     }
     num_settled_in_a_row_ = shift < options_.ba_calibration_settled_px ? num_settled_in_a_row_ + 1 : 0;
+    refinements_.back().settled = CalibrationSettled();
     VLOG(1) << "refractive_mapper: the refinement on " << r->poses().size() << " images moved the image by up to "
             << shift << " px at the median depth " << depth << (CalibrationSettled() ? " (settled)" : "");
   }
@@ -563,10 +565,9 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
 
 }  // namespace
 
-std::vector<Reconstruction> RunIncrementalMapper(const SfmInputs& inputs,
-                                                 const std::map<camera_t, SfmCamera>& cameras,
-                                                 const IncrementalMapperOptions& options,
-                                                 ProgressSink& progress) {
+std::vector<MappedModel> RunIncrementalMapper(const SfmInputs& inputs,
+                                              const std::map<camera_t, SfmCamera>& cameras,
+                                              const IncrementalMapperOptions& options, ProgressSink& progress) {
   options.Check();
   Mapper mapper(inputs, cameras, options);
   return mapper.Run(progress);

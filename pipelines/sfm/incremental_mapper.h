@@ -68,6 +68,11 @@ struct IncrementalMapperOptions {
   // port, docs/benchmarks.md). Below the keypoints' noise (~0.2 px there),
   // the held calibration bends no structure. 0: refine to the end.
   double ba_calibration_settled_px = 0.25;
+  // Below this many images the calibration is refined whenever the model
+  // has grown by a third, however little it moves: such adjustments take
+  // seconds, and from a few dozen views the estimate still moves with each
+  // image (the 25-view target sets).
+  int ba_calibration_settled_min_images = 50;
   bool multiple_models = true;
   int max_num_models = 50;
   int min_model_size = 3;
@@ -80,10 +85,25 @@ struct IncrementalMapperOptions {
   void Check() const;  // throws OptionError naming --Mapper.*
 };
 
+// A global adjustment that refined the intrinsics or housing.
+struct CalibrationRefinement {
+  int num_images = 0;  // in the model then
+  // How far it moved the image, pixels at the scene's median depth
+  // (MaxImageShiftPx); infinity where not measured: on fewer than
+  // ba_calibration_settled_min_images, or when the adjustment did not
+  // converge.
+  double image_shift_px = 0;
+  bool settled = false;  // from here on held, until the model's final adjustment
+};
+
+struct MappedModel {
+  Reconstruction reconstruction;
+  std::vector<CalibrationRefinement> calibration_refinements;  // in order; the final adjustment's last
+};
+
 // Grows models until no image can be added; returns them largest first.
-std::vector<Reconstruction> RunIncrementalMapper(const SfmInputs& inputs,
-                                                 const std::map<camera_t, SfmCamera>& cameras,
-                                                 const IncrementalMapperOptions& options,
-                                                 ProgressSink& progress);
+std::vector<MappedModel> RunIncrementalMapper(const SfmInputs& inputs,
+                                              const std::map<camera_t, SfmCamera>& cameras,
+                                              const IncrementalMapperOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

@@ -140,7 +140,7 @@ TEST(CameraChange, AFlatPortsDistanceMovesTheImageLessWithDepth) {
   EXPECT_NEAR(far / near, 0.25, 0.01);
 }
 
-TEST(IncrementalMapperOptions, NegativeSettledShiftIsNamed) {
+TEST(IncrementalMapperOptions, BadSettlingOptionsAreNamed) {
   IncrementalMapperOptions options;
   options.ba_calibration_settled_px = 0;
   EXPECT_NO_THROW(options.Check());
@@ -150,6 +150,15 @@ TEST(IncrementalMapperOptions, NegativeSettledShiftIsNamed) {
     ADD_FAILURE() << "accepted -0.1";
   } catch (const OptionError& e) {
     EXPECT_NE(std::string(e.what()).find("--Mapper.ba_calibration_settled_px"), std::string::npos) << e.what();
+  }
+  options.ba_calibration_settled_px = 0.25;
+  options.ba_calibration_settled_min_images = 1;
+  try {
+    options.Check();
+    ADD_FAILURE() << "accepted a minimum of 1 image";
+  } catch (const OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("--Mapper.ba_calibration_settled_min_images"), std::string::npos)
+        << e.what();
   }
 }
 
