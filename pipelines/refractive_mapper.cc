@@ -105,8 +105,8 @@ RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& optio
     summary.calibration_refinements.push_back(refinements);
     if (held != refinements.end()) {
       LOG(INFO) << "refractive_mapper: model " << m << ": intrinsics and housing held from " << held->num_images
-                << " images on (moved the image by " << held->image_shift_px
-                << " px at the last refinement), refined again at the end";
+                << " images on (that refinement moved the image by " << held->image_shift_px
+                << " px), refined again at the end";
     }
   }
   summary.num_models = static_cast<int>(models.size());

@@ -60,6 +60,7 @@ namespace {
 
 constexpr double kDegree = M_PI / 180.0;
 constexpr int kMinImagesForIntrinsics = 5;
+
 bool BogusIntrinsics(const std::map<camera_t, SfmCamera>& before, const std::map<camera_t, SfmCamera>& after) {
   for (const auto& [id, camera] : after) {
     if (ImplausibleIntrinsics(before.at(id).camera, camera.camera)) return true;
