@@ -138,6 +138,13 @@ FeatureMaskingSummary MaskFeatures(const FeatureMaskerOptions& options, Progress
         database.DeleteMatchesOfImage(image_id);
       });
   progress.End();
+  if (summary.num_without_markers == summary.num_images) {
+    // Every feature would go: markers of another dictionary, most likely.
+    throw InputError(options.database_path + ": no " + options.dictionary + " marker in any of the " +
+                     std::to_string(summary.num_images) + " images under " + options.image_path +
+                     "; nothing was changed (markers of another dictionary? --Mask.dictionary, "
+                     "--Markers.dictionary in auto_calibrator)");
+  }
   run.Finish(&database, {{"images", summary.num_images},
                          {"without_markers", summary.num_without_markers},
                          {"markers", summary.num_markers},
