@@ -93,7 +93,9 @@ struct CalibrationRefinement {
   // ba_calibration_settled_min_images, or when the adjustment did not
   // converge.
   double image_shift_px = 0;
-  bool settled = false;  // from here on held, until the model's final adjustment
+  // The calibration counts as settled after this one: held from here on,
+  // except in the model's final adjustments (which are recorded too).
+  bool settled = false;
 };
 
 struct MappedModel {

@@ -87,7 +87,8 @@ render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
   ASSERT_GE(mapped.num_models, 1);
   {
     const std::vector<CalibrationRefinement>& refinements = mapped.calibration_refinements[0];
-    const int size = mapped.num_registered;  // of the one model (checked below)
+    ASSERT_FALSE(refinements.empty());
+    const int size = refinements.back().num_images;  // the final adjustment's: all of the model's images
     const auto held = std::find_if(refinements.begin(), refinements.end(),
                                    [](const CalibrationRefinement& c) { return c.settled; });
     ASSERT_NE(held, refinements.end()) << "the calibration was never held";
