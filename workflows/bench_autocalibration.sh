@@ -51,19 +51,8 @@ echo "colmap feature_extractor:  ${colmap_s} s, ${colmap_n} features"
 awk -v p="$portcal_s" -v c="$colmap_s" 'BEGIN { if (c != "nan") printf "extraction speed-up (colmap / portcal): %.2fx\n", c / p }'
 
 echo "== mapping one database (portcal: extracted, masked, matched), no housing"
-db="$work/auto/database.db"
-t0=$(now)
-build/portcal refractive_mapper --log_level warn --database_path "$db" --output_path "$work/portcal_sparse"
-t1=$(now)
-pm_s=$(elapsed "$t0" "$t1")
-echo "portcal refractive_mapper: ${pm_s} s"
 if command -v colmap >/dev/null; then
-  mkdir -p "$work/colmap_sparse"
-  t0=$(now)
-  colmap mapper --database_path "$db" --image_path "$images" --output_path "$work/colmap_sparse" \
-    --Mapper.num_threads 2 >/dev/null 2>&1
-  t1=$(now)
-  cm_s=$(elapsed "$t0" "$t1")
-  echo "colmap mapper:             ${cm_s} s"
-  awk -v p="$pm_s" -v c="$cm_s" 'BEGIN { printf "mapper time ratio (portcal / colmap): %.2f\n", p / c }'
+  workflows/bench_mapper_vs_colmap.sh "$work/auto/database.db" "$images" "$work/mappers"
+else
+  echo "colmap is not installed: no mapper comparison"
 fi
