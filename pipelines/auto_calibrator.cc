@@ -26,6 +26,7 @@ void AutoCalibratorOptions::Check() const {
     throw OptionError("--AutoCalibration.refine_principal_point", std::to_string(refine_principal_point),
                       "-1, 0 or 1");
   }
+  if (random_seed < 0) throw OptionError("--random_seed", std::to_string(random_seed), ">= 0");
   if (marker_side_length_m < 0) {
     throw OptionError("--Markers.side_length", std::to_string(marker_side_length_m), ">= 0 m");
   }
@@ -94,6 +95,7 @@ AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   match.database_path = database_path;
   match.mode = options.matcher;
   match.num_threads = options.num_threads;
+  match.verification.random_seed = options.random_seed;
   MatchFeatures(match, progress);
   lap(options.matcher + "_matcher");
 
@@ -103,6 +105,7 @@ AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   map.output_path = (fs::path(options.output_path) / "sparse").string();
   map.housing = options.housing;
   map.mapper.num_threads = options.num_threads;
+  map.mapper.random_seed = options.random_seed;
   map.mapper.marker_scale.side_length_m = options.marker_side_length_m;
   map.mapper.ba_refine_focal_length = refine_intrinsics;
   map.mapper.ba_refine_extra_params = refine_intrinsics;

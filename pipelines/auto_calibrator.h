@@ -37,6 +37,9 @@ struct AutoCalibratorOptions {
   // RefractiveBundleAdjusterOptions::principal_point_test_sigmas); 0 holds
   // it; 1 refines it.
   int refine_principal_point = -1;
+  // Seeds every random choice (RANSAC in verification and mapping): the
+  // same images and options give the same calibration.
+  int random_seed = 0;
   int num_threads = 2;
   void Check() const;  // throws OptionError naming the option
 };

@@ -18,6 +18,10 @@ void RefractiveMapperOptions::Check() const {
   if (init_focal_from_markers < -1 || init_focal_from_markers > 1) {
     throw OptionError("--Mapper.init_focal_from_markers", std::to_string(init_focal_from_markers), "-1, 0 or 1");
   }
+  if (init_radial_from_matches < -1 || init_radial_from_matches > 1) {
+    throw OptionError("--Mapper.init_radial_from_matches", std::to_string(init_radial_from_matches), "-1, 0 or 1");
+  }
+  radial_start.Check();
   if (housing.model.empty() != housing.params.empty()) {
     throw OptionError("--Housing.params", housing.params, "given together with --Housing.model");
   }
@@ -66,6 +70,28 @@ void InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<came
   }
 }
 
+void InitializeRadialFromMatches(const SfmInputs& inputs, const RefractiveMapperOptions& options,
+                                 std::map<camera_t, SfmCamera>* cameras) {
+  const int mode = options.init_radial_from_matches;
+  if (mode == 0 || (mode == -1 && !options.mapper.ba_refine_extra_params)) return;
+  for (auto& [camera_id, camera] : *cameras) {
+    const std::vector<int> extra = CameraModelExtraParamsIdxs(camera.camera.model_id);
+    const bool undistorted = std::all_of(extra.begin(), extra.end(),
+                                         [&](int idx) { return camera.camera.params[idx] == 0; });
+    if (mode == -1 && (camera.camera.has_prior_focal_length || !undistorted)) continue;
+    const auto start = EstimateFirstRadialTerm(inputs, camera_id, camera, options.radial_start);
+    if (!start) {
+      VLOG(1) << "camera " << camera_id << ": no first radial term from the matches (no such term or too few pairs)";
+      continue;
+    }
+    LOG(INFO) << "camera " << camera_id << ": first radial term from " << start->num_matches << " matches of "
+              << start->num_pairs << " pairs: " << start->k << " (epipolar RMS " << start->residual_px
+              << " px, at " << camera.camera.params[FirstRadialParamIdx(camera.camera)] << ": "
+              << start->residual_at_start_px << " px)";
+    camera.camera.params[FirstRadialParamIdx(camera.camera)] = start->k;
+  }
+}
+
 RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& options, ProgressSink& progress) {
   options.Check();
   SfmInputs inputs;
@@ -85,6 +111,7 @@ RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& optio
   std::map<camera_t, SfmCamera> cameras = inputs.cameras;
   ApplyHousingOverride(options.housing, &cameras);
   InitializeFocalFromMarkers(inputs, options.init_focal_from_markers, &cameras);
+  InitializeRadialFromMatches(inputs, options, &cameras);
   const std::vector<MappedModel> models = RunIncrementalMapper(inputs, cameras, options.mapper, progress);
   if (models.empty()) {
     throw NumericalError("refractive_mapper: no model could be initialised from " +

@@ -11,6 +11,7 @@
 
 #include "colmap_ext/util/progress.h"
 #include "pipelines/sfm/incremental_mapper.h"
+#include "pipelines/sfm/radial_start.h"
 
 namespace portcal {
 
@@ -27,6 +28,11 @@ struct RefractiveMapperOptions {
   HousingOverride housing;
   // -1: when the camera has no prior focal length; 0: never; 1: always.
   int init_focal_from_markers = -1;
+  // The lens's first radial term from the verified matches (radial_start.h)
+  // before mapping. -1: when the camera has no prior focal length, its
+  // distortion is all zero and the mapper refines it; 0: never; 1: always.
+  int init_radial_from_matches = -1;
+  RadialStartOptions radial_start;
   void Check() const;  // throws OptionError naming the option
 };
 
@@ -45,6 +51,11 @@ void ApplyHousingOverride(const HousingOverride& override_housing, std::map<came
 // Focal lengths from the markers of each camera's images (see
 // FocalLengthFromMarkers), where `mode` asks for it.
 void InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<camera_t, SfmCamera>* cameras);
+
+// The first radial term of each camera from the matches
+// (EstimateFirstRadialTerm), where `options.init_radial_from_matches` asks.
+void InitializeRadialFromMatches(const SfmInputs& inputs, const RefractiveMapperOptions& options,
+                                 std::map<camera_t, SfmCamera>* cameras);
 
 RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& options, ProgressSink& progress);
 

@@ -70,6 +70,8 @@ void AddMatchingOptions(CommandLine* cli, FeatureMatcherOptions* options) {
   cli->Add("TwoViewGeometry.min_num_inliers", &options->verification.min_num_inliers, "per verified pair");
   cli->Add("TwoViewGeometry.min_inlier_ratio", &options->verification.min_inlier_ratio,
            "inliers / matches for a verified pair");
+  cli->Add("random_seed", &options->verification.random_seed,
+           "seed of E's and H's RANSAC samples (>= 0): same matches, same geometry");
   cli->Add("overwrite", &options->overwrite, "re-match pairs that have a geometry (0 | 1)");
   cli->Add("num_threads", &options->num_threads, "threads");
 }

@@ -44,6 +44,7 @@ static void AddMapperOptions(CommandLine* cli, IncrementalMapperOptions* o) {
   cli->Add("Markers.side_sigma", &o->marker_scale.sigma_m, "uncertainty of a marker side, metres");
   cli->Add("PosePrior.position_sigma", &o->position_prior_sigma_m,
            "position priors' uncertainty, metres (0: unused); global adjustments take the scale from them");
+  cli->Add("random_seed", &o->random_seed, "seed of RANSAC's samples (>= 0): same input, same model");
   cli->Add("num_threads", &o->num_threads, "threads");
 }
 
@@ -139,6 +140,7 @@ int RunAutoCalibrator(int argc, char** argv) {
           "-1: with the intrinsics, held at the image centre unless the data move it beyond 3 sigma; 0; 1");
   cli.Add("SiftExtraction.max_num_features", &options.sift.max_num_features, "per image");
   cli.Add("SiftExtraction.max_image_size", &options.sift.max_image_size, "pixels");
+  cli.Add("random_seed", &options.random_seed, "seed of every random choice (>= 0): same images, same calibration");
   cli.Add("num_threads", &options.num_threads, "threads");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;

@@ -4,6 +4,7 @@
 #include <opencv2/core/eigen.hpp>
 
 #include "colmap_ext/util/error.h"
+#include "colmap_ext/util/random_seed.h"
 
 namespace portcal {
 
@@ -15,6 +16,7 @@ void TwoViewVerificationOptions::Check() const {
   if (max_num_trials < 1) {
     throw OptionError("--TwoViewGeometry.max_num_trials", std::to_string(max_num_trials), ">= 1");
   }
+  if (random_seed < 0) throw OptionError("--random_seed", std::to_string(random_seed), ">= 0");
   if (min_num_inliers < 8) {
     throw OptionError("--TwoViewGeometry.min_num_inliers", std::to_string(min_num_inliers), ">= 8");
   }
@@ -105,9 +107,11 @@ TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& key
   cv::Mat E;
   if (static_cast<int>(e_rays1.size()) >= options.min_num_inliers) {
     const double focal = 0.5 * (camera1.MeanFocalLength() + camera2.MeanFocalLength());
+    cv::theRNG() = cv::RNG(GeneratorState(options.random_seed));
     E = cv::findEssentialMat(e_rays1, e_rays2, cv::Mat::eye(3, 3, CV_64F), cv::RANSAC, options.confidence,
                              options.max_error / focal, options.max_num_trials, e_mask);
   }
+  cv::theRNG() = cv::RNG(GeneratorState(options.random_seed));
   const cv::Mat H = cv::findHomography(f_pixels1, f_pixels2, cv::RANSAC, options.max_error, h_mask,
                                        options.max_num_trials, options.confidence);
   const FeatureMatches e_inliers = E.rows == 3 ? Inliers(matches, e_index, e_mask) : FeatureMatches();

@@ -29,6 +29,11 @@ struct TwoViewVerificationOptions {
   double min_inlier_ratio = 0.25;
   double min_E_F_inlier_ratio = 0.95;
   double max_H_inlier_ratio = 0.8;
+  // E's and H's RANSAC draw from OpenCV's thread-local generator, whose
+  // state otherwise depends on which thread verified which pairs before:
+  // each call starts it from this seed, so the same matches give the same
+  // geometry on any thread (F's USAC seeds itself, from a fixed state).
+  int random_seed = 0;
   void Check() const;  // throws OptionError naming --TwoViewGeometry.*
 };
 

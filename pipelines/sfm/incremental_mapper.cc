@@ -38,6 +38,7 @@ void IncrementalMapperOptions::Check() const {
   if (abs_pose_min_num_inliers < 6) {
     throw OptionError("--Mapper.abs_pose_min_num_inliers", std::to_string(abs_pose_min_num_inliers), ">= 6");
   }
+  if (random_seed < 0) throw OptionError("--random_seed", std::to_string(random_seed), ">= 0");
   if (init_max_restarts < 0) throw OptionError("--Mapper.init_max_restarts", std::to_string(init_max_restarts), ">= 0");
   if (min_model_size < 2) throw OptionError("--Mapper.min_model_size", std::to_string(min_model_size), ">= 2");
   if (ba_local_num_images < 1) {
@@ -296,6 +297,7 @@ bool Mapper::Register(Reconstruction* r, image_t image_id) {
   GeneralizedAbsolutePoseOptions pose_options;
   pose_options.max_angle_error_rad = options_.abs_pose_max_error_px / FocalOf(image_id);
   pose_options.min_num_inliers = options_.abs_pose_min_num_inliers;
+  pose_options.random_seed = options_.random_seed;
   std::vector<char> inliers;
   const auto cam_from_world = EstimateGeneralizedAbsolutePose(rays, points, pose_options, &inliers);
   if (!cam_from_world) return false;

@@ -81,6 +81,7 @@ struct IncrementalMapperOptions {
   // and keep them as residuals of this sigma (metres): the scale of a
   // survey, so that ba_refine_housing can estimate the port distance.
   double position_prior_sigma_m = 0;
+  int random_seed = 0;  // RANSAC's samples (colmap_ext/util/random_seed.h)
   int num_threads = 2;
   void Check() const;  // throws OptionError naming --Mapper.*
 };

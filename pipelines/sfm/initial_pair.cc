@@ -58,7 +58,7 @@ bool StartFromPair(const IncrementalMapperOptions& options, image_t a, image_t b
   if (static_cast<int>(pairs.size()) < options.init_min_num_inliers) return false;
   std::vector<char> inliers;
   const double angle = options.init_max_error_px / std::min(focal_of(a), focal_of(b));
-  const auto b_from_a = EstimateRelativePose(dirs_a, dirs_b, angle, &inliers);
+  const auto b_from_a = EstimateRelativePose(dirs_a, dirs_b, angle, options.random_seed, &inliers);
   if (!b_from_a) return false;
   const auto triangulate = [&](const Rigid3d& pose_b, std::vector<Eigen::Vector3d>* points,
                                std::vector<double>* angles) {

@@ -11,6 +11,8 @@
 #include <opengv/sac/Ransac.hpp>
 #include <opengv/sac_problems/absolute_pose/AbsolutePoseSacProblem.hpp>
 
+#include "colmap_ext/util/random_seed.h"
+
 namespace portcal {
 
 Ray3d RayInWorld(const Ray3d& ray_in_cam, const Rigid3d& cam_from_world) {
@@ -78,7 +80,7 @@ std::optional<Rigid3d> EstimateGeneralizedAbsolutePose(const std::vector<Ray3d>&
   opengv::sac::Ransac<Problem> ransac;
   // Deterministic: OpenGV seeds its generator from the clock unless told.
   std::shared_ptr<Problem> problem(new Problem(adapter, Problem::GP3P, false));
-  problem->rng_alg_.seed(12345);
+  problem->rng_alg_.seed(GeneratorState(options.random_seed));
   ransac.sac_model_ = problem;
   ransac.threshold_ = 1.0 - std::cos(options.max_angle_error_rad);
   ransac.max_iterations_ = options.max_iterations;
@@ -110,7 +112,8 @@ std::optional<Rigid3d> EstimateGeneralizedAbsolutePose(const std::vector<Ray3d>&
 
 std::optional<Rigid3d> EstimateRelativePose(const std::vector<Eigen::Vector3d>& directions1,
                                             const std::vector<Eigen::Vector3d>& directions2,
-                                            double max_angle_error_rad, std::vector<char>* inliers) {
+                                            double max_angle_error_rad, int random_seed,
+                                            std::vector<char>* inliers) {
   const size_t n = directions1.size();
   inliers->assign(n, 0);
   std::vector<cv::Point2d> p1, p2;
@@ -125,7 +128,7 @@ std::optional<Rigid3d> EstimateRelativePose(const std::vector<Eigen::Vector3d>& 
   }
   if (p1.size() < 8) return std::nullopt;
   cv::Mat mask;
-  cv::setRNGSeed(12345);
+  cv::theRNG() = cv::RNG(GeneratorState(random_seed));
   const cv::Mat E = cv::findEssentialMat(p1, p2, cv::Mat::eye(3, 3, CV_64F), cv::RANSAC, 0.9999,
                                          max_angle_error_rad, 2000, mask);
   if (E.rows != 3 || E.cols != 3) return std::nullopt;

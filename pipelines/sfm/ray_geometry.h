@@ -27,6 +27,7 @@ struct GeneralizedAbsolutePoseOptions {
   double confidence = 0.9999;
   int max_iterations = 2000;
   int min_num_inliers = 12;
+  int random_seed = 0;  // RANSAC's samples (random_seed.h)
 };
 
 // cam_from_world of a non-central camera from rays in the camera frame and
@@ -45,7 +46,8 @@ std::optional<Rigid3d> EstimateGeneralizedAbsolutePose(const std::vector<Ray3d>&
 // translation has unit length. `inliers` gets a flag per correspondence.
 std::optional<Rigid3d> EstimateRelativePose(const std::vector<Eigen::Vector3d>& directions1,
                                             const std::vector<Eigen::Vector3d>& directions2,
-                                            double max_angle_error_rad, std::vector<char>* inliers);
+                                            double max_angle_error_rad, int random_seed,
+                                            std::vector<char>* inliers);
 
 // Focal length from ArUco markers: each marker is a planar square seen in
 // one view, and with the principal point at (cx, cy), square pixels and no
