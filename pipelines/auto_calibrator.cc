@@ -106,6 +106,7 @@ AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   map.housing = options.housing;
   map.mapper.num_threads = options.num_threads;
   map.mapper.random_seed = options.random_seed;
+  map.init_radial_from_matches = options.init_radial_from_matches;
   map.mapper.marker_scale.side_length_m = options.marker_side_length_m;
   map.mapper.ba_refine_focal_length = refine_intrinsics;
   map.mapper.ba_refine_extra_params = refine_intrinsics;

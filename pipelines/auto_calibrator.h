@@ -40,6 +40,9 @@ struct AutoCalibratorOptions {
   // Seeds every random choice (RANSAC in verification and mapping): the
   // same images and options give the same calibration.
   int random_seed = 0;
+  // The lens's first radial term from the matches before mapping
+  // (RefractiveMapperOptions::init_radial_from_matches): -1 or 0.
+  int init_radial_from_matches = -1;
   int num_threads = 2;
   void Check() const;  // throws OptionError naming the option
 };

@@ -26,6 +26,8 @@ static void AddMapperOptions(CommandLine* cli, IncrementalMapperOptions* o) {
   cli->Add("Mapper.ba_refine_extra_params", &o->ba_refine_extra_params, "0 | 1");
   cli->Add("Mapper.ba_refine_housing", &o->ba_refine_housing,
            "refine the housing with the intrinsics in global adjustments (0 | 1)");
+  cli->Add("Mapper.ba_full_intrinsics_min_images", &o->ba_full_intrinsics_min_images,
+           "below this many images refine only the focal length and the first radial term");
   cli->Add("Mapper.ba_local_num_images", &o->ba_local_num_images, "images in a local adjustment");
   cli->Add("Mapper.ba_global_images_ratio", &o->ba_global_images_ratio, "global adjustment when the model grows by");
   cli->Add("Mapper.ba_global_function_tolerance", &o->ba_global_function_tolerance,
@@ -61,6 +63,9 @@ int RunRefractiveMapper(int argc, char** argv) {
   cli.Add("Housing.params", &options.housing.params, "housing parameters in the model's order");
   cli.Add("Mapper.init_focal_from_markers", &options.init_focal_from_markers,
           "focal length from ArUco markers: -1 when the camera has no prior, 0 never, 1 always");
+  cli.Add("Mapper.init_radial_from_matches", &options.init_radial_from_matches,
+          "first radial distortion term from the verified matches: -1 when the camera has no prior focal length "
+          "and no distortion, 0 never, 1 always");
   AddMapperOptions(&cli, &options.mapper);
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
@@ -140,6 +145,9 @@ int RunAutoCalibrator(int argc, char** argv) {
           "-1: with the intrinsics, held at the image centre unless the data move it beyond 3 sigma; 0; 1");
   cli.Add("SiftExtraction.max_num_features", &options.sift.max_num_features, "per image");
   cli.Add("SiftExtraction.max_image_size", &options.sift.max_image_size, "pixels");
+  cli.Add("Mapper.init_radial_from_matches", &options.init_radial_from_matches,
+          "first radial distortion term from the verified matches before mapping: -1 when the intrinsics are "
+          "refined, 0 never");
   cli.Add("random_seed", &options.random_seed, "seed of every random choice (>= 0): same images, same calibration");
   cli.Add("num_threads", &options.num_threads, "threads");
   return ReportErrors([&] {

@@ -160,7 +160,12 @@ std::vector<int> ConstantIntrinsics(const Camera& camera, const BundleAdjustment
   const auto add = [&](const std::vector<int>& idxs) { constant.insert(constant.end(), idxs.begin(), idxs.end()); };
   if (!o.refine_focal_length) add(CameraModelFocalLengthIdxs(camera.model_id));
   if (!o.refine_principal_point) add(CameraModelPrincipalPointIdxs(camera.model_id));
-  if (!o.refine_extra_params) add(CameraModelExtraParamsIdxs(camera.model_id));
+  const std::vector<int> extra = CameraModelExtraParamsIdxs(camera.model_id);
+  if (!o.refine_extra_params) {
+    add(extra);
+  } else if (o.max_num_extra_params >= 0 && static_cast<size_t>(o.max_num_extra_params) < extra.size()) {
+    add(std::vector<int>(extra.begin() + o.max_num_extra_params, extra.end()));
+  }
   return constant;
 }
 

@@ -18,6 +18,9 @@ struct BundleAdjustmentOptions {
   bool refine_focal_length = false;
   bool refine_principal_point = false;
   bool refine_extra_params = false;
+  // With refine_extra_params: only the first this many distortion
+  // parameters (the radial terms come first in every model); -1: all.
+  int max_num_extra_params = -1;
   bool refine_housing = false;
   // With refine_housing: a flat port's distance too (else only its normal).
   bool refine_port_distance = true;

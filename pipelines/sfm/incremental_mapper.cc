@@ -51,6 +51,10 @@ void IncrementalMapperOptions::Check() const {
   if (!(ba_calibration_settled_px >= 0)) {
     throw OptionError("--Mapper.ba_calibration_settled_px", std::to_string(ba_calibration_settled_px), ">= 0");
   }
+  if (ba_full_intrinsics_min_images < 0) {
+    throw OptionError("--Mapper.ba_full_intrinsics_min_images", std::to_string(ba_full_intrinsics_min_images),
+                      ">= 0");
+  }
   if (ba_calibration_settled_min_images < 2) {
     throw OptionError("--Mapper.ba_calibration_settled_min_images",
                       std::to_string(ba_calibration_settled_min_images), ">= 2");
@@ -474,6 +478,10 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   ba.refine_focal_length = refine_intrinsics && options_.ba_refine_focal_length;
   ba.refine_principal_point = refine_intrinsics && options_.ba_refine_principal_point;
   ba.refine_extra_params = refine_intrinsics && options_.ba_refine_extra_params;
+  if (static_cast<int>(r->poses().size()) < options_.ba_full_intrinsics_min_images) {
+    ba.max_num_extra_params = 1;
+    ba.refine_principal_point = false;
+  }
   ba.refine_housing = refine_intrinsics && options_.ba_refine_housing;
   ba.max_num_iterations = options_.ba_max_num_iterations;
   ba.function_tolerance = options_.ba_global_function_tolerance;

@@ -46,6 +46,13 @@ struct IncrementalMapperOptions {
   // refinement may not climb out). Wants a metric scale (markers): without
   // one the port distance wanders and models split.
   bool ba_refine_housing = false;
+  // Below this many images only the focal length and the first radial term
+  // are refined (principal point and the other distortion terms held): a
+  // handful of views of a small target cannot tell eight intrinsics apart,
+  // and freed together they leave the basin (own render, wide OPENCV lens
+  // behind a flat port, 15 views at 960 x 540: f 785 px for 452 at 5
+  // images; docs/auto_calibration.md). 0: all from the start.
+  int ba_full_intrinsics_min_images = 10;
   int ba_local_num_images = 6;
   double ba_global_images_ratio = 1.1;
   int ba_max_num_iterations = 50;

@@ -160,7 +160,12 @@ std::pair<double, int> ResidualAt(const std::vector<Matches>& pairs, const SfmCa
       x1.push_back(ra->direction.hnormalized());
       x2.push_back(rb->direction.hnormalized());
     }
-    if (x1.size() < 16) return {std::numeric_limits<double>::infinity(), 0};
+    // A candidate that leaves keypoints without a ray (a distortion that
+    // cannot be inverted that far out) is no candidate: the residuals of the
+    // rest would look better for having fewer points.
+    if (x1.size() < 16 || x1.size() < matches.size() * 95 / 100) {
+      return {std::numeric_limits<double>::infinity(), 0};
+    }
     const auto [pair_sum, pair_count] = PairResidual(x1, x2);
     sum += pair_sum;
     count += pair_count;
@@ -182,7 +187,11 @@ std::optional<RadialStart> EstimateFirstRadialTerm(const SfmInputs& inputs, came
   for (int i = 0; i < options.num_steps; ++i) {
     ks[i] = options.min_k + (options.max_k - options.min_k) * i / (options.num_steps - 1);
   }
-  ParallelFor(ks.size(), 2, [&](size_t i) { costs[i] = ResidualAt(pairs, camera, idx, ks[i]).first; });
+  // Mean squared residual per candidate.
+  ParallelFor(ks.size(), 2, [&](size_t i) {
+    const auto [sum, count] = ResidualAt(pairs, camera, idx, ks[i]);
+    costs[i] = count > 0 ? sum / count : std::numeric_limits<double>::infinity();
+  });
   const size_t best = std::min_element(costs.begin(), costs.end()) - costs.begin();
   if (!std::isfinite(costs[best])) return std::nullopt;
   RadialStart start;
@@ -191,7 +200,7 @@ std::optional<RadialStart> EstimateFirstRadialTerm(const SfmInputs& inputs, came
     // The parabola through the best grid point and its neighbours.
     const double c0 = costs[best - 1], c1 = costs[best], c2 = costs[best + 1];
     const double curvature = c0 - 2 * c1 + c2;
-    if (curvature > 0) start.k += 0.5 * (ks[1] - ks[0]) * (c0 - c2) / curvature;
+    if (std::isfinite(curvature) && curvature > 0) start.k += 0.5 * (ks[1] - ks[0]) * (c0 - c2) / curvature;
   }
   const auto [sum, count] = ResidualAt(pairs, camera, idx, start.k);
   const auto [sum0, count0] = ResidualAt(pairs, camera, idx, camera.camera.params[idx]);
