@@ -1,7 +1,12 @@
 #include "pipelines/auto_calibrator.h"
 
 #include <chrono>
+#include <iomanip>
+#include <limits>
+#include <sstream>
 
+#include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/housing/flat_port.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "database/database.h"
@@ -40,18 +45,76 @@ namespace {
 // the mapper gets (own renders: the same seed failed from 1152 px and
 // calibrated when verified with 609 px). The markers give a far better
 // start: it is written to the database camera before matching.
-void StartFocalFromMarkers(const std::string& database_path, const HousingOverride& housing) {
+// Returns the markers' focal length (in-air equivalent), or nullopt.
+std::optional<double> StartFocalFromMarkers(const std::string& database_path, const HousingOverride& housing) {
   Database database(database_path, Database::OpenMode::kReadWrite);
   const SfmInputs inputs = SfmInputs::Read(&database);
   std::map<camera_t, SfmCamera> cameras = inputs.cameras;
   ApplyHousingOverride(housing, &cameras);
   InitializeFocalFromMarkers(inputs, 1, &cameras);
   Transaction transaction = database.BeginTransaction();
-  for (const auto& [id, camera] : cameras) database.UpdateCamera(camera.camera);
+  std::optional<double> focal;
+  for (const auto& [id, camera] : cameras) {
+    if (camera.camera.params != inputs.cameras.at(id).camera.params) focal = camera.camera.MeanFocalLength();
+    database.UpdateCamera(camera.camera);
+  }
   transaction.Commit();
+  return focal;
 }
 
+// A refined focal length this far from the markers' independent estimate
+// (measured within 1-6 % of the truth on own and shared renders) is a
+// wrong solution, whatever its standard deviation says: the lens's
+// distortion or the housing absorbed the other (docs/auto_calibration.md).
+constexpr double kMaxFocalRatioToMarkers = 1.25;
+
+std::string FormatNumber(double value) {
+  std::ostringstream out;
+  out << std::setprecision(4) << value;
+  return out.str();
+}
+
+// A focal length with a standard deviation above this fraction of itself
+// is not determined by the views (well-posed sets: 0.05-0.5 %).
+constexpr double kMaxRelativeFocalStdDev = 0.01;
+
 }  // namespace
+
+// Fails on a focal length the markers rule out; warns, first in the
+// report, of what the views leave undetermined.
+void JudgeAutoCalibration(const std::optional<double>& markers_focal, CalibrationReport* report) {
+  const double focal = report->camera.MeanFocalLength();
+  const std::string remedy = "give the in-air intrinsics (--ImageReader.camera_params), more views, or views "
+                             "with wider tilt and nearer the image corners";
+  if (markers_focal && !(focal / *markers_focal < kMaxFocalRatioToMarkers &&
+                         *markers_focal / focal < kMaxFocalRatioToMarkers)) {
+    throw NumericalError("auto_calibrator: the refined focal length " + FormatNumber(focal) +
+                         " px is far from the ArUco markers' estimate " + FormatNumber(*markers_focal) +
+                         " px: the reconstruction settled in a wrong solution (lens distortion and housing "
+                         "traded against each other); " + remedy);
+  }
+  const std::vector<int> focal_idxs = CameraModelFocalLengthIdxs(report->camera.model_id);
+  const double focal_std_dev = report->parameters_std_dev.at(focal_idxs.front());
+  if (focal_std_dev > kMaxRelativeFocalStdDev * focal) {
+    report->warnings.push_back("the focal length is poorly determined: std dev " + FormatNumber(focal_std_dev) +
+                               " px, " + FormatNumber(100 * focal_std_dev / focal) + " % of it; " + remedy);
+  }
+  if (report->housing && report->housing->ModelName() == FlatPort::kName && !report->views.empty()) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const CalibratedView& view : report->views) {
+      nearest = std::min(nearest, view.cam_from_target.translation.norm());
+    }
+    // The port lies between the lens and the scene, a few centimetres out.
+    const double distance = FlatPort::InterfaceDistance(report->housing->params.data());
+    if (distance > 0.5 * nearest) {
+      report->warnings.push_back("the flat port's distance " + FormatNumber(distance) +
+                                 " m is more than half the nearest view's distance to the target (" +
+                                 FormatNumber(nearest) + " m): implausible; " + remedy);
+    }
+  }
+  for (const std::string& warning : report->warnings) LOG(WARNING) << "auto_calibrator: " << warning;
+}
+
 
 AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, ProgressSink& progress) {
   options.Check();
@@ -89,7 +152,8 @@ AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
     lap("feature_masker");
   }
 
-  if (!intrinsics_given) StartFocalFromMarkers(database_path, options.housing);
+  std::optional<double> markers_focal;
+  if (!intrinsics_given) markers_focal = StartFocalFromMarkers(database_path, options.housing);
 
   FeatureMatcherOptions match;
   match.database_path = database_path;
@@ -153,6 +217,7 @@ AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   refine.principal_point_test_sigmas = options.refine_principal_point == -1 ? 3.0 : 0.0;
   refine.ba.num_threads = options.num_threads;
   result.refined = RunRefractiveBundleAdjuster(refine);
+  if (refine_intrinsics) JudgeAutoCalibration(markers_focal, &result.refined.report);
   WriteCalibrationReport(result.refined.report, options.output_path);
   lap("refractive_bundle_adjuster");
   std::string times;

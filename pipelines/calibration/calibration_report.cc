@@ -62,8 +62,9 @@ std::string StdDevSourcesText(const std::vector<double>& by_noise, const std::ve
 
 std::string Yaml(const CalibrationReport& r) {
   std::ostringstream out;
-  out << "# portcal calibration report (calibmar-compatible keys first)\n"
-      << "model: " << r.camera.ModelName() << "\n"
+  out << "# portcal calibration report (calibmar-compatible keys first)\n";
+  for (const std::string& warning : r.warnings) out << "# WARNING: " << warning << "\n";
+  out << "model: " << r.camera.ModelName() << "\n"
       << "parameters: " << List(r.camera.params) << "\n"
       << "non_svp_model: " << (r.housing ? r.housing->ModelName() : "NONE") << "\n"
       << "non_svp_parameters: " << List(r.housing ? r.housing->params : std::vector<double>{}) << "\n"
@@ -89,6 +90,10 @@ std::string Yaml(const CalibrationReport& r) {
     out << "board_warp: " << List({r.board_warp->x(), r.board_warp->y()}) << "\n"
         << "board_warp_std_dev: " << List({r.board_warp_std_dev->x(), r.board_warp_std_dev->y()}) << "\n";
   }
+  if (!r.warnings.empty()) {
+    out << "warnings:\n";
+    for (const std::string& warning : r.warnings) out << "- " << SingleQuoted(warning) << "\n";
+  }
   if (!r.notes.empty()) {
     out << "notes:\n";
     for (const std::string& note : r.notes) out << "- " << SingleQuoted(note) << "\n";
@@ -110,7 +115,9 @@ std::string Yaml(const CalibrationReport& r) {
 std::string Text(const CalibrationReport& r) {
   std::ostringstream out;
   out << std::fixed;
-  out << "portcal calibration\n===================\n\n"
+  out << "portcal calibration\n===================\n\n";
+  for (const std::string& warning : r.warnings) out << "WARNING: " << warning << "\n\n";
+  out
       << "Camera model " << r.camera.ModelName() << ", " << r.camera.width << " x " << r.camera.height
       << " px\nTarget: " << r.target_description << "\n\n";
   const std::vector<std::string> names = SplitTokens(r.camera.ParamsInfo(), ", ");
@@ -279,6 +286,7 @@ CalibrationReport ReadCalibrationReport(const fs::path& path) {
     }
     if (root["target"]) report.target_description = root["target"].as<std::string>();
     if (root["notes"]) report.notes = root["notes"].as<std::vector<std::string>>();
+    if (root["warnings"]) report.warnings = root["warnings"].as<std::vector<std::string>>();
   } catch (const YAML::Exception& e) {
     throw InputError(path.string() + ": " + e.what());
   }

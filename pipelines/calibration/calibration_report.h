@@ -35,6 +35,9 @@ struct CalibrationReport {
   // Decisions a reader needs to weigh the numbers (e.g. a parameter held
   // because the data could not tell it from its default).
   std::vector<std::string> notes;
+  // Reasons not to trust the result (e.g. a focal length whose standard
+  // deviation is a large fraction of it): written first in both files.
+  std::vector<std::string> warnings;
 };
 
 // Writes calibration.yaml and calibration.txt into `dir` (created),
