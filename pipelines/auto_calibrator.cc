@@ -2,11 +2,9 @@
 
 #include <chrono>
 #include <iomanip>
-#include <limits>
 #include <sstream>
 
 #include "colmap_ext/camera/camera_models.h"
-#include "colmap_ext/housing/flat_port.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "database/database.h"
@@ -98,19 +96,6 @@ void JudgeAutoCalibration(const std::optional<double>& markers_focal, Calibratio
   if (focal_std_dev > kMaxRelativeFocalStdDev * focal) {
     report->warnings.push_back("the focal length is poorly determined: std dev " + FormatNumber(focal_std_dev) +
                                " px, " + FormatNumber(100 * focal_std_dev / focal) + " % of it; " + remedy);
-  }
-  if (report->housing && report->housing->ModelName() == FlatPort::kName && !report->views.empty()) {
-    double nearest = std::numeric_limits<double>::infinity();
-    for (const CalibratedView& view : report->views) {
-      nearest = std::min(nearest, view.cam_from_target.translation.norm());
-    }
-    // The port lies between the lens and the scene, a few centimetres out.
-    const double distance = FlatPort::InterfaceDistance(report->housing->params.data());
-    if (distance > 0.5 * nearest) {
-      report->warnings.push_back("the flat port's distance " + FormatNumber(distance) +
-                                 " m is more than half the nearest view's distance to the target (" +
-                                 FormatNumber(nearest) + " m): implausible; " + remedy);
-    }
   }
   for (const std::string& warning : report->warnings) LOG(WARNING) << "auto_calibrator: " << warning;
 }

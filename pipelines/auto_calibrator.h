@@ -58,8 +58,7 @@ struct AutoCalibrationResult {
 // NumericalError when the focal length is far from the markers' estimate
 // (`markers_focal`, the in-air focal length the ArUco markers give; a wrong
 // solution however small its standard deviation), and adds warnings to the
-// report for a poorly determined focal length and for a flat port farther
-// out than half the nearest view's distance to the target.
+// report for a poorly determined focal length.
 void JudgeAutoCalibration(const std::optional<double>& markers_focal, CalibrationReport* report);
 
 AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, ProgressSink& progress);
