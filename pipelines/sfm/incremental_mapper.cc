@@ -480,7 +480,6 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   ba.refine_extra_params = refine_intrinsics && options_.ba_refine_extra_params;
   if (static_cast<int>(r->poses().size()) < options_.ba_full_intrinsics_min_images) {
     ba.max_num_extra_params = 1;
-    ba.refine_principal_point = false;
   }
   ba.refine_housing = refine_intrinsics && options_.ba_refine_housing;
   ba.max_num_iterations = options_.ba_max_num_iterations;

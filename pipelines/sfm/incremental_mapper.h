@@ -46,8 +46,8 @@ struct IncrementalMapperOptions {
   // refinement may not climb out). Wants a metric scale (markers): without
   // one the port distance wanders and models split.
   bool ba_refine_housing = false;
-  // Below this many images only the focal length and the first radial term
-  // are refined (principal point and the other distortion terms held): a
+  // Below this many images, of the distortion only the first radial term
+  // is refined (the other terms held; the principal point as asked): a
   // handful of views of a small target cannot tell eight intrinsics apart,
   // and freed together they leave the basin (own render, wide OPENCV lens
   // behind a flat port, 15 views at 960 x 540: f 785 px for 452 at 5
