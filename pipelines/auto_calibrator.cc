@@ -60,12 +60,6 @@ std::optional<double> StartFocalFromMarkers(const std::string& database_path, co
   return focal;
 }
 
-// A refined focal length this far from the markers' independent estimate
-// (measured within 1-6 % of the truth on own and shared renders) is a
-// wrong solution, whatever its standard deviation says: the lens's
-// distortion or the housing absorbed the other (docs/auto_calibration.md).
-constexpr double kMaxFocalRatioToMarkers = 1.25;
-
 std::string FormatNumber(double value) {
   std::ostringstream out;
   out << std::setprecision(4) << value;

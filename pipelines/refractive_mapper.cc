@@ -42,8 +42,9 @@ void ApplyHousingOverride(const HousingOverride& override_housing, std::map<came
   for (auto& [id, camera] : *cameras) camera.housing = housing;
 }
 
-void InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<camera_t, SfmCamera>* cameras) {
-  if (mode == 0) return;
+bool InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<camera_t, SfmCamera>* cameras) {
+  if (mode == 0) return false;
+  bool any = false;
   for (auto& [camera_id, camera] : *cameras) {
     if (mode == -1 && camera.camera.has_prior_focal_length) continue;
     std::vector<MarkerQuad> quads;
@@ -67,7 +68,9 @@ void InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<came
     LOG(INFO) << "camera " << camera_id << ": focal length from " << quads.size() << " markers: " << *focal
               << " px (was " << camera.camera.MeanFocalLength() << ")";
     for (int idx : CameraModelFocalLengthIdxs(camera.camera.model_id)) camera.camera.params[idx] = *focal;
+    any = true;
   }
+  return any;
 }
 
 void InitializeRadialFromMatches(const SfmInputs& inputs, const RefractiveMapperOptions& options,
@@ -86,8 +89,7 @@ void InitializeRadialFromMatches(const SfmInputs& inputs, const RefractiveMapper
     }
     LOG(INFO) << "camera " << camera_id << ": first radial term from " << start->num_matches << " matches of "
               << start->num_pairs << " pairs: " << start->k << " (epipolar RMS " << start->residual_px
-              << " px, at " << camera.camera.params[FirstRadialParamIdx(camera.camera)] << ": "
-              << start->residual_at_start_px << " px)";
+              << " px; at the start " << start->residual_at_start_px << " px)";
     camera.camera.params[FirstRadialParamIdx(camera.camera)] = start->k;
   }
 }
@@ -110,9 +112,12 @@ RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& optio
   }
   std::map<camera_t, SfmCamera> cameras = inputs.cameras;
   ApplyHousingOverride(options.housing, &cameras);
-  InitializeFocalFromMarkers(inputs, options.init_focal_from_markers, &cameras);
+  IncrementalMapperOptions mapper = options.mapper;
+  if (InitializeFocalFromMarkers(inputs, options.init_focal_from_markers, &cameras)) {
+    mapper.max_focal_ratio_to_start = std::min(mapper.max_focal_ratio_to_start, kMaxFocalRatioToMarkers);
+  }
   InitializeRadialFromMatches(inputs, options, &cameras);
-  const std::vector<MappedModel> models = RunIncrementalMapper(inputs, cameras, options.mapper, progress);
+  const std::vector<MappedModel> models = RunIncrementalMapper(inputs, cameras, mapper, progress);
   if (models.empty()) {
     throw NumericalError("refractive_mapper: no model could be initialised from " +
                          std::to_string(inputs.pair_inliers.size()) +

@@ -14,6 +14,8 @@ static void AddMapperOptions(CommandLine* cli, IncrementalMapperOptions* o) {
   cli->Add("Mapper.init_max_error", &o->init_max_error_px, "initial pair inlier threshold, pixels");
   cli->Add("Mapper.init_max_restarts", &o->init_max_restarts,
            "models started again from another initial pair when their intrinsics keep coming out implausible");
+  cli->Add("Mapper.max_focal_ratio_to_start", &o->max_focal_ratio_to_start,
+           "a focal length beyond this factor from the start is implausible (1.25 when the markers gave the start)");
   cli->Add("Mapper.init_scene_depth", &o->init_scene_depth_m,
            "scale when no marker size is given: median depth of the initial pair, metres");
   cli->Add("Mapper.abs_pose_max_error", &o->abs_pose_max_error_px, "registration threshold, pixels");
@@ -66,6 +68,12 @@ int RunRefractiveMapper(int argc, char** argv) {
   cli.Add("Mapper.init_radial_from_matches", &options.init_radial_from_matches,
           "first radial distortion term from the verified matches: -1 when the camera has no prior focal length "
           "and no distortion, 0 never, 1 always");
+  RadialStartOptions& radial = options.radial_start;
+  cli.Add("Mapper.init_radial_min_k", &radial.min_k, "search range of the first radial term, lower end");
+  cli.Add("Mapper.init_radial_max_k", &radial.max_k, "search range of the first radial term, upper end");
+  cli.Add("Mapper.init_radial_num_steps", &radial.num_steps, "grid points over that range");
+  cli.Add("Mapper.init_radial_max_num_pairs", &radial.max_num_pairs, "best-matched pairs used");
+  cli.Add("Mapper.init_radial_max_matches", &radial.max_matches_per_pair, "matches used per pair");
   AddMapperOptions(&cli, &options.mapper);
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;

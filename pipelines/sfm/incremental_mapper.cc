@@ -38,6 +38,9 @@ void IncrementalMapperOptions::Check() const {
   if (abs_pose_min_num_inliers < 6) {
     throw OptionError("--Mapper.abs_pose_min_num_inliers", std::to_string(abs_pose_min_num_inliers), ">= 6");
   }
+  if (!(max_focal_ratio_to_start > 1)) {
+    throw OptionError("--Mapper.max_focal_ratio_to_start", std::to_string(max_focal_ratio_to_start), "> 1");
+  }
   if (random_seed < 0) throw OptionError("--random_seed", std::to_string(random_seed), ">= 0");
   if (init_max_restarts < 0) throw OptionError("--Mapper.init_max_restarts", std::to_string(init_max_restarts), ">= 0");
   if (min_model_size < 2) throw OptionError("--Mapper.min_model_size", std::to_string(min_model_size), ">= 2");
@@ -66,9 +69,15 @@ namespace {
 constexpr double kDegree = M_PI / 180.0;
 constexpr int kMinImagesForIntrinsics = 5;
 
-bool BogusIntrinsics(const std::map<camera_t, SfmCamera>& before, const std::map<camera_t, SfmCamera>& after) {
+// COLMAP's bogus-camera test against the intrinsics before the adjustment,
+// and the focal length against the mapper's start, which a slow drift of
+// many adjustments would otherwise pass.
+bool BogusIntrinsics(const std::map<camera_t, SfmCamera>& before, const std::map<camera_t, SfmCamera>& after,
+                     const std::map<camera_t, SfmCamera>& start, double max_focal_ratio_to_start) {
   for (const auto& [id, camera] : after) {
     if (ImplausibleIntrinsics(before.at(id).camera, camera.camera)) return true;
+    const double ratio = camera.camera.MeanFocalLength() / start.at(id).camera.MeanFocalLength();
+    if (!(ratio < max_focal_ratio_to_start && 1 / ratio < max_focal_ratio_to_start)) return true;
   }
   return false;
 }
@@ -520,7 +529,7 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   }
   const ceres::Solver::Summary summary =
       AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
-  const bool implausible = refine_intrinsics && BogusIntrinsics(cameras_before, r->cameras());
+  const bool implausible = refine_intrinsics && BogusIntrinsics(cameras_before, r->cameras(), cameras_, options_.max_focal_ratio_to_start);
   if (refine_intrinsics) num_implausible_in_a_row_ = implausible ? num_implausible_in_a_row_ + 1 : 0;
   if (implausible) {
     std::ostringstream values;

@@ -28,6 +28,13 @@ struct IncrementalMapperOptions {
   // again from the next candidate pair, at most this many times; with no
   // pair left, the first start is built to the end, its intrinsics held.
   int init_max_restarts = 2;
+  // A focal length more than this factor from the start counts as
+  // implausible too (COLMAP's bound, 2, against its prior). When the ArUco
+  // markers gave the start (within 1-6 % of the truth on every render),
+  // refractive_mapper tightens it to 1.25: a model grown from a wrong pair
+  // drifted there over many adjustments, none of them a factor 2 (own
+  // render, wide lens: 448 -> 994 px).
+  double max_focal_ratio_to_start = 2.0;
   double init_max_error_px = 4.0;
   // Scale of a model when markers do not give it: the initial pair's median
   // scene depth, metres.

@@ -144,7 +144,8 @@ std::vector<Matches> CollectPairs(const SfmInputs& inputs, camera_t camera_id, c
   return pairs;
 }
 
-// Sum of squared residuals and their count over all pairs, at radial term k.
+// Mean squared residual over all pairs, in pixels squared, and its count,
+// with the radial term k.
 std::pair<double, int> ResidualAt(const std::vector<Matches>& pairs, const SfmCamera& camera, int idx, double k) {
   Camera trial = camera.camera;
   trial.params[idx] = k;
@@ -170,7 +171,33 @@ std::pair<double, int> ResidualAt(const std::vector<Matches>& pairs, const SfmCa
     sum += pair_sum;
     count += pair_count;
   }
-  return {sum, count};
+  // Sampson's distance in normalised coordinates times the focal length:
+  // pixels.
+  const double focal = trial.MeanFocalLength();
+  return {count > 0 ? focal * focal * sum / count : std::numeric_limits<double>::infinity(), count};
+}
+
+// The parabola's vertex through three equally spaced samples, as an offset
+// from the middle one in units of the spacing (0 where it has no minimum).
+double ParabolaVertex(double c0, double c1, double c2) {
+  const double curvature = c0 - 2 * c1 + c2;
+  return std::isfinite(curvature) && curvature > 0 ? std::clamp(0.5 * (c0 - c2) / curvature, -1.0, 1.0) : 0.0;
+}
+
+// The best k and its mean squared residual: the grid's minimum, then the
+// parabola's vertex if that is lower still.
+std::pair<double, double> BestRadialTerm(const std::vector<Matches>& pairs, const SfmCamera& camera, int idx,
+                                         const RadialStartOptions& options) {
+  const double step = (options.max_k - options.min_k) / (options.num_steps - 1);
+  std::vector<double> costs(options.num_steps);
+  ParallelFor(costs.size(), 2, [&](size_t i) {
+    costs[i] = ResidualAt(pairs, camera, idx, options.min_k + i * step).first;
+  });
+  const size_t best = std::min_element(costs.begin(), costs.end()) - costs.begin();
+  double k = options.min_k + best * step;
+  if (best > 0 && best + 1 < costs.size()) k += step * ParabolaVertex(costs[best - 1], costs[best], costs[best + 1]);
+  const double cost = ResidualAt(pairs, camera, idx, k).first;
+  return cost <= costs[best] ? std::make_pair(k, cost) : std::make_pair(options.min_k + best * step, costs[best]);
 }
 
 }  // namespace
@@ -182,32 +209,16 @@ std::optional<RadialStart> EstimateFirstRadialTerm(const SfmInputs& inputs, came
   if (idx < 0) return std::nullopt;
   const std::vector<Matches> pairs = CollectPairs(inputs, camera_id, options);
   if (pairs.size() < 2) return std::nullopt;
-  const double focal = camera.camera.MeanFocalLength();
-  std::vector<double> ks(options.num_steps), costs(options.num_steps);
-  for (int i = 0; i < options.num_steps; ++i) {
-    ks[i] = options.min_k + (options.max_k - options.min_k) * i / (options.num_steps - 1);
-  }
-  // Mean squared residual per candidate.
-  ParallelFor(ks.size(), 2, [&](size_t i) {
-    const auto [sum, count] = ResidualAt(pairs, camera, idx, ks[i]);
-    costs[i] = count > 0 ? sum / count : std::numeric_limits<double>::infinity();
-  });
-  const size_t best = std::min_element(costs.begin(), costs.end()) - costs.begin();
-  if (!std::isfinite(costs[best])) return std::nullopt;
+  int num_matches = 0;
+  for (const Matches& matches : pairs) num_matches += static_cast<int>(matches.size());
   RadialStart start;
-  start.k = ks[best];
-  if (best > 0 && best + 1 < ks.size()) {
-    // The parabola through the best grid point and its neighbours.
-    const double c0 = costs[best - 1], c1 = costs[best], c2 = costs[best + 1];
-    const double curvature = c0 - 2 * c1 + c2;
-    if (std::isfinite(curvature) && curvature > 0) start.k += 0.5 * (ks[1] - ks[0]) * (c0 - c2) / curvature;
-  }
-  const auto [sum, count] = ResidualAt(pairs, camera, idx, start.k);
-  const auto [sum0, count0] = ResidualAt(pairs, camera, idx, camera.camera.params[idx]);
-  start.residual_px = focal * std::sqrt(sum / std::max(count, 1));
-  start.residual_at_start_px = focal * std::sqrt(sum0 / std::max(count0, 1));
+  double cost;
+  std::tie(start.k, cost) = BestRadialTerm(pairs, camera, idx, options);
+  if (!std::isfinite(cost)) return std::nullopt;
+  start.residual_px = std::sqrt(cost);
+  start.residual_at_start_px = std::sqrt(ResidualAt(pairs, camera, idx, camera.camera.params[idx]).first);
   start.num_pairs = static_cast<int>(pairs.size());
-  start.num_matches = count;
+  start.num_matches = num_matches;
   return start;
 }
 

@@ -13,8 +13,13 @@
 // for each candidate k1 the matched keypoints are turned into rays through
 // the camera and housing, a fundamental matrix is fitted on their
 // normalised coordinates (it absorbs errors of the focal length and
-// principal point, which are projective), and the k1 whose epipolar
-// residuals are smallest over the best-matched pairs is kept.
+// principal point, which are projective in air), and the k1 whose epipolar
+// residuals are smallest over the best-matched pairs is kept. Behind a
+// flat port a focal length error is not projective (refraction depends on
+// the ray's angle) and leaks into k1 (own render, the markers' focal
+// length 11 % low, k1 = 0: k1 +0.10); searching the focal length with k1
+// was tried and fitted the start's principal point and tilt errors instead
+// (synthetic test: f +25 %, k1 -0.41 for -0.30).
 #pragma once
 
 #include <optional>
@@ -34,7 +39,7 @@ struct RadialStartOptions {
 
 struct RadialStart {
   double k = 0;              // the first radial term chosen
-  double residual_px = 0;    // RMS epipolar (Sampson) residual there, pixels
+  double residual_px = 0;    // RMS epipolar (Sampson) residual there (trimmed), pixels
   double residual_at_start_px = 0;  // the same at the camera's own value
   int num_pairs = 0;
   int num_matches = 0;

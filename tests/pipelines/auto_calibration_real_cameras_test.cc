@@ -47,11 +47,7 @@ AutoCalibrationResult Calibrate(const fs::path& images, const fs::path& out) {
   return RunAutoCalibrator(options, progress);
 }
 
-// Disabled: it passes when the mapper also holds the principal point below
-// 10 images, which sent OwnRenderFlatPortIntrinsicsUnknown (a principal
-// point 4 px off, k1 = 0) to a normal 8 deg off; with the principal point
-// free this render's first model is wrong again (issue 21, open).
-TEST(AutoCalibrationRealCameras, DISABLED_WideOffCentreLensBehindATiltedFlatPortAndTheSameTwice) {
+TEST(AutoCalibrationRealCameras, WideOffCentreLensBehindATiltedFlatPortAndTheSameTwice) {
   testing::TempDir dir;
   std::ofstream(dir.path() / "set.yaml") << kWideLensBehindFlatPort << testing::kTwoFaceTargetYaml;
   SynthesizeOptions synthesize;
