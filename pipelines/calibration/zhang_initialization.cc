@@ -3,22 +3,10 @@
 #include <Eigen/Dense>
 #include <cmath>
 
+#include "colmap_ext/geometry/hartley_normalization.h"
+
 namespace portcal {
 namespace {
-
-// Hartley normalization: centroid to 0, mean distance sqrt(2).
-Eigen::Matrix3d Normalization(const std::vector<Eigen::Vector2d>& points) {
-  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
-  for (const auto& p : points) centroid += p;
-  centroid /= static_cast<double>(points.size());
-  double mean = 0;
-  for (const auto& p : points) mean += (p - centroid).norm();
-  mean /= static_cast<double>(points.size());
-  const double s = mean > 0 ? std::sqrt(2.0) / mean : 1.0;
-  Eigen::Matrix3d t;
-  t << s, 0, -s * centroid.x(), 0, s, -s * centroid.y(), 0, 0, 1;
-  return t;
-}
 
 // v_ij of Zhang's paper (eq. 8) for columns i, j of H.
 Eigen::Matrix<double, 1, 6> V(const Eigen::Matrix3d& h, int i, int j) {
@@ -34,7 +22,7 @@ Eigen::Matrix<double, 1, 6> V(const Eigen::Matrix3d& h, int i, int j) {
 std::optional<Eigen::Matrix3d> EstimateHomography(const std::vector<Eigen::Vector2d>& from,
                                                   const std::vector<Eigen::Vector2d>& to) {
   if (from.size() < 4 || from.size() != to.size()) return std::nullopt;
-  const Eigen::Matrix3d tf = Normalization(from), tt = Normalization(to);
+  const Eigen::Matrix3d tf = HartleyNormalization(from), tt = HartleyNormalization(to);
   Eigen::MatrixXd a(2 * from.size(), 9);
   for (size_t i = 0; i < from.size(); ++i) {
     const Eigen::Vector3d x = tf * from[i].homogeneous();

@@ -6,6 +6,7 @@
 #include <limits>
 #include <tuple>
 
+#include "colmap_ext/geometry/hartley_normalization.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/parallel.h"
 #include "colmap_ext/util/string_utils.h"
@@ -35,19 +36,6 @@ namespace {
 
 using Matches = std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>>;  // pixels in a, in b
 
-// Normalises points to zero mean and mean distance sqrt(2) (Hartley 1997).
-Eigen::Matrix3d NormalizingTransform(const std::vector<Eigen::Vector2d>& points) {
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const auto& p : points) mean += p;
-  mean /= static_cast<double>(points.size());
-  double spread = 0;
-  for (const auto& p : points) spread += (p - mean).norm();
-  spread = spread > 0 ? std::sqrt(2.0) * static_cast<double>(points.size()) / spread : 1.0;
-  Eigen::Matrix3d T;
-  T << spread, 0, -spread * mean.x(), 0, spread, -spread * mean.y(), 0, 0, 1;
-  return T;
-}
-
 double SampsonSquared(const Eigen::Matrix3d& F, const Eigen::Vector2d& x1, const Eigen::Vector2d& x2) {
   const Eigen::Vector3d p1 = x1.homogeneous(), p2 = x2.homogeneous();
   const Eigen::Vector3d Fp1 = F * p1, Ftp2 = F.transpose() * p2;
@@ -61,7 +49,7 @@ double SampsonSquared(const Eigen::Matrix3d& F, const Eigen::Vector2d& x1, const
 // approximate the geometric one), rank 2 enforced.
 Eigen::Matrix3d FitFundamental(const std::vector<Eigen::Vector2d>& x1, const std::vector<Eigen::Vector2d>& x2,
                                const std::vector<double>& weights) {
-  const Eigen::Matrix3d T1 = NormalizingTransform(x1), T2 = NormalizingTransform(x2);
+  const Eigen::Matrix3d T1 = HartleyNormalization(x1), T2 = HartleyNormalization(x2);
   Eigen::Matrix<double, 9, 9> AtA = Eigen::Matrix<double, 9, 9>::Zero();
   for (size_t i = 0; i < x1.size(); ++i) {
     if (weights[i] <= 0) continue;
