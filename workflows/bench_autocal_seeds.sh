@@ -8,18 +8,36 @@
 # (honest: 0.7-1.4), with the reported std devs and with each of the two
 # estimates they are the larger of (by the noise, by the clusters' spread:
 # images and tracks).
-# Usage: workflows/bench_autocal_seeds.sh [N=10]
+# CAMERA "wide" instead: a camera like a real one (issue 21), OPENCV with
+# k1 = -0.3, k2 = 0.09, tangential terms, fx != fy and the principal point
+# (10, -7.5) px off, 15 views at 0.3-0.8 m, behind a flat port tilted 2.5
+# deg at 30 mm; calibrated as OPENCV (fx, fy, cx, cy, Nx, Ny, distance).
+# Usage: workflows/bench_autocal_seeds.sh [N=10] [CAMERA=centred|wide]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ -x build/portcal ] || bash workflows/setup.sh >/dev/null
 n="${1:-10}"
+camera="${2:-centred}"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-cat > "$work/set.yaml" <<'YAML'
-name: seeds
-num_images: 12
+case "$camera" in
+  centred)
+    model=RADIAL
+    guess=0,0,1,0.015,0.010,1,1.473,1.334
+    scene='num_images: 12
 camera: {model: RADIAL, width: 960, height: 540, params: [650.0, 484.0, 266.5, 0.0, 0.0]}
 housing: {model: FLATPORT, params: [0.0697565, 0.0, 0.9975641, 0.015, 0.010, 1.0, 1.473, 1.334]}
+poses: {distance: [0.4, 1.0], tilt_max_deg: 45, roll_max_deg: 180, visibility: markers, border_margin_px: 10, max_view_angle_deg: 70}' ;;
+  wide)
+    model=OPENCV
+    guess=0,0,1,0.03,0.008,1,1.473,1.334
+    scene='num_images: 15
+camera: {model: OPENCV, width: 960, height: 540, params: [452.0, 450.5, 490.0, 262.5, -0.30, 0.09, 0.0012, 0.0009]}
+housing: {model: FLATPORT, params: [0.0436194, 0.0, 0.9990482, 0.03, 0.008, 1.0, 1.473, 1.334]}
+poses: {distance: [0.3, 0.8], tilt_max_deg: 45, roll_max_deg: 180, visibility: markers, border_margin_px: 10, max_view_angle_deg: 70}' ;;
+  *) echo "bench_autocal_seeds.sh: CAMERA must be centred or wide, not '$camera'" >&2; exit 2 ;;
+esac
+{ echo "name: seeds"; echo "$scene"; cat <<'YAML'; } > "$work/set.yaml"
 target:
   type: target3d
   num_faces: 2
@@ -31,14 +49,13 @@ target:
   marker_size: 0.06
   quiet_zone_modules: 1
   dots: {seed: 11, r_min: 0.0015, r_max: 0.009, coverage: 0.5, gray_min: 20, gray_max: 110, edge_margin: 0.004}
-poses: {distance: [0.4, 1.0], tilt_max_deg: 45, roll_max_deg: 180, visibility: markers, border_margin_px: 10, max_view_angle_deg: 70}
 render: {spp: 4, noise_sigma: 1.0, white: 220, black: 30, background: 110}
 YAML
 for seed in $(seq 1 "$n"); do
   build/portcal synthesize --log_level warn --config "$work/set.yaml" --output_path "$work/s$seed" --seed "$seed"
   if build/portcal auto_calibrator --log_level error --image_path "$work/s$seed/images" \
-       --output_path "$work/o$seed" --Housing.model FLATPORT \
-       --Housing.params 0,0,1,0.015,0.010,1,1.473,1.334 --Markers.side_length 0.06; then
+       --output_path "$work/o$seed" --ImageReader.camera_model "$model" --Housing.model FLATPORT \
+       --Housing.params "$guess" --Markers.side_length 0.06; then
     echo "$seed $work/s$seed/ground_truth.yaml $work/o$seed/calibration.yaml"
   else
     echo "$seed failed"
@@ -46,27 +63,34 @@ for seed in $(seq 1 "$n"); do
 done > "$work/runs.txt"
 /usr/bin/python3 - "$work/runs.txt" <<'PY'
 import math, sys, yaml
-names = ["f", "cx", "cy", "Nx", "Ny", "distance"]
-n = len(names)
+names = None
 # The reported std devs, and the two estimates they are the larger of.
 kinds = {"reported": "", "by the noise": "_by_noise", "by the clusters": "_by_clusters"}
-sums = {kind: [0.0] * n for kind in kinds}
+sums = {}
 count = 0
+failed = 0
 for line in open(sys.argv[1]):
     parts = line.split()
     if parts[1] == "failed":
         print(f"seed {parts[0]}: auto_calibrator failed")
+        failed += 1
         continue
     truth = yaml.safe_load(open(parts[1]))
     result = yaml.safe_load(open(parts[2]))
-    t = truth["camera"]["params"][0:3] + truth["housing"]["params"][0:2] + [truth["housing"]["params"][3]]
-    e = result["parameters"][0:3] + result["non_svp_parameters"][0:2] + [result["non_svp_parameters"][3]]
+    # The focal length(s) and the principal point lead every model's list.
+    m = 4 if result["model"] == "OPENCV" else 3
+    if names is None:
+        names = (["fx", "fy"] if m == 4 else ["f"]) + ["cx", "cy", "Nx", "Ny", "distance"]
+        n = len(names)
+        sums = {kind: [0.0] * n for kind in kinds}
+    t = truth["camera"]["params"][0:m] + truth["housing"]["params"][0:2] + [truth["housing"]["params"][3]]
+    e = result["parameters"][0:m] + result["non_svp_parameters"][0:2] + [result["non_svp_parameters"][3]]
     for kind, suffix in kinds.items():
         cam = result.get("parameters_std_dev" + suffix)
         hou = result.get("non_svp_parameters_std_dev" + suffix)
         if cam is None or hou is None:
             sys.exit(f"{parts[2]}: no parameters_std_dev{suffix} / non_svp_parameters_std_dev{suffix}")
-        s = cam[0:3] + hou[0:2] + [hou[3]]
+        s = cam[0:m] + hou[0:2] + [hou[3]]
         z = [(e[i] - t[i]) / s[i] if s[i] else float("nan") for i in range(n)]
         if kind == "reported":
             print(f"seed {parts[0]}: " + ", ".join(f"{names[i]} {e[i] - t[i]:+.5g} (sd {s[i]:.3g}, z {z[i]:+.2f})"
@@ -74,6 +98,7 @@ for line in open(sys.argv[1]):
         for i in range(n):
             sums[kind][i] += z[i] ** 2
     count += 1
+print(f"{count} seeds calibrated, {failed} failed (an error, no report)")
 if count:
     for kind in kinds:
         print(f"RMS z over {count} seeds, std devs {kind} (honest: 0.7-1.4): " +
