@@ -30,6 +30,9 @@ void AutoCalibratorOptions::Check() const {
                       "-1, 0 or 1");
   }
   if (random_seed < 0) throw OptionError("--random_seed", std::to_string(random_seed), ">= 0");
+  if (max_num_starts < 1) {
+    throw OptionError("--AutoCalibration.max_num_starts", std::to_string(max_num_starts), ">= 1");
+  }
   if (marker_side_length_m < 0) {
     throw OptionError("--Markers.side_length", std::to_string(marker_side_length_m), ">= 0 m");
   }
@@ -95,6 +98,115 @@ void JudgeAutoCalibration(const std::optional<double>& markers_focal, Calibratio
 }
 
 
+namespace {
+
+struct CalibrationStart {
+  int index = 0;  // 0: written to output_path itself; k: output_path/start_k
+  int num_registered = 0;
+  RefractiveBundleAdjusterResult refined;
+};
+
+std::string StartDir(int k) { return "start_" + std::to_string(k); }
+
+bool BetterStart(const CalibrationStart& a, const CalibrationStart& b) {
+  const auto& ra = a.refined.report;
+  const auto& rb = b.refined.report;
+  if (ra.warnings.size() != rb.warnings.size()) return ra.warnings.size() < rb.warnings.size();
+  return ra.residual_sigma_px < rb.residual_sigma_px;
+}
+
+// Moves the kept start's sparse/ and refined/ to output_path (kept < 0:
+// none) and removes the other starts' folders.
+void KeepStart(const fs::path& output_path, int kept, int num_starts) {
+  if (kept > 0) {
+    for (const char* name : {"sparse", "refined"}) {
+      fs::remove_all(output_path / name);
+      fs::rename(output_path / StartDir(kept) / name, output_path / name);
+    }
+  }
+  for (int k = 1; k < num_starts; ++k) fs::remove_all(output_path / StartDir(k));
+}
+
+RefractiveMapperOptions MapperOptions(const AutoCalibratorOptions& options, const std::string& database_path,
+                                      const fs::path& dir, int random_seed, bool refine_intrinsics) {
+  RefractiveMapperOptions map;
+  map.database_path = database_path;
+  map.image_path = options.image_path;
+  map.output_path = (dir / "sparse").string();
+  map.housing = options.housing;
+  map.mapper.num_threads = options.num_threads;
+  map.mapper.random_seed = random_seed;
+  map.init_radial_from_matches = options.init_radial_from_matches;
+  map.mapper.marker_scale.side_length_m = options.marker_side_length_m;
+  map.mapper.ba_refine_focal_length = refine_intrinsics;
+  map.mapper.ba_refine_extra_params = refine_intrinsics;
+  const bool refine_principal_point = refine_intrinsics && options.refine_principal_point != 0;
+  // A flat port's tilt, under the untilted guess, is absorbed by the
+  // mapper's poses and points unless the port is refined as the model
+  // grows (own renders: 4 of 10 seeds off by up to 2.5 deg; shared set:
+  // normal 0.067 -> 0.012 deg, |df| 1.53 -> 0.58 px). A dome's centred
+  // guess is close, and its axial decentering trades with the focal length
+  // on a few views (shared set: |df| 0.26 -> 1.28 px when refined in the
+  // mapper), so it is left to the final refinement. Only with marker scale:
+  // without it the port distance is barely observed, and on a rendered
+  // survey (120 images, no markers) refining the port in the growing models
+  // split the reconstruction into 9 pieces instead of 3.
+  map.mapper.ba_refine_housing = options.housing.model == "FLATPORT" && options.marker_side_length_m > 0;
+  // The principal point with it: held at the image centre when it is not
+  // there, the global adjustments fight the port (own render with it 5 px
+  // off: 90 s of global adjustment growing the port at 3 mm instead of
+  // 30 mm; refined, 28 s and 29.8 mm). With the dome left to the final
+  // refinement, its principal point is too (refined in the mapper as well,
+  // both the shared and an own dome render came out a little worse: |df|
+  // 0.16 -> 0.93 and 0.84 -> 1.23 px). The final refinement decides whether
+  // it stays off the centre.
+  map.mapper.ba_refine_principal_point = refine_principal_point && map.mapper.ba_refine_housing;
+  return map;
+}
+
+RefractiveBundleAdjusterOptions RefinerOptions(const AutoCalibratorOptions& options, const std::string& database_path,
+                                               const std::string& input_path, const fs::path& dir,
+                                               bool refine_intrinsics) {
+  const bool refine_principal_point = refine_intrinsics && options.refine_principal_point != 0;
+  RefractiveBundleAdjusterOptions refine;
+  refine.input_path = input_path;
+  refine.output_path = (dir / "refined").string();
+  refine.database_path = database_path;
+  refine.marker_scale.side_length_m = options.marker_side_length_m;
+  refine.housing_guess = options.housing;
+  refine.ba.refine_housing = !options.housing.model.empty();
+  refine.ba.refine_focal_length = refine_intrinsics;
+  refine.ba.refine_extra_params = refine_intrinsics;
+  // A camera's principal point is rarely exactly at the image centre, and
+  // held there when it is not, the port absorbs the offset: own render with
+  // it 5 px off, flat port 0.55 deg and 27 mm wrong; refined, 0.01 deg and
+  // 0.16 mm (docs/auto_calibration.md). Held at the centre again unless it
+  // lies beyond 3 sigma from it.
+  refine.ba.refine_principal_point = refine_principal_point;
+  refine.principal_point_test_sigmas = options.refine_principal_point == -1 ? 3.0 : 0.0;
+  refine.ba.num_threads = options.num_threads;
+  return refine;
+}
+
+// Start k: the mapper (random seed + k) and the refinement, judged; throws
+// NumericalError where either fails or the result is ruled out.
+CalibrationStart MapAndRefine(const AutoCalibratorOptions& options, const std::string& database_path, int k,
+                              const std::optional<double>& markers_focal, bool refine_intrinsics,
+                              ProgressSink& progress) {
+  const fs::path dir = k == 0 ? fs::path(options.output_path) : fs::path(options.output_path) / StartDir(k);
+  const RefractiveMapperSummary mapped = RunRefractiveMapper(
+      MapperOptions(options, database_path, dir, options.random_seed + k, refine_intrinsics), progress);
+  CalibrationStart start;
+  start.index = k;
+  start.num_registered = static_cast<int>(ReadSparseModel(mapped.model_paths.at(0)).images.size());
+  start.refined = RunRefractiveBundleAdjuster(
+      RefinerOptions(options, database_path, mapped.model_paths.at(0).string(), dir, refine_intrinsics));
+  if (refine_intrinsics) JudgeAutoCalibration(markers_focal, &start.refined.report);
+  return start;
+}
+
+}  // namespace
+
 AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, ProgressSink& progress) {
   options.Check();
   fs::create_directories(options.output_path);
@@ -142,63 +254,33 @@ AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   MatchFeatures(match, progress);
   lap(options.matcher + "_matcher");
 
-  RefractiveMapperOptions map;
-  map.database_path = database_path;
-  map.image_path = options.image_path;
-  map.output_path = (fs::path(options.output_path) / "sparse").string();
-  map.housing = options.housing;
-  map.mapper.num_threads = options.num_threads;
-  map.mapper.random_seed = options.random_seed;
-  map.init_radial_from_matches = options.init_radial_from_matches;
-  map.mapper.marker_scale.side_length_m = options.marker_side_length_m;
-  map.mapper.ba_refine_focal_length = refine_intrinsics;
-  map.mapper.ba_refine_extra_params = refine_intrinsics;
-  const bool refine_principal_point = refine_intrinsics && options.refine_principal_point != 0;
-  // A flat port's tilt, under the untilted guess, is absorbed by the
-  // mapper's poses and points unless the port is refined as the model
-  // grows (own renders: 4 of 10 seeds off by up to 2.5 deg; shared set:
-  // normal 0.067 -> 0.012 deg, |df| 1.53 -> 0.58 px). A dome's centred
-  // guess is close, and its axial decentering trades with the focal length
-  // on a few views (shared set: |df| 0.26 -> 1.28 px when refined in the
-  // mapper), so it is left to the final refinement. Only with marker scale:
-  // without it the port distance is barely observed, and on a rendered
-  // survey (120 images, no markers) refining the port in the growing models
-  // split the reconstruction into 9 pieces instead of 3.
-  map.mapper.ba_refine_housing = options.housing.model == "FLATPORT" && options.marker_side_length_m > 0;
-  // The principal point with it: held at the image centre when it is not
-  // there, the global adjustments fight the port (own render with it 5 px
-  // off: 90 s of global adjustment growing the port at 3 mm instead of
-  // 30 mm; refined, 28 s and 29.8 mm). With the dome left to the final
-  // refinement, its principal point is too (refined in the mapper as well,
-  // both the shared and an own dome render came out a little worse: |df|
-  // 0.16 -> 0.93 and 0.84 -> 1.23 px). The final refinement decides whether
-  // it stays off the centre.
-  map.mapper.ba_refine_principal_point = refine_principal_point && map.mapper.ba_refine_housing;
-  const RefractiveMapperSummary mapped = RunRefractiveMapper(map, progress);
-  result.num_registered = static_cast<int>(ReadSparseModel(mapped.model_paths.at(0)).images.size());
-  lap("refractive_mapper");
-
-  RefractiveBundleAdjusterOptions refine;
-  refine.input_path = mapped.model_paths.at(0).string();
-  refine.output_path = (fs::path(options.output_path) / "refined").string();
-  refine.database_path = database_path;
-  refine.marker_scale.side_length_m = options.marker_side_length_m;
-  refine.housing_guess = options.housing;
-  refine.ba.refine_housing = !options.housing.model.empty();
-  refine.ba.refine_focal_length = refine_intrinsics;
-  refine.ba.refine_extra_params = refine_intrinsics;
-  // A camera's principal point is rarely exactly at the image centre, and
-  // held there when it is not, the port absorbs the offset: own render with
-  // it 5 px off, flat port 0.55 deg and 27 mm wrong; refined, 0.01 deg and
-  // 0.16 mm (docs/auto_calibration.md). Held at the centre again unless it
-  // lies beyond 3 sigma from it.
-  refine.ba.refine_principal_point = refine_principal_point;
-  refine.principal_point_test_sigmas = options.refine_principal_point == -1 ? 3.0 : 0.0;
-  refine.ba.num_threads = options.num_threads;
-  result.refined = RunRefractiveBundleAdjuster(refine);
-  if (refine_intrinsics) JudgeAutoCalibration(markers_focal, &result.refined.report);
+  // Several starts when one cannot be trusted (a wrong basin, or a
+  // poorly determined solution): the mapper's random choices from another
+  // seed take another path; the start with the fewest warnings, then the
+  // smallest residual, is kept.
+  const int num_starts = refine_intrinsics ? options.max_num_starts : 1;
+  std::optional<CalibrationStart> best;
+  std::string first_error;
+  for (int k = 0; k < num_starts; ++k) {
+    try {
+      CalibrationStart start = MapAndRefine(options, database_path, k, markers_focal, refine_intrinsics, progress);
+      if (!best || BetterStart(start, *best)) best = std::move(start);
+    } catch (const NumericalError& e) {
+      if (first_error.empty()) first_error = e.what();
+      LOG(WARNING) << "auto_calibrator: start " << k + 1 << " of " << num_starts << " failed: " << e.what();
+    }
+    if (best && best->refined.report.warnings.empty()) break;
+    if (k + 1 < num_starts) {
+      LOG(WARNING) << "auto_calibrator: start " << k + 1 << " is not to be trusted; mapping again from random seed "
+                   << options.random_seed + k + 1;
+    }
+  }
+  KeepStart(options.output_path, best ? best->index : -1, num_starts);
+  if (!best) throw NumericalError(first_error);
+  result.refined = best->refined;
+  result.num_registered = best->num_registered;
+  lap("refractive_mapper + refractive_bundle_adjuster");
   WriteCalibrationReport(result.refined.report, options.output_path);
-  lap("refractive_bundle_adjuster");
   std::string times;
   for (const auto& [stage, seconds] : result.stage_seconds) times += " " + stage + " " + std::to_string(seconds) + " s;";
   LOG(INFO) << "auto_calibrator: " << result.num_registered << " of " << result.num_images

@@ -156,6 +156,8 @@ int RunAutoCalibrator(int argc, char** argv) {
   cli.Add("Mapper.init_radial_from_matches", &options.init_radial_from_matches,
           "first radial distortion term from the verified matches before mapping: -1 when the intrinsics are "
           "refined, 0 never");
+  cli.Add("AutoCalibration.max_num_starts", &options.max_num_starts,
+          "map and refine again from the next random seed while a start fails or warns, at most this often");
   cli.Add("random_seed", &options.random_seed, "seed of every random choice (>= 0): same images, same calibration");
   cli.Add("num_threads", &options.num_threads, "threads");
   return ReportErrors([&] {
