@@ -93,10 +93,9 @@ void JudgeAutoCalibration(const std::optional<double>& markers_focal, Calibratio
   if (focal_std_dev > kMaxRelativeFocalStdDev * focal) {
     report->warnings.push_back("the focal length is poorly determined: std dev " + FormatNumber(focal_std_dev) +
                                " px, " + FormatNumber(100 * focal_std_dev / focal) + " % of it; " + remedy);
+    LOG(WARNING) << "auto_calibrator: " << report->warnings.back();
   }
-  for (const std::string& warning : report->warnings) LOG(WARNING) << "auto_calibrator: " << warning;
 }
-
 
 namespace {
 

@@ -529,7 +529,8 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   }
   const ceres::Solver::Summary summary =
       AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
-  const bool implausible = refine_intrinsics && BogusIntrinsics(cameras_before, r->cameras(), cameras_, options_.max_focal_ratio_to_start);
+  const bool implausible =
+      refine_intrinsics && BogusIntrinsics(cameras_before, r->cameras(), cameras_, options_.max_focal_ratio_to_start);
   if (refine_intrinsics) num_implausible_in_a_row_ = implausible ? num_implausible_in_a_row_ + 1 : 0;
   if (implausible) {
     std::ostringstream values;
