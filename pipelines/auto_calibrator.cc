@@ -107,11 +107,16 @@ struct CalibrationStart {
 
 std::string StartDir(int k) { return "start_" + std::to_string(k); }
 
+// Warnings another start might cure: not those about what the views'
+// geometry cannot tell apart.
+size_t NumCurableWarnings(const RefractiveBundleAdjusterResult& refined) {
+  return refined.report.warnings.size() - static_cast<size_t>(refined.num_geometry_warnings);
+}
+
 bool BetterStart(const CalibrationStart& a, const CalibrationStart& b) {
-  const auto& ra = a.refined.report;
-  const auto& rb = b.refined.report;
-  if (ra.warnings.size() != rb.warnings.size()) return ra.warnings.size() < rb.warnings.size();
-  return ra.residual_sigma_px < rb.residual_sigma_px;
+  const size_t wa = NumCurableWarnings(a.refined), wb = NumCurableWarnings(b.refined);
+  if (wa != wb) return wa < wb;
+  return a.refined.report.residual_sigma_px < b.refined.report.residual_sigma_px;
 }
 
 // Moves the kept start's sparse/ and refined/ to output_path (kept < 0:
@@ -200,7 +205,16 @@ CalibrationStart MapAndRefine(const AutoCalibratorOptions& options, const std::s
   start.num_registered = static_cast<int>(ReadSparseModel(mapped.model_paths.at(0)).images.size());
   start.refined = RunRefractiveBundleAdjuster(
       RefinerOptions(options, database_path, mapped.model_paths.at(0).string(), dir, refine_intrinsics));
-  if (refine_intrinsics) JudgeAutoCalibration(markers_focal, &start.refined.report);
+  if (refine_intrinsics) {
+    const size_t num_warnings = start.refined.report.warnings.size();
+    JudgeAutoCalibration(markers_focal, &start.refined.report);
+    // A focal length poorly determined where the views trade it against
+    // the housing: another start cannot cure it either (own fisheye behind
+    // a decentred dome: three starts, three identical models).
+    if (start.refined.num_geometry_warnings > 0) {
+      start.refined.num_geometry_warnings += static_cast<int>(start.refined.report.warnings.size() - num_warnings);
+    }
+  }
   return start;
 }
 
@@ -268,7 +282,7 @@ AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
       if (first_error.empty()) first_error = e.what();
       LOG(WARNING) << "auto_calibrator: start " << k + 1 << " of " << num_starts << " failed: " << e.what();
     }
-    if (best && best->refined.report.warnings.empty()) break;
+    if (best && NumCurableWarnings(best->refined) == 0) break;
     if (k + 1 < num_starts) {
       LOG(WARNING) << "auto_calibrator: start " << k + 1 << " is not to be trusted; mapping again from random seed "
                    << options.random_seed + k + 1;

@@ -41,7 +41,8 @@ struct AutoCalibratorOptions {
   // same images and options give the same calibration.
   int random_seed = 0;
   // The lens's first radial term from the matches before mapping
-  // (RefractiveMapperOptions::init_radial_from_matches): -1 or 0.
+  // (RefractiveMapperOptions::init_radial_from_matches: not for fisheye
+  // models): -1 or 0.
   int init_radial_from_matches = -1;
   // With the intrinsics refined: starts of the mapper and refinement (each
   // from the next random seed) while a start fails or its report carries

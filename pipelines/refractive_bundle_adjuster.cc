@@ -45,6 +45,12 @@ namespace {
 // report warns: the housing's standard deviation is then at least 3.2 times
 // what it would be with the intrinsic known.
 constexpr double kTradeOffCorrelation = 0.95;
+// From this inflation of the housing's standard deviation by a trade-off
+// (|rho| >= 0.995) the housing is hardly measured at all: a warning, not a
+// note (own renders at 1920 x 1080, 30 views, OPENCV behind a dome 4 mm
+// off along its axis, intrinsics unknown: factors 18-21, the dome centre's
+// sd 1.0 mm where the intrinsics given make it 0.07 mm).
+constexpr double kTradeOffWarningFactor = 10.0;
 
 std::string FormatSigmas(double sigmas) {
   std::ostringstream out;
@@ -103,6 +109,23 @@ double PoorPrincipalPointStdDev(const std::map<camera_t, SfmCamera>& cameras, co
   return worst;
 }
 
+// A refined housing a real one would hardly have (Housing::Implausibility):
+// a self-calibration that traded the port against the lens, however small
+// its standard deviations (issue 21: a flat port 361 mm from the camera
+// centre, reported at 0.39 +- 0.07 m).
+std::vector<std::string> ImplausibleHousingWarnings(const std::map<camera_t, SfmCamera>& cameras) {
+  std::vector<std::string> warnings;
+  for (const auto& [id, camera] : cameras) {
+    if (!camera.housing) continue;
+    if (const std::optional<std::string> why = camera.housing->Implausibility()) {
+      warnings.push_back("camera " + std::to_string(id) + ": " + *why +
+                         ": the calibration likely traded the housing against the lens; give the in-air "
+                         "intrinsics (--ImageReader.camera_params), a closer housing guess, or more views");
+    }
+  }
+  return warnings;
+}
+
 std::vector<std::string> SplitParamsInfo(const std::string& info) {
   std::vector<std::string> names;
   std::istringstream in(info);
@@ -121,9 +144,14 @@ std::vector<std::string> SplitParamsInfo(const std::string& info) {
 // 2.3 mm off, each ~1.2 sd; with the in-air intrinsics given Cz 0.05 mm).
 // The housing's variance is then at least 1 / (1 - rho^2) times what it
 // would be with that intrinsic known.
-std::vector<std::string> TradeOffNotes(const std::map<camera_t, SfmCamera>& cameras,
-                                       const CalibrationStdDevs& std_devs, double limit) {
-  std::vector<std::string> notes;
+struct TradeOff {
+  std::string text;
+  double factor = 1;  // the housing's sd at least this many times that with the intrinsics known
+};
+
+std::vector<TradeOff> TradeOffs(const std::map<camera_t, SfmCamera>& cameras, const CalibrationStdDevs& std_devs,
+                                double limit) {
+  std::vector<TradeOff> trade_offs;
   for (const auto& [id, correlation] : std_devs.intrinsics_housing_correlation) {
     if (correlation.size() == 0) continue;
     Eigen::Index i, j;
@@ -132,17 +160,17 @@ std::vector<std::string> TradeOffNotes(const std::map<camera_t, SfmCamera>& came
     const SfmCamera& camera = cameras.at(id);
     const std::vector<std::string> intrinsic = SplitParamsInfo(camera.camera.ParamsInfo());
     const std::vector<std::string> housing = SplitParamsInfo(camera.housing->ParamsInfo());
+    const double factor = 1.0 / std::sqrt(std::max(1e-12, 1.0 - strongest * strongest));
     std::ostringstream note;
     note << std::fixed << std::setprecision(4) << (cameras.size() > 1 ? "camera " + std::to_string(id) + ": " : "")
          << intrinsic.at(static_cast<size_t>(i)) << " and " << housing.at(static_cast<size_t>(j))
          << " are correlated at " << std::showpos << correlation(i, j) << std::noshowpos
          << ": the views hardly tell them apart (the housing's standard deviation is at least "
-         << std::setprecision(1) << 1.0 / std::sqrt(std::max(1e-12, 1.0 - strongest * strongest))
-         << " times what it would be with the intrinsics known); give in-air intrinsics "
+         << std::setprecision(1) << factor << " times what it would be with the intrinsics known); give in-air intrinsics "
             "(--ImageReader.camera_params) or views with more depth and angle";
-    notes.push_back(note.str());
+    trade_offs.push_back({note.str(), factor});
   }
-  return notes;
+  return trade_offs;
 }
 
 // Sets every camera's principal point to its image centre.
@@ -367,16 +395,27 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
   if (const camera_t id = housing_at_bound(); id != kInvalidCameraId) {
     // Not an estimate: its standard deviations describe a bound.
     const Housing& housing = *r.cameras().at(id).housing;
-    notes.push_back("camera " + std::to_string(id) + ": the housing ended at a bound of the adjustment (" +
+    warnings.push_back("camera " + std::to_string(id) + ": the housing ended at a bound of the adjustment (" +
                     (housing.model_id == 0 ? "port distance 0.1 mm" : "decentering 90 % of the radius") +
                     "), not an estimate; the data traded it against the intrinsics: give the intrinsics, more "
                     "views or a closer housing guess");
-    LOG(WARNING) << "refractive_bundle_adjuster: " << notes.back();
+    LOG(WARNING) << "refractive_bundle_adjuster: " << warnings.back();
+  }
+  if (options.ba.refine_housing) {
+    for (const std::string& warning : ImplausibleHousingWarnings(r.cameras())) {
+      warnings.push_back(warning);
+      LOG(WARNING) << "refractive_bundle_adjuster: " << warning;
+    }
   }
 
-  for (const std::string& note : TradeOffNotes(r.cameras(), std_devs, kTradeOffCorrelation)) {
-    notes.push_back(note);
-    LOG(WARNING) << "refractive_bundle_adjuster: " << note;
+  for (const TradeOff& trade_off : TradeOffs(r.cameras(), std_devs, kTradeOffCorrelation)) {
+    if (trade_off.factor >= kTradeOffWarningFactor) {
+      warnings.push_back(trade_off.text);
+      ++result.num_geometry_warnings;
+    } else {
+      notes.push_back(trade_off.text);
+    }
+    LOG(WARNING) << "refractive_bundle_adjuster: " << trade_off.text;
   }
 
   // Report: the first camera, RMS of the exact reprojection error.

@@ -61,6 +61,10 @@ struct RefractiveBundleAdjusterResult {
   int num_position_priors = 0;  // images whose priors fixed the frame
   int num_filtered = 0;
   bool principal_point_held = false;  // by principal_point_test_sigmas
+  // Of report.warnings, those about what the views' geometry cannot tell
+  // apart (an intrinsic and a housing parameter traded): another start on
+  // the same views cannot cure them.
+  int num_geometry_warnings = 0;
 };
 
 RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options);

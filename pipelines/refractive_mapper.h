@@ -30,7 +30,8 @@ struct RefractiveMapperOptions {
   int init_focal_from_markers = -1;
   // The lens's first radial term from the verified matches (radial_start.h)
   // before mapping. -1: when the camera has no prior focal length, its
-  // distortion is all zero and the mapper refines it; 0: never; 1: always.
+  // distortion is all zero, the mapper refines it and the model is not a
+  // fisheye; 0: never; 1: always.
   int init_radial_from_matches = -1;
   RadialStartOptions radial_start;
   void Check() const;  // throws OptionError naming the option

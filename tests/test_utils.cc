@@ -72,5 +72,18 @@ const char* const kTwoFaceTargetYaml = R"(target:
   dots: {seed: 11, r_min: 0.0015, r_max: 0.009, coverage: 0.5, gray_min: 20, gray_max: 110, edge_margin: 0.004}
 )";
 
+const char* const kThreeFaceTargetYaml = R"(target:
+  type: target3d
+  num_faces: 3
+  fold_angle_deg: 120
+  face_width: 0.2
+  face_height: 0.25
+  aruco_dict: DICT_4X4_50
+  marker_ids: [0, 1, 2]
+  marker_size: 0.06
+  quiet_zone_modules: 1
+  dots: {seed: 11, r_min: 0.0015, r_max: 0.009, coverage: 0.5, gray_min: 20, gray_max: 110, edge_margin: 0.004}
+)";
+
 }  // namespace testing
 }  // namespace portcal

@@ -47,6 +47,8 @@ std::string ReadFileToString(const std::filesystem::path& path);
 // target: two faces folded at 120 deg, dots, ArUco markers 0 and 1 of
 // DICT_4X4_50, 0.06 m.
 extern const char* const kTwoFaceTargetYaml;
+// The same with a third face (markers 0, 1 and 2).
+extern const char* const kThreeFaceTargetYaml;
 
 }  // namespace testing
 }  // namespace portcal

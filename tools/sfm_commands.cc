@@ -67,7 +67,7 @@ int RunRefractiveMapper(int argc, char** argv) {
           "focal length from ArUco markers: -1 when the camera has no prior, 0 never, 1 always");
   cli.Add("Mapper.init_radial_from_matches", &options.init_radial_from_matches,
           "first radial distortion term from the verified matches: -1 when the camera has no prior focal length "
-          "and no distortion, 0 never, 1 always");
+          "and no distortion and is not a fisheye, 0 never, 1 always");
   RadialStartOptions& radial = options.radial_start;
   cli.Add("Mapper.init_radial_min_k", &radial.min_k, "search range of the first radial term, lower end");
   cli.Add("Mapper.init_radial_max_k", &radial.max_k, "search range of the first radial term, upper end");
@@ -155,7 +155,7 @@ int RunAutoCalibrator(int argc, char** argv) {
   cli.Add("SiftExtraction.max_image_size", &options.sift.max_image_size, "pixels");
   cli.Add("Mapper.init_radial_from_matches", &options.init_radial_from_matches,
           "first radial distortion term from the verified matches before mapping: -1 when the intrinsics are "
-          "refined, 0 never");
+          "refined and the model is not a fisheye, 0 never");
   cli.Add("AutoCalibration.max_num_starts", &options.max_num_starts,
           "map and refine again from the next random seed while a start fails or warns, at most this often");
   cli.Add("random_seed", &options.random_seed, "seed of every random choice (>= 0): same images, same calibration");

@@ -12,7 +12,10 @@
 # k1 = -0.3, k2 = 0.09, tangential terms, fx != fy and the principal point
 # (10, -7.5) px off, 15 views at 0.3-0.8 m, behind a flat port tilted 2.5
 # deg at 30 mm; calibrated as OPENCV (fx, fy, cx, cy, Nx, Ny, distance).
-# Usage: workflows/bench_autocal_seeds.sh [N=10] [CAMERA=centred|wide]
+# CAMERA "fisheye": the same views and port with an OPENCV_FISHEYE lens
+# (about 100 deg across, principal point (-8, 6) px off), calibrated as
+# OPENCV_FISHEYE.
+# Usage: workflows/bench_autocal_seeds.sh [N=10] [CAMERA=centred|wide|fisheye]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ -x build/portcal ] || bash workflows/setup.sh >/dev/null
@@ -35,7 +38,14 @@ poses: {distance: [0.4, 1.0], tilt_max_deg: 45, roll_max_deg: 180, visibility: m
 camera: {model: OPENCV, width: 960, height: 540, params: [452.0, 450.5, 490.0, 262.5, -0.30, 0.09, 0.0012, 0.0009]}
 housing: {model: FLATPORT, params: [0.0436194, 0.0, 0.9990482, 0.03, 0.008, 1.0, 1.473, 1.334]}
 poses: {distance: [0.3, 0.8], tilt_max_deg: 45, roll_max_deg: 180, visibility: markers, border_margin_px: 10, max_view_angle_deg: 70}' ;;
-  *) echo "bench_autocal_seeds.sh: CAMERA must be centred or wide, not '$camera'" >&2; exit 2 ;;
+  fisheye)
+    model=OPENCV_FISHEYE
+    guess=0,0,1,0.03,0.008,1,1.473,1.334
+    scene='num_images: 15
+camera: {model: OPENCV_FISHEYE, width: 960, height: 540, params: [380.0, 379.0, 472.0, 276.0, 0.06, -0.02, 0.004, -0.001]}
+housing: {model: FLATPORT, params: [0.0436194, 0.0, 0.9990482, 0.03, 0.008, 1.0, 1.473, 1.334]}
+poses: {distance: [0.3, 0.8], tilt_max_deg: 45, roll_max_deg: 180, visibility: markers, border_margin_px: 10, max_view_angle_deg: 70}' ;;
+  *) echo "bench_autocal_seeds.sh: CAMERA must be centred, wide or fisheye, not '$camera'" >&2; exit 2 ;;
 esac
 { echo "name: seeds"; echo "$scene"; cat <<'YAML'; } > "$work/set.yaml"
 target:
@@ -63,11 +73,13 @@ for seed in $(seq 1 "$n"); do
 done > "$work/runs.txt"
 /usr/bin/python3 - "$work/runs.txt" <<'PY'
 import math, sys, yaml
-names = None
 # The reported std devs, and the two estimates they are the larger of.
 kinds = {"reported": "", "by the noise": "_by_noise", "by the clusters": "_by_clusters"}
-sums = {}
-count = 0
+# Over all seeds, and over those whose report carries no warning (what a
+# user would take as trustworthy).
+groups = {"all": {}, "unwarned": {}}
+names = None
+counts = {"all": 0, "unwarned": 0}
 failed = 0
 for line in open(sys.argv[1]):
     parts = line.split()
@@ -78,29 +90,42 @@ for line in open(sys.argv[1]):
     truth = yaml.safe_load(open(parts[1]))
     result = yaml.safe_load(open(parts[2]))
     # The focal length(s) and the principal point lead every model's list.
-    m = 4 if result["model"] == "OPENCV" else 3
+    m = 4 if result["parameter_names"][1] == "fy" else 3
     if names is None:
-        names = (["fx", "fy"] if m == 4 else ["f"]) + ["cx", "cy", "Nx", "Ny", "distance"]
+        names = result["parameter_names"][0:m] + ["Nx", "Ny", "distance"]
         n = len(names)
-        sums = {kind: [0.0] * n for kind in kinds}
+        for g in groups:
+            groups[g] = {kind: ([0.0] * n, [0] * n) for kind in kinds}
     t = truth["camera"]["params"][0:m] + truth["housing"]["params"][0:2] + [truth["housing"]["params"][3]]
     e = result["parameters"][0:m] + result["non_svp_parameters"][0:2] + [result["non_svp_parameters"][3]]
+    warnings = result.get("warnings") or []
+    members = ["all"] + ([] if warnings else ["unwarned"])
     for kind, suffix in kinds.items():
         cam = result.get("parameters_std_dev" + suffix)
         hou = result.get("non_svp_parameters_std_dev" + suffix)
         if cam is None or hou is None:
             sys.exit(f"{parts[2]}: no parameters_std_dev{suffix} / non_svp_parameters_std_dev{suffix}")
         s = cam[0:m] + hou[0:2] + [hou[3]]
-        z = [(e[i] - t[i]) / s[i] if s[i] else float("nan") for i in range(n)]
+        # A parameter held (sd 0, the principal point at the centre) has no z.
+        z = [(e[i] - t[i]) / s[i] if s[i] else None for i in range(n)]
         if kind == "reported":
-            print(f"seed {parts[0]}: " + ", ".join(f"{names[i]} {e[i] - t[i]:+.5g} (sd {s[i]:.3g}, z {z[i]:+.2f})"
-                                                  for i in range(n)))
-        for i in range(n):
-            sums[kind][i] += z[i] ** 2
-    count += 1
-print(f"{count} seeds calibrated, {failed} failed (an error, no report)")
-if count:
+            print(f"seed {parts[0]}: " + ", ".join(
+                f"{names[i]} {e[i] - t[i]:+.5g} " + (f"(sd {s[i]:.3g}, z {z[i]:+.2f})" if z[i] is not None else "(held)")
+                for i in range(n)) + (f"; {len(warnings)} warning(s): " + " | ".join(w[:90] for w in warnings) if warnings else ""))
+        for g in members:
+            sums, num = groups[g][kind]
+            for i in range(n):
+                if z[i] is not None:
+                    sums[i] += z[i] ** 2
+                    num[i] += 1
+    for g in members:
+        counts[g] += 1
+print(f"{counts['all']} seeds calibrated ({counts['all'] - counts['unwarned']} with a warning), {failed} failed (an error, no report)")
+for g in groups:
+    if not counts[g]:
+        continue
     for kind in kinds:
-        print(f"RMS z over {count} seeds, std devs {kind} (honest: 0.7-1.4): " +
-              ", ".join(f"{names[i]} {math.sqrt(sums[kind][i] / count):.2f}" for i in range(n)))
+        sums, num = groups[g][kind]
+        print(f"RMS z over the {counts[g]} {'' if g == 'all' else 'unwarned '}seeds, std devs {kind} (honest: 0.7-1.4): " +
+              ", ".join(f"{names[i]} " + (f"{math.sqrt(sums[i] / num[i]):.2f}" if num[i] else "held") for i in range(n)))
 PY

@@ -74,6 +74,12 @@ std::vector<int> CameraModelExtraParamsIdxs(int model_id) {
   return idxs;
 }
 
+bool CameraModelIsFisheye(int model_id) {
+  bool fisheye = false;
+  VisitCameraModel(model_id, [&](auto model) { fisheye = decltype(model)::kFisheye; });
+  return fisheye;
+}
+
 std::vector<double> CameraModelInitializeParams(int model_id,
                                                 double focal_length, int width,
                                                 int height) {

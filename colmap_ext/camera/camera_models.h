@@ -43,6 +43,8 @@ std::string CameraModelParamsInfo(int model_id);
 std::vector<int> CameraModelFocalLengthIdxs(int model_id);
 std::vector<int> CameraModelPrincipalPointIdxs(int model_id);
 std::vector<int> CameraModelExtraParamsIdxs(int model_id);
+// Built on the equidistant angle (OPENCV_FISHEYE and the other *_FISHEYE).
+bool CameraModelIsFisheye(int model_id);
 std::vector<double> CameraModelInitializeParams(int model_id,
                                                 double focal_length, int width,
                                                 int height);

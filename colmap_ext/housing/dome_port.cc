@@ -4,6 +4,8 @@
 #include <cmath>
 #include <complex>
 
+#include "colmap_ext/util/string_utils.h"
+
 namespace portcal {
 
 std::optional<std::string> DomePort::Invalidity(const double* port) {
@@ -23,6 +25,17 @@ std::optional<std::string> DomePort::Invalidity(const double* port) {
            "decentering |C| = " + std::to_string(decentering) +
            " m is not below int_radius = " + std::to_string(InnerRadius(port)) +
            " m";
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> DomePort::Implausibility(const double* port) {
+  constexpr double kMaxPlausibleDecenteringFraction = 0.25;
+  const double decentering = Center(port).norm();
+  if (decentering > kMaxPlausibleDecenteringFraction * InnerRadius(port)) {
+    return "the dome's centre is " + FormatFixed(1000 * decentering, 1) + " mm from the camera centre, " +
+           FormatFixed(100 * decentering / InnerRadius(port), 0) +
+           " % of its radius, where dome housings centre the lens to a few mm";
   }
   return std::nullopt;
 }

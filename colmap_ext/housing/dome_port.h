@@ -42,6 +42,14 @@ struct DomePort {
 
   static std::optional<std::string> Invalidity(const double* port);
 
+  // Why a real housing would hardly have these (valid) parameters, or
+  // nullopt: a camera centre decentred by more than a quarter of the inner
+  // radius. Dome housings are built to centre the lens's entrance pupil to
+  // a few mm; beyond, the refraction is strong enough that a real lens
+  // would show it and a self-calibration that ends there has likely traded
+  // the dome against the focal length.
+  static std::optional<std::string> Implausibility(const double* port);
+
   // Traces a ray from `origin` (inside the inner sphere) along `dir_in_air`
   // through both spheres. Templated on the dimension so the forward solve can
   // run it inside the 2-D plane of refraction.

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "colmap_ext/util/string_utils.h"
+
 namespace portcal {
 
 std::optional<std::string> FlatPort::Invalidity(const double* port) {
@@ -25,6 +27,23 @@ std::optional<std::string> FlatPort::Invalidity(const double* port) {
   if (!(Thickness(port) > 0)) return "FLATPORT int_thick must be positive";
   if (!(AirIndex(port) > 0 && GlassIndex(port) > 0 && WaterIndex(port) > 0)) {
     return "FLATPORT refractive indices must be positive";
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> FlatPort::Implausibility(const double* port) {
+  constexpr double kMaxPlausibleDistance = 0.1;
+  constexpr double kMaxPlausibleTiltDeg = 10.0;
+  const double distance = InterfaceDistance(port);
+  if (distance > kMaxPlausibleDistance) {
+    return "the flat port's inner surface is " + FormatFixed(1000 * distance, 1) +
+           " mm in front of the camera centre, where housings put it within a few cm";
+  }
+  const Eigen::Vector3d normal(port[0], port[1], port[2]);
+  const double tilt_deg = std::acos(std::min(1.0, normal.normalized().z())) * 180.0 / M_PI;
+  if (tilt_deg > kMaxPlausibleTiltDeg) {
+    return "the flat port is tilted " + FormatFixed(tilt_deg, 1) +
+           " deg from the optical axis, where housings mount it within a few degrees of square";
   }
   return std::nullopt;
 }

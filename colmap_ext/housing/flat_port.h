@@ -53,6 +53,14 @@ struct FlatPort {
   // Why these parameters describe no flat port, or nullopt if they do.
   static std::optional<std::string> Invalidity(const double* port);
 
+  // Why a real housing would hardly have these (valid) parameters, or
+  // nullopt: a camera centre more than 10 cm behind the port, or a port
+  // tilted more than 10 deg from the optical axis. Housings put the lens
+  // within a few cm of a port mounted square to it; a self-calibration
+  // that ends beyond has traded the port against the lens (issue 21: 14 deg
+  // and 0.1 mm, 11.4 deg and 361 mm).
+  static std::optional<std::string> Implausibility(const double* port);
+
   // Back-projection: a ray leaving the camera centre along `dir_in_air` (any
   // length) -> ray in water, origin on the outer surface, unit direction.
   // False if the ray misses the port (n . d <= 0) or is totally reflected.

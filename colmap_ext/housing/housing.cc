@@ -82,6 +82,16 @@ void Housing::Validate(const std::string& context) const {
   if (problem) throw InputError(context + ": " + *problem);
 }
 
+std::optional<std::string> Housing::Implausibility() const {
+  std::optional<std::string> why;
+  VisitHousingModel(model_id, [&](auto model) {
+    using Port = decltype(model);
+    PORTCAL_CHECK(static_cast<int>(params.size()) == Port::kNumParams);
+    why = Port::Implausibility(params.data());
+  });
+  return why;
+}
+
 std::optional<Eigen::Vector2d> ProjectPoint(const Camera& camera,
                                             const Housing* housing,
                                             const Eigen::Vector3d& point_in_cam) {

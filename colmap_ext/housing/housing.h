@@ -26,6 +26,9 @@ struct Housing {
   // Throws InputError (prefixed by `context`): unknown model, wrong count,
   // non-finite values, normal not unit, camera outside the dome, ...
   void Validate(const std::string& context) const;
+  // Why a real housing would hardly have these valid parameters (the
+  // model's own bounds of plausibility), or nullopt.
+  std::optional<std::string> Implausibility() const;
 };
 
 struct Ray3d {

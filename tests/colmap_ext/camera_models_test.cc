@@ -179,6 +179,9 @@ TEST(CameraModels, IdsAndNamesAreCOLMAPs) {
     EXPECT_EQ(CameraModelNameToId(expected[id]), id);
     EXPECT_EQ(CameraModelIdToName(id), expected[id]);
     EXPECT_EQ(CameraModelNumParams(id), num_params[id]);
+    // The fisheye models are those on the equidistant angle (COLMAP's ids
+    // 5, 8, 9, 10), by their names.
+    EXPECT_EQ(CameraModelIsFisheye(id), expected[id].find("FISHEYE") != std::string::npos) << expected[id];
   }
 }
 

@@ -200,6 +200,29 @@ void CheckProjectionDerivatives(const Camera& camera, const Housing& housing,
   }
 }
 
+TEST(Housing, ImplausibleButValidHousingsSayWhy) {
+  // Within the bounds: a port 3 cm away tilted 5 deg, a dome off by 5 mm.
+  const double tilt = 5.0 * M_PI / 180.0;
+  EXPECT_FALSE(Housing::FromName("FLATPORT", {std::sin(tilt), 0, std::cos(tilt), 0.03, 0.008, 1, 1.473, 1.334}, "t")
+                   .Implausibility());
+  EXPECT_FALSE(Housing::FromName("DOMEPORT", {0.003, -0.002, 0.004, 0.05, 0.006, 1, 1.473, 1.334}, "t")
+                   .Implausibility());
+  // Issue 21's wrong basins: 361 mm away; tilted 11.4 deg; a dome 15 mm off.
+  const auto why_flat = Housing::FromName("FLATPORT", {0, 0, 1, 0.361, 0.008, 1, 1.473, 1.334}, "t").Implausibility();
+  ASSERT_TRUE(why_flat);
+  EXPECT_NE(why_flat->find("361.0 mm"), std::string::npos) << *why_flat;
+  const double wrong = 11.4 * M_PI / 180.0;
+  const auto why_tilt =
+      Housing::FromName("FLATPORT", {std::sin(wrong), 0, std::cos(wrong), 0.03, 0.008, 1, 1.473, 1.334}, "t")
+          .Implausibility();
+  ASSERT_TRUE(why_tilt);
+  EXPECT_NE(why_tilt->find("tilted 11.4 deg"), std::string::npos) << *why_tilt;
+  const auto why_dome =
+      Housing::FromName("DOMEPORT", {0.0, 0.009, -0.012, 0.05, 0.006, 1, 1.473, 1.334}, "t").Implausibility();
+  ASSERT_TRUE(why_dome);
+  EXPECT_NE(why_dome->find("15.0 mm"), std::string::npos) << *why_dome;
+}
+
 TEST(Housing, ForwardProjectionDerivativesMatchCentralDifferences) {
   const Camera camera = TestCamera();
   const std::vector<Housing> housings = TestHousings();

@@ -38,6 +38,10 @@ struct UndistortionOptions {
 
 template <typename Model>
 struct CameraModelBase {
+  // Built on the equidistant angle (fisheye.h): with its distortion at 0 the
+  // model is the equidistant projection, not the pinhole.
+  static constexpr bool kFisheye = false;
+
   // Single-focal models store (f, cx, cy, extra...), the others
   // (fx, fy, cx, cy, extra...).
   static constexpr int FocalCount() { return Model::kSingleFocal ? 1 : 2; }

@@ -17,6 +17,7 @@ struct OpenCVFisheyeModel : CameraModelBase<OpenCVFisheyeModel> {
   static constexpr int kNumParams = 8;
   static constexpr const char* kParamsInfo = "fx, fy, cx, cy, k1, k2, k3, k4";
   static constexpr bool kSingleFocal = false;
+  static constexpr bool kFisheye = true;
 
   template <typename T>
   static void Distort(const T* extra, const T& u, const T& v, T* ud, T* vd) {
@@ -38,6 +39,7 @@ struct SimpleRadialFisheyeModel : CameraModelBase<SimpleRadialFisheyeModel> {
   static constexpr int kNumParams = 4;
   static constexpr const char* kParamsInfo = "f, cx, cy, k";
   static constexpr bool kSingleFocal = true;
+  static constexpr bool kFisheye = true;
 
   template <typename T>
   static void Distort(const T* extra, const T& u, const T& v, T* ud, T* vd) {
@@ -57,6 +59,7 @@ struct RadialFisheyeModel : CameraModelBase<RadialFisheyeModel> {
   static constexpr int kNumParams = 5;
   static constexpr const char* kParamsInfo = "f, cx, cy, k1, k2";
   static constexpr bool kSingleFocal = true;
+  static constexpr bool kFisheye = true;
 
   template <typename T>
   static void Distort(const T* extra, const T& u, const T& v, T* ud, T* vd) {
@@ -79,6 +82,7 @@ struct ThinPrismFisheyeModel : CameraModelBase<ThinPrismFisheyeModel> {
   static constexpr const char* kParamsInfo =
       "fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, sx1, sy1";
   static constexpr bool kSingleFocal = false;
+  static constexpr bool kFisheye = true;
 
   template <typename T>
   static void Distort(const T* extra, const T& u, const T& v, T* ud, T* vd) {
