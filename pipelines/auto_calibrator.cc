@@ -90,7 +90,10 @@ void JudgeAutoCalibration(const std::optional<double>& markers_focal, Calibratio
   }
   const std::vector<int> focal_idxs = CameraModelFocalLengthIdxs(report->camera.model_id);
   const double focal_std_dev = report->parameters_std_dev.at(focal_idxs.front());
-  if (focal_std_dev > kMaxRelativeFocalStdDev * focal) {
+  if (focal_std_dev < 0) {
+    report->warnings.push_back("the focal length is undetermined (no finite standard deviation); " + remedy);
+    LOG(WARNING) << "auto_calibrator: " << report->warnings.back();
+  } else if (focal_std_dev > kMaxRelativeFocalStdDev * focal) {
     report->warnings.push_back("the focal length is poorly determined: std dev " + FormatNumber(focal_std_dev) +
                                " px, " + FormatNumber(100 * focal_std_dev / focal) + " % of it; " + remedy);
     LOG(WARNING) << "auto_calibrator: " << report->warnings.back();

@@ -201,24 +201,21 @@ int FilterObservations(Reconstruction* r, double max_error_px) {
   return removed;
 }
 
-// Moves the bound parameters of every housing at a bound of the adjustment
-// (flat: distance; dome: centre) to the guess's, when the guess is of the
-// same model; the rest stays.
+// Moves the position of every housing at a bound of the adjustment (flat:
+// distance; dome: centre) to the guess's, when the guess is of the same
+// model; the rest stays.
 void MoveHousingsOffBound(const HousingOverride& guess, Reconstruction* r) {
   if (guess.model.empty()) return;
   std::map<camera_t, SfmCamera> guessed = r->cameras();
   ApplyHousingOverride(guess, &guessed);
   for (auto& [id, camera] : r->mutable_cameras()) {
-    if (!camera.housing || !HousingAtBound(*camera.housing)) continue;
+    if (!camera.housing || !camera.housing->AtBound()) continue;
     const Housing& from = *guessed.at(id).housing;
     if (from.model_id != camera.housing->model_id) continue;
-    if (camera.housing->model_id == 0) {
-      camera.housing->params[3] = from.params[3];
-    } else {
-      for (int k = 0; k < 3; ++k) camera.housing->params[k] = from.params[k];
-    }
+    const HousingRefinement refinement = camera.housing->Refinement();
+    for (int k : refinement.position) camera.housing->params[static_cast<size_t>(k)] = from.params[static_cast<size_t>(k)];
     LOG(INFO) << "refractive_bundle_adjuster: camera " << id << ": housing started again off its bound, from the "
-              << "guess's " << (camera.housing->model_id == 0 ? "port distance" : "decentering");
+              << "guess's " << refinement.position_name;
   }
   r->UpdateRays();
 }
@@ -396,9 +393,9 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
     // Not an estimate: its standard deviations describe a bound.
     const Housing& housing = *r.cameras().at(id).housing;
     warnings.push_back("camera " + std::to_string(id) + ": the housing ended at a bound of the adjustment (" +
-                    (housing.model_id == 0 ? "port distance 0.1 mm" : "decentering 90 % of the radius") +
-                    "), not an estimate; the data traded it against the intrinsics: give the intrinsics, more "
-                    "views or a closer housing guess");
+                       housing.Refinement().bound_description +
+                       "), not an estimate; the data traded it against the intrinsics: give the intrinsics, more "
+                       "views or a closer housing guess");
     LOG(WARNING) << "refractive_bundle_adjuster: " << warnings.back();
   }
   if (options.ba.refine_housing) {
@@ -443,8 +440,15 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
   report.parameters_std_dev_by_clusters = of_camera(std_devs.intrinsics_by_clusters);
   report.housing_std_dev_by_noise = of_camera(std_devs.housing_by_noise);
   report.housing_std_dev_by_clusters = of_camera(std_devs.housing_by_clusters);
-  for (double& v : report.parameters_std_dev) if (!std::isfinite(v)) v = 0.0;
-  for (double& v : report.housing_std_dev) if (!std::isfinite(v)) v = 0.0;
+  // A refined parameter without a finite standard deviation is
+  // undetermined (negative in the report), not held (0).
+  for (auto* std_dev : {&report.parameters_std_dev, &report.housing_std_dev, &report.parameters_std_dev_by_noise,
+                        &report.parameters_std_dev_by_clusters, &report.housing_std_dev_by_noise,
+                        &report.housing_std_dev_by_clusters}) {
+    for (double& v : *std_dev) {
+      if (!std::isfinite(v)) v = -1.0;
+    }
+  }
   report.residual_sigma_px = std_devs.sigma0;
   report.notes = notes;
   report.warnings = warnings;

@@ -54,12 +54,9 @@ bool InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<came
     }
     auto focal = FocalLengthFromMarkers(quads, camera.camera.PrincipalPointX(), camera.camera.PrincipalPointY());
     // The markers give the focal length the camera appears to have in
-    // water. A flat port magnifies paraxial rays by n_water / n_air
-    // (tan a_air = n_w / n_a tan a_water near the axis); a dome, centred,
-    // does not magnify. Bundle adjustment refines the rest.
-    if (focal && camera.housing && camera.housing->model_id == 0) {
-      *focal *= camera.housing->params[5] / camera.housing->params[7];
-    }
+    // water (a flat port magnifies paraxial rays); bundle adjustment refines
+    // the rest.
+    if (focal && camera.housing) *focal *= camera.housing->InAirFocalRatio();
     if (!focal) {
       LOG(WARNING) << "camera " << camera_id << ": too few markers for a focal length; keeping "
                    << camera.camera.MeanFocalLength() << " px";

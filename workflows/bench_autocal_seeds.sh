@@ -106,7 +106,8 @@ for line in open(sys.argv[1]):
         if cam is None or hou is None:
             sys.exit(f"{parts[2]}: no parameters_std_dev{suffix} / non_svp_parameters_std_dev{suffix}")
         s = cam[0:m] + hou[0:2] + [hou[3]]
-        # A parameter held (sd 0, the principal point at the centre) has no z.
+        # A parameter held (sd 0, the principal point at the centre) or
+        # undetermined (null) has no z.
         z = [(e[i] - t[i]) / s[i] if s[i] else None for i in range(n)]
         if kind == "reported":
             print(f"seed {parts[0]}: " + ", ".join(

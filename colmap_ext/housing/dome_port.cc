@@ -29,6 +29,28 @@ std::optional<std::string> DomePort::Invalidity(const double* port) {
   return std::nullopt;
 }
 
+namespace {
+constexpr double kMaxAdjustedDecentering = 0.9;  // in inner radii
+}  // namespace
+
+HousingRefinement DomePort::Refinement(const double* port) {
+  HousingRefinement refinement;
+  refinement.position = {0, 1, 2};
+  const double bound = kMaxAdjustedDecentering * InnerRadius(port);
+  for (int k = 0; k < 3; ++k) refinement.bounds.push_back({k, -bound, bound});
+  refinement.position_name = "decentering";
+  refinement.bound_description = "decentering 90 % of the radius";
+  return refinement;
+}
+
+bool DomePort::AtBound(const double* port) {
+  const double bound = kMaxAdjustedDecentering * InnerRadius(port);
+  for (int k = 0; k < 3; ++k) {
+    if (std::abs(port[k]) >= 0.99 * bound) return true;
+  }
+  return false;
+}
+
 std::optional<std::string> DomePort::Implausibility(const double* port) {
   constexpr double kMaxPlausibleDecenteringFraction = 0.25;
   const double decentering = Center(port).norm();

@@ -14,6 +14,7 @@
 #include <optional>
 #include <string>
 
+#include "colmap_ext/housing/housing_refinement.h"
 #include "colmap_ext/housing/refraction.h"
 
 namespace portcal {
@@ -49,6 +50,15 @@ struct DomePort {
   // would show it and a self-calibration that ends there has likely traded
   // the dome against the focal length.
   static std::optional<std::string> Implausibility(const double* port);
+
+  // An adjustment refines the centre, each coordinate within 90 % of the
+  // inner radius: the camera centre stays inside the dome.
+  static HousingRefinement Refinement(const double* port);
+  // A centre coordinate at its bound: the adjustment traded it.
+  static bool AtBound(const double* port);
+  // Centred, a dome does not magnify paraxial rays; decentring's effect is
+  // left to the adjustment.
+  static double InAirFocalRatio(const double* /*port*/) { return 1.0; }
 
   // Traces a ray from `origin` (inside the inner sphere) along `dir_in_air`
   // through both spheres. Templated on the dimension so the forward solve can

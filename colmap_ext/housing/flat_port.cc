@@ -48,6 +48,22 @@ std::optional<std::string> FlatPort::Implausibility(const double* port) {
   return std::nullopt;
 }
 
+namespace {
+constexpr double kMinAdjustedDistance = 1e-4;  // metres
+}  // namespace
+
+HousingRefinement FlatPort::Refinement(const double* /*port*/) {
+  HousingRefinement refinement;
+  refinement.orientation = {0, 1, 2};
+  refinement.position = {3};
+  refinement.bounds = {{3, kMinAdjustedDistance}};
+  refinement.position_name = "port distance";
+  refinement.bound_description = "port distance 0.1 mm";
+  return refinement;
+}
+
+bool FlatPort::AtBound(const double* port) { return InterfaceDistance(port) <= 1.5 * kMinAdjustedDistance; }
+
 bool FlatPort::AirRayToPointValue(const double* port,
                                   const Eigen::Vector3d& point,
                                   Eigen::Vector3d* dir_in_air) {

@@ -15,6 +15,7 @@
 #include <optional>
 #include <string>
 
+#include "colmap_ext/housing/housing_refinement.h"
 #include "colmap_ext/housing/refraction.h"
 #include "colmap_ext/util/jet_utils.h"
 
@@ -60,6 +61,17 @@ struct FlatPort {
   // that ends beyond has traded the port against the lens (issue 21: 14 deg
   // and 0.1 mm, 11.4 deg and 361 mm).
   static std::optional<std::string> Implausibility(const double* port);
+
+  // An adjustment refines the normal (on the sphere) and the distance, down
+  // to 0.1 mm: the interface is in front of the lens, and a distance the
+  // data cannot fix must not wander through zero.
+  static HousingRefinement Refinement(const double* port);
+  // The distance at its floor: the adjustment traded it, not measured it.
+  static bool AtBound(const double* port);
+  // In-air focal length over the one the camera appears to have behind the
+  // port near the axis: a flat port magnifies paraxial rays by nw / na
+  // (tan a_air = nw / na tan a_water).
+  static double InAirFocalRatio(const double* port) { return AirIndex(port) / WaterIndex(port); }
 
   // Back-projection: a ray leaving the camera centre along `dir_in_air` (any
   // length) -> ray in water, origin on the outer surface, unit direction.

@@ -82,14 +82,42 @@ void Housing::Validate(const std::string& context) const {
   if (problem) throw InputError(context + ": " + *problem);
 }
 
+namespace {
+
+// Calls f(Port) for the housing's model, its parameter count checked.
+template <typename F>
+void VisitPort(const Housing& housing, F&& f) {
+  VisitHousingModel(housing.model_id, [&](auto model) {
+    using Port = decltype(model);
+    PORTCAL_CHECK(static_cast<int>(housing.params.size()) == Port::kNumParams);
+    f(model);
+  });
+}
+
+}  // namespace
+
 std::optional<std::string> Housing::Implausibility() const {
   std::optional<std::string> why;
-  VisitHousingModel(model_id, [&](auto model) {
-    using Port = decltype(model);
-    PORTCAL_CHECK(static_cast<int>(params.size()) == Port::kNumParams);
-    why = Port::Implausibility(params.data());
-  });
+  VisitPort(*this, [&](auto model) { why = decltype(model)::Implausibility(params.data()); });
   return why;
+}
+
+HousingRefinement Housing::Refinement() const {
+  HousingRefinement refinement;
+  VisitPort(*this, [&](auto model) { refinement = decltype(model)::Refinement(params.data()); });
+  return refinement;
+}
+
+bool Housing::AtBound() const {
+  bool at_bound = false;
+  VisitPort(*this, [&](auto model) { at_bound = decltype(model)::AtBound(params.data()); });
+  return at_bound;
+}
+
+double Housing::InAirFocalRatio() const {
+  double ratio = 1;
+  VisitPort(*this, [&](auto model) { ratio = decltype(model)::InAirFocalRatio(params.data()); });
+  return ratio;
 }
 
 std::optional<Eigen::Vector2d> ProjectPoint(const Camera& camera,

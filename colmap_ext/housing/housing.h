@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "colmap_ext/camera/camera.h"
+#include "colmap_ext/housing/housing_refinement.h"
 
 namespace portcal {
 
@@ -29,6 +30,13 @@ struct Housing {
   // Why a real housing would hardly have these valid parameters (the
   // model's own bounds of plausibility), or nullopt.
   std::optional<std::string> Implausibility() const;
+  // The model's answers for an adjustment (housing_refinement.h): what it
+  // refines and within which bounds, whether the parameters sit at one.
+  HousingRefinement Refinement() const;
+  bool AtBound() const;
+  // In-air focal length over the one the camera appears to have behind
+  // the housing near the axis (1 where the housing does not magnify).
+  double InAirFocalRatio() const;
 };
 
 struct Ray3d {

@@ -98,13 +98,6 @@ std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconst
 
 namespace {
 
-// Smallest flat-port interface distance an adjustment may reach, metres.
-constexpr double kMinPortDistance = 1e-4;
-
-// Largest dome decentering an adjustment may reach, in dome radii: the
-// camera centre stays inside the dome.
-constexpr double kMaxDomeDecentering = 0.9;
-
 // Keypoints up to this scale (pixels) get sigma_px; coarser ones more.
 constexpr double kReferenceScale = 2.0;
 
@@ -169,20 +162,48 @@ std::vector<int> ConstantIntrinsics(const Camera& camera, const BundleAdjustment
   return constant;
 }
 
-}  // namespace
-
-bool HousingAtBound(const Housing& housing) {
-  if (housing.model_id == 0) return housing.params[3] <= 1.5 * kMinPortDistance;
-  const double bound = kMaxDomeDecentering * housing.params[3];
-  for (int k = 0; k < 3; ++k) {
-    if (std::abs(housing.params[k]) >= 0.99 * bound) return true;
+// What the housing's model lets an adjustment refine (HousingRefinement):
+// its orientation on the sphere, its position within the bounds, the rest
+// held.
+void SetHousingRefinement(const Housing& model, bool refine_position, double* housing, ceres::Problem* problem) {
+  const HousingRefinement refinement = model.Refinement();
+  const int n = static_cast<int>(model.params.size());
+  std::vector<bool> refined(static_cast<size_t>(n), false);
+  for (int k : refinement.orientation) refined[static_cast<size_t>(k)] = true;
+  if (refine_position) {
+    for (int k : refinement.position) refined[static_cast<size_t>(k)] = true;
   }
-  return false;
+  if (std::none_of(refined.begin(), refined.end(), [](bool r) { return r; })) {
+    problem->SetParameterBlockConstant(housing);
+    return;
+  }
+  if (refinement.orientation.empty()) {
+    std::vector<int> held;
+    for (int k = 0; k < n; ++k) {
+      if (!refined[static_cast<size_t>(k)]) held.push_back(k);
+    }
+    problem->SetManifold(housing, new ceres::SubsetManifold(n, held));
+  } else {
+    // The unit vector leads the parameters (every port model with one).
+    PORTCAL_CHECK(refinement.orientation == (std::vector<int>{0, 1, 2}));
+    std::vector<int> held;
+    for (int k = 3; k < n; ++k) {
+      if (!refined[static_cast<size_t>(k)]) held.push_back(k - 3);
+    }
+    problem->SetManifold(housing, new ceres::ProductManifold<ceres::SphereManifold<3>, ceres::SubsetManifold>(
+                                      ceres::SphereManifold<3>(), ceres::SubsetManifold(n - 3, held)));
+  }
+  for (const HousingParamBound& bound : refinement.bounds) {
+    if (std::isfinite(bound.lower)) problem->SetParameterLowerBound(housing, bound.index, bound.lower);
+    if (std::isfinite(bound.upper)) problem->SetParameterUpperBound(housing, bound.index, bound.upper);
+  }
 }
+
+}  // namespace
 
 camera_t CameraWithHousingAtBound(const std::map<camera_t, SfmCamera>& cameras) {
   for (const auto& [id, camera] : cameras) {
-    if (camera.housing && HousingAtBound(*camera.housing)) return id;
+    if (camera.housing && camera.housing->AtBound()) return id;
   }
   return kInvalidCameraId;
 }
@@ -389,24 +410,8 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
     double* housing = housings.at(id).data();
     if (local || !options.refine_housing) {
       problem.SetParameterBlockConstant(housing);
-    } else if (camera.housing->model_id == 0) {
-      // FLATPORT: normal on the unit sphere, distance free; thickness and
-      // refractive indices are the user's constants.
-      const std::vector<int> held = options.refine_port_distance ? std::vector<int>{1, 2, 3, 4}
-                                                                  : std::vector<int>{0, 1, 2, 3, 4};
-      problem.SetManifold(housing, new ceres::ProductManifold<ceres::SphereManifold<3>, ceres::SubsetManifold>(
-                                       ceres::SphereManifold<3>(), ceres::SubsetManifold(5, held)));
-      // The interface is in front of the lens: a distance the data cannot
-      // fix (no scale) must not wander through zero.
-      problem.SetParameterLowerBound(housing, 3, kMinPortDistance);
     } else {
-      // DOMEPORT: the decentering (Cx, Cy, Cz) only.
-      problem.SetManifold(housing, new ceres::SubsetManifold(8, {3, 4, 5, 6, 7}));
-      const double bound = kMaxDomeDecentering * camera.housing->params[3];
-      for (int k = 0; k < 3; ++k) {
-        problem.SetParameterLowerBound(housing, k, -bound);
-        problem.SetParameterUpperBound(housing, k, bound);
-      }
+      SetHousingRefinement(*camera.housing, options.refine_housing_position, housing, &problem);
     }
   }
 

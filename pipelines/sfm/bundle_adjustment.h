@@ -22,8 +22,10 @@ struct BundleAdjustmentOptions {
   // parameters (the radial terms come first in every model); -1: all.
   int max_num_extra_params = -1;
   bool refine_housing = false;
-  // With refine_housing: a flat port's distance too (else only its normal).
-  bool refine_port_distance = true;
+  // With refine_housing: the housing's position too (a flat port's
+  // distance, a dome's centre; HousingRefinement::position), else only its
+  // orientation (a flat port's normal).
+  bool refine_housing_position = true;
   bool virtual_camera_error = false;  // else the exact reprojection error
   double sigma_px = 1.0;              // residuals in units of this
   bool scale_weighting = true;        // sigma grows with the keypoint's scale (above 2 px)
@@ -94,11 +96,6 @@ struct CalibrationStdDevs {
 // max_extra_param 1) of `after` against `before`; says why in `why`.
 bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::string* why = nullptr);
 
-// Whether a refined housing ended at a bound the adjustment imposes (a flat
-// port's distance at its floor of 0.1 mm, a dome's decentering at 90 % of
-// its radius): not an estimate but a sign that the data traded the housing
-// against something else (e.g. the focal length).
-bool HousingAtBound(const Housing& housing);
 // The first camera whose housing is at such a bound, or kInvalidCameraId.
 camera_t CameraWithHousingAtBound(const std::map<camera_t, SfmCamera>& cameras);
 

@@ -82,9 +82,11 @@ bool BogusIntrinsics(const std::map<camera_t, SfmCamera>& before, const std::map
   return false;
 }
 
-bool HasFlatPort(const Reconstruction& r) {
+// A housing with an orientation to refine apart from its position (a flat
+// port's normal).
+bool HasOrientedHousing(const Reconstruction& r) {
   return std::any_of(r.cameras().begin(), r.cameras().end(), [](const auto& entry) {
-    return entry.second.housing && entry.second.housing->model_id == FlatPort::kId;
+    return entry.second.housing && !entry.second.housing->Refinement().orientation.empty();
   });
 }
 
@@ -508,7 +510,7 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   std::map<point3D_t, Eigen::Vector3d> points_before;
   for (const auto& [id, point] : r->points()) points_before[id] = point.xyz;
   const std::vector<MarkerCorner> markers_before = markers;
-  if (ba.refine_housing && !port_converged_ && HasFlatPort(*r)) {
+  if (ba.refine_housing && !port_converged_ && HasOrientedHousing(*r)) {
     // A flat port's normal first, its distance held, until one joint
     // adjustment has converged: from the untilted guess the joint solve
     // pushes the distance into its 0.1 mm floor and then creeps along the
@@ -518,7 +520,7 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
     // 19 iterations, the joint step then 10, 50 s in all, the port within
     // 0.02 deg and 2.2 mm from 5 images on, the same refined result).
     BundleAdjustmentOptions normal_first = ba.WithIntrinsicsHeld();
-    normal_first.refine_port_distance = false;
+    normal_first.refine_housing_position = false;
     AdjustBundle(r, normal_first, BundleAdjustmentScope(), &markers, options_.marker_scale);
   }
   if (ba.refine_housing && (ba.refine_focal_length || ba.refine_principal_point || ba.refine_extra_params)) {

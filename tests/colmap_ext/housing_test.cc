@@ -223,6 +223,42 @@ TEST(Housing, ImplausibleButValidHousingsSayWhy) {
   EXPECT_NE(why_dome->find("15.0 mm"), std::string::npos) << *why_dome;
 }
 
+TEST(Housing, AtBoundIsTheAdjustmentsFloorOrWall) {
+  // A flat port at the 0.1 mm floor of its distance, a dome decentred to
+  // 90 % of its radius: bounds, not estimates.
+  const auto flat = [](double distance) {
+    return Housing::FromName("FLATPORT", {0.05, 0.0, std::sqrt(1 - 0.0025), distance, 0.01, 1, 1.473, 1.334}, "test");
+  };
+  EXPECT_TRUE(flat(1e-4).AtBound());
+  EXPECT_FALSE(flat(0.015).AtBound());
+  EXPECT_FALSE(flat(1e-3).AtBound());
+  const auto dome = [](double cz) { return Housing::FromName("DOMEPORT", {0.01, 0.0, cz, 0.05, 0.006, 1, 1.473, 1.334}, "test"); };
+  EXPECT_TRUE(dome(-0.045).AtBound());
+  EXPECT_FALSE(dome(0.02).AtBound());
+}
+
+TEST(Housing, RefinementNamesWhatAnAdjustmentMayMoveAndHowFar) {
+  const Housing flat = Housing::FromName("FLATPORT", {0, 0, 1, 0.03, 0.008, 1, 1.473, 1.334}, "test");
+  const HousingRefinement f = flat.Refinement();
+  EXPECT_EQ(f.orientation, (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(f.position, (std::vector<int>{3}));
+  ASSERT_EQ(f.bounds.size(), 1u);
+  EXPECT_EQ(f.bounds[0].index, 3);
+  EXPECT_EQ(f.bounds[0].lower, 1e-4);
+  EXPECT_FALSE(std::isfinite(f.bounds[0].upper));
+  EXPECT_EQ(flat.InAirFocalRatio(), 1.0 / 1.334);
+  const Housing dome = Housing::FromName("DOMEPORT", {0.001, 0, 0, 0.05, 0.006, 1, 1.473, 1.334}, "test");
+  const HousingRefinement d = dome.Refinement();
+  EXPECT_TRUE(d.orientation.empty());
+  EXPECT_EQ(d.position, (std::vector<int>{0, 1, 2}));
+  ASSERT_EQ(d.bounds.size(), 3u);
+  for (const HousingParamBound& b : d.bounds) {
+    EXPECT_DOUBLE_EQ(b.upper, 0.045);
+    EXPECT_DOUBLE_EQ(b.lower, -0.045);
+  }
+  EXPECT_EQ(dome.InAirFocalRatio(), 1.0);
+}
+
 TEST(Housing, ForwardProjectionDerivativesMatchCentralDifferences) {
   const Camera camera = TestCamera();
   const std::vector<Housing> housings = TestHousings();

@@ -266,6 +266,13 @@ TEST(AutoCalibrationRealCameras, WhatTheViewsLeaveUndeterminedIsAWarningFirstInT
   const CalibrationReport back = ReadCalibrationReport(dir.path() / "calibration.yaml");
   EXPECT_EQ(back.warnings, r.warnings);
 
+  // No finite standard deviation (negative in a report): undetermined,
+  // which is a warning, not "held fixed".
+  CalibrationReport undetermined = FlatPortReport(1310, -1, 0.03);
+  JudgeAutoCalibration(1300.0, &undetermined);
+  ASSERT_EQ(undetermined.warnings.size(), 1u);
+  EXPECT_NE(undetermined.warnings[0].find("focal length is undetermined"), std::string::npos);
+
   // A well-determined calibration: no warning.
   CalibrationReport good = FlatPortReport(1310, 0.7, 0.03);
   JudgeAutoCalibration(1290.0, &good);

@@ -517,20 +517,6 @@ TEST(IncrementalMapperOptions, NegativeRestartsAreNamed) {
   }
 }
 
-TEST(BundleAdjustment, HousingAtBoundIsTheAdjustmentsFloorOrWall) {
-  // A flat port at the 0.1 mm floor of its distance, a dome decentred to
-  // 90 % of its radius: bounds, not estimates.
-  const auto flat = [](double distance) {
-    return Housing::FromName("FLATPORT", {0.05, 0.0, std::sqrt(1 - 0.0025), distance, 0.01, 1, 1.473, 1.334}, "test");
-  };
-  EXPECT_TRUE(HousingAtBound(flat(1e-4)));
-  EXPECT_FALSE(HousingAtBound(flat(0.015)));
-  EXPECT_FALSE(HousingAtBound(flat(1e-3)));
-  const auto dome = [](double cz) { return Housing::FromName("DOMEPORT", {0.01, 0.0, cz, 0.05, 0.006, 1, 1.473, 1.334}, "test"); };
-  EXPECT_TRUE(HousingAtBound(dome(-0.045)));
-  EXPECT_FALSE(HousingAtBound(dome(0.02)));
-}
-
 TEST(Parallel, OrderedParallelForConsumesInOrderAndPropagatesErrors) {
   std::vector<int> computed(100, 0), order;
   OrderedParallelFor(100, 2, 4, [&](size_t i) { computed[i] = static_cast<int>(i) * 2; },
