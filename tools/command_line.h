@@ -7,6 +7,9 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
+
+#include "colmap_ext/util/string_utils.h"
 
 namespace portcal {
 
@@ -28,9 +31,13 @@ class CommandLine {
   // Registers --name with *value as default; the parsed value lands there.
   template <typename T>
   void Add(const std::string& name, T* value, const std::string& help) {
-    options_.add_options()(
-        name.c_str(), boost::program_options::value<T>(value)->default_value(*value),
-        help.c_str());
+    auto* semantic = boost::program_options::value<T>(value);
+    if constexpr (std::is_floating_point_v<T>) {
+      semantic->default_value(*value, FormatShortest(*value));
+    } else {
+      semantic->default_value(*value);
+    }
+    options_.add_options()(name.c_str(), semantic, help.c_str());
   }
   // Required option without default.
   template <typename T>

@@ -1,4 +1,5 @@
 // The portcal executable: a table of colmap-style subcommands.
+#include <algorithm>
 #include <csignal>
 #include <cstring>
 #include <iostream>
@@ -68,12 +69,14 @@ void PrintHelp() {
             << " -- camera, stereo and housing calibration for underwater "
                "photogrammetry\n\nUsage:\n  portcal <command> [options]\n  "
                "portcal <command> -h\n\nCommands:\n";
-  std::cout << "  help                  list the commands\n";
-  for (const Command& command : Commands()) {
-    std::string name = command.name;
-    name.resize(22, ' ');
-    std::cout << "  " << name << command.summary << "\n";
-  }
+  // The summaries start two spaces after the longest name.
+  size_t width = std::string("help").size();
+  for (const Command& command : Commands()) width = std::max(width, std::string(command.name).size());
+  const auto print = [width](const std::string& name, const std::string& summary) {
+    std::cout << "  " << name << std::string(width + 2 - name.size(), ' ') << summary << "\n";
+  };
+  print("help", "list the commands");
+  for (const Command& command : Commands()) print(command.name, command.summary);
 }
 
 void HandleSignal(int signal) {

@@ -79,4 +79,17 @@ std::string FormatFixed(double value, int digits) {
   return out.str();
 }
 
+std::string FormatShortest(double value) {
+  // 17 significant digits always read back exactly; the first precision
+  // that does is the shortest.
+  for (int digits = 1; digits < 17; ++digits) {
+    std::ostringstream out;
+    out << std::setprecision(digits) << value;
+    if (std::strtod(out.str().c_str(), nullptr) == value) return out.str();
+  }
+  std::ostringstream out;
+  out << std::setprecision(17) << value;
+  return out.str();
+}
+
 }  // namespace portcal

@@ -20,5 +20,8 @@ std::vector<double> ParseDoubleList(const std::string& s,
                                     const std::string& context);
 // `value` with `digits` digits after the point (std::fixed), for reports.
 std::string FormatFixed(double value, int digits);
+// The shortest text that reads back as exactly `value` ("0.04", where
+// lexical_cast gives "0.040000000000000001"), for help texts and defaults.
+std::string FormatShortest(double value);
 
 }  // namespace portcal

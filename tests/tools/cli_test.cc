@@ -7,6 +7,7 @@
 
 #include "colmap_ext/housing/housing.h"
 #include "colmap_ext/io/sparse_model.h"
+#include "colmap_ext/util/string_utils.h"
 #include "tests/test_utils.h"
 
 namespace fs = std::filesystem;
@@ -24,6 +25,9 @@ TEST(Cli, HelpListsTheCommands) {
   for (const char* command : {"database_creator", "model_converter", "project_points"}) {
     EXPECT_NE(result.output.find(command), std::string::npos) << command;
   }
+  // Every name is followed by at least two spaces before its summary
+  // (refractive_bundle_adjuster once ran into it).
+  EXPECT_NE(result.output.find("  refractive_bundle_adjuster  "), std::string::npos) << result.output;
   EXPECT_EQ(RunCommand(Portcal("")).exit_code, 2);
   const auto unknown = RunCommand(Portcal("frobnicate"));
   EXPECT_EQ(unknown.exit_code, 2);
@@ -36,6 +40,14 @@ TEST(Cli, CommandHelpShowsOptionsWithDefaults) {
   EXPECT_NE(result.output.find("--Housing.model"), std::string::npos);
   EXPECT_NE(result.output.find("--log_level"), std::string::npos);
   EXPECT_NE(result.output.find("(=info)"), std::string::npos) << result.output;
+  // Real defaults print as written, not as 0.80000000000000004.
+  const auto matcher = RunCommand(Portcal("exhaustive_matcher -h"));
+  EXPECT_NE(matcher.output.find("(=0.8)"), std::string::npos) << matcher.output;
+  EXPECT_EQ(matcher.output.find("0000000"), std::string::npos) << matcher.output;
+  EXPECT_EQ(FormatShortest(0.04), "0.04");
+  EXPECT_EQ(FormatShortest(1.0 / 3.0), "0.3333333333333333");  // 16 digits read it back
+  EXPECT_EQ(FormatShortest(1e-5), "1e-05");
+  EXPECT_EQ(std::stod(FormatShortest(0.1 + 0.2)), 0.1 + 0.2);
 }
 
 TEST(Cli, BadOptionsAreUsageErrorsNamingTheOption) {
