@@ -50,7 +50,7 @@ namespace {
 std::optional<double> StartFocalFromMarkers(const std::string& database_path, const HousingOverride& housing) {
   Database database(database_path, Database::OpenMode::kReadWrite);
   const SfmInputs inputs = SfmInputs::Read(&database);
-  std::map<camera_t, SfmCamera> cameras = inputs.cameras;
+  std::map<camera_t, HousedCamera> cameras = inputs.cameras;
   ApplyHousingOverride(housing, &cameras);
   InitializeFocalFromMarkers(inputs, 1, &cameras);
   Transaction transaction = database.BeginTransaction();

@@ -61,7 +61,7 @@ std::string FormatSigmas(double sigmas) {
 // Whether any camera's refined principal point lies more than `sigmas`
 // standard deviations (per axis) from the image centre; describes each
 // camera's offset in `offset`.
-bool PrincipalPointOffCentre(const std::map<camera_t, SfmCamera>& cameras, const CalibrationStdDevs& std_devs,
+bool PrincipalPointOffCentre(const std::map<camera_t, HousedCamera>& cameras, const CalibrationStdDevs& std_devs,
                              double sigmas, std::ostringstream* offset) {
   bool significant = false;
   *offset << std::fixed << std::setprecision(2);
@@ -95,7 +95,7 @@ bool PrincipalPointOffCentre(const std::map<camera_t, SfmCamera>& cameras, const
 constexpr double kMaxPrincipalPointStdDevFraction = 0.002;
 
 // The largest principal point standard deviation above that bound, or 0.
-double PoorPrincipalPointStdDev(const std::map<camera_t, SfmCamera>& cameras, const CalibrationStdDevs& std_devs) {
+double PoorPrincipalPointStdDev(const std::map<camera_t, HousedCamera>& cameras, const CalibrationStdDevs& std_devs) {
   double worst = 0;
   for (const auto& [id, camera] : cameras) {
     const auto sd = std_devs.intrinsics.find(id);
@@ -113,7 +113,7 @@ double PoorPrincipalPointStdDev(const std::map<camera_t, SfmCamera>& cameras, co
 // a self-calibration that traded the port against the lens, however small
 // its standard deviations (issue 21: a flat port 361 mm from the camera
 // centre, reported at 0.39 +- 0.07 m).
-std::vector<std::string> ImplausibleHousingWarnings(const std::map<camera_t, SfmCamera>& cameras) {
+std::vector<std::string> ImplausibleHousingWarnings(const std::map<camera_t, HousedCamera>& cameras) {
   std::vector<std::string> warnings;
   for (const auto& [id, camera] : cameras) {
     if (!camera.housing) continue;
@@ -149,7 +149,7 @@ struct TradeOff {
   double factor = 1;  // the housing's sd at least this many times that with the intrinsics known
 };
 
-std::vector<TradeOff> TradeOffs(const std::map<camera_t, SfmCamera>& cameras, const CalibrationStdDevs& std_devs,
+std::vector<TradeOff> TradeOffs(const std::map<camera_t, HousedCamera>& cameras, const CalibrationStdDevs& std_devs,
                                 double limit) {
   std::vector<TradeOff> trade_offs;
   for (const auto& [id, correlation] : std_devs.intrinsics_housing_correlation) {
@@ -157,7 +157,7 @@ std::vector<TradeOff> TradeOffs(const std::map<camera_t, SfmCamera>& cameras, co
     Eigen::Index i, j;
     const double strongest = correlation.cwiseAbs().maxCoeff(&i, &j);
     if (!(strongest >= limit)) continue;
-    const SfmCamera& camera = cameras.at(id);
+    const HousedCamera& camera = cameras.at(id);
     const std::vector<std::string> intrinsic = SplitParamsInfo(camera.camera.ParamsInfo());
     const std::vector<std::string> housing = SplitParamsInfo(camera.housing->ParamsInfo());
     const double factor = 1.0 / std::sqrt(std::max(1e-12, 1.0 - strongest * strongest));
@@ -206,7 +206,7 @@ int FilterObservations(Reconstruction* r, double max_error_px) {
 // model; the rest stays.
 void MoveHousingsOffBound(const HousingOverride& guess, Reconstruction* r) {
   if (guess.model.empty()) return;
-  std::map<camera_t, SfmCamera> guessed = r->cameras();
+  std::map<camera_t, HousedCamera> guessed = r->cameras();
   ApplyHousingOverride(guess, &guessed);
   for (auto& [id, camera] : r->mutable_cameras()) {
     if (!camera.housing || !camera.housing->AtBound()) continue;
@@ -300,7 +300,7 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
   const bool joint = options.ba.refine_housing && (options.ba.refine_focal_length ||
                                                    options.ba.refine_principal_point ||
                                                    options.ba.refine_extra_params);
-  const std::map<camera_t, SfmCamera> cameras_before = r.cameras();
+  const std::map<camera_t, HousedCamera> cameras_before = r.cameras();
   // A first solve, outliers out, then the final solve with covariance.
   const auto solve = [&](const BundleAdjustmentOptions& ba, CalibrationStdDevs* std_devs) {
     AdjustBundle(&r, ba, BundleAdjustmentScope(), &markers, options.marker_scale);
@@ -422,7 +422,7 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
                  << " cameras; the report describes camera " << camera_id << " (the model has all)";
   }
   CalibrationReport& report = result.report;
-  const SfmCamera& camera = r.cameras().at(camera_id);
+  const HousedCamera& camera = r.cameras().at(camera_id);
   report.camera = camera.camera;
   report.housing = camera.housing;
   report.parameters_std_dev = std_devs.intrinsics.count(camera_id)

@@ -28,7 +28,7 @@ void RefractiveMapperOptions::Check() const {
   mapper.Check();
 }
 
-void ApplyHousingOverride(const HousingOverride& override_housing, std::map<camera_t, SfmCamera>* cameras) {
+void ApplyHousingOverride(const HousingOverride& override_housing, std::map<camera_t, HousedCamera>* cameras) {
   if (override_housing.model.empty()) return;
   std::vector<double> params;
   for (const std::string& token : SplitTokens(override_housing.params, ", ")) {
@@ -42,7 +42,7 @@ void ApplyHousingOverride(const HousingOverride& override_housing, std::map<came
   for (auto& [id, camera] : *cameras) camera.housing = housing;
 }
 
-bool InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<camera_t, SfmCamera>* cameras) {
+bool InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<camera_t, HousedCamera>* cameras) {
   if (mode == 0) return false;
   bool any = false;
   for (auto& [camera_id, camera] : *cameras) {
@@ -71,7 +71,7 @@ bool InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<came
 }
 
 void InitializeRadialFromMatches(const SfmInputs& inputs, const RefractiveMapperOptions& options,
-                                 std::map<camera_t, SfmCamera>* cameras) {
+                                 std::map<camera_t, HousedCamera>* cameras) {
   const int mode = options.init_radial_from_matches;
   if (mode == 0 || (mode == -1 && !options.mapper.ba_refine_extra_params)) return;
   for (auto& [camera_id, camera] : *cameras) {
@@ -115,7 +115,7 @@ RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& optio
     throw InputError(options.database_path + ": no image has a position prior, so --PosePrior.position_sigma "
                      "has nothing to use (run pose_prior_importer, or set it to 0)");
   }
-  std::map<camera_t, SfmCamera> cameras = inputs.cameras;
+  std::map<camera_t, HousedCamera> cameras = inputs.cameras;
   ApplyHousingOverride(options.housing, &cameras);
   IncrementalMapperOptions mapper = options.mapper;
   if (InitializeFocalFromMarkers(inputs, options.init_focal_from_markers, &cameras)) {

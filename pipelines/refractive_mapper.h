@@ -47,7 +47,7 @@ struct RefractiveMapperSummary {
 };
 
 // Sets the housing of every camera when `override.model` is given.
-void ApplyHousingOverride(const HousingOverride& override_housing, std::map<camera_t, SfmCamera>* cameras);
+void ApplyHousingOverride(const HousingOverride& override_housing, std::map<camera_t, HousedCamera>* cameras);
 
 // A focal length this far from the markers' estimate (measured within
 // 1-6 % of the truth on own and shared renders) is a wrong solution,
@@ -56,12 +56,12 @@ constexpr double kMaxFocalRatioToMarkers = 1.25;
 
 // Focal lengths from the markers of each camera's images (see
 // FocalLengthFromMarkers), where `mode` asks for it. True if any was set.
-bool InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<camera_t, SfmCamera>* cameras);
+bool InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<camera_t, HousedCamera>* cameras);
 
 // The first radial term of each camera from the matches
 // (EstimateFirstRadialTerm), where `options.init_radial_from_matches` asks.
 void InitializeRadialFromMatches(const SfmInputs& inputs, const RefractiveMapperOptions& options,
-                                 std::map<camera_t, SfmCamera>* cameras);
+                                 std::map<camera_t, HousedCamera>* cameras);
 
 RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& options, ProgressSink& progress);
 

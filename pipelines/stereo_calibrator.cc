@@ -26,7 +26,7 @@ void StereoCalibratorOptions::Check() const {
 
 namespace {
 
-RigCamera CameraFor(const std::string& input_calibration, const Camera& database_camera,
+HousedCamera CameraFor(const std::string& input_calibration, const Camera& database_camera,
                     const std::vector<CalibrationView>& views, int num_threads) {
   if (!input_calibration.empty()) {
     const CalibrationReport report = ReadCalibrationReport(input_calibration);
@@ -79,9 +79,9 @@ StereoCalibrationResult CalibrateStereoStage(const StereoCalibratorOptions& opti
   }
   LOG(INFO) << "stereo_calibrator: cameras " << id1 << " and " << id2 << ", " << frames.size()
             << " frames paired by " << options.pairing;
-  const RigCamera camera1 = CameraFor(options.input_calibration1, *database.ReadCamera(id1), views1,
+  const HousedCamera camera1 = CameraFor(options.input_calibration1, *database.ReadCamera(id1), views1,
                                       options.stereo.num_threads);
-  const RigCamera camera2 = CameraFor(options.input_calibration2, *database.ReadCamera(id2), views2,
+  const HousedCamera camera2 = CameraFor(options.input_calibration2, *database.ReadCamera(id2), views2,
                                       options.stereo.num_threads);
   const StereoCalibrationResult result = CalibrateStereo(frames, camera1, camera2, options.stereo);
   WriteStereoCalibrationReport(result, camera1, camera2, target_views.target, options.output_path);

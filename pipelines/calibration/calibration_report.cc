@@ -174,8 +174,8 @@ std::string CameraBlock(const std::string& key, const Camera& camera, const std:
 
 }  // namespace
 
-void WriteStereoCalibrationReport(const StereoCalibrationResult& r, const RigCamera& camera1,
-                                  const RigCamera& camera2, const std::string& target_description,
+void WriteStereoCalibrationReport(const StereoCalibrationResult& r, const HousedCamera& camera1,
+                                  const HousedCamera& camera2, const std::string& target_description,
                                   const fs::path& dir) {
   std::error_code ec;
   fs::create_directories(dir, ec);

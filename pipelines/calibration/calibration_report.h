@@ -47,8 +47,8 @@ void WriteCalibrationReport(const CalibrationReport& report, const std::filesyst
 // Stereo: calibmar's cam_to_world_rotation_rowmajor / cam_to_world_translation
 // (camera 2 in the camera-1 frame), cam2_from_cam1 (rotation_wxyz,
 // translation) with standard deviations, and a block per camera.
-void WriteStereoCalibrationReport(const StereoCalibrationResult& result, const RigCamera& camera1,
-                                  const RigCamera& camera2, const std::string& target_description,
+void WriteStereoCalibrationReport(const StereoCalibrationResult& result, const HousedCamera& camera1,
+                                  const HousedCamera& camera2, const std::string& target_description,
                                   const std::filesystem::path& dir);
 
 // Reads the camera (and housing) of a calibration.yaml written by portcal or

@@ -70,8 +70,8 @@ Rigid3d MedianPose(const std::vector<Rigid3d>& poses) {
   return Rigid3d(rotation, translation);
 }
 
-StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames, const RigCamera& camera1,
-                                        const RigCamera& camera2, const StereoCalibrationSettings& settings) {
+StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames, const HousedCamera& camera1,
+                                        const HousedCamera& camera2, const StereoCalibrationSettings& settings) {
   settings.Check();
   if (frames.size() < 2) throw NumericalError("stereo calibration needs at least 2 frames seen by both cameras");
   // A board that looks the same rotated by 180 degrees (an even number of
@@ -180,7 +180,7 @@ StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames, 
   result.num_points = num_points;
   result.overall_rms_px = std::sqrt(sum_squares / std::max(1, num_points));
   result.residual_sigma_px = dof > 0 ? std::sqrt(sum_squares / dof) : 0;
-  const RigCamera final1{result.camera1, camera1.housing}, final2{result.camera2, camera2.housing};
+  const HousedCamera final1{result.camera1, camera1.housing}, final2{result.camera2, camera2.housing};
   for (size_t f = 0; f < frames.size(); ++f) {
     const Rigid3d cam1_from_target = FromPose(poses1[f]);
     const Rigid3d cam2_from_target = result.cam2_from_cam1 * cam1_from_target;

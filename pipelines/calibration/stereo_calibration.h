@@ -42,8 +42,8 @@ struct StereoCalibrationResult {
   std::vector<CalibratedView> views1, views2;  // per frame
 };
 
-StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames, const RigCamera& camera1,
-                                        const RigCamera& camera2, const StereoCalibrationSettings& settings);
+StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames, const HousedCamera& camera1,
+                                        const HousedCamera& camera2, const StereoCalibrationSettings& settings);
 
 // Geodesic L1 median of rotations and geometric median of translations of
 // a set of poses (Weiszfeld iterations).

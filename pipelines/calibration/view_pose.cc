@@ -81,7 +81,7 @@ Rigid3d FromPose(const PoseBlock& p) {
   return Rigid3d(Eigen::Quaterniond(p[3], p[0], p[1], p[2]).normalized(), Eigen::Vector3d(p[4], p[5], p[6]));
 }
 
-void AddRigView(const CalibrationView& view, const RigCamera& rig_camera, double* cam1_from_target,
+void AddRigView(const CalibrationView& view, const HousedCamera& rig_camera, double* cam1_from_target,
              double* camk_from_cam1, double* intrinsics, ceres::Problem* problem) {
   VisitCameraModel(rig_camera.camera.model_id, [&](auto camera_tag) {
     using CameraModel = decltype(camera_tag);
@@ -112,7 +112,7 @@ ceres::Manifold* PoseManifold() {
 
 // cam_from_target of one camera and view: homography on the undistorted
 // rays, then a pose-only solve through lens and port.
-Rigid3d EstimateViewPose(const CalibrationView& view, const RigCamera& rig_camera, int num_threads) {
+Rigid3d EstimateViewPose(const CalibrationView& view, const HousedCamera& rig_camera, int num_threads) {
   PlanarView planar;
   for (size_t i = 0; i < view.pixels.size(); ++i) {
     const auto ray = rig_camera.camera.CamFromImg(view.pixels[i]);
@@ -140,18 +140,17 @@ Rigid3d EstimateViewPose(const CalibrationView& view, const RigCamera& rig_camer
   return FromPose(p);
 }
 
-double ViewRms(const CalibrationView& view, const RigCamera& rig_camera, const Rigid3d& cam_from_target) {
+double ViewRms(const CalibrationView& view, const HousedCamera& rig_camera, const Rigid3d& cam_from_target) {
   double sum = 0;
   for (size_t i = 0; i < view.pixels.size(); ++i) {
-    const auto pixel = ProjectPoint(rig_camera.camera, rig_camera.housing ? &*rig_camera.housing : nullptr,
-                                    cam_from_target * view.points_in_target[i]);
+    const auto pixel = rig_camera.Project(cam_from_target * view.points_in_target[i]);
     sum += pixel ? (*pixel - view.pixels[i]).squaredNorm() : 1e6;
   }
   return std::sqrt(sum / std::max<size_t>(1, view.pixels.size()));
 }
 
 
-double HeldOutRms(const std::vector<CalibrationView>& views, const RigCamera& camera, int num_threads) {
+double HeldOutRms(const std::vector<CalibrationView>& views, const HousedCamera& camera, int num_threads) {
   double sum = 0;
   size_t count = 0;
   for (const CalibrationView& view : views) {

@@ -9,15 +9,11 @@
 #include <vector>
 
 #include "colmap_ext/camera/camera.h"
+#include "colmap_ext/camera/housed_camera.h"
 #include "colmap_ext/housing/housing.h"
 #include "pipelines/calibration/camera_calibration.h"
 
 namespace portcal {
-
-struct RigCamera {
-  Camera camera;
-  std::optional<Housing> housing;
-};
 
 using PoseBlock = std::array<double, 7>;  // quaternion x, y, z, w + translation
 
@@ -36,18 +32,18 @@ ceres::Covariance::Options CalibrationCovarianceOptions(int num_threads);
 
 // Adds the view's points: X_k = camk_from_cam1 * cam1_from_target * X
 // through lens and housing (fixed), residuals in pixels.
-void AddRigView(const CalibrationView& view, const RigCamera& camera, double* cam1_from_target,
+void AddRigView(const CalibrationView& view, const HousedCamera& camera, double* cam1_from_target,
                 double* camk_from_cam1, double* intrinsics, ceres::Problem* problem);
 
 // cam_from_target of a view: homography on the undistorted rays, then a
 // pose-only solve through lens and housing. Throws NumericalError.
-Rigid3d EstimateViewPose(const CalibrationView& view, const RigCamera& camera, int num_threads);
+Rigid3d EstimateViewPose(const CalibrationView& view, const HousedCamera& camera, int num_threads);
 
 // RMS (px) of a view at a pose, through lens and housing.
-double ViewRms(const CalibrationView& view, const RigCamera& camera, const Rigid3d& cam_from_target);
+double ViewRms(const CalibrationView& view, const HousedCamera& camera, const Rigid3d& cam_from_target);
 
 // Held-out error of a calibration: each view's pose estimated alone (pose
 // only, everything else fixed), RMS over all points of all views.
-double HeldOutRms(const std::vector<CalibrationView>& views, const RigCamera& camera, int num_threads);
+double HeldOutRms(const std::vector<CalibrationView>& views, const HousedCamera& camera, int num_threads);
 
 }  // namespace portcal

@@ -74,8 +74,8 @@ std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconst
     if (corner.observations.size() < 2) continue;
     std::vector<Ray3d> rays;
     for (const auto& [image_id, pixel] : corner.observations) {
-      const SfmCamera& camera = reconstruction.CameraOf(image_id);
-      const auto ray = UnprojectPixel(camera.camera, camera.housing ? &*camera.housing : nullptr, pixel);
+      const HousedCamera& camera = reconstruction.CameraOf(image_id);
+      const auto ray = camera.Unproject(pixel);
       if (ray) rays.push_back(RayInWorld(*ray, reconstruction.poses().at(image_id)));
     }
     const auto xyz = TriangulateRays(rays);
@@ -83,9 +83,8 @@ std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconst
     // Drop observations that disagree (a marker id seen twice, a bad corner).
     std::vector<std::pair<image_t, Eigen::Vector2d>> kept;
     for (const auto& [image_id, pixel] : corner.observations) {
-      const SfmCamera& camera = reconstruction.CameraOf(image_id);
-      const auto projected = ProjectPoint(camera.camera, camera.housing ? &*camera.housing : nullptr,
-                                          reconstruction.poses().at(image_id) * *xyz);
+      const HousedCamera& camera = reconstruction.CameraOf(image_id);
+      const auto projected = camera.Project(reconstruction.poses().at(image_id) * *xyz);
       if (projected && (*projected - pixel).norm() < max_error_px) kept.emplace_back(image_id, pixel);
     }
     if (kept.size() < 2) continue;
@@ -201,7 +200,7 @@ void SetHousingRefinement(const Housing& model, bool refine_position, double* ho
 
 }  // namespace
 
-camera_t CameraWithHousingAtBound(const std::map<camera_t, SfmCamera>& cameras) {
+camera_t CameraWithHousingAtBound(const std::map<camera_t, HousedCamera>& cameras) {
   for (const auto& [id, camera] : cameras) {
     if (camera.housing && camera.housing->AtBound()) return id;
   }
@@ -216,7 +215,7 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
   PORTCAL_CHECK(poses.size() >= 2);
   std::map<image_t, PoseBlock> pose_blocks;
   for (const auto& [id, pose] : poses) pose_blocks[id] = ToPose(pose);
-  std::map<camera_t, SfmCamera>& cameras = reconstruction->mutable_cameras();
+  std::map<camera_t, HousedCamera>& cameras = reconstruction->mutable_cameras();
   std::map<camera_t, std::vector<double>> intrinsics, housings;
   for (auto& [id, camera] : cameras) {
     intrinsics[id] = camera.camera.params;
@@ -237,7 +236,7 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
   const bool refine_intrinsics =
       !local && (options.refine_focal_length || options.refine_principal_point || options.refine_extra_params);
   const bool refine_housing = !local && options.refine_housing;
-  const auto blocks_of = [&](const SfmCamera& camera) {
+  const auto blocks_of = [&](const HousedCamera& camera) {
     if (refine_housing && camera.housing) {
       return refine_intrinsics || options.virtual_camera_error ? CostBlocks::kAll : CostBlocks::kPosePointHousing;
     }
@@ -248,7 +247,7 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
   };
   const auto add_observation = [&](image_t image_id, const Eigen::Vector2d& pixel, double* xyz, double sigma) {
     const SfmImage& image = reconstruction->inputs().images.at(image_id);
-    const SfmCamera& camera = cameras.at(image.camera_id);
+    const HousedCamera& camera = cameras.at(image.camera_id);
     ObservationModel model;
     model.camera_model_id = camera.camera.model_id;
     model.intrinsics = camera.camera.params;
@@ -296,7 +295,7 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
   };
   for (auto& [point_id, xyz] : point_blocks) {
     for (const TrackElement& e : reconstruction->points().at(point_id).track) {
-      const SfmCamera& camera = reconstruction->CameraOf(e.image_id);
+      const HousedCamera& camera = reconstruction->CameraOf(e.image_id);
       const double sigma = sigma_of(e);
       const auto& ray = reconstruction->RayOf(e.image_id, e.point2D_idx);
       if (blocks_of(camera) == CostBlocks::kPosePoint && ray && ray->direction.z() > 1e-6) {
@@ -395,7 +394,7 @@ ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const Bundle
   }
   // Intrinsics and housings.
   for (camera_t id : used_cameras) {
-    const SfmCamera& camera = cameras.at(id);
+    const HousedCamera& camera = cameras.at(id);
     double* params = intrinsics.at(id).data();
     if (problem.HasParameterBlock(params)) {
       const std::vector<int> constant = local ? std::vector<int>() : ConstantIntrinsics(camera.camera, options);

@@ -97,7 +97,7 @@ struct CalibrationStdDevs {
 bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::string* why = nullptr);
 
 // The first camera whose housing is at such a bound, or kInvalidCameraId.
-camera_t CameraWithHousingAtBound(const std::map<camera_t, SfmCamera>& cameras);
+camera_t CameraWithHousingAtBound(const std::map<camera_t, HousedCamera>& cameras);
 
 // Adjusts in place. The gauge: the position priors (global adjustments with
 // position_prior_sigma_m > 0 and priors spanning a plane), else the first

@@ -5,7 +5,7 @@
 
 namespace portcal {
 
-double MaxImageShiftPx(const SfmCamera& before, const SfmCamera& after, double depth_m) {
+double MaxImageShiftPx(const HousedCamera& before, const HousedCamera& after, double depth_m) {
   // A 9 x 9 grid from corner to corner (half a pixel in): the image's edges
   // are where distortion and a port's tilt move it most.
   constexpr int kGrid = 9;
@@ -15,10 +15,10 @@ double MaxImageShiftPx(const SfmCamera& before, const SfmCamera& after, double d
   for (int i = 0; i < kGrid; ++i) {
     for (int j = 0; j < kGrid; ++j) {
       const Eigen::Vector2d pixel(0.5 + (width - 1) * i / (kGrid - 1), 0.5 + (height - 1) * j / (kGrid - 1));
-      const auto ray = UnprojectPixel(before.camera, before.housing ? &*before.housing : nullptr, pixel);
+      const auto ray = before.Unproject(pixel);
       if (!ray || !(ray->direction.z() > 0)) return std::numeric_limits<double>::infinity();
       const Eigen::Vector3d point = ray->origin + (depth_m - ray->origin.z()) / ray->direction.z() * ray->direction;
-      const auto seen = ProjectPoint(after.camera, after.housing ? &*after.housing : nullptr, point);
+      const auto seen = after.Project(point);
       if (!seen) return std::numeric_limits<double>::infinity();
       max_shift = std::max(max_shift, (*seen - pixel).norm());
     }

@@ -12,7 +12,7 @@ namespace portcal {
 // image and where `after` sees the points that `before` sees there at
 // `depth_m` (metres along the optical axis). Infinity where a grid pixel
 // has no ray under `before` or its point no image under `after`.
-double MaxImageShiftPx(const SfmCamera& before, const SfmCamera& after, double depth_m);
+double MaxImageShiftPx(const HousedCamera& before, const HousedCamera& after, double depth_m);
 
 // The median depth (metres along the optical axis) of the model's points
 // in the images that see them, over up to `max_samples` points; 0 if there

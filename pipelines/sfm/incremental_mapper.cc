@@ -72,8 +72,8 @@ constexpr int kMinImagesForIntrinsics = 5;
 // COLMAP's bogus-camera test against the intrinsics before the adjustment,
 // and the focal length against the mapper's start, which a slow drift of
 // many adjustments would otherwise pass.
-bool BogusIntrinsics(const std::map<camera_t, SfmCamera>& before, const std::map<camera_t, SfmCamera>& after,
-                     const std::map<camera_t, SfmCamera>& start, double max_focal_ratio_to_start) {
+bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before, const std::map<camera_t, HousedCamera>& after,
+                     const std::map<camera_t, HousedCamera>& start, double max_focal_ratio_to_start) {
   for (const auto& [id, camera] : after) {
     if (ImplausibleIntrinsics(before.at(id).camera, camera.camera)) return true;
     const double ratio = camera.camera.MeanFocalLength() / start.at(id).camera.MeanFocalLength();
@@ -92,7 +92,7 @@ bool HasOrientedHousing(const Reconstruction& r) {
 
 class Mapper {
  public:
-  Mapper(const SfmInputs& inputs, const std::map<camera_t, SfmCamera>& cameras,
+  Mapper(const SfmInputs& inputs, const std::map<camera_t, HousedCamera>& cameras,
          const IncrementalMapperOptions& options)
       : inputs_(inputs), cameras_(cameras), options_(options) {}
 
@@ -113,7 +113,7 @@ class Mapper {
   std::vector<image_t> NextImages(const Reconstruction& r) const;
 
   const SfmInputs& inputs_;
-  const std::map<camera_t, SfmCamera>& cameras_;
+  const std::map<camera_t, HousedCamera>& cameras_;
   const IncrementalMapperOptions& options_;
   std::set<image_t> used_;    // registered in an earlier model
   std::set<image_t> failed_;  // failed to register since the model last grew
@@ -319,7 +319,7 @@ bool Mapper::Register(Reconstruction* r, image_t image_id) {
 
   // Pose-only refinement through the exact projection, robust loss.
   PoseBlock pose = ToPose(*cam_from_world);
-  const SfmCamera& camera = r->CameraOf(image_id);
+  const HousedCamera& camera = r->CameraOf(image_id);
   ObservationModel model;
   model.camera_model_id = camera.camera.model_id;
   model.intrinsics = camera.camera.params;
@@ -505,7 +505,7 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   if (options_.marker_scale.side_length_m > 0) {
     markers = TriangulateMarkerCorners(*r, options_.filter_max_reproj_error_px * 4);
   }
-  const std::map<camera_t, SfmCamera> cameras_before = r->cameras();
+  const std::map<camera_t, HousedCamera> cameras_before = r->cameras();
   const std::map<image_t, Rigid3d> poses_before = r->poses();
   std::map<point3D_t, Eigen::Vector3d> points_before;
   for (const auto& [id, point] : r->points()) points_before[id] = point.xyz;
@@ -588,7 +588,7 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
 }  // namespace
 
 std::vector<MappedModel> RunIncrementalMapper(const SfmInputs& inputs,
-                                              const std::map<camera_t, SfmCamera>& cameras,
+                                              const std::map<camera_t, HousedCamera>& cameras,
                                               const IncrementalMapperOptions& options, ProgressSink& progress) {
   options.Check();
   Mapper mapper(inputs, cameras, options);

@@ -120,7 +120,7 @@ struct MappedModel {
 
 // Grows models until no image can be added; returns them largest first.
 std::vector<MappedModel> RunIncrementalMapper(const SfmInputs& inputs,
-                                              const std::map<camera_t, SfmCamera>& cameras,
+                                              const std::map<camera_t, HousedCamera>& cameras,
                                               const IncrementalMapperOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

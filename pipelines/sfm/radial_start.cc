@@ -134,10 +134,10 @@ std::vector<Matches> CollectPairs(const SfmInputs& inputs, camera_t camera_id, c
 
 // Mean squared residual over all pairs, in pixels squared, and its count,
 // with the radial term k.
-std::pair<double, int> ResidualAt(const std::vector<Matches>& pairs, const SfmCamera& camera, int idx, double k) {
+std::pair<double, int> ResidualAt(const std::vector<Matches>& pairs, const HousedCamera& camera, int idx, double k) {
   Camera trial = camera.camera;
   trial.params[idx] = k;
-  const Housing* housing = camera.housing ? &*camera.housing : nullptr;
+  const Housing* housing = camera.HousingOrNull();
   double sum = 0;
   int count = 0;
   for (const Matches& matches : pairs) {
@@ -174,7 +174,7 @@ double ParabolaVertex(double c0, double c1, double c2) {
 
 // The best k and its mean squared residual: the grid's minimum, then the
 // parabola's vertex if that is lower still.
-std::pair<double, double> BestRadialTerm(const std::vector<Matches>& pairs, const SfmCamera& camera, int idx,
+std::pair<double, double> BestRadialTerm(const std::vector<Matches>& pairs, const HousedCamera& camera, int idx,
                                          const RadialStartOptions& options) {
   const double step = (options.max_k - options.min_k) / (options.num_steps - 1);
   std::vector<double> costs(options.num_steps);
@@ -191,7 +191,7 @@ std::pair<double, double> BestRadialTerm(const std::vector<Matches>& pairs, cons
 }  // namespace
 
 std::optional<RadialStart> EstimateFirstRadialTerm(const SfmInputs& inputs, camera_t camera_id,
-                                                   const SfmCamera& camera, const RadialStartOptions& options) {
+                                                   const HousedCamera& camera, const RadialStartOptions& options) {
   options.Check();
   const int idx = FirstRadialParamIdx(camera.camera);
   if (idx < 0) return std::nullopt;

@@ -50,6 +50,6 @@ int FirstRadialParamIdx(const Camera& camera);
 
 // nullopt when the model has no radial term or fewer than two usable pairs.
 std::optional<RadialStart> EstimateFirstRadialTerm(const SfmInputs& inputs, camera_t camera_id,
-                                                   const SfmCamera& camera, const RadialStartOptions& options);
+                                                   const HousedCamera& camera, const RadialStartOptions& options);
 
 }  // namespace portcal

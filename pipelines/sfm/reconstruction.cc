@@ -11,7 +11,7 @@ SfmInputs SfmInputs::Read(Database* database) {
   SfmInputs inputs;
   const std::map<camera_t, Housing> housings = database->ReadAllHousings();
   for (const Camera& camera : database->ReadAllCameras()) {
-    SfmCamera& c = inputs.cameras[camera.camera_id];
+    HousedCamera& c = inputs.cameras[camera.camera_id];
     c.camera = camera;
     const auto it = housings.find(camera.camera_id);
     if (it != housings.end()) c.housing = it->second;
@@ -88,7 +88,7 @@ Reconstruction Reconstruction::FromSparseModel(const SfmInputs* inputs, const Sp
   return r;
 }
 
-Eigen::Vector3d VirtualCenterOf(const SfmCamera& camera, const Ray3d& ray) {
+Eigen::Vector3d VirtualCenterOf(const HousedCamera& camera, const Ray3d& ray) {
   if (!camera.housing) return Eigen::Vector3d::Zero();
   const std::vector<double>& p = camera.housing->params;
   Eigen::Vector3d axis(p[0], p[1], p[2]);
@@ -101,7 +101,7 @@ Eigen::Vector3d VirtualCenterOf(const SfmCamera& camera, const Ray3d& ray) {
   return ((axis.dot(ray.origin) - c * d.dot(ray.origin)) / sin2) * axis;
 }
 
-Reconstruction::Reconstruction(const SfmInputs* inputs, std::map<camera_t, SfmCamera> cameras)
+Reconstruction::Reconstruction(const SfmInputs* inputs, std::map<camera_t, HousedCamera> cameras)
     : inputs_(inputs), cameras_(std::move(cameras)) {
   for (const auto& [id, image] : inputs_->images) {
     num_observing_correspondences_[id].assign(image.keypoints.size(), 0);
@@ -128,11 +128,10 @@ void Reconstruction::UpdateRays() {
   }
   ParallelFor(images.size(), 2, [&](size_t i) {
     const SfmImage& image = *images[i];
-    const SfmCamera& camera = cameras_.at(image.camera_id);
+    const HousedCamera& camera = cameras_.at(image.camera_id);
     std::vector<std::optional<Ray3d>>& rays = rays_.at(image.image_id);
     for (size_t k = 0; k < image.keypoints.size(); ++k) {
-      rays[k] = UnprojectPixel(camera.camera, camera.housing ? &*camera.housing : nullptr,
-                               image.keypoints[k]);
+      rays[k] = camera.Unproject(image.keypoints[k]);
     }
   });
 }
@@ -207,14 +206,14 @@ int Reconstruction::NumObservations(image_t image_id) const {
   return n;
 }
 
-const SfmCamera& Reconstruction::CameraOf(image_t image_id) const {
+const HousedCamera& Reconstruction::CameraOf(image_t image_id) const {
   return cameras_.at(inputs_->images.at(image_id).camera_id);
 }
 
 double Reconstruction::ReprojectionError(image_t image_id, point2D_t idx, const Eigen::Vector3d& xyz) const {
-  const SfmCamera& camera = CameraOf(image_id);
+  const HousedCamera& camera = CameraOf(image_id);
   const Eigen::Vector3d in_cam = poses_.at(image_id) * xyz;
-  const auto pixel = ProjectPoint(camera.camera, camera.housing ? &*camera.housing : nullptr, in_cam);
+  const auto pixel = camera.Project(in_cam);
   if (!pixel) return std::numeric_limits<double>::infinity();
   return (*pixel - inputs_->images.at(image_id).keypoints[idx]).norm();
 }

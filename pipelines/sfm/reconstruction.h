@@ -13,16 +13,12 @@
 #include <unordered_map>
 #include <vector>
 
+#include "colmap_ext/camera/housed_camera.h"
 #include "colmap_ext/housing/housing.h"
 #include "colmap_ext/io/sparse_model.h"
 #include "database/database.h"
 
 namespace portcal {
-
-struct SfmCamera {
-  Camera camera;
-  std::optional<Housing> housing;
-};
 
 struct Correspondence {
   image_t image_id;
@@ -44,7 +40,7 @@ struct SfmImage {
 
 // Read-only inputs of the mapper.
 struct SfmInputs {
-  std::map<camera_t, SfmCamera> cameras;
+  std::map<camera_t, HousedCamera> cameras;
   std::map<image_t, SfmImage> images;
   // Verified pairs (pair id -> number of inlier matches).
   std::map<image_pair_t, int> pair_inliers;
@@ -67,13 +63,13 @@ struct SfmPoint {
 // point of the housing's refraction axis closest to it (flat port: the axis
 // along the normal; dome: through the sphere's centre), or the camera
 // centre without a housing or for a ray along the axis.
-Eigen::Vector3d VirtualCenterOf(const SfmCamera& camera, const Ray3d& ray_in_cam);
+Eigen::Vector3d VirtualCenterOf(const HousedCamera& camera, const Ray3d& ray_in_cam);
 
 // One model being grown.
 class Reconstruction {
  public:
   // `cameras`: the intrinsics and housings to start from.
-  Reconstruction(const SfmInputs* inputs, std::map<camera_t, SfmCamera> cameras);
+  Reconstruction(const SfmInputs* inputs, std::map<camera_t, HousedCamera> cameras);
 
   const SfmInputs& inputs() const { return *inputs_; }
   bool IsRegistered(image_t image_id) const { return poses_.count(image_id) > 0; }
@@ -100,9 +96,9 @@ class Reconstruction {
   int NumVisiblePoints(image_t image_id) const;
 
   // Camera and housing of an image (the inputs' unless refined here).
-  const SfmCamera& CameraOf(image_t image_id) const;
-  std::map<camera_t, SfmCamera>& mutable_cameras() { return cameras_; }
-  const std::map<camera_t, SfmCamera>& cameras() const { return cameras_; }
+  const HousedCamera& CameraOf(image_t image_id) const;
+  std::map<camera_t, HousedCamera>& mutable_cameras() { return cameras_; }
+  const std::map<camera_t, HousedCamera>& cameras() const { return cameras_; }
 
   // The keypoint's ray in the camera frame (nullopt: the pixel has none).
   const std::optional<Ray3d>& RayOf(image_t image_id, point2D_t idx) const {
@@ -122,7 +118,7 @@ class Reconstruction {
 
  private:
   const SfmInputs* inputs_;
-  std::map<camera_t, SfmCamera> cameras_;
+  std::map<camera_t, HousedCamera> cameras_;
   std::map<image_t, Rigid3d> poses_;
   std::map<point3D_t, SfmPoint> points_;
   std::map<image_t, std::vector<point3D_t>> point_of_;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/camera/housed_camera.h"
 #include "colmap_ext/housing/housing.h"
 #include "colmap_ext/housing/housing_models.h"
 #include "colmap_ext/housing/port_projection.h"
@@ -257,6 +258,23 @@ TEST(Housing, RefinementNamesWhatAnAdjustmentMayMoveAndHowFar) {
     EXPECT_DOUBLE_EQ(b.lower, -0.045);
   }
   EXPECT_EQ(dome.InAirFocalRatio(), 1.0);
+}
+
+TEST(Housing, HousedCameraProjectsThroughItsHousingOrInAir) {
+  const Eigen::Vector3d point(0.1, -0.05, 0.8);
+  for (const Housing& housing : TestHousings()) {
+    const HousedCamera housed{TestCamera(), housing};
+    EXPECT_EQ(housed.HousingOrNull(), &*housed.housing);
+    const auto pixel = housed.Project(point);
+    ASSERT_TRUE(pixel);
+    EXPECT_EQ(*pixel, *ProjectPoint(housed.camera, &housing, point));
+    const auto ray = housed.Unproject(*pixel);
+    ASSERT_TRUE(ray);
+    EXPECT_EQ(ray->origin, UnprojectPixel(housed.camera, &housing, *pixel)->origin);
+  }
+  const HousedCamera in_air{TestCamera(), std::nullopt};
+  EXPECT_EQ(in_air.HousingOrNull(), nullptr);
+  EXPECT_EQ(*in_air.Project(point), *TestCamera().ImgFromCam(point));
 }
 
 TEST(Housing, ForwardProjectionDerivativesMatchCentralDifferences) {

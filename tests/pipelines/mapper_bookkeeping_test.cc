@@ -106,8 +106,8 @@ TEST(Reconstruction, VisiblePointCountsFollowEveryObservationChange) {
   EXPECT_GT(nonzero, 2000);  // the counts were exercised, not zero throughout
 }
 
-SfmCamera Pinhole(double f) {
-  SfmCamera camera;
+HousedCamera Pinhole(double f) {
+  HousedCamera camera;
   camera.camera = Camera::FromModelName("PINHOLE", f, 960, 540);
   camera.camera.params = {f, f, 480, 270};
   return camera;
@@ -128,7 +128,7 @@ TEST(CameraChange, AFlatPortsDistanceMovesTheImageLessWithDepth) {
   // Moving the port moves the virtual centres of the rays: a parallax that
   // falls off as 1 / depth.
   const auto behind_port = [](double distance) {
-    SfmCamera camera = Pinhole(700);
+    HousedCamera camera = Pinhole(700);
     camera.housing = Housing::FromName("FLATPORT", {0.05, 0.0, std::sqrt(1 - 0.0025), distance, 0.01, 1, 1.473, 1.334},
                                        "test");
     return camera;

@@ -160,7 +160,7 @@ struct SyntheticSurvey {
 
   SyntheticSurvey(double pixel_sigma, double navigation_sigma, std::mt19937* rng) {
     camera.camera_id = 1;
-    inputs.cameras[1] = SfmCamera{camera, true_housing};
+    inputs.cameras[1] = HousedCamera{camera, true_housing};
     std::normal_distribution<double> noise(0.0, 1.0);
     image_t id = 1;
     const Eigen::Quaterniond down(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
@@ -193,7 +193,7 @@ struct SyntheticSurvey {
   }
 
   Reconstruction InArbitraryFrame(const Similarity3d& arbitrary_from_true) const {
-    std::map<camera_t, SfmCamera> guess = inputs.cameras;
+    std::map<camera_t, HousedCamera> guess = inputs.cameras;
     guess.at(1).housing->params = {0, 0, 1, 0.01, 0.01, 1.0, 1.473, 1.334};
     Reconstruction r(&inputs, guess);
     const Similarity3d& s = arbitrary_from_true;

@@ -12,12 +12,12 @@ namespace {
 
 struct Scene {
   SfmInputs inputs;
-  SfmCamera truth;
+  HousedCamera truth;
 };
 
 // `num_images` views on an arc around a cloud of points 0.6-1.0 m away,
 // every view matched with every other; keypoints with noise `sigma_px`.
-Scene MakeScene(const SfmCamera& truth, int num_images, double sigma_px, uint32_t seed) {
+Scene MakeScene(const HousedCamera& truth, int num_images, double sigma_px, uint32_t seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
   std::normal_distribution<double> noise(0, sigma_px);
@@ -69,20 +69,20 @@ Scene MakeScene(const SfmCamera& truth, int num_images, double sigma_px, uint32_
   return scene;
 }
 
-SfmCamera WithoutDistortion(SfmCamera camera) {
+HousedCamera WithoutDistortion(HousedCamera camera) {
   for (size_t i = 4; i < camera.camera.params.size(); ++i) camera.camera.params[i] = 0;
   return camera;
 }
 
 TEST(RadialStart, FindsTheFirstRadialTermOfAWideLensBehindAFlatPort) {
-  SfmCamera truth;
+  HousedCamera truth;
   truth.camera = Camera::FromModelName("OPENCV", 905, 1920, 1080);
   truth.camera.params = {905, 902, 981, 527, -0.3, 0, 0.0012, 0.0009};
   truth.housing = Housing::FromName("FLATPORT", {0.0436194, 0, 0.9990482, 0.03, 0.008, 1, 1.473, 1.334}, "test");
   const Scene scene = MakeScene(truth, 6, 0.3, 3);
   // All but k1 known: the estimate is the lens's k1, to the
   // noise (0.3 px on ~10 pairs; the grid's step is 0.025).
-  SfmCamera k1_unknown = truth;
+  HousedCamera k1_unknown = truth;
   k1_unknown.camera.params[4] = 0;
   const auto exact = EstimateFirstRadialTerm(scene.inputs, 1, k1_unknown, RadialStartOptions());
   ASSERT_TRUE(exact);
@@ -94,7 +94,7 @@ TEST(RadialStart, FindsTheFirstRadialTermOfAWideLensBehindAFlatPort) {
   // lens distorts, so the estimate is biased toward 0; the mapper needs a
   // start in the right basin (the render of docs/auto_calibration.md:
   // k1 = -0.21 and -0.25 for -0.3 both converged to -0.300, 0 did not).
-  SfmCamera start = WithoutDistortion(truth);
+  HousedCamera start = WithoutDistortion(truth);
   start.camera.params = {895, 895, 960, 540, 0, 0, 0, 0};
   start.housing = Housing::FromName("FLATPORT", {0, 0, 1, 0.03, 0.008, 1, 1.473, 1.334}, "test");
   const auto estimate = EstimateFirstRadialTerm(scene.inputs, 1, start, RadialStartOptions());
@@ -105,7 +105,7 @@ TEST(RadialStart, FindsTheFirstRadialTermOfAWideLensBehindAFlatPort) {
 }
 
 TEST(RadialStart, KeepsAnUndistortedLensUndistorted) {
-  SfmCamera truth;
+  HousedCamera truth;
   truth.camera = Camera::FromModelName("RADIAL", 1300, 1920, 1080);
   truth.camera.params = {1300, 960, 540, 0, 0};
   const Scene scene = MakeScene(truth, 5, 0.3, 5);
@@ -120,12 +120,12 @@ TEST(RadialStart, KeepsAnUndistortedLensUndistorted) {
 }
 
 TEST(RadialStart, NoRadialTermNoEstimate) {
-  SfmCamera pinhole;
+  HousedCamera pinhole;
   pinhole.camera = Camera::FromModelName("PINHOLE", 1000, 1280, 720);
   const Scene scene = MakeScene(pinhole, 3, 0.3, 7);
   EXPECT_EQ(FirstRadialParamIdx(pinhole.camera), -1);
   EXPECT_FALSE(EstimateFirstRadialTerm(scene.inputs, 1, pinhole, RadialStartOptions()));
-  SfmCamera fisheye;
+  HousedCamera fisheye;
   fisheye.camera = Camera::FromModelName("OPENCV_FISHEYE", 500, 1280, 720);
   EXPECT_EQ(FirstRadialParamIdx(fisheye.camera), 4);
 }
