@@ -4,41 +4,6 @@
 
 namespace portcal {
 
-FeatureKeypoint FeatureKeypoint::FromScaleOrientation(float x, float y,
-                                                      float scale,
-                                                      float orientation) {
-  FeatureKeypoint keypoint;
-  keypoint.x = x;
-  keypoint.y = y;
-  const float c = std::cos(orientation), s = std::sin(orientation);
-  keypoint.a11 = scale * c;
-  keypoint.a12 = -scale * s;
-  keypoint.a21 = scale * s;
-  keypoint.a22 = scale * c;
-  return keypoint;
-}
-
-float FeatureKeypoint::ComputeScale() const {
-  return 0.5f * (std::sqrt(a11 * a11 + a21 * a21) +
-                 std::sqrt(a12 * a12 + a22 * a22));
-}
-
-float FeatureKeypoint::ComputeOrientation() const {
-  return std::atan2(a21, a11);
-}
-
-TwoViewGeometry TwoViewGeometry::Inverse() const {
-  TwoViewGeometry inverse = *this;
-  inverse.F = F.transpose();
-  inverse.E = E.transpose();
-  if (H.determinant() != 0) inverse.H = H.inverse();
-  inverse.cam2_from_cam1 = cam2_from_cam1.Inverse();
-  for (FeatureMatch& match : inverse.inlier_matches) {
-    std::swap(match.point2D_idx1, match.point2D_idx2);
-  }
-  return inverse;
-}
-
 bool SwapImagePair(image_t image_id1, image_t image_id2) {
   return image_id1 > image_id2;
 }

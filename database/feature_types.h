@@ -1,4 +1,6 @@
-// What the COLMAP tables hold, in memory.
+// The rows of the COLMAP and portcal tables that are not features
+// (colmap_ext/feature/: keypoints, matches, two-view geometries, markers),
+// and COLMAP's image pair ids.
 #pragma once
 
 #include <Eigen/Core>
@@ -9,60 +11,13 @@
 #include <vector>
 
 #include "colmap_ext/camera/camera.h"
+#include "colmap_ext/feature/keypoint.h"
+#include "colmap_ext/feature/marker_detection.h"
+#include "colmap_ext/feature/two_view_geometry.h"
 #include "colmap_ext/geometry/rigid3d.h"
+#include "colmap_ext/util/types.h"
 
 namespace portcal {
-
-using image_t = uint32_t;
-using image_pair_t = uint64_t;
-
-// COLMAP's SIFT keypoint: position (COLMAP pixels) and the affine shape
-// [a11 a12; a21 a22] (scale and orientation).
-struct FeatureKeypoint {
-  float x = 0, y = 0;
-  float a11 = 1, a12 = 0, a21 = 0, a22 = 1;
-
-  static FeatureKeypoint FromScaleOrientation(float x, float y, float scale,
-                                              float orientation);
-  float ComputeScale() const;
-  float ComputeOrientation() const;
-};
-using FeatureKeypoints = std::vector<FeatureKeypoint>;
-
-// One row per keypoint, 128 uint8 columns (COLMAP's normalisation).
-using FeatureDescriptors =
-    Eigen::Matrix<uint8_t, Eigen::Dynamic, 128, Eigen::RowMajor>;
-
-struct FeatureMatch {
-  uint32_t point2D_idx1 = 0;
-  uint32_t point2D_idx2 = 0;
-};
-using FeatureMatches = std::vector<FeatureMatch>;
-
-// Values of two_view_geometries.config, as in COLMAP 3.8.
-enum class TwoViewGeometryConfig : int {
-  kUndefined = 0,
-  kDegenerate = 1,
-  kCalibrated = 2,
-  kUncalibrated = 3,
-  kPlanar = 4,
-  kPanoramic = 5,
-  kPlanarOrPanoramic = 6,
-  kWatermark = 7,
-  kMultiple = 8,
-};
-
-struct TwoViewGeometry {
-  TwoViewGeometryConfig config = TwoViewGeometryConfig::kUndefined;
-  Eigen::Matrix3d F = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d E = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-  Rigid3d cam2_from_cam1;
-  FeatureMatches inlier_matches;
-
-  // The same geometry seen from the other image (swapped roles).
-  TwoViewGeometry Inverse() const;
-};
 
 // A row of the images table.
 struct DatabaseImage {
@@ -94,13 +49,6 @@ struct TargetDetectionStatus {
   bool found = false;
   int num_points = 0;
   std::string reason;  // why not, when not found
-};
-
-// portcal_marker_detections: one ArUco marker in an image.
-struct MarkerDetection {
-  std::string dictionary;  // e.g. DICT_4X4_50
-  int marker_id = 0;
-  std::array<Eigen::Vector2d, 4> corners;  // COLMAP pixels, OpenCV's order
 };
 
 // portcal_stage_log: one completed stage run.

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "colmap_ext/util/progress.h"
-#include "database/feature_types.h"
+#include "colmap_ext/feature/marker_detection.h"
 
 namespace portcal {
 

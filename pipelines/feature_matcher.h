@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "colmap_ext/util/progress.h"
+#include "colmap_ext/util/types.h"
 #include "pipelines/features/descriptor_matching.h"
 #include "pipelines/features/two_view_verification.h"
 

@@ -14,12 +14,10 @@
 #include "colmap_ext/camera/camera.h"
 #include "colmap_ext/geometry/rigid3d.h"
 #include "colmap_ext/housing/housing.h"
+#include "colmap_ext/util/types.h"
 
 namespace portcal {
 
-using image_t = uint32_t;
-using point2D_t = uint32_t;
-using point3D_t = uint64_t;
 constexpr point3D_t kInvalidPoint3DId = static_cast<point3D_t>(-1);
 
 struct Point2D {

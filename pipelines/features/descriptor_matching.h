@@ -16,7 +16,8 @@
 
 #include <string>
 
-#include "database/feature_types.h"
+#include "colmap_ext/feature/keypoint.h"
+#include "colmap_ext/feature/two_view_geometry.h"
 #include "pipelines/features/nearest_descriptors.h"
 
 namespace portcal {

@@ -11,7 +11,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "database/feature_types.h"
+#include "colmap_ext/feature/keypoint.h"
 
 namespace portcal {
 

@@ -17,7 +17,9 @@
 // epipolar models still separate right matches from wrong ones.
 #pragma once
 
-#include "database/feature_types.h"
+#include "colmap_ext/camera/camera.h"
+#include "colmap_ext/feature/keypoint.h"
+#include "colmap_ext/feature/two_view_geometry.h"
 
 namespace portcal {
 

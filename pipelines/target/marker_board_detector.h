@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "database/feature_types.h"
+#include "colmap_ext/feature/marker_detection.h"
 #include "pipelines/target/corner_refinement.h"
 
 namespace portcal {
