@@ -222,14 +222,11 @@ void MoveHousingsOffBound(const HousingOverride& guess, Reconstruction* r) {
 
 }  // namespace
 
-RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options) {
-  options.Check();
-  const SparseModel model = ReadSparseModel(options.input_path);
-  model.Validate(options.input_path);
-  if (model.images.size() < 2) {
-    throw InputError(options.input_path + ": " + std::to_string(model.images.size()) +
-                     " registered image(s); bundle adjustment needs at least 2");
-  }
+namespace {
+
+// The model's images and cameras (the housing override applied), with the
+// database's marker detections, position priors and keypoint scales.
+SfmInputs ReadAdjusterInputs(const RefractiveBundleAdjusterOptions& options, const SparseModel& model) {
   SfmInputs inputs = SfmInputs::FromSparseModel(model);
   ApplyHousingOverride(options.housing, &inputs.cameras);
   if (options.ba.refine_housing) {
@@ -260,31 +257,119 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
       for (const FeatureKeypoint& k : keypoints) image.scales.push_back(k.ComputeScale());
     }
   }
-  Reconstruction r = Reconstruction::FromSparseModel(&inputs, model);
-  RefractiveBundleAdjusterResult result;
-  const bool use_priors = options.ba.position_prior_sigma_m > 0;
+  return inputs;
+}
+
+// The metric scale: the model aligned to the images' position priors, or
+// the markers' corners triangulated, as the options ask.
+void PrepareScale(const RefractiveBundleAdjusterOptions& options, bool use_priors, Reconstruction* r,
+                  std::vector<MarkerCorner>* markers, RefractiveBundleAdjusterResult* result) {
   if (use_priors) {
-    const auto alignment = AlignToPositionPriors(&r, 5 * options.ba.position_prior_sigma_m);
+    const auto alignment = AlignToPositionPriors(r, 5 * options.ba.position_prior_sigma_m);
     if (!alignment) {
       throw InputError(options.database_path + ": fewer than 3 registered images of " + options.input_path +
                        " have position priors, or their positions are collinear; the scale cannot come "
                        "from --PosePrior.position_sigma (run pose_prior_importer, or set it to 0)");
     }
-    result.num_position_priors = alignment->num_inliers;
+    result->num_position_priors = alignment->num_inliers;
     LOG(INFO) << "refractive_bundle_adjuster: aligned to " << alignment->num_inliers << " of "
               << alignment->num_priors << " position priors (scale " << alignment->new_from_old.scale
               << ", RMS " << alignment->rms_m << " m)";
   }
-  std::vector<MarkerCorner> markers;
   if (options.marker_scale.side_length_m > 0) {
-    markers = TriangulateMarkerCorners(r, 4 * options.max_reproj_error_px);
-    result.num_marker_corners = static_cast<int>(markers.size());
-    if (markers.empty()) {
+    *markers = TriangulateMarkerCorners(*r, 4 * options.max_reproj_error_px);
+    result->num_marker_corners = static_cast<int>(markers->size());
+    if (markers->empty()) {
       throw InputError(options.database_path + ": no marker corner is seen by two registered images; the "
                        "scale cannot come from --Markers.side_length (run feature_masker, or set it to 0)");
     }
-    LOG(INFO) << "refractive_bundle_adjuster: " << markers.size() << " marker corners give the scale";
+    LOG(INFO) << "refractive_bundle_adjuster: " << markers->size() << " marker corners give the scale";
   }
+}
+
+// The report of camera `camera_id`: parameters, standard deviations,
+// exact reprojection RMS overall and per view.
+void FillReport(const RefractiveBundleAdjusterOptions& options, const Reconstruction& r, camera_t camera_id,
+                const CalibrationStdDevs& std_devs, bool use_priors, CalibrationReport* out) {
+  CalibrationReport& report = *out;
+  const HousedCamera& camera = r.cameras().at(camera_id);
+  report.camera = camera.camera;
+  report.housing = camera.housing;
+  report.parameters_std_dev = std_devs.intrinsics.count(camera_id)
+                                  ? std_devs.intrinsics.at(camera_id)
+                                  : std::vector<double>(camera.camera.params.size(), 0.0);
+  if (camera.housing) {
+    report.housing_std_dev = std_devs.housing.count(camera_id)
+                                 ? std_devs.housing.at(camera_id)
+                                 : std::vector<double>(camera.housing->params.size(), 0.0);
+  }
+  const auto of_camera = [camera_id](const std::map<camera_t, std::vector<double>>& std_dev) {
+    return std_dev.count(camera_id) ? std_dev.at(camera_id) : std::vector<double>{};
+  };
+  report.parameters_std_dev_by_noise = of_camera(std_devs.intrinsics_by_noise);
+  report.parameters_std_dev_by_clusters = of_camera(std_devs.intrinsics_by_clusters);
+  report.housing_std_dev_by_noise = of_camera(std_devs.housing_by_noise);
+  report.housing_std_dev_by_clusters = of_camera(std_devs.housing_by_clusters);
+  // A refined parameter without a finite standard deviation is
+  // undetermined (negative in the report), not held (0).
+  for (auto* std_dev : {&report.parameters_std_dev, &report.housing_std_dev, &report.parameters_std_dev_by_noise,
+                        &report.parameters_std_dev_by_clusters, &report.housing_std_dev_by_noise,
+                        &report.housing_std_dev_by_clusters}) {
+    for (double& v : *std_dev) {
+      if (!std::isfinite(v)) v = -1.0;
+    }
+  }
+  report.residual_sigma_px = std_devs.sigma0;
+  report.target_description =
+      options.marker_scale.side_length_m > 0
+          ? "auto-calibration (SIFT points, ArUco markers of side " +
+                std::to_string(options.marker_scale.side_length_m) + " m give the scale)"
+          : use_priors ? "self-calibration (SIFT points; position priors of sigma " +
+                             std::to_string(options.ba.position_prior_sigma_m) + " m give the scale)"
+                       : "auto-calibration (SIFT points; no metric scale)";
+  double sum_sq = 0;
+  int64_t count = 0;
+  std::map<image_t, std::pair<double, int>> per_image;
+  for (const auto& [id, point] : r.points()) {
+    for (const TrackElement& e : point.track) {
+      const double err = r.ReprojectionError(e.image_id, e.point2D_idx, point.xyz);
+      if (!std::isfinite(err)) continue;
+      sum_sq += err * err;
+      ++count;
+      per_image[e.image_id].first += err * err;
+      per_image[e.image_id].second += 1;
+    }
+  }
+  report.overall_rms_px = count ? std::sqrt(sum_sq / count) : 0.0;
+  report.num_points = static_cast<int>(count);
+  for (const auto& [image_id, pose] : r.poses()) {
+    if (r.inputs().images.at(image_id).camera_id != camera_id) continue;
+    CalibratedView view;
+    view.image_name = r.inputs().images.at(image_id).name;
+    view.cam_from_target = pose;
+    const auto it = per_image.find(image_id);
+    view.num_points = it == per_image.end() ? 0 : it->second.second;
+    view.rms_px = view.num_points ? std::sqrt(it->second.first / view.num_points) : 0.0;
+    report.views.push_back(view);
+  }
+}
+
+}  // namespace
+
+RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options) {
+  options.Check();
+  const SparseModel model = ReadSparseModel(options.input_path);
+  model.Validate(options.input_path);
+  if (model.images.size() < 2) {
+    throw InputError(options.input_path + ": " + std::to_string(model.images.size()) +
+                     " registered image(s); bundle adjustment needs at least 2");
+  }
+  SfmInputs inputs = ReadAdjusterInputs(options, model);
+  Reconstruction r = Reconstruction::FromSparseModel(&inputs, model);
+  RefractiveBundleAdjusterResult result;
+  const bool use_priors = options.ba.position_prior_sigma_m > 0;
+  std::vector<MarkerCorner> markers;
+  PrepareScale(options, use_priors, &r, &markers, &result);
 
   if (options.ba.refine_housing && options.marker_scale.side_length_m <= 0 && !use_priors) {
     LOG(WARNING) << "refractive_bundle_adjuster: no marker scale (--Markers.side_length): the model's scale "
@@ -422,73 +507,15 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
                  << " cameras; the report describes camera " << camera_id << " (the model has all)";
   }
   CalibrationReport& report = result.report;
-  const HousedCamera& camera = r.cameras().at(camera_id);
-  report.camera = camera.camera;
-  report.housing = camera.housing;
-  report.parameters_std_dev = std_devs.intrinsics.count(camera_id)
-                                  ? std_devs.intrinsics.at(camera_id)
-                                  : std::vector<double>(camera.camera.params.size(), 0.0);
-  if (camera.housing) {
-    report.housing_std_dev = std_devs.housing.count(camera_id)
-                                 ? std_devs.housing.at(camera_id)
-                                 : std::vector<double>(camera.housing->params.size(), 0.0);
-  }
-  const auto of_camera = [camera_id](const std::map<camera_t, std::vector<double>>& std_dev) {
-    return std_dev.count(camera_id) ? std_dev.at(camera_id) : std::vector<double>{};
-  };
-  report.parameters_std_dev_by_noise = of_camera(std_devs.intrinsics_by_noise);
-  report.parameters_std_dev_by_clusters = of_camera(std_devs.intrinsics_by_clusters);
-  report.housing_std_dev_by_noise = of_camera(std_devs.housing_by_noise);
-  report.housing_std_dev_by_clusters = of_camera(std_devs.housing_by_clusters);
-  // A refined parameter without a finite standard deviation is
-  // undetermined (negative in the report), not held (0).
-  for (auto* std_dev : {&report.parameters_std_dev, &report.housing_std_dev, &report.parameters_std_dev_by_noise,
-                        &report.parameters_std_dev_by_clusters, &report.housing_std_dev_by_noise,
-                        &report.housing_std_dev_by_clusters}) {
-    for (double& v : *std_dev) {
-      if (!std::isfinite(v)) v = -1.0;
-    }
-  }
-  report.residual_sigma_px = std_devs.sigma0;
+  FillReport(options, r, camera_id, std_devs, use_priors, &report);
   report.notes = notes;
   report.warnings = warnings;
-  report.target_description =
-      options.marker_scale.side_length_m > 0
-          ? "auto-calibration (SIFT points, ArUco markers of side " +
-                std::to_string(options.marker_scale.side_length_m) + " m give the scale)"
-          : use_priors ? "self-calibration (SIFT points; position priors of sigma " +
-                             std::to_string(options.ba.position_prior_sigma_m) + " m give the scale)"
-                       : "auto-calibration (SIFT points; no metric scale)";
-  double sum_sq = 0;
-  int64_t count = 0;
-  std::map<image_t, std::pair<double, int>> per_image;
-  for (const auto& [id, point] : r.points()) {
-    for (const TrackElement& e : point.track) {
-      const double err = r.ReprojectionError(e.image_id, e.point2D_idx, point.xyz);
-      if (!std::isfinite(err)) continue;
-      sum_sq += err * err;
-      ++count;
-      per_image[e.image_id].first += err * err;
-      per_image[e.image_id].second += 1;
-    }
-  }
-  report.overall_rms_px = count ? std::sqrt(sum_sq / count) : 0.0;
-  report.num_points = static_cast<int>(count);
-  for (const auto& [image_id, pose] : r.poses()) {
-    if (inputs.images.at(image_id).camera_id != camera_id) continue;
-    CalibratedView view;
-    view.image_name = inputs.images.at(image_id).name;
-    view.cam_from_target = pose;
-    const auto it = per_image.find(image_id);
-    view.num_points = it == per_image.end() ? 0 : it->second.second;
-    view.rms_px = view.num_points ? std::sqrt(it->second.first / view.num_points) : 0.0;
-    report.views.push_back(view);
-  }
   WriteSparseModel(r.ToSparseModel(), options.output_path, ModelFormat::kBinary);
   WriteCalibrationReport(report, options.output_path);
-  LOG(INFO) << "refractive_bundle_adjuster: RMS " << report.overall_rms_px << " px over " << count
+  LOG(INFO) << "refractive_bundle_adjuster: RMS " << report.overall_rms_px << " px over " << report.num_points
             << " observations; " << result.num_filtered << " observations dropped; written to "
             << options.output_path;
+  const HousedCamera& camera = r.cameras().at(camera_id);
   if (camera.housing) LOG(INFO) << "housing: " << camera.housing->ModelName() << " " << [&] {
     std::string s;
     for (double v : camera.housing->params) s += std::to_string(v) + " ";
