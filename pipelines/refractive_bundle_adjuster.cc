@@ -166,7 +166,8 @@ std::vector<TradeOff> TradeOffs(const std::map<camera_t, HousedCamera>& cameras,
          << intrinsic.at(static_cast<size_t>(i)) << " and " << housing.at(static_cast<size_t>(j))
          << " are correlated at " << std::showpos << correlation(i, j) << std::noshowpos
          << ": the views hardly tell them apart (the housing's standard deviation is at least "
-         << std::setprecision(1) << factor << " times what it would be with the intrinsics known); give in-air intrinsics "
+         << std::setprecision(1) << factor
+         << " times what it would be with the intrinsics known); give in-air intrinsics "
             "(--ImageReader.camera_params) or views with more depth and angle";
     trade_offs.push_back({note.str(), factor});
   }
@@ -213,16 +214,14 @@ void MoveHousingsOffBound(const HousingOverride& guess, Reconstruction* r) {
     const Housing& from = *guessed.at(id).housing;
     if (from.model_id != camera.housing->model_id) continue;
     const HousingRefinement refinement = camera.housing->Refinement();
-    for (int k : refinement.position) camera.housing->params[static_cast<size_t>(k)] = from.params[static_cast<size_t>(k)];
+    for (int k : refinement.position) {
+      camera.housing->params[static_cast<size_t>(k)] = from.params[static_cast<size_t>(k)];
+    }
     LOG(INFO) << "refractive_bundle_adjuster: camera " << id << ": housing started again off its bound, from the "
               << "guess's " << refinement.position_name;
   }
   r->UpdateRays();
 }
-
-}  // namespace
-
-namespace {
 
 // The model's images and cameras (the housing override applied), with the
 // database's marker detections, position priors and keypoint scales.

@@ -233,7 +233,9 @@ TEST(Housing, AtBoundIsTheAdjustmentsFloorOrWall) {
   EXPECT_TRUE(flat(1e-4).AtBound());
   EXPECT_FALSE(flat(0.015).AtBound());
   EXPECT_FALSE(flat(1e-3).AtBound());
-  const auto dome = [](double cz) { return Housing::FromName("DOMEPORT", {0.01, 0.0, cz, 0.05, 0.006, 1, 1.473, 1.334}, "test"); };
+  const auto dome = [](double cz) {
+    return Housing::FromName("DOMEPORT", {0.01, 0.0, cz, 0.05, 0.006, 1, 1.473, 1.334}, "test");
+  };
   EXPECT_TRUE(dome(-0.045).AtBound());
   EXPECT_FALSE(dome(0.02).AtBound());
 }

@@ -62,9 +62,8 @@ struct MemberRun {
 };
 
 fs::path Render(const fs::path& dir, const FamilyMember& m) {
-  std::ofstream(dir / "set.yaml") << "name: member\n"
-                                   << kViews << m.camera_yaml << (m.housing_yaml.empty() ? "housing: null\n" : m.housing_yaml)
-                                   << m.target_yaml;
+  const std::string housing = m.housing_yaml.empty() ? "housing: null\n" : m.housing_yaml;
+  std::ofstream(dir / "set.yaml") << "name: member\n" << kViews << m.camera_yaml << housing << m.target_yaml;
   SynthesizeOptions synthesize;
   synthesize.config_path = (dir / "set.yaml").string();
   synthesize.output_path = (dir / "set").string();
