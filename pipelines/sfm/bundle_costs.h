@@ -23,6 +23,8 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "colmap_ext/camera/housed_camera.h"
+
 namespace portcal {
 
 constexpr int kNoHousing = -1;
@@ -34,6 +36,18 @@ struct ObservationModel {
   std::vector<double> intrinsics;  // used as constants where not a block
   int housing_model_id = kNoHousing;
   std::vector<double> housing;     // used as a constant where not a block
+
+  // The camera's (and its housing's) model and current parameters.
+  static ObservationModel Of(const HousedCamera& camera) {
+    ObservationModel model;
+    model.camera_model_id = camera.camera.model_id;
+    model.intrinsics = camera.camera.params;
+    if (camera.housing) {
+      model.housing_model_id = camera.housing->model_id;
+      model.housing = camera.housing->params;
+    }
+    return model;
+  }
 };
 
 // Exact reprojection error: world point -> camera frame -> through the port

@@ -207,13 +207,7 @@ CostBlocks BundleProblem::BlocksOf(const HousedCamera& camera) const {
 void BundleProblem::AddObservation(image_t image_id, const Eigen::Vector2d& pixel, double* xyz, double sigma) {
   const SfmImage& image = reconstruction_->inputs().images.at(image_id);
   const HousedCamera& camera = cameras_.at(image.camera_id);
-  ObservationModel model;
-  model.camera_model_id = camera.camera.model_id;
-  model.intrinsics = camera.camera.params;
-  if (camera.housing) {
-    model.housing_model_id = camera.housing->model_id;
-    model.housing = camera.housing->params;
-  }
+  const ObservationModel model = ObservationModel::Of(camera);
   const CostBlocks kind = BlocksOf(camera);
   ceres::CostFunction* cost =
       options_.virtual_camera_error && camera.housing

@@ -320,13 +320,7 @@ bool Mapper::Register(Reconstruction* r, image_t image_id) {
   // Pose-only refinement through the exact projection, robust loss.
   PoseBlock pose = ToPose(*cam_from_world);
   const HousedCamera& camera = r->CameraOf(image_id);
-  ObservationModel model;
-  model.camera_model_id = camera.camera.model_id;
-  model.intrinsics = camera.camera.params;
-  if (camera.housing) {
-    model.housing_model_id = camera.housing->model_id;
-    model.housing = camera.housing->params;
-  }
+  const ObservationModel model = ObservationModel::Of(camera);
   std::vector<Eigen::Vector3d> fixed_points;
   fixed_points.reserve(links.size());
   ceres::Problem problem;
