@@ -43,8 +43,7 @@ namespace {
 // Without given intrinsics the database camera starts at the image reader's
 // guess (1.2 x the larger image side). Two-view verification estimates E on
 // rays normalised with it, so a wrong guess shapes which pairs and inliers
-// the mapper gets (own renders: the same seed failed from 1152 px and
-// calibrated when verified with 609 px). The markers give a far better
+// the mapper gets (docs/auto_calibration.md). The markers give a far better
 // start: it is written to the database camera before matching.
 // Returns the markers' focal length (in-air equivalent), or nullopt.
 std::optional<double> StartFocalFromMarkers(const std::string& database_path, const HousingOverride& housing) {
@@ -150,23 +149,17 @@ RefractiveMapperOptions MapperOptions(const AutoCalibratorOptions& options, cons
   const bool refine_principal_point = refine_intrinsics && options.refine_principal_point != 0;
   // A flat port's tilt, under the untilted guess, is absorbed by the
   // mapper's poses and points unless the port is refined as the model
-  // grows (own renders: 4 of 10 seeds off by up to 2.5 deg; shared set:
-  // normal 0.067 -> 0.012 deg, |df| 1.53 -> 0.58 px). A dome's centred
-  // guess is close, and its axial decentering trades with the focal length
-  // on a few views (shared set: |df| 0.26 -> 1.28 px when refined in the
-  // mapper), so it is left to the final refinement. Only with marker scale:
-  // without it the port distance is barely observed, and on a rendered
-  // survey (120 images, no markers) refining the port in the growing models
-  // split the reconstruction into 9 pieces instead of 3.
+  // grows. A dome's centred guess is close, and its axial decentering
+  // trades with the focal length on a few views, so it is left to the final
+  // refinement. Only with marker scale: without it the port distance is
+  // barely observed and refining it splits the models
+  // (docs/auto_calibration.md).
   map.mapper.ba_refine_housing = options.housing.model == "FLATPORT" && options.marker_side_length_m > 0;
   // The principal point with it: held at the image centre when it is not
-  // there, the global adjustments fight the port (own render with it 5 px
-  // off: 90 s of global adjustment growing the port at 3 mm instead of
-  // 30 mm; refined, 28 s and 29.8 mm). With the dome left to the final
-  // refinement, its principal point is too (refined in the mapper as well,
-  // both the shared and an own dome render came out a little worse: |df|
-  // 0.16 -> 0.93 and 0.84 -> 1.23 px). The final refinement decides whether
-  // it stays off the centre.
+  // there, the global adjustments fight the port. With the dome left to the
+  // final refinement, its principal point is too (refined in the mapper,
+  // dome renders came out worse). The final refinement decides whether it
+  // stays off the centre (docs/auto_calibration.md).
   map.mapper.ba_refine_principal_point = refine_principal_point && map.mapper.ba_refine_housing;
   return map;
 }
@@ -185,10 +178,9 @@ RefractiveBundleAdjusterOptions RefinerOptions(const AutoCalibratorOptions& opti
   refine.ba.refine_focal_length = refine_intrinsics;
   refine.ba.refine_extra_params = refine_intrinsics;
   // A camera's principal point is rarely exactly at the image centre, and
-  // held there when it is not, the port absorbs the offset: own render with
-  // it 5 px off, flat port 0.55 deg and 27 mm wrong; refined, 0.01 deg and
-  // 0.16 mm (docs/auto_calibration.md). Held at the centre again unless it
-  // lies beyond 3 sigma from it.
+  // held there when it is not, the port absorbs the offset
+  // (docs/auto_calibration.md). Held at the centre again unless it lies
+  // beyond 3 sigma from it.
   refine.ba.refine_principal_point = refine_principal_point;
   refine.principal_point_test_sigmas = options.refine_principal_point == -1 ? 3.0 : 0.0;
   refine.ba.num_threads = options.num_threads;

@@ -21,19 +21,17 @@ struct IncrementalMapperOptions {
   double init_min_tri_angle_deg = 4.0;  // median over the initial points
   int init_max_num_trials = 20;         // candidate initial pairs tried per model
   // A model whose intrinsics come out implausible at three refinements in a
-  // row, or at the last one, grew from a wrong start (own render: a
-  // low-parallax pair of nearly frontal views whose relative pose took the
-  // other side of the bas-relief ambiguity; from 5 images on every
-  // adjustment sent the focal length to ~1300 px for 650): it is started
-  // again from the next candidate pair, at most this many times; with no
-  // pair left, the first start is built to the end, its intrinsics held.
+  // row, or at the last one, grew from a wrong start (e.g. a low-parallax
+  // pair on the wrong side of the bas-relief ambiguity;
+  // docs/auto_calibration.md): it is started again from the next candidate
+  // pair, at most this many times; with no pair left, the first start is
+  // built to the end, its intrinsics held.
   int init_max_restarts = 2;
   // A focal length more than this factor from the start counts as
   // implausible too (COLMAP's bound, 2, against its prior). When the ArUco
-  // markers gave the start (within 1-6 % of the truth on every render),
-  // refractive_mapper tightens it to 1.25: a model grown from a wrong pair
-  // drifted there over many adjustments, none of them a factor 2 (own
-  // render, wide lens: 448 -> 994 px).
+  // markers gave the start, refractive_mapper tightens it to 1.25: a model
+  // grown from a wrong pair can drift that far over many adjustments, none
+  // of them a factor 2 (docs/auto_calibration.md).
   double max_focal_ratio_to_start = 2.0;
   double init_max_error_px = 4.0;
   // Scale of a model when markers do not give it: the initial pair's median
@@ -56,19 +54,16 @@ struct IncrementalMapperOptions {
   // Below this many images, of the distortion only the first radial term
   // is refined (the other terms held; the principal point as asked): a
   // handful of views of a small target cannot tell eight intrinsics apart,
-  // and freed together they leave the basin (own render, wide OPENCV lens
-  // behind a flat port, 15 views at 960 x 540: f 785 px for 452 at 5
-  // images; docs/auto_calibration.md). 0: all from the start.
+  // and freed together they leave the basin (docs/auto_calibration.md).
+  // 0: all from the start.
   int ba_full_intrinsics_min_images = 10;
   int ba_local_num_images = 6;
   double ba_global_images_ratio = 1.1;
   int ba_max_num_iterations = 50;
   // A global adjustment ends when an iteration lowers the cost by less than
   // this fraction. The mapper's models are intermediate (the refinement
-  // stage converges fully, at 1e-8): on the 120-image survey global
-  // adjustments at 1e-8 ran 20-36 iterations for ~2e-4 each; at 1e-5, 2-14,
-  // mapping 384 s -> 169 s with the same mean reprojection error (0.1956 px)
-  // and the same refined port (docs/benchmarks.md).
+  // stage converges fully, at 1e-8), and iterating them further changed
+  // nothing downstream but the time (docs/benchmarks.md).
   double ba_global_function_tolerance = 1e-5;
   // The intrinsics and housing are refined whenever the model has grown by
   // a third, until two such refinements in a row, on models of 50 images or
@@ -76,11 +71,8 @@ struct IncrementalMapperOptions {
   // then they are held until the model's final adjustment, which refines
   // them on all images. Each refinement costs the exact refraction on every
   // observation, and on a survey the mapper's estimate stops improving early
-  // (300-image survey: from 57 images on each refinement moved the image by
-  // 0.03-0.18 px, the port distance wandering within 19.7-21.1 mm; 1000-image
-  // survey, settled at 77 images: mapping 1406 -> 1074 s, the same refined
-  // port, docs/benchmarks.md). Below the keypoints' noise (~0.2 px there),
-  // the held calibration bends no structure. 0: refine to the end.
+  // (docs/benchmarks.md). Below the keypoints' noise, the held calibration
+  // bends no structure. 0: refine to the end.
   double ba_calibration_settled_px = 0.25;
   // Below this many images the calibration is refined whenever the model
   // has grown by a third, however little it moves: such adjustments take
