@@ -79,12 +79,9 @@ void InitializeRadialFromMatches(const SfmInputs& inputs, const RefractiveMapper
     const bool undistorted = std::all_of(extra.begin(), extra.end(),
                                          [&](int idx) { return camera.camera.params[idx] == 0; });
     // A fisheye model at k = 0 is the equidistant projection, near what
-    // fisheye lenses are built to (equisolid: k1 ~ -0.04, stereographic:
-    // +0.08), where k = 0 of a pinhole model is far from a wide angle's.
-    // And for a fisheye a focal length error is not projective, so the
-    // search takes it up: own 2-face render, k1 0.06, the markers' focal
-    // length 3 % low, 2 pairs -> 0.35, and the calibration in a wrong
-    // basin (port 207 mm away); without the search f within 0.2 px.
+    // fisheye lenses are built to, where k = 0 of a pinhole model is far
+    // from a wide angle's; and for a fisheye a focal length error is not
+    // projective, so the search takes it up (docs/auto_calibration.md).
     const bool fisheye = CameraModelIsFisheye(camera.camera.model_id);
     if (mode == -1 && (camera.camera.has_prior_focal_length || !undistorted || fisheye)) continue;
     const auto start = EstimateFirstRadialTerm(inputs, camera_id, camera, options.radial_start);

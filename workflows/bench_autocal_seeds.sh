@@ -23,6 +23,11 @@ n="${1:-10}"
 camera="${2:-centred}"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
+# The wide and fisheye lenses' views and port: 15 views at 0.3-0.8 m, the
+# port tilted 2.5 deg at 30 mm, guessed untilted.
+tilted_port_guess=0,0,1,0.03,0.008,1,1.473,1.334
+tilted_port_views='housing: {model: FLATPORT, params: [0.0436194, 0.0, 0.9990482, 0.03, 0.008, 1.0, 1.473, 1.334]}
+poses: {distance: [0.3, 0.8], tilt_max_deg: 45, roll_max_deg: 180, visibility: markers, border_margin_px: 10, max_view_angle_deg: 70}'
 case "$camera" in
   centred)
     model=RADIAL
@@ -33,18 +38,16 @@ housing: {model: FLATPORT, params: [0.0697565, 0.0, 0.9975641, 0.015, 0.010, 1.0
 poses: {distance: [0.4, 1.0], tilt_max_deg: 45, roll_max_deg: 180, visibility: markers, border_margin_px: 10, max_view_angle_deg: 70}' ;;
   wide)
     model=OPENCV
-    guess=0,0,1,0.03,0.008,1,1.473,1.334
-    scene='num_images: 15
+    guess=$tilted_port_guess
+    scene="num_images: 15
 camera: {model: OPENCV, width: 960, height: 540, params: [452.0, 450.5, 490.0, 262.5, -0.30, 0.09, 0.0012, 0.0009]}
-housing: {model: FLATPORT, params: [0.0436194, 0.0, 0.9990482, 0.03, 0.008, 1.0, 1.473, 1.334]}
-poses: {distance: [0.3, 0.8], tilt_max_deg: 45, roll_max_deg: 180, visibility: markers, border_margin_px: 10, max_view_angle_deg: 70}' ;;
+$tilted_port_views" ;;
   fisheye)
     model=OPENCV_FISHEYE
-    guess=0,0,1,0.03,0.008,1,1.473,1.334
-    scene='num_images: 15
+    guess=$tilted_port_guess
+    scene="num_images: 15
 camera: {model: OPENCV_FISHEYE, width: 960, height: 540, params: [380.0, 379.0, 472.0, 276.0, 0.06, -0.02, 0.004, -0.001]}
-housing: {model: FLATPORT, params: [0.0436194, 0.0, 0.9990482, 0.03, 0.008, 1.0, 1.473, 1.334]}
-poses: {distance: [0.3, 0.8], tilt_max_deg: 45, roll_max_deg: 180, visibility: markers, border_margin_px: 10, max_view_angle_deg: 70}' ;;
+$tilted_port_views" ;;
   *) echo "bench_autocal_seeds.sh: CAMERA must be centred, wide or fisheye, not '$camera'" >&2; exit 2 ;;
 esac
 { echo "name: seeds"; echo "$scene"; cat <<'YAML'; } > "$work/set.yaml"
