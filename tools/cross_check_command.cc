@@ -1,6 +1,6 @@
 #include <iostream>
 
-#include "pipelines/cross_checker.h"
+#include "pipelines/stages/cross_check.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 

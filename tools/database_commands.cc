@@ -1,5 +1,5 @@
-#include "pipelines/database_creator.h"
-#include "pipelines/pose_prior_importer.h"
+#include "pipelines/stages/database_creator.h"
+#include "pipelines/stages/pose_prior_importer.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 

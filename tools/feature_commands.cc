@@ -1,8 +1,8 @@
 // Subcommands of the auto-calibration front end: feature_extractor,
 // feature_masker, exhaustive_matcher, sequential_matcher.
-#include "pipelines/feature_extractor.h"
-#include "pipelines/feature_masker.h"
-#include "pipelines/feature_matcher.h"
+#include "pipelines/stages/feature_extractor.h"
+#include "pipelines/stages/feature_masker.h"
+#include "pipelines/stages/feature_matcher.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 #include "tools/option_groups.h"

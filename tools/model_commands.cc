@@ -1,7 +1,7 @@
 #include <iostream>
 
-#include "pipelines/model_converter.h"
-#include "pipelines/project_points.h"
+#include "pipelines/stages/model_converter.h"
+#include "pipelines/stages/project_points.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 

@@ -1,7 +1,7 @@
 // Option groups several subcommands share, declared once.
 #pragma once
 
-#include "pipelines/image_reader.h"
+#include "pipelines/images/image_reader.h"
 #include "tools/command_line.h"
 
 namespace portcal {

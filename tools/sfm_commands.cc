@@ -1,8 +1,8 @@
 // Subcommands of the reconstruction back end: refractive_mapper,
 // refractive_bundle_adjuster, auto_calibrator.
-#include "pipelines/auto_calibrator.h"
-#include "pipelines/refractive_bundle_adjuster.h"
-#include "pipelines/refractive_mapper.h"
+#include "pipelines/stages/auto_calibrator.h"
+#include "pipelines/stages/refractive_bundle_adjuster.h"
+#include "pipelines/stages/refractive_mapper.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 

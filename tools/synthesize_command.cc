@@ -1,4 +1,4 @@
-#include "pipelines/synthesize/synthesize.h"
+#include "pipelines/stages/synthesize.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 

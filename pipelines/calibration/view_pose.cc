@@ -72,15 +72,6 @@ ceres::Covariance::Options CalibrationCovarianceOptions(int num_threads) {
   return options;
 }
 
-PoseBlock ToPose(const Rigid3d& rigid) {
-  const Eigen::Quaterniond q = rigid.rotation.normalized();
-  return {q.x(), q.y(), q.z(), q.w(), rigid.translation.x(), rigid.translation.y(), rigid.translation.z()};
-}
-
-Rigid3d FromPose(const PoseBlock& p) {
-  return Rigid3d(Eigen::Quaterniond(p[3], p[0], p[1], p[2]).normalized(), Eigen::Vector3d(p[4], p[5], p[6]));
-}
-
 void AddRigView(const CalibrationView& view, const HousedCamera& rig_camera, double* cam1_from_target,
              double* camk_from_cam1, double* intrinsics, ceres::Problem* problem) {
   VisitCameraModel(rig_camera.camera.model_id, [&](auto camera_tag) {
@@ -104,10 +95,6 @@ void AddRigView(const CalibrationView& view, const HousedCamera& rig_camera, dou
       });
     });
   });
-}
-
-ceres::Manifold* PoseManifold() {
-  return new ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>();
 }
 
 // cam_from_target of one camera and view: homography on the undistorted

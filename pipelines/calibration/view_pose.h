@@ -10,17 +10,11 @@
 
 #include "colmap_ext/camera/camera.h"
 #include "colmap_ext/camera/housed_camera.h"
+#include "colmap_ext/geometry/pose_block.h"
 #include "colmap_ext/housing/housing.h"
 #include "pipelines/calibration/camera_calibration.h"
 
 namespace portcal {
-
-using PoseBlock = std::array<double, 7>;  // quaternion x, y, z, w + translation
-
-PoseBlock ToPose(const Rigid3d& rigid);
-Rigid3d FromPose(const PoseBlock& pose);
-// Quaternion (Eigen's manifold) x translation.
-ceres::Manifold* PoseManifold();
 
 // Solves a calibration problem: Schur complement, tight tolerances, silent.
 // Throws NumericalError("<what> did not converge: ...").

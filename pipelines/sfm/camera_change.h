@@ -4,7 +4,7 @@
 // IncrementalMapperOptions::ba_calibration_settled_px).
 #pragma once
 
-#include "pipelines/sfm/reconstruction.h"
+#include "pipelines/reconstruction/reconstruction.h"
 
 namespace portcal {
 

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "colmap_ext/util/progress.h"
-#include "pipelines/sfm/bundle_adjustment.h"
-#include "pipelines/sfm/reconstruction.h"
+#include "pipelines/bundle_adjustment/bundle_adjustment.h"
+#include "pipelines/reconstruction/reconstruction.h"
 
 namespace portcal {
 

@@ -5,8 +5,8 @@
 #include <map>
 #include <tuple>
 
-#include "pipelines/sfm/bundle_adjustment.h"
-#include "pipelines/sfm/ray_geometry.h"
+#include "pipelines/bundle_adjustment/bundle_adjustment.h"
+#include "pipelines/reconstruction/ray_geometry.h"
 
 namespace portcal {
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "pipelines/sfm/incremental_mapper.h"
-#include "pipelines/sfm/reconstruction.h"
+#include "pipelines/reconstruction/reconstruction.h"
 
 namespace portcal {
 

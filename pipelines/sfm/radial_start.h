@@ -24,7 +24,7 @@
 
 #include <optional>
 
-#include "pipelines/sfm/reconstruction.h"
+#include "pipelines/reconstruction/reconstruction.h"
 
 namespace portcal {
 

@@ -12,7 +12,7 @@
 
 #include "colmap_ext/io/sparse_model.h"
 #include "database/database.h"
-#include "pipelines/synthesize/synthesize.h"
+#include "pipelines/stages/synthesize.h"
 #include "tests/test_utils.h"
 
 namespace fs = std::filesystem;

@@ -15,8 +15,8 @@
 
 #include "colmap_ext/io/ground_truth.h"
 #include "colmap_ext/util/error.h"
-#include "pipelines/auto_calibrator.h"
-#include "pipelines/synthesize/synthesize.h"
+#include "pipelines/stages/auto_calibrator.h"
+#include "pipelines/stages/synthesize.h"
 #include "tests/test_utils.h"
 
 namespace fs = std::filesystem;

@@ -12,8 +12,8 @@
 #include "pipelines/calibration/housing_calibration.h"
 #include "pipelines/calibration/stereo_calibration.h"
 #include "pipelines/calibration/target_views.h"
-#include "pipelines/synthesize/synthesize.h"
-#include "pipelines/target_extractor.h"
+#include "pipelines/stages/synthesize.h"
+#include "pipelines/stages/target_extractor.h"
 #include "tests/test_utils.h"
 
 namespace fs = std::filesystem;

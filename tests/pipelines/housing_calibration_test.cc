@@ -8,8 +8,8 @@
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
-#include "pipelines/housing_calibrator.h"
-#include "pipelines/target_extractor.h"
+#include "pipelines/stages/housing_calibrator.h"
+#include "pipelines/stages/target_extractor.h"
 #include "tests/test_utils.h"
 
 namespace fs = std::filesystem;

@@ -11,7 +11,7 @@
 #include "colmap_ext/util/error.h"
 #include "pipelines/sfm/camera_change.h"
 #include "pipelines/sfm/incremental_mapper.h"
-#include "pipelines/sfm/reconstruction.h"
+#include "pipelines/reconstruction/reconstruction.h"
 
 namespace portcal {
 namespace {

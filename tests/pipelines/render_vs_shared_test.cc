@@ -8,8 +8,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "colmap_ext/io/ground_truth.h"
-#include "pipelines/render/renderer.h"
-#include "pipelines/synthesize/target_builder.h"
+#include "pipelines/synthetic/renderer.h"
+#include "pipelines/synthetic/target_builder.h"
 #include "tests/test_utils.h"
 
 namespace portcal {

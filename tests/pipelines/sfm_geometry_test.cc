@@ -12,15 +12,15 @@
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/parallel.h"
-#include "pipelines/feature_masker.h"
+#include "pipelines/stages/feature_masker.h"
 #include "pipelines/features/descriptor_matching.h"
 #include "pipelines/features/sift.h"
-#include "pipelines/sfm/bundle_adjustment.h"
-#include "pipelines/sfm/bundle_costs.h"
-#include "pipelines/sfm/calibration_covariance.h"
+#include "pipelines/bundle_adjustment/bundle_adjustment.h"
+#include "pipelines/bundle_adjustment/bundle_costs.h"
+#include "pipelines/bundle_adjustment/calibration_covariance.h"
 #include "pipelines/sfm/incremental_mapper.h"
-#include "pipelines/sfm/ray_geometry.h"
-#include "pipelines/target/marker_edge_refinement.h"
+#include "pipelines/reconstruction/ray_geometry.h"
+#include "pipelines/markers/marker_edge_refinement.h"
 
 namespace portcal {
 namespace {

@@ -9,9 +9,9 @@
 #include "colmap_ext/io/ground_truth.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
-#include "pipelines/stereo_calibrator.h"
-#include "pipelines/synthesize/synthesize.h"
-#include "pipelines/target_extractor.h"
+#include "pipelines/stages/stereo_calibrator.h"
+#include "pipelines/stages/synthesize.h"
+#include "pipelines/stages/target_extractor.h"
 #include "tests/test_utils.h"
 
 namespace fs = std::filesystem;

@@ -14,12 +14,12 @@
 #include <fstream>
 
 #include "colmap_ext/io/ground_truth.h"
-#include "pipelines/feature_extractor.h"
-#include "pipelines/feature_matcher.h"
-#include "pipelines/pose_prior_importer.h"
-#include "pipelines/refractive_bundle_adjuster.h"
-#include "pipelines/refractive_mapper.h"
-#include "pipelines/synthesize/synthesize.h"
+#include "pipelines/stages/feature_extractor.h"
+#include "pipelines/stages/feature_matcher.h"
+#include "pipelines/stages/pose_prior_importer.h"
+#include "pipelines/stages/refractive_bundle_adjuster.h"
+#include "pipelines/stages/refractive_mapper.h"
+#include "pipelines/stages/synthesize.h"
 #include "tests/test_utils.h"
 
 namespace fs = std::filesystem;

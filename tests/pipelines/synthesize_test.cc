@@ -12,7 +12,7 @@
 
 #include "colmap_ext/io/ground_truth.h"
 #include "colmap_ext/util/error.h"
-#include "pipelines/synthesize/synthesize.h"
+#include "pipelines/stages/synthesize.h"
 #include "pipelines/target/corner_refinement.h"
 #include "tests/test_utils.h"
 

@@ -1,0 +1,15 @@
+# portcal_layering(TARGET UNIT FOLDER ALLOWED...): before TARGET builds,
+# check that the sources and headers in FOLDER include only UNIT itself and
+# the ALLOWED units (see check_includes.cmake).
+function(portcal_layering target unit folder)
+  file(GLOB files CONFIGURE_DEPENDS "${folder}/*.h" "${folder}/*.cc" "${folder}/*/*.h" "${folder}/*/*.cc")
+  set(stamp "${CMAKE_CURRENT_BINARY_DIR}/${target}_layering.stamp")
+  add_custom_command(OUTPUT "${stamp}"
+    COMMAND ${CMAKE_COMMAND} "-DUNIT=${unit}" "-DALLOWED=${ARGN}" "-DSOURCES=${files}"
+            "-DSTAMP=${stamp}" -P "${PROJECT_SOURCE_DIR}/cmake/check_includes.cmake"
+    DEPENDS ${files} "${PROJECT_SOURCE_DIR}/cmake/check_includes.cmake"
+    COMMENT "Checking ${unit}'s includes against its declared dependencies"
+    VERBATIM)
+  add_custom_target(${target}_layering DEPENDS "${stamp}")
+  add_dependencies(${target} ${target}_layering)
+endfunction()

@@ -1,0 +1,97 @@
+#include "pipelines/bundle_adjustment/bundle_adjustment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/string_utils.h"
+#include "pipelines/reconstruction/ray_geometry.h"
+
+namespace portcal {
+
+void BundleAdjustmentOptions::Check() const {
+  if (!(sigma_px > 0)) throw OptionError("--BundleAdjustment.sigma_px", std::to_string(sigma_px), "> 0");
+  if (max_num_iterations < 1) {
+    throw OptionError("--BundleAdjustment.max_num_iterations", std::to_string(max_num_iterations), ">= 1");
+  }
+  if (!(loss_scale >= 0)) throw OptionError("--BundleAdjustment.loss_scale", std::to_string(loss_scale), ">= 0");
+  if (!(position_prior_sigma_m >= 0)) {
+    throw OptionError("--PosePrior.position_sigma", std::to_string(position_prior_sigma_m), ">= 0 m");
+  }
+  if (!(function_tolerance > 0)) {
+    throw OptionError("--BundleAdjustment.function_tolerance", std::to_string(function_tolerance), "> 0");
+  }
+}
+
+BundleAdjustmentOptions BundleAdjustmentOptions::WithIntrinsicsHeld() const {
+  BundleAdjustmentOptions held = *this;
+  held.refine_focal_length = held.refine_principal_point = held.refine_extra_params = false;
+  return held;
+}
+
+bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::string* why) {
+  std::ostringstream text;
+  const double ratio = after.MeanFocalLength() / before.MeanFocalLength();
+  if (!(ratio > 0.5 && ratio < 2.0)) {
+    text << "focal length " << after.MeanFocalLength() << " px from " << before.MeanFocalLength() << " px";
+  }
+  const std::vector<std::string> names = SplitTokens(after.ParamsInfo(), ", ");
+  for (int idx : CameraModelExtraParamsIdxs(after.model_id)) {
+    if (!(std::abs(after.params[idx]) < 1.0)) {
+      text << (text.tellp() > 0 ? ", " : "") << names.at(idx) << " = " << after.params[idx];
+    }
+  }
+  if (why) *why = text.str();
+  return text.tellp() > 0;
+}
+
+std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconstruction, double max_error_px) {
+  std::map<std::pair<int, int>, MarkerCorner> corners;
+  for (const auto& [image_id, pose] : reconstruction.poses()) {
+    for (const MarkerDetection& m : reconstruction.inputs().images.at(image_id).markers) {
+      for (int c = 0; c < 4; ++c) {
+        MarkerCorner& corner = corners[{m.marker_id, c}];
+        corner.marker_id = m.marker_id;
+        corner.corner = c;
+        corner.observations.emplace_back(image_id, m.corners[c]);
+      }
+    }
+  }
+  std::vector<MarkerCorner> result;
+  for (auto& [key, corner] : corners) {
+    if (corner.observations.size() < 2) continue;
+    std::vector<Ray3d> rays;
+    for (const auto& [image_id, pixel] : corner.observations) {
+      const HousedCamera& camera = reconstruction.CameraOf(image_id);
+      const auto ray = camera.Unproject(pixel);
+      if (ray) rays.push_back(RayInWorld(*ray, reconstruction.poses().at(image_id)));
+    }
+    const auto xyz = TriangulateRays(rays);
+    if (!xyz) continue;
+    // Drop observations that disagree (a marker id seen twice, a bad corner).
+    std::vector<std::pair<image_t, Eigen::Vector2d>> kept;
+    for (const auto& [image_id, pixel] : corner.observations) {
+      const HousedCamera& camera = reconstruction.CameraOf(image_id);
+      const auto projected = camera.Project(reconstruction.poses().at(image_id) * *xyz);
+      if (projected && (*projected - pixel).norm() < max_error_px) kept.emplace_back(image_id, pixel);
+    }
+    if (kept.size() < 2) continue;
+    corner.observations = kept;
+    corner.xyz = *xyz;
+    result.push_back(corner);
+  }
+  return result;
+}
+
+camera_t CameraWithHousingAtBound(const std::map<camera_t, HousedCamera>& cameras) {
+  for (const auto& [id, camera] : cameras) {
+    if (camera.housing && camera.housing->AtBound()) return id;
+  }
+  return kInvalidCameraId;
+}
+
+}  // namespace portcal

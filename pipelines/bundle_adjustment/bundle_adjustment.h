@@ -1,0 +1,112 @@
+// Refractive bundle adjustment over a Reconstruction: poses, points and,
+// optionally, intrinsics and housings, with the exact reprojection error or
+// the virtual-camera error, a robust loss, and ArUco markers as scale: the
+// marker corners are extra points, observed where they were detected, whose
+// distances must equal the known side length (and diagonal).
+#pragma once
+
+#include <ceres/ceres.h>
+
+#include <set>
+#include <vector>
+
+#include "pipelines/reconstruction/reconstruction.h"
+
+namespace portcal {
+
+struct BundleAdjustmentOptions {
+  bool refine_focal_length = false;
+  bool refine_principal_point = false;
+  bool refine_extra_params = false;
+  // With refine_extra_params: only the first this many distortion
+  // parameters (the radial terms come first in every model); -1: all.
+  int max_num_extra_params = -1;
+  bool refine_housing = false;
+  // With refine_housing: the housing's position too (a flat port's
+  // distance, a dome's centre; HousingRefinement::position), else only its
+  // orientation (a flat port's normal).
+  bool refine_housing_position = true;
+  bool virtual_camera_error = false;  // else the exact reprojection error
+  double sigma_px = 1.0;              // residuals in units of this
+  bool scale_weighting = true;        // sigma grows with the keypoint's scale (above 2 px)
+  double marker_sigma_px = 1.0;       // of an ArUco marker corner (edge-refined)
+  double loss_scale = 1.0;            // Cauchy loss scale, in sigma; <= 0: no robust loss
+  // > 0: in global adjustments, the registered images' position priors are
+  // residuals with this standard deviation (metres) and hold the gauge
+  // (align the model to them first: AlignToPositionPriors).
+  double position_prior_sigma_m = 0;
+  int max_num_iterations = 100;
+  double function_tolerance = 1e-8;  // relative cost change that ends the solve
+  int num_threads = 2;
+  void Check() const;  // throws OptionError naming --BundleAdjustment.*
+  // These options with focal length, principal point and extra parameters
+  // held (a stage that adjusts the housing under the current intrinsics).
+  BundleAdjustmentOptions WithIntrinsicsHeld() const;
+};
+
+// A physical marker corner: its point and where it was seen.
+struct MarkerCorner {
+  int marker_id = 0;
+  int corner = 0;  // 0..3, OpenCV's order
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
+  std::vector<std::pair<image_t, Eigen::Vector2d>> observations;
+};
+
+struct MarkerScale {
+  double side_length_m = 0;   // <= 0: markers do not constrain the scale
+  double sigma_m = 0.0001;    // of each side and diagonal
+};
+
+// Marker corners seen by at least two registered images, triangulated from
+// the current poses (corners whose rays miss each other are dropped).
+std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconstruction,
+                                                   double max_error_px);
+
+struct BundleAdjustmentScope {
+  // Images whose poses are free; all registered images when empty.
+  std::set<image_t> variable_images;
+  // Points to adjust; all points of the variable images when empty.
+  bool all_points = true;
+};
+
+// Standard deviations of the cameras' and housings' parameters (0 for
+// parameters held fixed): each the larger of two estimates, by the noise
+// (the covariance of the solution scaled by the residual variance: every
+// residual independent) and by the clusters' spread (the covariance
+// clustered two ways, by image and by track, calibration_covariance.h: it
+// grows when an image's errors share a cause, as a view-dependent keypoint
+// bias does, or a track's, as the same texture seen from nearby views
+// does). The first is the better estimate when the noise is what the model
+// says, and the second, from a dozen images, is itself uncertain by ~20 %;
+// the larger is wrong in the safe direction.
+struct CalibrationStdDevs {
+  std::map<camera_t, std::vector<double>> intrinsics;
+  std::map<camera_t, std::vector<double>> housing;
+  std::map<camera_t, std::vector<double>> intrinsics_by_noise, intrinsics_by_clusters;
+  std::map<camera_t, std::vector<double>> housing_by_noise, housing_by_clusters;
+  // Correlation of each intrinsic parameter (row) with each housing
+  // parameter (column), 0 where either is held: near +-1 the data cannot
+  // tell the two apart.
+  std::map<camera_t, Eigen::MatrixXd> intrinsics_housing_correlation;
+  double sigma0 = 0;  // estimated pixel noise (residual RMS corrected for the degrees of freedom)
+  int64_t num_residuals = 0;
+};
+
+// COLMAP's bogus-camera test (min/max_focal_length_ratio 0.5 / 2,
+// max_extra_param 1) of `after` against `before`; says why in `why`.
+bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::string* why = nullptr);
+
+// The first camera whose housing is at such a bound, or kInvalidCameraId.
+camera_t CameraWithHousingAtBound(const std::map<camera_t, HousedCamera>& cameras);
+
+// Adjusts in place. The gauge: the position priors (global adjustments with
+// position_prior_sigma_m > 0 and priors spanning a plane), else the first
+// registered image's pose is held, and, without marker scale, one
+// translation coordinate of the second.
+// Returns Ceres' summary; throws NumericalError if the solve fails.
+ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const BundleAdjustmentOptions& options,
+                                    const BundleAdjustmentScope& scope, std::vector<MarkerCorner>* markers,
+                                    const MarkerScale& marker_scale,
+                                    CalibrationStdDevs* std_devs = nullptr);
+
+}  // namespace portcal

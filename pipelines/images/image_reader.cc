@@ -1,0 +1,101 @@
+#include "pipelines/images/image_reader.h"
+
+#include <algorithm>
+#include <cctype>
+
+#include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/string_utils.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+
+void ImageReaderOptions::Check() const {
+  if (!ExistsCameraModelWithName(camera_model)) {
+    throw OptionError("--ImageReader.camera_model", camera_model, "one of " + CameraModelNames());
+  }
+  if (!camera_params.empty()) {
+    const std::vector<double> params = ParseDoubleList(camera_params, "--ImageReader.camera_params");
+    const int expected = CameraModelNumParams(CameraModelNameToId(camera_model));
+    if (static_cast<int>(params.size()) != expected) {
+      throw OptionError("--ImageReader.camera_params", camera_params,
+                        std::to_string(expected) + " numbers (" +
+                            CameraModelParamsInfo(CameraModelNameToId(camera_model)) + ")");
+    }
+  }
+  if (!(default_focal_length_factor > 0)) {
+    throw OptionError("--ImageReader.default_focal_length_factor",
+                      std::to_string(default_focal_length_factor), "> 0");
+  }
+}
+
+std::vector<std::string> ListImages(const fs::path& dir) {
+  if (!fs::is_directory(dir)) throw InputError(dir.string() + ": not a directory of images");
+  std::vector<std::string> names;
+  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+    if (!entry.is_regular_file()) continue;
+    std::string ext = entry.path().extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".tif" || ext == ".tiff" ||
+        ext == ".bmp") {
+      names.push_back(fs::relative(entry.path(), dir).generic_string());
+    }
+  }
+  std::sort(names.begin(), names.end());
+  if (names.empty()) throw InputError(dir.string() + ": no images (.png, .jpg, .tif, .bmp)");
+  return names;
+}
+
+namespace {
+
+Camera NewCamera(const ImageReaderOptions& options, int width, int height) {
+  Camera camera = Camera::FromModelName(
+      options.camera_model, options.default_focal_length_factor * std::max(width, height), width, height);
+  if (!options.camera_params.empty()) {
+    camera.params = ParseDoubleList(options.camera_params, "--ImageReader.camera_params");
+    camera.has_prior_focal_length = true;
+  }
+  return camera;
+}
+
+}  // namespace
+
+image_t ImportImage(Database* database, const ImageReaderOptions& options,
+                    const std::string& name, int width, int height, SharedCameras* shared) {
+  const bool sharing = options.single_camera || options.single_camera_per_folder;
+  const std::string key =
+      options.single_camera ? std::string() : fs::path(name).parent_path().generic_string();
+  if (const std::optional<DatabaseImage> existing = database->ReadImageWithName(name)) {
+    const std::optional<Camera> camera = database->ReadCamera(existing->camera_id);
+    if (camera && (camera->width != static_cast<uint64_t>(width) ||
+                   camera->height != static_cast<uint64_t>(height))) {
+      throw InputError(name + ": " + std::to_string(width) + "x" + std::to_string(height) +
+                       " pixels, but its camera in the database is " +
+                       std::to_string(camera->width) + "x" + std::to_string(camera->height));
+    }
+    if (sharing) shared->emplace(key, existing->camera_id);
+    return existing->image_id;
+  }
+  camera_t camera_id = kInvalidCameraId;
+  if (sharing && shared->count(key)) {
+    camera_id = shared->at(key);
+    const std::optional<Camera> camera = database->ReadCamera(camera_id);
+    if (camera && (camera->width != static_cast<uint64_t>(width) ||
+                   camera->height != static_cast<uint64_t>(height))) {
+      throw InputError(name + ": " + std::to_string(width) + "x" + std::to_string(height) +
+                       " pixels, but it shares a " + std::to_string(camera->width) + "x" +
+                       std::to_string(camera->height) + " camera (--ImageReader.single_camera" +
+                       (options.single_camera ? "" : "_per_folder") + ")");
+    }
+  } else {
+    camera_id = database->WriteCamera(NewCamera(options, width, height));
+    if (sharing) shared->emplace(key, camera_id);
+  }
+  DatabaseImage image;
+  image.name = name;
+  image.camera_id = camera_id;
+  return database->WriteImage(image);
+}
+
+}  // namespace portcal

@@ -1,0 +1,73 @@
+// `portcal auto_calibrator`: calibration without a known target, all the
+// database stages in one command with defaults for a calibration object
+// carrying ArUco markers: feature_extractor -> feature_masker ->
+// exhaustive (or sequential) matcher -> refractive_mapper ->
+// refractive_bundle_adjuster. Writes, under output_path: database.db,
+// sparse/0 (the mapper's model), refined/ (the self-calibrated model) and
+// calibration.yaml / calibration.txt.
+#pragma once
+
+#include <string>
+
+#include "colmap_ext/util/progress.h"
+#include "pipelines/stages/feature_extractor.h"
+#include "pipelines/stages/feature_masker.h"
+#include "pipelines/stages/feature_matcher.h"
+#include "pipelines/stages/refractive_bundle_adjuster.h"
+#include "pipelines/stages/refractive_mapper.h"
+
+namespace portcal {
+
+struct AutoCalibratorOptions {
+  std::string image_path;
+  std::string output_path;
+  std::string camera_model = "RADIAL";
+  std::string camera_params;  // given: intrinsics known and held
+  HousingOverride housing;    // the housing to calibrate, with a first guess
+  std::string marker_dictionary = "DICT_4X4_50";
+  double marker_side_length_m = 0;  // > 0: metric scale from the markers
+  double mask_enlargement_factor = 3.0;
+  bool mask = true;                   // keep only features near markers
+  std::string matcher = "exhaustive";  // exhaustive | sequential
+  SiftExtractionOptions sift;
+  // Refine the intrinsics with the housing; -1: when camera_params is empty.
+  int refine_intrinsics = -1;
+  // With the intrinsics refined: -1 refines the principal point but holds it
+  // at the image centre again unless it moves beyond 3 sigma (see
+  // RefractiveBundleAdjusterOptions::principal_point_test_sigmas); 0 holds
+  // it; 1 refines it.
+  int refine_principal_point = -1;
+  // Seeds every random choice (RANSAC in verification and mapping): the
+  // same images and options give the same calibration.
+  int random_seed = 0;
+  // The lens's first radial term from the matches before mapping
+  // (RefractiveMapperOptions::init_radial_from_matches: not for fisheye
+  // models): -1 or 0.
+  int init_radial_from_matches = -1;
+  // With the intrinsics refined: starts of the mapper and refinement (each
+  // from the next random seed) while a start fails or its report carries
+  // a warning; the start with the fewest warnings, then the smallest
+  // residual, is kept (own render at a knife edge between two basins:
+  // residual sigma 0.170 px in the right one, 0.275 in the wrong).
+  int max_num_starts = 3;
+  int num_threads = 2;
+  void Check() const;  // throws OptionError naming the option
+};
+
+struct AutoCalibrationResult {
+  RefractiveBundleAdjusterResult refined;
+  int num_images = 0;
+  int num_registered = 0;
+  std::vector<std::pair<std::string, double>> stage_seconds;
+};
+
+// The last look before the report is written (intrinsics refined): throws
+// NumericalError when the focal length is far from the markers' estimate
+// (`markers_focal`, the in-air focal length the ArUco markers give; a wrong
+// solution however small its standard deviation), and adds warnings to the
+// report for a poorly determined focal length.
+void JudgeAutoCalibration(const std::optional<double>& markers_focal, CalibrationReport* report);
+
+AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, ProgressSink& progress);
+
+}  // namespace portcal

@@ -1,0 +1,309 @@
+#include "pipelines/stages/cross_check.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <numeric>
+#include <set>
+#include <sstream>
+
+#include "colmap_ext/io/mrcal_model.h"
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/string_utils.h"
+#include "database/database.h"
+#include "pipelines/calibration/calibration_report.h"
+#include "pipelines/calibration/target_views.h"
+#include "pipelines/crosscheck/mrcal_calibration.h"
+
+namespace portcal {
+namespace {
+
+const char* kMrcalParamNames[] = {"fx", "fy", "cx", "cy", "k1", "k2",
+                                  "p1", "p2", "k3", "k4", "k5", "k6"};
+
+// Both calibrations in mrcal's parameterisation of the lens.
+std::vector<ParameterComparison> CompareParameters(const Camera& portcal,
+                                                   const std::vector<double>& portcal_std_dev,
+                                                   const MrcalCalibrationResult& mrcal) {
+  const std::vector<int> sources = MrcalParamSources(portcal.ModelName());
+  std::vector<ParameterComparison> out;
+  for (size_t i = 0; i < sources.size(); ++i) {
+    ParameterComparison p;
+    p.name = kMrcalParamNames[i];
+    const int s = sources[i];
+    p.portcal = s >= 0 ? portcal.params[s] : 0.0;
+    // -1: undetermined by portcal's views (rank-deficient covariance).
+    p.portcal_std_dev = s >= 0 && s < static_cast<int>(portcal_std_dev.size()) ? portcal_std_dev[s] : 0.0;
+    p.mrcal = mrcal.camera.params[i];
+    p.mrcal_std_dev = mrcal.params_std_dev[i];
+    const double combined = std::hypot(std::max(0.0, p.portcal_std_dev), p.mrcal_std_dev);
+    p.z = p.portcal_std_dev < 0 ? std::numeric_limits<double>::quiet_NaN()
+                                : combined > 0 ? (p.mrcal - p.portcal) / combined : 0.0;
+    out.push_back(p);
+  }
+  return out;
+}
+
+CalibratedLens LensOf(const CameraCalibrationResult& result) {
+  return {result.camera, result.params_covariance};
+}
+
+CalibratedLens LensOf(const MrcalCalibrationResult& result) {
+  return {result.camera, result.params_covariance};
+}
+
+std::vector<Rigid3d> Poses(const CameraCalibrationResult& result) {
+  std::vector<Rigid3d> poses;
+  for (const CalibratedView& view : result.views) poses.push_back(view.cam_from_target);
+  return poses;
+}
+
+bool WarpSignificant(const MrcalCalibrationResult& mrcal) {
+  for (int i = 0; i < 2; ++i) {
+    if (mrcal.board_warp_std_dev[i] > 0 &&
+        std::abs(mrcal.board_warp[i]) > 3 * mrcal.board_warp_std_dev[i]) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// Cross-validation: disjoint interleaved subsets (view i in fold i mod K, so
+// each fold spans the whole capture), each calibrated alone, every pair
+// differenced and set against the difference their covariances predict.
+CrossValidation CrossValidate(const std::vector<CalibrationView>& views, const Camera& initial,
+                              const CameraCalibrationSettings& settings,
+                              const CrossCheckerOptions& options, const std::string& description,
+                              const std::filesystem::path& heat_map) {
+  const int k = options.folds;
+  std::vector<std::vector<CalibrationView>> subsets(k);
+  for (size_t v = 0; v < views.size(); ++v) subsets[v % k].push_back(views[v]);
+  std::vector<CameraCalibrationResult> fits;
+  CameraCalibrationSettings fold_settings = settings;
+  fold_settings.initialize_from_data = true;  // each fold on its own
+  for (int f = 0; f < k; ++f) {
+    if (subsets[f].size() < 3) {
+      throw InputError("--CrossCheck.folds " + std::to_string(k) + ": fold " + std::to_string(f) +
+                       " gets " + std::to_string(subsets[f].size()) + " of " +
+                       std::to_string(views.size()) + " views; at least 3 per fold are needed");
+    }
+    fits.push_back(CalibrateCamera(subsets[f], initial, fold_settings));
+    LOG(INFO) << "cross_check: fold " << f << " (" << subsets[f].size() << " views, " << description
+              << "): RMS " << fits.back().overall_rms_px << " px";
+  }
+  ProjectionDiffOptions diff_options;
+  diff_options.gridn_width = options.gridn_width;
+  CrossValidation out;
+  out.settings = description;
+  for (int a = 0; a < k; ++a) {
+    for (int b = a + 1; b < k; ++b) {
+      const ProjectionDiff diff = ComputeProjectionDiff(LensOf(fits[a]), LensOf(fits[b]), diff_options);
+      FoldComparison fold;
+      fold.fold_a = a;
+      fold.fold_b = b;
+      fold.views_a = static_cast<int>(subsets[a].size());
+      fold.views_b = static_cast<int>(subsets[b].size());
+      fold.mean_px = diff.mean_px;
+      fold.p95_px = diff.p95_px;
+      fold.predicted_mean_px = diff.predicted_mean_px;
+      fold.predicted_p95_px = diff.predicted_p95_px;
+      out.pairs.push_back(fold);
+      if (diff.predicted_p95_px > 0) out.worst_ratio = std::max(out.worst_ratio, diff.p95_px / diff.predicted_p95_px);
+      if (a == 0 && b == 1) {
+        WriteProjectionDiffHeatMap(diff, static_cast<int>(initial.width), static_cast<int>(initial.height),
+                                   "fold 0 vs fold 1, " + description, heat_map);
+      }
+    }
+  }
+  // The differences of independent fits scatter like a chi distribution
+  // around the prediction; beyond twice the prediction the spread is not
+  // noise.
+  out.verdict =
+      out.worst_ratio <= 2.0
+          ? "consistent: the folds differ by what their uncertainty predicts (worst ratio " +
+                FormatFixed(out.worst_ratio, 2) + ")"
+          : "NOT consistent: the folds differ by up to " + FormatFixed(out.worst_ratio, 2) +
+                "x what their uncertainty predicts; the lens model is too lean for this lens, "
+                "or the data carry a systematic error (board warp, outliers, rolling shutter)";
+  return out;
+}
+
+}  // namespace
+
+void CrossCheckerOptions::Check() const {
+  if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
+  if (input_calibration.empty()) throw OptionError("--input_calibration", "''", "a calibration.yaml");
+  if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
+  if (folds == 1 || folds < 0) throw OptionError("--CrossCheck.folds", std::to_string(folds), "0 or >= 2");
+  if (!(max_diff_px > 0)) throw OptionError("--CrossCheck.max_diff_px", std::to_string(max_diff_px), "> 0");
+  if (gridn_width < 3) throw OptionError("--CrossCheck.gridn_width", std::to_string(gridn_width), ">= 3");
+  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+}
+
+CrossCheckResult CrossCheck(const CrossCheckerOptions& options) {
+  options.Check();
+  const CalibrationReport input = ReadCalibrationReport(options.input_calibration);
+  // A model mrcal cannot express stops here, naming the nearest one.
+  const std::string lensmodel = MrcalLensModelFor(input.camera.ModelName());
+
+  Database database(options.database_path, Database::OpenMode::kReadOnly);
+  const TargetViews target_views = ReadTargetViews(&database);
+  const camera_t camera_id = ChooseCamera(target_views, options.camera_id, options.database_path);
+  // The views the input calibration used: its dropped outlier views stay out.
+  std::set<std::string> dropped;
+  for (const CalibratedView& view : input.views) {
+    if (view.dropped) dropped.insert(view.image_name);
+  }
+  std::vector<CalibrationView> views;
+  for (const CalibrationView& view : target_views.by_camera.at(camera_id)) {
+    if (!dropped.count(view.image_name)) views.push_back(view);
+  }
+  if (!dropped.empty()) {
+    LOG(INFO) << "cross_check: " << dropped.size() << " views dropped by the input calibration left out";
+  }
+  const Camera db_camera = *database.ReadCamera(camera_id);
+  if (db_camera.width != input.camera.width || db_camera.height != input.camera.height) {
+    throw InputError(options.input_calibration + ": image size " + std::to_string(input.camera.width) +
+                     "x" + std::to_string(input.camera.height) + " differs from camera " +
+                     std::to_string(camera_id) + " of " + options.database_path + " (" +
+                     std::to_string(db_camera.width) + "x" + std::to_string(db_camera.height) + ")");
+  }
+  std::filesystem::create_directories(options.output_path);
+
+  // portcal's solution re-solved from the input (same model, same board
+  // model): the poses that seed mrcal and the full covariance, which the
+  // report file does not carry.
+  CameraCalibrationSettings settings;
+  settings.estimate_board_warp = input.board_warp.has_value();
+  settings.initialize_from_data = false;
+  settings.num_threads = options.num_threads;
+  const CameraCalibrationResult portcal = CalibrateCamera(views, input.camera, settings);
+  CalibratedLens portcal_lens{input.camera, portcal.params_covariance};
+
+  CrossCheckResult result;
+  result.camera_model = input.camera.ModelName();
+  result.mrcal_lensmodel = lensmodel;
+  result.max_diff_px = options.max_diff_px;
+  result.num_views = static_cast<int>(views.size());
+  result.portcal_rms_px = portcal.overall_rms_px;
+  if (input.board_warp) {
+    result.portcal_warp = input.board_warp;
+    result.portcal_warp_std_dev = input.board_warp_std_dev;
+  }
+  ProjectionDiffOptions diff_options;
+  diff_options.gridn_width = options.gridn_width;
+  {
+    ProjectionDiffOptions plain = diff_options;
+    plain.focus_radius = 1e9;  // the whole imager, unweighted
+    const ProjectionDiff resolve = ComputeProjectionDiff({input.camera, {}}, {portcal.camera, {}}, plain);
+    if (resolve.mean_px > 0.01) {
+      result.causes.push_back(
+          "the input calibration is not portcal's solution of these observations (re-solving "
+          "from it moves the projection by " + FormatFixed(resolve.mean_px, 3) +
+          " px on average): made from other views or settings?");
+    }
+  }
+
+  MrcalCalibrationOptions mrcal_options;
+  mrcal_options.estimate_board_warp = options.mrcal_board_warp;
+  mrcal_options.reject_outliers = options.mrcal_outlier_rejection;
+  mrcal_options.regularization = options.mrcal_regularization;
+  const MrcalCalibrationResult mrcal = CalibrateWithMrcal(views, input.camera, Poses(portcal), mrcal_options);
+  result.num_points = mrcal.num_points;
+  result.mrcal_rms_px = mrcal.rms_px;
+  result.mrcal_outliers = mrcal.num_outliers;
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (!mrcal.outliers[v].empty()) {
+      result.mrcal_outliers_per_view.emplace_back(views[v].image_name,
+                                                  static_cast<int>(mrcal.outliers[v].size()));
+    }
+  }
+  result.mrcal_warp = mrcal.board_warp;
+  result.mrcal_warp_std_dev = mrcal.board_warp_std_dev;
+  const std::vector<double> portcal_std_dev =
+      input.parameters_std_dev.size() == input.camera.params.size() ? input.parameters_std_dev
+                                                                      : portcal.params_std_dev;
+  result.parameters = CompareParameters(input.camera, portcal_std_dev, mrcal);
+  result.diff = ComputeProjectionDiff(portcal_lens, LensOf(mrcal), diff_options);
+  result.pass = result.diff.p95_px <= options.max_diff_px;
+  const std::filesystem::path dir(options.output_path);
+  WriteProjectionDiffHeatMap(result.diff, static_cast<int>(input.camera.width),
+                             static_cast<int>(input.camera.height), "portcal vs mrcal",
+                             dir / "projection_diff.png");
+  WriteMrcalCameraModel(mrcal.camera, Rigid3d(), dir / "mrcal.cameramodel");
+  WriteMrcalCameraModel(input.camera, Rigid3d(), dir / "portcal.cameramodel");
+
+  // Why they disagree: the differences between the two solvers' problems,
+  // strongest evidence first.
+  const double max_z = std::accumulate(result.parameters.begin(), result.parameters.end(), 0.0,
+                                       [](double m, const ParameterComparison& p) { return std::max(m, std::abs(p.z)); });
+  const bool warp_cause = !input.board_warp && options.mrcal_board_warp && WarpSignificant(mrcal);
+  const bool outlier_cause = mrcal.num_outliers > 0;
+  if (!result.pass || max_z > 3) {
+    if (warp_cause) {
+      result.causes.push_back(
+          "board warp: mrcal finds the board bent by x " + FormatFixed(mrcal.board_warp.x() * 1e3, 2) +
+          " +- " + FormatFixed(mrcal.board_warp_std_dev.x() * 1e3, 2) + " mm, y " +
+          FormatFixed(mrcal.board_warp.y() * 1e3, 2) + " +- " + FormatFixed(mrcal.board_warp_std_dev.y() * 1e3, 2) +
+          " mm, portcal holds it flat (camera_calibrator --Calibration.estimate_board_warp 1)");
+    }
+    if (outlier_cause) {
+      result.causes.push_back("outliers: mrcal rejected " + std::to_string(mrcal.num_outliers) +
+                              " corners in " + std::to_string(result.mrcal_outliers_per_view.size()) +
+                              " views; portcal fits every corner");
+    }
+    const std::string freedom = MrcalExtraFreedom(input.camera.ModelName());
+    if (!freedom.empty()) {
+      result.causes.push_back("parameterisation: mrcal's " + lensmodel + " frees " + freedom + ", which " +
+                              input.camera.ModelName() + " holds");
+    }
+    if (options.mrcal_regularization) {
+      result.causes.push_back("regularisation: mrcal pulls the distortions and the principal point "
+                              "weakly towards zero and the centre (a small bias by design)");
+    }
+  }
+
+  CameraCalibrationSettings rerun_settings = settings;
+  std::vector<CalibrationView> rerun_views = views;
+  if ((!result.pass || max_z > 3) && (warp_cause || outlier_cause)) {
+    // Re-run portcal with what mrcal did differently, and compare again.
+    rerun_settings.estimate_board_warp = true;
+    if (outlier_cause) {
+      for (size_t v = 0; v < views.size(); ++v) {
+        std::vector<int> drop = mrcal.outliers[v];
+        std::sort(drop.rbegin(), drop.rend());
+        for (const int i : drop) {
+          rerun_views[v].pixels.erase(rerun_views[v].pixels.begin() + i);
+          rerun_views[v].points_in_target.erase(rerun_views[v].points_in_target.begin() + i);
+        }
+      }
+    }
+    result.rerun_description = std::string("portcal with board warp") +
+                               (outlier_cause ? " and without mrcal's outlier corners" : "");
+    const CameraCalibrationResult rerun = CalibrateCamera(rerun_views, input.camera, rerun_settings);
+    result.rerun_diff = ComputeProjectionDiff(LensOf(rerun), LensOf(mrcal), diff_options);
+    result.rerun_parameters = CompareParameters(rerun.camera, rerun.params_std_dev, mrcal);
+    WriteProjectionDiffHeatMap(*result.rerun_diff, static_cast<int>(input.camera.width),
+                               static_cast<int>(input.camera.height), "portcal (re-run) vs mrcal",
+                               dir / "projection_diff_rerun.png");
+  }
+
+  if (options.folds >= 2) {
+    result.cross_validations.push_back(CrossValidate(
+        views, input.camera, settings, options,
+        settings.estimate_board_warp ? "as the input (board warp)" : "as the input (flat board)",
+        dir / "cross_validation_diff.png"));
+    if (result.rerun_diff) {
+      result.cross_validations.push_back(CrossValidate(rerun_views, input.camera, rerun_settings,
+                                                       options, "as the re-run",
+                                                       dir / "cross_validation_diff_rerun.png"));
+    }
+  }
+  WriteCrossCheckReport(result, dir);
+  LOG(INFO) << "cross_check: " << result.Verdict();
+  return result;
+}
+
+}  // namespace portcal

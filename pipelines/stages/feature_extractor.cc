@@ -1,0 +1,120 @@
+#include "pipelines/stages/feature_extractor.h"
+
+#include <opencv2/imgcodecs.hpp>
+#include <set>
+#include <sstream>
+
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/parallel.h"
+#include "database/database.h"
+#include "database/stage_run.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+
+void FeatureExtractorOptions::Check() const {
+  if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
+  if (image_path.empty()) throw OptionError("--image_path", "''", "a directory of images");
+  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+  reader.Check();
+  sift.Check();
+}
+
+namespace {
+
+std::string OptionsText(const FeatureExtractorOptions& o) {
+  std::ostringstream out;
+  out << "image_path=" << o.image_path << "\nImageReader.camera_model=" << o.reader.camera_model
+      << "\nImageReader.single_camera=" << o.reader.single_camera
+      << "\nImageReader.single_camera_per_folder=" << o.reader.single_camera_per_folder
+      << "\nImageReader.camera_params=" << o.reader.camera_params
+      << "\nSiftExtraction.max_num_features=" << o.sift.max_num_features
+      << "\nSiftExtraction.max_image_size=" << o.sift.max_image_size
+      << "\nSiftExtraction.first_octave=" << o.sift.first_octave
+      << "\nSiftExtraction.peak_threshold=" << o.sift.peak_threshold
+      << "\nSiftExtraction.edge_threshold=" << o.sift.edge_threshold
+      << "\noverwrite=" << o.overwrite << "\n";
+  return out.str();
+}
+
+struct Extracted {
+  bool readable = false;
+  int width = 0, height = 0;
+  SiftFeatures features;
+};
+
+}  // namespace
+
+FeatureExtractionSummary ExtractFeatures(const FeatureExtractorOptions& options,
+                                         ProgressSink& progress) {
+  options.Check();
+  StageRun run("feature_extractor", OptionsText(options));
+  const std::vector<std::string> names = ListImages(options.image_path);
+  Database database(options.database_path, Database::OpenMode::kCreate);
+  Transaction transaction = database.BeginTransaction();
+
+  // Rerun: images that have features already are left alone.
+  std::vector<std::string> todo;
+  FeatureExtractionSummary summary;
+  summary.num_images = static_cast<int>(names.size());
+  for (const std::string& name : names) {
+    const std::optional<DatabaseImage> image = database.ReadImageWithName(name);
+    if (image && !options.overwrite && database.ExistsKeypoints(image->image_id) &&
+        database.ExistsDescriptors(image->image_id)) {
+      ++summary.num_skipped;
+    } else {
+      todo.push_back(name);
+    }
+  }
+  LOG(INFO) << "feature_extractor: " << names.size() << " images, " << todo.size()
+            << " to extract, " << summary.num_skipped << " already have features";
+
+  std::vector<Extracted> slots(todo.size());
+  SharedCameras shared_cameras;
+  progress.Begin("feature_extractor: images", todo.size());
+  OrderedParallelFor(
+      todo.size(), options.num_threads, 2 * static_cast<size_t>(options.num_threads) + 2,
+      [&](size_t i) {
+        const cv::Mat gray = cv::imread((fs::path(options.image_path) / todo[i]).string(),
+                                        cv::IMREAD_GRAYSCALE);
+        if (gray.empty()) return;
+        slots[i].readable = true;
+        slots[i].width = gray.cols;
+        slots[i].height = gray.rows;
+        slots[i].features = ExtractSift(gray, options.sift);
+      },
+      [&](size_t i) {
+        Extracted extracted = std::move(slots[i]);
+        progress.Advance(1);
+        if (!extracted.readable) {
+          LOG(WARNING) << todo[i] << ": cannot read the image; skipped";
+          ++summary.num_unreadable;
+          return;
+        }
+        const image_t image_id = ImportImage(&database, options.reader, todo[i], extracted.width,
+                                             extracted.height, &shared_cameras);
+        database.DeleteMatchesOfImage(image_id);
+        database.WriteKeypoints(image_id, extracted.features.keypoints);
+        database.WriteDescriptors(image_id, extracted.features.descriptors);
+        if (extracted.features.keypoints.empty()) LOG(WARNING) << todo[i] << ": no SIFT features";
+        VLOG(1) << todo[i] << ": " << extracted.features.keypoints.size() << " features";
+        ++summary.num_extracted;
+        summary.num_features += static_cast<int64_t>(extracted.features.keypoints.size());
+      });
+  progress.End();
+  run.Finish(&database, {{"images", summary.num_images},
+                         {"extracted", summary.num_extracted},
+                         {"skipped", summary.num_skipped},
+                         {"unreadable", summary.num_unreadable},
+                         {"features", summary.num_features}});
+  CancelFlag::ThrowIfRequested();
+  transaction.Commit();
+  LOG(INFO) << "feature_extractor: " << summary.num_extracted << " images extracted ("
+            << summary.num_features << " features), " << summary.num_skipped << " skipped, "
+            << summary.num_unreadable << " unreadable";
+  return summary;
+}
+
+}  // namespace portcal

@@ -1,0 +1,395 @@
+#include "pipelines/stages/synthesize.h"
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <opencv2/imgcodecs.hpp>
+#include <random>
+#include <sstream>
+
+#include "colmap_ext/io/ground_truth.h"
+#include "colmap_ext/io/sparse_model.h"
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
+#include "pipelines/synthetic/renderer.h"
+#include "pipelines/synthetic/scene.h"
+#include "pipelines/synthetic/view_sampler.h"
+#include "pipelines/synthetic/dataset_config.h"
+#include "pipelines/synthetic/target_builder.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+
+void SynthesizeOptions::Check() const {
+  if (config_path.empty()) throw OptionError("--config", "''", "a dataset YAML file");
+  if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
+  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+std::string ImageName(int frame, int num_images) {
+  std::ostringstream name;
+  const int digits = std::max(3, static_cast<int>(std::to_string(num_images).size()));
+  name << "img_" << std::setw(digits) << std::setfill('0') << frame + 1 << ".png";
+  return name.str();
+}
+
+// The static background: a fronto-parallel textured plane at `distance` in
+// the camera-1 frame, one texel per pixel there, covering the view.
+struct Clutter {
+  std::unique_ptr<SceneObject> object;
+  Rigid3d cam_from_clutter;
+  Eigen::Vector4d extent;
+  double texel = 0;
+};
+
+Clutter MakeClutter(const DatasetConfig& config) {
+  Clutter clutter;
+  const double d = config.clutter_distance_m;
+  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+  const Camera& camera = config.camera;
+  for (const Eigen::Vector2d& pixel : {Eigen::Vector2d(0, 0), Eigen::Vector2d(camera.width, 0),
+                                       Eigen::Vector2d(0, camera.height),
+                                       Eigen::Vector2d(camera.width, camera.height)}) {
+    const auto ray = UnprojectPixel(camera, config.housing ? &*config.housing : nullptr, pixel);
+    const Eigen::Vector3d p = ray ? Eigen::Vector3d(ray->origin + (d - ray->origin.z()) /
+                                                                      ray->direction.z() * ray->direction)
+                                  : Eigen::Vector3d(d, d, d);
+    x0 = std::min(x0, p.x());
+    x1 = std::max(x1, p.x());
+    y0 = std::min(y0, p.y());
+    y1 = std::max(y1, p.y());
+  }
+  // Wider for a stereo rig's second camera.
+  const double pad = 0.2 * (x1 - x0) + (config.stereo ? config.cam2_from_cam1.translation.norm() : 0.0);
+  clutter.extent = Eigen::Vector4d(x0 - pad, x1 + pad, y0 - pad, y1 + pad);
+  clutter.texel = d / config.camera.MeanFocalLength();
+  const int cols = static_cast<int>(std::ceil((clutter.extent[1] - clutter.extent[0]) / clutter.texel));
+  const int rows = static_cast<int>(std::ceil((clutter.extent[3] - clutter.extent[2]) / clutter.texel));
+  const int scale = std::max(4, std::min(cols, rows) / 60);
+  auto texture = std::make_shared<RasterTexture>(
+      RandomShapesRaster(cols, rows, config.clutter_num_shapes, config.clutter_seed, scale / 2, 3 * scale),
+      clutter.extent[0], clutter.extent[2], clutter.texel);
+  clutter.object = std::make_unique<FacesObject>(std::vector<Face>{{texture, Rigid3d(), -1.0}},
+                                                 static_cast<float>(config.render.levels.back));
+  clutter.cam_from_clutter = Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, d));
+  return clutter;
+}
+
+// An opaque dark plate between the camera and a random part of the target.
+std::unique_ptr<SceneObject> MakeOccluder(const BuiltTarget& target, const Rigid3d& cam_from_target,
+                                          double fraction, std::mt19937_64* rng, Rigid3d* cam_from_occluder) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  const auto& points = target.outline_points;
+  const Eigen::Vector3d anchor_in_target =
+      target.center + unit(*rng) * (points[static_cast<size_t>(unit(*rng) * points.size()) % points.size()] - target.center);
+  double size = 0;
+  for (const auto& p : points) size = std::max(size, 2 * (p - target.center).norm());
+  const double along = 0.55;
+  const Eigen::Vector3d anchor = along * (cam_from_target * anchor_in_target);
+  const double side = std::sqrt(fraction) * size * along;
+  const int n = 16;
+  cv::Mat raster(n, n, CV_8UC1);
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) raster.at<uint8_t>(r, c) = static_cast<uint8_t>(20 + 40 * unit(*rng));
+  }
+  auto texture = std::make_shared<RasterTexture>(raster, -side / 2, -side / 2, side / n);
+  *cam_from_occluder = Rigid3d(
+      Eigen::Quaterniond(Eigen::AngleAxisd(2 * M_PI * unit(*rng), Eigen::Vector3d::UnitZ())), anchor);
+  return std::make_unique<FacesObject>(std::vector<Face>{{texture, Rigid3d(), -1.0}}, 40.0f);
+}
+
+// Ground truth of one camera's view of the target.
+ImageTruth TargetTruth(const Camera& camera, const Housing* housing, const BuiltTarget& target,
+                       const Rigid3d& cam_from_target, const std::vector<PlacedObject>& objects,
+                       bool check_occlusion) {
+  ImageTruth truth;
+  truth.cam_from_target = cam_from_target;
+  const auto inside = [&](const Eigen::Vector2d& p) {
+    return p.x() >= 0 && p.y() >= 0 && p.x() <= camera.width && p.y() <= camera.height;
+  };
+  bool any_hidden = false;
+  for (const Eigen::Vector3d& corner : target.description.corners_3d) {
+    const Eigen::Vector3d in_cam = cam_from_target * corner;
+    const std::optional<Eigen::Vector2d> pixel = ProjectPoint(camera, housing, in_cam);
+    truth.corners_px.push_back(pixel);
+    bool visible = pixel.has_value() && inside(*pixel);
+    if (visible && check_occlusion) {
+      // Visible if the pixel's ray hits the scene at the corner itself.
+      const auto ray = UnprojectPixel(camera, housing, *pixel);
+      Hit hit;
+      visible = ray && IntersectScene(objects, ray->origin, ray->direction, &hit) &&
+                (ray->origin + hit.t * ray->direction - in_cam).norm() < 1e-6;
+    }
+    any_hidden = any_hidden || !visible;
+    truth.corners_visible.push_back(visible);
+  }
+  if (!any_hidden) truth.corners_visible.clear();
+  for (const TargetMarker& marker : target.description.markers) {
+    ImageTruth::Marker seen;
+    seen.id = marker.id;
+    bool projects = true;
+    for (int k = 0; k < 4; ++k) {
+      const auto pixel = ProjectPoint(camera, housing, cam_from_target * marker.corners[k]);
+      if (!pixel) {
+        projects = false;
+        break;
+      }
+      seen.corners_px[k] = *pixel;
+      seen.fully_inside = seen.fully_inside && inside(*pixel);
+    }
+    if (projects) truth.markers.push_back(seen);
+  }
+  return truth;
+}
+
+std::string ExtraYaml(const DatasetConfig& config, const Clutter* clutter, const SurveyPath* survey) {
+  std::ostringstream out;
+  out.precision(17);
+  if (clutter) {
+    out << "clutter:\n  plane: z = " << config.clutter_distance_m
+        << " in the rig (camera 1) frame, fronto-parallel, static\n  distance: "
+        << config.clutter_distance_m << "\n  extent_xy:\n  - [" << clutter->extent[0] << ", "
+        << clutter->extent[1] << "]\n  - [" << clutter->extent[2] << ", " << clutter->extent[3]
+        << "]\n  texel: " << clutter->texel << "\n  seed: " << config.clutter_seed
+        << "\n  num_shapes: " << config.clutter_num_shapes << "\n";
+  } else {
+    out << "clutter: null\n";
+  }
+  const ImageFormationOptions& r = config.render;
+  out << "render:\n  spp: " << r.spp << "\n  sample_positions: stratum centres\n"
+      << "  filter: box (mean of samples)\n  blur_sigma: " << r.blur_sigma_px
+      << "\n  noise_sigma: " << r.noise_sigma << "\n  levels:\n    white: " << r.levels.white
+      << "\n    black: " << r.levels.black << "\n    background: " << r.levels.background
+      << "\n    invalid: " << r.levels.invalid << "\n    back: " << r.levels.back
+      << "\n  water:\n    attenuation_per_m: " << r.attenuation_per_m
+      << "\n    backscatter_gray: " << r.backscatter_gray
+      << "\n    forward_scatter_per_m: " << r.forward_scatter_per_m
+      << "\n    forward_scatter_sigma_px: " << r.forward_scatter_sigma_px
+      << "\n  vignetting: " << r.vignetting << "\n  motion_blur:\n    velocity_m_s: ["
+      << r.velocity_m_s.x() << ", " << r.velocity_m_s.y() << ", " << r.velocity_m_s.z()
+      << "]\n    angular_velocity_rad_s: [" << r.angular_velocity_rad_s.x() << ", "
+      << r.angular_velocity_rad_s.y() << ", " << r.angular_velocity_rad_s.z()
+      << "]\n    exposure_s: " << r.exposure_s << "\n    samples: " << r.motion_samples
+      << "\n  png: 8-bit grayscale\n";
+  out << "occlusion:\n  probability: " << config.occlusion_probability
+      << "\n  fraction: " << config.occlusion_fraction << "\n";
+  if (survey) {
+    const SurveyOptions& s = config.survey_options;
+    out << "survey:\n  world_frame: seabed, z up; cam_from_target = cam_from_world\n"
+        << "  height: " << s.height_m << "\n  speed: " << s.speed_m_s << "\n  frame_rate: "
+        << s.frame_rate_hz << "\n  side_overlap: " << s.side_overlap << "\n  line_length: "
+        << s.line_length_m << "\n  line_spacing: " << survey->line_spacing_m
+        << "\n  frame_spacing: " << survey->frame_spacing_m << "\n  footprint_width: "
+        << survey->footprint_width_m << "\n  roughness: " << s.roughness_m
+        << "\n  relief_wavelength: " << s.relief_wavelength_m << "\n  texel: " << s.texel_m
+        << "\n  seed: " << s.texture_seed << "\n";
+  } else {
+    const ViewSamplingOptions& p = config.poses;
+    out << "pose_generation:\n  distance: [" << p.distance_min_m << ", " << p.distance_max_m
+        << "]\n  tilt_max_deg: " << p.tilt_max_deg << "\n  roll_max_deg: " << p.roll_max_deg
+        << "\n  border_margin_px: " << p.border_margin_px << "\n  max_view_angle_deg: "
+        << p.max_view_angle_deg << "\n  visibility: " << p.visibility << "\n";
+  }
+  return out.str();
+}
+
+// A survey's navigation: each image's camera centre plus Gaussian noise per
+// axis, as pose_prior_importer reads it (names relative to images/).
+std::string NavigationText(const GroundTruth& truth, double sigma_m, uint64_t seed) {
+  std::mt19937_64 rng(seed * 7919ULL + 17ULL);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::ostringstream out;
+  out << "# NAME X Y Z: camera centres in the seabed frame (z up), metres, with noise of sigma "
+      << sigma_m << " m per axis\n";
+  out.precision(9);
+  const auto line = [&](const std::string& file, const Rigid3d& cam_from_world) {
+    const Eigen::Vector3d centre = cam_from_world.Inverse().translation;
+    const std::string prefix = "images/";
+    const std::string name = file.rfind(prefix, 0) == 0 ? file.substr(prefix.size()) : file;
+    out << name;
+    for (int k = 0; k < 3; ++k) out << " " << centre[k] + sigma_m * noise(rng);
+    out << "\n";
+  };
+  for (const FrameTruth& frame : truth.images) {
+    line(frame.cam1.file, frame.cam1.cam_from_target);
+    if (frame.cam2) line(frame.cam2->file, frame.cam2->cam_from_target);
+  }
+  return out.str();
+}
+
+void WriteImage(const fs::path& path, const cv::Mat& image) {
+  if (!cv::imwrite(path.string(), image)) throw InputError(path.string() + ": cannot write image");
+}
+
+}  // namespace
+
+SynthesizeSummary Synthesize(const SynthesizeOptions& options, ProgressSink& progress) {
+  options.Check();
+  const auto start = Clock::now();
+  DatasetConfig config = ReadDatasetConfig(options.config_path);
+  if (options.seed >= 0) config.seed = static_cast<uint64_t>(options.seed);
+  config.render.num_threads = options.num_threads;
+  const Housing* housing1 = config.housing ? &*config.housing : nullptr;
+  const Housing* housing2 = config.housing2 ? &*config.housing2 : nullptr;
+  LOG(INFO) << "synthesize: " << config.name << ", " << config.num_images << " frames of "
+            << config.camera.width << "x" << config.camera.height << (config.stereo ? " (stereo)" : "")
+            << ", " << (config.survey ? "survey" : config.target.type);
+
+  const fs::path output(options.output_path);
+  const fs::path staging = output / ".synthesize_staging";
+  fs::remove_all(staging);
+  fs::create_directories(staging / "images");
+  const std::string dir1 = config.stereo ? "images/cam1" : "images";
+  const std::string dir2 = "images/cam2";
+  fs::create_directories(staging / dir1);
+  if (config.stereo) fs::create_directories(staging / dir2);
+
+  GroundTruth truth;
+  truth.name = config.name;
+  truth.description = config.description;
+  truth.seed = static_cast<int64_t>(config.seed);
+  truth.camera = config.camera;
+  truth.housing = config.housing;
+  if (config.stereo) {
+    truth.stereo = StereoTruth{config.cam2_from_cam1, config.camera2, config.housing2,
+                               config.cam2_from_cam1.Inverse().translation.norm(),
+                               {dir1, dir2}};
+  }
+
+  std::mt19937_64 rng(config.seed);
+  BuiltTarget target;
+  std::unique_ptr<SeabedObject> seabed;
+  SurveyPath survey;
+  if (config.survey) {
+    survey = PlanSurvey(config.camera, housing1, config.survey_options);
+    const SurveyOptions& s = config.survey_options;
+    const int cols = static_cast<int>(std::ceil((survey.area[1] - survey.area[0]) / s.texel_m));
+    const int rows = static_cast<int>(std::ceil((survey.area[3] - survey.area[2]) / s.texel_m));
+    const int shapes = static_cast<int>((survey.area[1] - survey.area[0]) * (survey.area[3] - survey.area[2]) * 600);
+    auto texture = std::make_shared<RasterTexture>(
+        RandomShapesRaster(cols, rows, shapes, s.texture_seed, 2, 10), survey.area[0], survey.area[2], s.texel_m);
+    seabed = std::make_unique<SeabedObject>(texture, s.roughness_m, s.relief_wavelength_m, s.texture_seed + 1);
+    truth.target.type = "seabed";
+  } else {
+    target = BuildTarget(config.target, config.render.levels);
+    truth.target = target.description;
+  }
+  std::optional<Clutter> clutter;
+  if (config.clutter) clutter = MakeClutter(config);
+
+  const auto ray_start = Clock::now();
+  const RayMap rays1(config.camera, housing1, config.render.spp, options.num_threads);
+  std::optional<RayMap> rays2;
+  if (config.stereo) rays2.emplace(config.camera2, housing2, config.render.spp, options.num_threads);
+  const double ray_seconds = Seconds(ray_start);
+
+  progress.Begin("synthesize: frames", config.num_images);
+  const auto render_start = Clock::now();
+  const std::vector<Eigen::Vector3d>& check_points =
+      config.poses.visibility == "markers" ? target.marker_points : target.outline_points;
+  for (int frame = 0; frame < config.num_images; ++frame) {
+    CancelFlag::ThrowIfRequested();
+    Rigid3d cam_from_target;
+    if (config.survey) {
+      cam_from_target = survey.cam_from_world[frame];
+    } else {
+      // Stereo: both cameras must see the target; resample until they do.
+      for (int attempt = 0;; ++attempt) {
+        cam_from_target = SampleTargetView(config.camera, housing1, check_points, target.center,
+                                           target.front_normal, config.poses, &rng);
+        if (!config.stereo) break;
+        bool seen = true;
+        for (const Eigen::Vector3d& p : check_points) {
+          const auto pixel = ProjectPoint(config.camera2, housing2, config.cam2_from_cam1 * cam_from_target * p);
+          seen = seen && pixel && pixel->x() >= config.poses.border_margin_px &&
+                 pixel->y() >= config.poses.border_margin_px &&
+                 pixel->x() <= config.camera2.width - config.poses.border_margin_px &&
+                 pixel->y() <= config.camera2.height - config.poses.border_margin_px;
+        }
+        if (seen) break;
+        if (attempt > 200) {
+          throw NumericalError("stereo: no pose found where both cameras see the target; "
+                               "check stereo.cam2_from_cam1 and poses.distance");
+        }
+      }
+    }
+    std::vector<PlacedObject> objects;
+    objects.push_back({config.survey ? static_cast<const SceneObject*>(seabed.get()) : target.object.get(),
+                       cam_from_target});
+    if (clutter) objects.push_back({clutter->object.get(), clutter->cam_from_clutter});
+    std::unique_ptr<SceneObject> occluder;
+    std::uniform_real_distribution<double> unit(0, 1);
+    if (!config.survey && unit(rng) < config.occlusion_probability) {
+      Rigid3d cam_from_occluder;
+      occluder = MakeOccluder(target, cam_from_target, config.occlusion_fraction, &rng, &cam_from_occluder);
+      objects.push_back({occluder.get(), cam_from_occluder});
+    }
+
+    FrameTruth frame_truth;
+    frame_truth.frame = frame;
+    const std::string name = ImageName(frame, config.num_images);
+    const uint64_t noise_seed = config.seed * 1000003ULL + 2ULL * frame;
+    WriteImage(staging / dir1 / name, RenderImage(rays1, objects, config.render, noise_seed));
+    frame_truth.cam1 = config.survey ? ImageTruth{} :
+        TargetTruth(config.camera, housing1, target, cam_from_target, objects, occluder != nullptr);
+    frame_truth.cam1.file = dir1 + "/" + name;
+    frame_truth.cam1.cam_from_target = cam_from_target;
+    if (config.stereo) {
+      std::vector<PlacedObject> objects2 = objects;
+      for (PlacedObject& placed : objects2) placed.cam_from_object = config.cam2_from_cam1 * placed.cam_from_object;
+      WriteImage(staging / dir2 / name, RenderImage(*rays2, objects2, config.render, noise_seed + 1));
+      const Rigid3d cam2_from_target = config.cam2_from_cam1 * cam_from_target;
+      frame_truth.cam2 = config.survey ? ImageTruth{} :
+          TargetTruth(config.camera2, housing2, target, cam2_from_target, objects2, occluder != nullptr);
+      frame_truth.cam2->file = dir2 + "/" + name;
+      frame_truth.cam2->cam_from_target = cam2_from_target;
+    }
+    truth.images.push_back(frame_truth);
+    progress.Advance(1);
+  }
+  progress.End();
+  const double render_seconds = Seconds(render_start);
+
+  WriteGroundTruth(truth, staging / "ground_truth.yaml",
+                   ExtraYaml(config, clutter ? &*clutter : nullptr, config.survey ? &survey : nullptr));
+  if (config.survey) {
+    const std::string navigation = NavigationText(truth, config.survey_options.navigation_sigma_m, config.seed);
+    WriteFileAtomically(staging / "navigation.txt", false, [&](std::ostream& out) { out << navigation; });
+  }
+  if (!config.survey && config.target.type == "target3d") {
+    const std::string csv = DotsCsv(target.dots);
+    WriteFileAtomically(staging / "target_dots.csv", false, [&](std::ostream& out) { out << csv; });
+  }
+  fs::copy_file(options.config_path, staging / "config_used.yaml", fs::copy_options::overwrite_existing);
+
+  // Move the finished set into place.
+  for (const char* entry : {"images", "ground_truth.yaml", "target_dots.csv", "config_used.yaml", "navigation.txt"}) {
+    if (!fs::exists(staging / entry)) continue;
+    fs::remove_all(output / entry);
+    fs::rename(staging / entry, output / entry);
+  }
+  fs::remove_all(staging);
+
+  SynthesizeSummary summary;
+  summary.num_images = config.num_images;
+  summary.seconds = Seconds(start);
+  summary.ray_seconds = ray_seconds;
+  summary.render_seconds_per_image =
+      render_seconds / (config.num_images * (config.stereo ? 2 : 1));
+  LOG(INFO) << "synthesize: " << summary.num_images << " frames in " << summary.seconds
+            << " s (rays " << ray_seconds << " s once, " << summary.render_seconds_per_image
+            << " s per image) -> " << output.string();
+  return summary;
+}
+
+}  // namespace portcal

@@ -1,0 +1,191 @@
+#include "pipelines/stages/target_extractor.h"
+
+#include <atomic>
+#include <mutex>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <thread>
+
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
+#include "database/database.h"
+#include "database/stage_run.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+
+void TargetExtractorOptions::Check() const {
+  if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
+  if (image_path.empty()) throw OptionError("--image_path", "''", "a directory of images");
+  if (target_type != "chessboard" && target_type != "aruco_grid" && target_type != "charuco") {
+    throw OptionError("--Target.type", target_type, "chessboard, aruco_grid or charuco");
+  }
+  if (!(square_size_m > 0)) throw OptionError("--Target.square_size", std::to_string(square_size_m), "> 0 m");
+  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+  reader.Check();
+  if (target_type == "chessboard") {
+    chessboard.Check();
+  } else {
+    MarkerBoardOptions board = markers;
+    board.type = target_type;
+    board.square_size_m = square_size_m;
+    board.Check();
+  }
+}
+
+namespace {
+
+// What one image gave, whatever the target.
+struct ImageResult {
+  std::string name;
+  int width = 0, height = 0;
+  bool readable = false;
+  bool found = false;
+  bool symmetric = false;  // chessboard that looks the same turned by 180 deg
+  std::string reason;
+  std::vector<TargetObservation> observations;
+  std::vector<MarkerDetection> markers;
+};
+
+void Detect(const cv::Mat& gray, const TargetExtractorOptions& o, ImageResult* result) {
+  if (o.target_type == "chessboard") {
+    const ChessboardDetection d = DetectChessboard(gray, o.chessboard);
+    result->found = d.found;
+    result->reason = d.reason;
+    result->symmetric = d.symmetric;
+    if (!d.found) return;
+    for (size_t i = 0; i < d.corners.size(); ++i) {
+      if (!d.corners[i]) continue;
+      TargetObservation observation;
+      observation.point_id = static_cast<int64_t>(i);
+      observation.xy = *d.corners[i];
+      observation.point_in_target = Eigen::Vector3d((i % o.chessboard.cols) * o.square_size_m,
+                                                    (i / o.chessboard.cols) * o.square_size_m, 0.0);
+      result->observations.push_back(observation);
+    }
+    return;
+  }
+  MarkerBoardOptions board = o.markers;
+  board.type = o.target_type;
+  board.square_size_m = o.square_size_m;
+  const MarkerBoardDetection d = DetectMarkerBoard(gray, board);
+  result->found = d.found;
+  result->reason = d.reason;
+  result->markers = d.markers;
+  if (!d.found) return;
+  for (const BoardPoint& p : d.points) result->observations.push_back({p.point_id, p.xy, p.point_in_target});
+}
+
+std::string OptionsText(const TargetExtractorOptions& o) {
+  std::ostringstream out;
+  out << "image_path=" << o.image_path << "\nImageReader.camera_model=" << o.reader.camera_model
+      << "\nImageReader.single_camera=" << o.reader.single_camera
+      << "\nImageReader.single_camera_per_folder=" << o.reader.single_camera_per_folder
+      << "\nImageReader.camera_params=" << o.reader.camera_params << "\nTarget.type=" << o.target_type
+      << "\nTarget.cols=" << o.chessboard.cols << "\nTarget.rows=" << o.chessboard.rows
+      << "\nTarget.square_size=" << o.square_size_m << "\n";
+  return out.str();
+}
+
+}  // namespace
+
+TargetExtractionSummary ExtractTargets(const TargetExtractorOptions& options,
+                                       ProgressSink& progress) {
+  options.Check();
+  StageRun run("target_extractor", OptionsText(options));
+  const std::vector<std::string> names = ListImages(options.image_path);
+  LOG(INFO) << "target_extractor: " << names.size() << " images, " << options.target_type;
+
+  // Detection in parallel, outside the database transaction.
+  std::vector<ImageResult> results(names.size());
+  std::atomic<size_t> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  progress.Begin("target_extractor: images", names.size());
+  const auto worker = [&] {
+    for (size_t i = next++; i < names.size(); i = next++) {
+      try {
+        CancelFlag::ThrowIfRequested();
+        ImageResult& result = results[i];
+        result.name = names[i];
+        const cv::Mat gray = cv::imread((fs::path(options.image_path) / names[i]).string(),
+                                        cv::IMREAD_GRAYSCALE);
+        if (!gray.empty()) {
+          result.readable = true;
+          result.width = gray.cols;
+          result.height = gray.rows;
+          Detect(gray, options, &result);
+        }
+        progress.Advance(1);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+        next = names.size();
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 1; t < options.num_threads; ++t) threads.emplace_back(worker);
+  worker();
+  for (std::thread& t : threads) t.join();
+  if (error) std::rethrow_exception(error);
+  progress.End();
+
+  // One transaction: images, cameras, observations, status, log.
+  Database database(options.database_path, Database::OpenMode::kCreate);
+  Transaction transaction = database.BeginTransaction();
+  TargetExtractionSummary summary;
+  SharedCameras shared_cameras;
+  const auto metres = [](double value) {
+    std::ostringstream out;
+    out << value << " m";
+    return out.str();
+  };
+  const MarkerBoardOptions& m = options.markers;
+  const std::string target =
+      options.target_type == "chessboard"
+          ? "chessboard " + std::to_string(options.chessboard.cols) + "x" +
+                std::to_string(options.chessboard.rows) + " inner corners, square " +
+                metres(options.square_size_m)
+      : options.target_type == "aruco_grid"
+          ? "aruco_grid " + std::to_string(m.markers_x) + "x" + std::to_string(m.markers_y) + " " +
+                m.dictionary + ", marker " + metres(m.marker_size_m) + ", separation " +
+                metres(m.marker_separation_m)
+          : "charuco " + std::to_string(m.squares_x) + "x" + std::to_string(m.squares_y) + " squares " +
+                m.dictionary + ", square " + metres(options.square_size_m) + ", marker " +
+                metres(m.marker_size_m);
+  for (const ImageResult& result : results) {
+    if (!result.readable) {
+      LOG(WARNING) << result.name << ": cannot read the image; skipped";
+      continue;
+    }
+    const image_t image_id = ImportImage(&database, options.reader, result.name, result.width,
+                                         result.height, &shared_cameras);
+    const std::vector<TargetObservation>& observations = result.observations;
+    if (!result.found) LOG(WARNING) << result.name << ": " << result.reason;
+    database.WriteTargetObservations(image_id, observations);
+    database.WriteMarkerDetections(image_id, result.markers);
+    TargetDetectionStatus status;
+    status.target = target;
+    status.found = result.found;
+    status.num_points = static_cast<int>(observations.size());
+    status.reason = result.found ? (result.symmetric ? "found (symmetric board: order may be rotated by 180 deg)"
+                                                     : "found")
+                                 : result.reason;
+    database.WriteTargetDetectionStatus(image_id, status);
+    ++summary.num_images;
+    summary.num_found += result.found;
+    summary.num_points += static_cast<int64_t>(observations.size());
+  }
+  run.Finish(&database, {{"images", summary.num_images},
+                         {"found", summary.num_found},
+                         {"points", summary.num_points}});
+  CancelFlag::ThrowIfRequested();
+  transaction.Commit();
+  LOG(INFO) << "target_extractor: target found in " << summary.num_found << " of "
+            << summary.num_images << " images, " << summary.num_points << " corners";
+  return summary;
+}
+
+}  // namespace portcal
