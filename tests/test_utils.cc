@@ -12,6 +12,11 @@
 namespace fs = std::filesystem;
 
 namespace portcal {
+
+ProgressSink& NoProgress() {
+  static NullProgress progress;  // stateless, so shared safely
+  return progress;
+}
 namespace testing {
 
 TempDir::TempDir() {

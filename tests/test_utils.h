@@ -9,7 +9,12 @@
 #include <random>
 #include <string>
 
+#include "colmap_ext/util/progress.h"
+
 namespace portcal {
+
+// A progress sink that drops everything, for the stages the tests run.
+ProgressSink& NoProgress();
 namespace testing {
 
 // A fresh directory removed at scope exit.

@@ -3,23 +3,23 @@
 
 namespace portcal {
 
-int RunDatabaseCreator(int argc, char** argv);
-int RunPosePriorImporter(int argc, char** argv);
-int RunModelConverter(int argc, char** argv);
-int RunProjectPoints(int argc, char** argv);
-int RunSynthesize(int argc, char** argv);
-int RunTargetExtractor(int argc, char** argv);
-int RunCameraCalibrator(int argc, char** argv);
-int RunHousingCalibrator(int argc, char** argv);
-int RunStereoCalibrator(int argc, char** argv);
-int RunFeatureExtractor(int argc, char** argv);
-int RunFeatureMasker(int argc, char** argv);
-int RunExhaustiveMatcher(int argc, char** argv);
-int RunSequentialMatcher(int argc, char** argv);
-int RunSpatialMatcher(int argc, char** argv);
-int RunRefractiveMapper(int argc, char** argv);
-int RunRefractiveBundleAdjuster(int argc, char** argv);
-int RunAutoCalibrator(int argc, char** argv);
-int RunCrossCheck(int argc, char** argv);
+int DatabaseCreatorCommand(int argc, char** argv);
+int PosePriorImporterCommand(int argc, char** argv);
+int ModelConverterCommand(int argc, char** argv);
+int ProjectPointsCommand(int argc, char** argv);
+int SynthesizeCommand(int argc, char** argv);
+int TargetExtractorCommand(int argc, char** argv);
+int CameraCalibratorCommand(int argc, char** argv);
+int HousingCalibratorCommand(int argc, char** argv);
+int StereoCalibratorCommand(int argc, char** argv);
+int FeatureExtractorCommand(int argc, char** argv);
+int FeatureMaskerCommand(int argc, char** argv);
+int ExhaustiveMatcherCommand(int argc, char** argv);
+int SequentialMatcherCommand(int argc, char** argv);
+int SpatialMatcherCommand(int argc, char** argv);
+int RefractiveMapperCommand(int argc, char** argv);
+int RefractiveBundleAdjusterCommand(int argc, char** argv);
+int AutoCalibratorCommand(int argc, char** argv);
+int CrossCheckCommand(int argc, char** argv);
 
 }  // namespace portcal

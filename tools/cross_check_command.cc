@@ -1,13 +1,14 @@
 #include <iostream>
 
 #include "pipelines/stages/cross_check.h"
+#include "colmap_ext/util/progress.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 
 namespace portcal {
 
-int RunCrossCheck(int argc, char** argv) {
-  CrossCheckerOptions options;
+int CrossCheckCommand(int argc, char** argv) {
+  CrossCheckOptions options;
   CommandLine cli("cross_check",
                   "Cross-checks portcal's in-air calibration against mrcal: solves the same "
                   "stored chessboard corners with mrcal's C library (its lens model matching "
@@ -36,7 +37,8 @@ int RunCrossCheck(int argc, char** argv) {
   cli.Add("num_threads", &options.num_threads, "threads");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
-    std::cout << CrossCheckText(CrossCheck(options));
+    StderrProgress progress;
+    std::cout << CrossCheckText(RunCrossCheck(options, progress));
   });
 }
 

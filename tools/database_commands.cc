@@ -1,23 +1,25 @@
 #include "pipelines/stages/database_creator.h"
 #include "pipelines/stages/pose_prior_importer.h"
+#include "colmap_ext/util/progress.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 
 namespace portcal {
 
-int RunDatabaseCreator(int argc, char** argv) {
-  std::string database_path;
+int DatabaseCreatorCommand(int argc, char** argv) {
+  DatabaseCreatorOptions options;
   CommandLine cli("database_creator",
                   "Creates a COLMAP 3.8 database (with portcal's tables), or "
                   "checks an existing one.");
-  cli.AddRequired("database_path", &database_path, "database file to create");
+  cli.AddRequired("database_path", &options.database_path, "database file to create");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
-    CreateDatabase(database_path);
+    StderrProgress progress;
+    RunDatabaseCreator(options, progress);
   });
 }
 
-int RunPosePriorImporter(int argc, char** argv) {
+int PosePriorImporterCommand(int argc, char** argv) {
   PosePriorImporterOptions options;
   CommandLine cli("pose_prior_importer",
                   "Stores navigation positions (camera centres, metres, a local Cartesian frame) as the "
@@ -27,7 +29,8 @@ int RunPosePriorImporter(int argc, char** argv) {
   cli.AddRequired("input_path", &options.input_path, "file of 'NAME X Y Z' lines");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
-    ImportPosePriors(options);
+    StderrProgress progress;
+    RunPosePriorImporter(options, progress);
   });
 }
 

@@ -9,7 +9,7 @@
 
 namespace portcal {
 
-int RunFeatureExtractor(int argc, char** argv) {
+int FeatureExtractorCommand(int argc, char** argv) {
   FeatureExtractorOptions options;
   CommandLine cli("feature_extractor",
                   "Imports the images into the database (like COLMAP's ImageReader) and stores "
@@ -30,11 +30,11 @@ int RunFeatureExtractor(int argc, char** argv) {
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
     StderrProgress progress;
-    ExtractFeatures(options, progress);
+    RunFeatureExtractor(options, progress);
   });
 }
 
-int RunFeatureMasker(int argc, char** argv) {
+int FeatureMaskerCommand(int argc, char** argv) {
   FeatureMaskerOptions options;
   CommandLine cli("feature_masker",
                   "Detects ArUco markers and keeps only the features inside each marker's quad "
@@ -48,7 +48,7 @@ int RunFeatureMasker(int argc, char** argv) {
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
     StderrProgress progress;
-    MaskFeatures(options, progress);
+    RunFeatureMasker(options, progress);
   });
 }
 
@@ -80,13 +80,13 @@ int ParseAndMatch(CommandLine* cli, const FeatureMatcherOptions& options, int ar
   return ReportErrors([&] {
     if (!cli->Parse(argc, argv)) return;
     StderrProgress progress;
-    MatchFeatures(options, progress);
+    RunFeatureMatcher(options, progress);
   });
 }
 
 }  // namespace
 
-int RunExhaustiveMatcher(int argc, char** argv) {
+int ExhaustiveMatcherCommand(int argc, char** argv) {
   FeatureMatcherOptions options;
   options.mode = "exhaustive";
   CommandLine cli("exhaustive_matcher",
@@ -97,7 +97,7 @@ int RunExhaustiveMatcher(int argc, char** argv) {
   return ParseAndMatch(&cli, options, argc, argv);
 }
 
-int RunSequentialMatcher(int argc, char** argv) {
+int SequentialMatcherCommand(int argc, char** argv) {
   FeatureMatcherOptions options;
   options.mode = "sequential";
   CommandLine cli("sequential_matcher",
@@ -118,7 +118,7 @@ int RunSequentialMatcher(int argc, char** argv) {
   return ParseAndMatch(&cli, options, argc, argv);
 }
 
-int RunSpatialMatcher(int argc, char** argv) {
+int SpatialMatcherCommand(int argc, char** argv) {
   FeatureMatcherOptions options;
   options.mode = "spatial";
   CommandLine cli("spatial_matcher",

@@ -2,12 +2,13 @@
 
 #include "pipelines/stages/model_converter.h"
 #include "pipelines/stages/project_points.h"
+#include "colmap_ext/util/progress.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 
 namespace portcal {
 
-int RunModelConverter(int argc, char** argv) {
+int ModelConverterCommand(int argc, char** argv) {
   ModelConverterOptions options;
   CommandLine cli("model_converter",
                   "Converts a COLMAP sparse model (cameras, images, points3D "
@@ -26,11 +27,12 @@ int RunModelConverter(int argc, char** argv) {
   cli.Add("camera_id", &options.camera_id, "camera to export from a model (-1: the only one)");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
-    ConvertModel(options);
+    StderrProgress progress;
+    RunModelConverter(options, progress);
   });
 }
 
-int RunProjectPoints(int argc, char** argv) {
+int ProjectPointsCommand(int argc, char** argv) {
   ProjectPointsOptions options;
   CommandLine cli("project_points",
                   "Projects 3-D points (camera frame, metres; one 'X Y Z' per "
@@ -54,7 +56,8 @@ int RunProjectPoints(int argc, char** argv) {
           "Cx,Cy,Cz,int_radius,int_thick,na,ng,nw (metres)");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
-    ProjectPoints(options, std::cout);
+    StderrProgress progress;
+    for (const std::string& line : RunProjectPoints(options, progress).lines) std::cout << line << "\n";
   });
 }
 

@@ -3,6 +3,7 @@
 #include "pipelines/stages/auto_calibrator.h"
 #include "pipelines/stages/refractive_bundle_adjuster.h"
 #include "pipelines/stages/refractive_mapper.h"
+#include "colmap_ext/util/progress.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 
@@ -52,7 +53,7 @@ static void AddMapperOptions(CommandLine* cli, IncrementalMapperOptions* o) {
   cli->Add("num_threads", &o->num_threads, "threads");
 }
 
-int RunRefractiveMapper(int argc, char** argv) {
+int RefractiveMapperCommand(int argc, char** argv) {
   RefractiveMapperOptions options;
   CommandLine cli("refractive_mapper",
                   "Incremental structure-from-motion on the verified matches in the database, every "
@@ -103,7 +104,7 @@ void AddBundleOptions(CommandLine* cli, BundleAdjustmentOptions* ba) {
 
 }  // namespace
 
-int RunRefractiveBundleAdjuster(int argc, char** argv) {
+int RefractiveBundleAdjusterCommand(int argc, char** argv) {
   RefractiveBundleAdjusterOptions options;
   CommandLine cli("refractive_bundle_adjuster",
                   "Bundle adjustment of a sparse model that self-calibrates the housing (flat: "
@@ -126,11 +127,12 @@ int RunRefractiveBundleAdjuster(int argc, char** argv) {
   AddBundleOptions(&cli, &options.ba);
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
-    RunRefractiveBundleAdjuster(options);
+    StderrProgress progress;
+    RunRefractiveBundleAdjuster(options, progress);
   });
 }
 
-int RunAutoCalibrator(int argc, char** argv) {
+int AutoCalibratorCommand(int argc, char** argv) {
   AutoCalibratorOptions options;
   CommandLine cli("auto_calibrator",
                   "Calibration without a known target: extract, mask (ArUco), match, refractive "

@@ -4,7 +4,7 @@
 
 namespace portcal {
 
-int RunSynthesize(int argc, char** argv) {
+int SynthesizeCommand(int argc, char** argv) {
   SynthesizeOptions options;
   CommandLine cli("synthesize",
                   "Renders a calibration image set with exact ground truth: DIR/images/*.png "
@@ -19,7 +19,7 @@ int RunSynthesize(int argc, char** argv) {
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
     StderrProgress progress;
-    Synthesize(options, progress);
+    RunSynthesize(options, progress);
   });
 }
 

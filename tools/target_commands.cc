@@ -3,13 +3,14 @@
 #include "pipelines/stages/housing_calibrator.h"
 #include "pipelines/stages/stereo_calibrator.h"
 #include "pipelines/stages/target_extractor.h"
+#include "colmap_ext/util/progress.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 #include "tools/option_groups.h"
 
 namespace portcal {
 
-int RunTargetExtractor(int argc, char** argv) {
+int TargetExtractorCommand(int argc, char** argv) {
   TargetExtractorOptions options;
   CommandLine cli("target_extractor",
                   "Imports the images into the database (like COLMAP's feature_extractor) and "
@@ -37,11 +38,11 @@ int RunTargetExtractor(int argc, char** argv) {
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
     StderrProgress progress;
-    ExtractTargets(options, progress);
+    RunTargetExtractor(options, progress);
   });
 }
 
-int RunCameraCalibrator(int argc, char** argv) {
+int CameraCalibratorCommand(int argc, char** argv) {
   CameraCalibratorOptions options;
   std::string fixed;
   CommandLine cli("camera_calibrator",
@@ -64,12 +65,13 @@ int RunCameraCalibrator(int argc, char** argv) {
   cli.Add("num_threads", &options.calibration.num_threads, "threads");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
+    StderrProgress progress;
     options.calibration.fixed_params = SplitTokens(fixed, ", ");
-    CalibrateCameraStage(options);
+    RunCameraCalibrator(options, progress);
   });
 }
 
-int RunHousingCalibrator(int argc, char** argv) {
+int HousingCalibratorCommand(int argc, char** argv) {
   HousingCalibratorOptions options;
   CommandLine cli("housing_calibrator",
                   "Calibrates a flat or dome port from the target observations of underwater "
@@ -92,11 +94,12 @@ int RunHousingCalibrator(int argc, char** argv) {
   cli.Add("num_threads", &options.calibration.num_threads, "threads");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
-    CalibrateHousingStage(options);
+    StderrProgress progress;
+    RunHousingCalibrator(options, progress);
   });
 }
 
-int RunStereoCalibrator(int argc, char** argv) {
+int StereoCalibratorCommand(int argc, char** argv) {
   StereoCalibratorOptions options;
   CommandLine cli("stereo_calibrator",
                   "Calibrates the relative pose of two cameras from frames in which both see the "
@@ -115,7 +118,8 @@ int RunStereoCalibrator(int argc, char** argv) {
   cli.Add("num_threads", &options.stereo.num_threads, "threads");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
-    CalibrateStereoStage(options);
+    StderrProgress progress;
+    RunStereoCalibrator(options, progress);
   });
 }
 

@@ -104,14 +104,14 @@ namespace {
 struct CalibrationStart {
   int index = 0;  // 0: written to output_path itself; k: output_path/start_k
   int num_registered = 0;
-  RefractiveBundleAdjusterResult refined;
+  RefractiveBundleAdjusterSummary refined;
 };
 
 std::string StartDir(int k) { return "start_" + std::to_string(k); }
 
 // Warnings another start might cure: not those about what the views'
 // geometry cannot tell apart.
-size_t NumCurableWarnings(const RefractiveBundleAdjusterResult& refined) {
+size_t NumCurableWarnings(const RefractiveBundleAdjusterSummary& refined) {
   return refined.report.warnings.size() - static_cast<size_t>(refined.num_geometry_warnings);
 }
 
@@ -199,7 +199,7 @@ CalibrationStart MapAndRefine(const AutoCalibratorOptions& options, const std::s
   start.index = k;
   start.num_registered = static_cast<int>(ReadSparseModel(mapped.model_paths.at(0)).images.size());
   start.refined = RunRefractiveBundleAdjuster(
-      RefinerOptions(options, database_path, mapped.model_paths.at(0).string(), dir, refine_intrinsics));
+      RefinerOptions(options, database_path, mapped.model_paths.at(0).string(), dir, refine_intrinsics), progress);
   if (refine_intrinsics) {
     const size_t num_warnings = start.refined.report.warnings.size();
     JudgeAutoCalibration(markers_focal, &start.refined.report);
@@ -215,13 +215,13 @@ CalibrationStart MapAndRefine(const AutoCalibratorOptions& options, const std::s
 
 }  // namespace
 
-AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, ProgressSink& progress) {
+AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, ProgressSink& progress) {
   options.Check();
   fs::create_directories(options.output_path);
   const std::string database_path = (fs::path(options.output_path) / "database.db").string();
   const bool intrinsics_given = !options.camera_params.empty();
   const bool refine_intrinsics = options.refine_intrinsics == -1 ? !intrinsics_given : options.refine_intrinsics == 1;
-  AutoCalibrationResult result;
+  AutoCalibratorSummary result;
   auto clock = std::chrono::steady_clock::now();
   const auto lap = [&](const std::string& stage) {
     const auto now = std::chrono::steady_clock::now();
@@ -237,7 +237,7 @@ AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   extract.reader.camera_params = options.camera_params;
   extract.sift = options.sift;
   extract.num_threads = options.num_threads;
-  result.num_images = ExtractFeatures(extract, progress).num_images;
+  result.num_images = RunFeatureExtractor(extract, progress).num_images;
   lap("feature_extractor");
 
   if (options.mask) {
@@ -247,7 +247,7 @@ AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
     mask.dictionary = options.marker_dictionary;
     mask.enlargement_factor = options.mask_enlargement_factor;
     mask.num_threads = options.num_threads;
-    MaskFeatures(mask, progress);
+    RunFeatureMasker(mask, progress);
     lap("feature_masker");
   }
 
@@ -259,7 +259,7 @@ AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   match.mode = options.matcher;
   match.num_threads = options.num_threads;
   match.verification.random_seed = options.random_seed;
-  MatchFeatures(match, progress);
+  RunFeatureMatcher(match, progress);
   lap(options.matcher + "_matcher");
 
   // Several starts when one cannot be trusted (a wrong basin, or a

@@ -54,8 +54,8 @@ struct AutoCalibratorOptions {
   void Check() const;  // throws OptionError naming the option
 };
 
-struct AutoCalibrationResult {
-  RefractiveBundleAdjusterResult refined;
+struct AutoCalibratorSummary {
+  RefractiveBundleAdjusterSummary refined;
   int num_images = 0;
   int num_registered = 0;
   std::vector<std::pair<std::string, double>> stage_seconds;
@@ -68,6 +68,6 @@ struct AutoCalibrationResult {
 // report for a poorly determined focal length.
 void JudgeAutoCalibration(const std::optional<double>& markers_focal, CalibrationReport* report);
 
-AutoCalibrationResult RunAutoCalibrator(const AutoCalibratorOptions& options, ProgressSink& progress);
+AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

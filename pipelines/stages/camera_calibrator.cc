@@ -18,7 +18,7 @@ void CameraCalibratorOptions::Check() const {
   calibration.Check();
 }
 
-CameraCalibrationResult CalibrateCameraStage(const CameraCalibratorOptions& options) {
+CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& options, ProgressSink& progress) {
   options.Check();
   Database database(options.database_path, Database::OpenMode::kReadOnly);
   const TargetViews target_views = ReadTargetViews(&database);

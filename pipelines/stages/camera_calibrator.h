@@ -5,6 +5,7 @@
 #include <string>
 
 #include "pipelines/calibration/camera_calibration.h"
+#include "colmap_ext/util/progress.h"
 
 namespace portcal {
 
@@ -19,6 +20,9 @@ struct CameraCalibratorOptions {
 
 // Throws InputError / NumericalError / DatabaseError. Reads the database
 // only.
-CameraCalibrationResult CalibrateCameraStage(const CameraCalibratorOptions& options);
+// The stage's summary is the calibration itself.
+using CameraCalibratorSummary = CameraCalibrationResult;
+
+CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

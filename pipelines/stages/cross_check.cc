@@ -75,7 +75,7 @@ bool WarpSignificant(const MrcalCalibrationResult& mrcal) {
 // differenced and set against the difference their covariances predict.
 CrossValidation CrossValidate(const std::vector<CalibrationView>& views, const Camera& initial,
                               const CameraCalibrationSettings& settings,
-                              const CrossCheckerOptions& options, const std::string& description,
+                              const CrossCheckOptions& options, const std::string& description,
                               const std::filesystem::path& heat_map) {
   const int k = options.folds;
   std::vector<std::vector<CalibrationView>> subsets(k);
@@ -132,7 +132,7 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views, const C
 
 }  // namespace
 
-void CrossCheckerOptions::Check() const {
+void CrossCheckOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (input_calibration.empty()) throw OptionError("--input_calibration", "''", "a calibration.yaml");
   if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
@@ -142,7 +142,7 @@ void CrossCheckerOptions::Check() const {
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
 }
 
-CrossCheckResult CrossCheck(const CrossCheckerOptions& options) {
+CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& progress) {
   options.Check();
   const CalibrationReport input = ReadCalibrationReport(options.input_calibration);
   // A model mrcal cannot express stops here, naming the nearest one.

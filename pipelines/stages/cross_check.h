@@ -9,10 +9,11 @@
 #include <string>
 
 #include "pipelines/crosscheck/cross_check_report.h"
+#include "colmap_ext/util/progress.h"
 
 namespace portcal {
 
-struct CrossCheckerOptions {
+struct CrossCheckOptions {
   std::string database_path;
   std::string input_calibration;  // portcal's calibration.yaml of the camera
   std::string output_path;        // directory (created)
@@ -29,6 +30,8 @@ struct CrossCheckerOptions {
 };
 
 // Throws InputError (files, model mrcal cannot express), NumericalError.
-CrossCheckResult CrossCheck(const CrossCheckerOptions& options);
+using CrossCheckSummary = CrossCheckResult;
+
+CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

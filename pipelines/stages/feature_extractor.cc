@@ -47,7 +47,7 @@ struct Extracted {
 
 }  // namespace
 
-FeatureExtractionSummary ExtractFeatures(const FeatureExtractorOptions& options,
+FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& options,
                                          ProgressSink& progress) {
   options.Check();
   StageRun run("feature_extractor", OptionsText(options));
@@ -57,7 +57,7 @@ FeatureExtractionSummary ExtractFeatures(const FeatureExtractorOptions& options,
 
   // Rerun: images that have features already are left alone.
   std::vector<std::string> todo;
-  FeatureExtractionSummary summary;
+  FeatureExtractorSummary summary;
   summary.num_images = static_cast<int>(names.size());
   for (const std::string& name : names) {
     const std::optional<DatabaseImage> image = database.ReadImageWithName(name);

@@ -24,7 +24,7 @@ struct FeatureExtractorOptions {
   void Check() const;  // throws OptionError naming the option
 };
 
-struct FeatureExtractionSummary {
+struct FeatureExtractorSummary {
   int num_images = 0;     // images found in image_path
   int num_extracted = 0;  // extracted in this run
   int num_skipped = 0;    // already had features
@@ -34,7 +34,7 @@ struct FeatureExtractionSummary {
 
 // Throws InputError, DatabaseError, Cancelled; the database is then left
 // as it was.
-FeatureExtractionSummary ExtractFeatures(const FeatureExtractorOptions& options,
+FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& options,
                                          ProgressSink& progress);
 
 }  // namespace portcal

@@ -69,7 +69,7 @@ bool InsideEnlargedQuad(const std::array<Eigen::Vector2d, 4>& quad, double facto
   return true;
 }
 
-FeatureMaskingSummary MaskFeatures(const FeatureMaskerOptions& options, ProgressSink& progress) {
+FeatureMaskerSummary RunFeatureMasker(const FeatureMaskerOptions& options, ProgressSink& progress) {
   options.Check();
   std::ostringstream options_text;
   options_text << "image_path=" << options.image_path << "\nMask.dictionary=" << options.dictionary
@@ -81,7 +81,7 @@ FeatureMaskingSummary MaskFeatures(const FeatureMaskerOptions& options, Progress
   if (images.empty()) throw InputError(options.database_path + ": no images; run feature_extractor first");
 
   std::vector<std::vector<MarkerDetection>> detections(images.size());
-  FeatureMaskingSummary summary;
+  FeatureMaskerSummary summary;
   summary.num_images = static_cast<int>(images.size());
   progress.Begin("feature_masker: images", images.size());
   OrderedParallelFor(

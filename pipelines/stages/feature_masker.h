@@ -29,7 +29,7 @@ struct FeatureMaskerOptions {
   void Check() const;  // throws OptionError naming --Mask.* or the option
 };
 
-struct FeatureMaskingSummary {
+struct FeatureMaskerSummary {
   int num_images = 0;
   int num_without_markers = 0;
   int64_t num_markers = 0;
@@ -45,6 +45,6 @@ std::vector<MarkerDetection> DetectArucoMarkers(const cv::Mat& gray, const std::
 bool InsideEnlargedQuad(const std::array<Eigen::Vector2d, 4>& quad, double factor,
                         const Eigen::Vector2d& xy);
 
-FeatureMaskingSummary MaskFeatures(const FeatureMaskerOptions& options, ProgressSink& progress);
+FeatureMaskerSummary RunFeatureMasker(const FeatureMaskerOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

@@ -164,7 +164,7 @@ std::vector<std::pair<image_t, image_t>> LoopPairs(Database* database,
 
 }  // namespace
 
-FeatureMatchingSummary MatchFeatures(const FeatureMatcherOptions& options, ProgressSink& progress) {
+FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, ProgressSink& progress) {
   options.Check();
   const std::string stage = options.mode + "_matcher";
   StageRun run(stage, OptionsText(options));
@@ -187,7 +187,7 @@ FeatureMatchingSummary MatchFeatures(const FeatureMatcherOptions& options, Progr
   std::map<camera_t, Camera> cameras;
   for (const Camera& camera : database.ReadAllCameras()) cameras[camera.camera_id] = camera;
 
-  FeatureMatchingSummary summary;
+  FeatureMatcherSummary summary;
   std::vector<std::pair<image_t, image_t>> candidates;
   if (options.mode == "exhaustive") {
     candidates = ExhaustivePairs(ids);

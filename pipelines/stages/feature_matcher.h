@@ -51,7 +51,7 @@ struct FeatureMatcherOptions {
   void Check() const;  // throws OptionError naming the option
 };
 
-struct FeatureMatchingSummary {
+struct FeatureMatcherSummary {
   int64_t num_pairs = 0;     // candidate pairs
   int64_t num_matched = 0;   // matched in this run
   int64_t num_skipped = 0;   // already had a geometry
@@ -68,6 +68,6 @@ std::vector<std::pair<image_t, image_t>> SequentialPairs(const std::vector<image
 std::vector<std::pair<image_t, image_t>> SpatialPairs(const std::vector<std::pair<image_t, Eigen::Vector3d>>& positions,
                                                       const SpatialPairingOptions& options);
 
-FeatureMatchingSummary MatchFeatures(const FeatureMatcherOptions& options, ProgressSink& progress);
+FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

@@ -22,7 +22,7 @@ void HousingCalibratorOptions::Check() const {
   calibration.Check();
 }
 
-HousingCalibrationResult CalibrateHousingStage(const HousingCalibratorOptions& options) {
+HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& options, ProgressSink& progress) {
   options.Check();
   const Housing housing = Housing::FromName(
       options.housing_model, ParseDoubleList(options.housing_params, "--Housing.params"),

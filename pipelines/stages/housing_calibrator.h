@@ -6,6 +6,7 @@
 #include <string>
 
 #include "pipelines/calibration/housing_calibration.h"
+#include "colmap_ext/util/progress.h"
 
 namespace portcal {
 
@@ -20,6 +21,9 @@ struct HousingCalibratorOptions {
   void Check() const;  // throws OptionError naming the option
 };
 
-HousingCalibrationResult CalibrateHousingStage(const HousingCalibratorOptions& options);
+// The stage's summary is the calibration itself.
+using HousingCalibratorSummary = HousingCalibrationResult;
+
+HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

@@ -67,7 +67,7 @@ void ModelConverterOptions::Check() const {
   }
 }
 
-std::string ConvertModel(const ModelConverterOptions& options) {
+ModelConverterSummary RunModelConverter(const ModelConverterOptions& options, ProgressSink& progress) {
   options.Check();
   const SparseModel model = ReadInput(options.input_path);
   std::string summary;
@@ -97,7 +97,7 @@ std::string ConvertModel(const ModelConverterOptions& options) {
               ") written as " + options.output_type + " to " + options.output_path;
   }
   LOG(INFO) << summary;
-  return summary;
+  return {summary};
 }
 
 }  // namespace portcal

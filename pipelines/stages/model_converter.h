@@ -6,6 +6,8 @@
 
 #include <string>
 
+#include "colmap_ext/util/progress.h"
+
 namespace portcal {
 
 struct ModelConverterOptions {
@@ -21,7 +23,10 @@ struct ModelConverterOptions {
   void Check() const;  // throws OptionError naming the option
 };
 
-// Returns a one-line summary of what was converted.
-std::string ConvertModel(const ModelConverterOptions& options);
+struct ModelConverterSummary {
+  std::string description;  // one line: what was converted into what
+};
+
+ModelConverterSummary RunModelConverter(const ModelConverterOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

@@ -49,7 +49,7 @@ std::map<std::string, Eigen::Vector3d> ReadPositions(const std::string& path) {
 
 }  // namespace
 
-PosePriorImporterSummary ImportPosePriors(const PosePriorImporterOptions& options) {
+PosePriorImporterSummary RunPosePriorImporter(const PosePriorImporterOptions& options, ProgressSink& progress) {
   options.Check();
   const std::map<std::string, Eigen::Vector3d> positions = ReadPositions(options.input_path);
   StageRun run("pose_prior_importer", "input_path=" + options.input_path + "\n");

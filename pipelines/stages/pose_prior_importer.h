@@ -12,6 +12,8 @@
 
 #include <string>
 
+#include "colmap_ext/util/progress.h"
+
 namespace portcal {
 
 struct PosePriorImporterOptions {
@@ -25,6 +27,6 @@ struct PosePriorImporterSummary {
   int num_images_without = 0;  // database images the file does not list
 };
 
-PosePriorImporterSummary ImportPosePriors(const PosePriorImporterOptions& options);
+PosePriorImporterSummary RunPosePriorImporter(const PosePriorImporterOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

@@ -3,8 +3,10 @@
 #include <fstream>
 #include <iomanip>
 #include <optional>
+#include <sstream>
 
 #include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/camera/housed_camera.h"
 #include "colmap_ext/housing/housing.h"
 #include "colmap_ext/housing/housing_models.h"
 #include "colmap_ext/io/sparse_model.h"
@@ -38,8 +40,9 @@ void ProjectPointsOptions::Check() const {
 
 namespace {
 
-void LoadCamera(const ProjectPointsOptions& options, Camera* camera,
-                std::optional<Housing>* housing) {
+HousedCamera LoadCamera(const ProjectPointsOptions& options) {
+  HousedCamera housed;
+  Camera& camera = housed.camera;
   if (!options.input_path.empty()) {
     const SparseModel model = ReadSparseModel(options.input_path);
     const auto it = model.cameras.find(static_cast<camera_t>(options.camera_id));
@@ -47,38 +50,53 @@ void LoadCamera(const ProjectPointsOptions& options, Camera* camera,
       throw InputError(options.input_path + ": no camera with id " +
                        std::to_string(options.camera_id));
     }
-    *camera = it->second;
-    const auto housing_it = model.housings.find(camera->camera_id);
-    if (housing_it != model.housings.end()) *housing = housing_it->second;
-    return;
+    camera = it->second;
+    const auto housing_it = model.housings.find(camera.camera_id);
+    if (housing_it != model.housings.end()) housed.housing = housing_it->second;
+    return housed;
   }
-  camera->model_id = CameraModelNameToId(options.camera_model);
-  camera->width = options.width;
-  camera->height = options.height;
-  camera->params = ParseDoubleList(options.camera_params, "--Camera.params");
-  camera->Validate("--Camera.params");
+  camera.model_id = CameraModelNameToId(options.camera_model);
+  camera.width = options.width;
+  camera.height = options.height;
+  camera.params = ParseDoubleList(options.camera_params, "--Camera.params");
+  camera.Validate("--Camera.params");
   if (!options.housing_model.empty() && options.housing_model != "NONE") {
-    *housing = Housing::FromName(
+    housed.housing = Housing::FromName(
         options.housing_model,
         ParseDoubleList(options.housing_params, "--Housing.params"),
         "--Housing.params");
   }
+  return housed;
+}
+
+// One output line for one input line's values, or nullopt without an answer.
+std::optional<std::string> Answer(const HousedCamera& camera, const std::vector<double>& values,
+                                  bool unproject) {
+  std::ostringstream out;
+  out << std::setprecision(17);
+  if (unproject) {
+    const std::optional<Ray3d> ray = camera.Unproject(Eigen::Vector2d(values[0], values[1]));
+    if (!ray) return std::nullopt;
+    out << ray->origin.x() << " " << ray->origin.y() << " " << ray->origin.z() << " "
+        << ray->direction.x() << " " << ray->direction.y() << " " << ray->direction.z();
+  } else {
+    const std::optional<Eigen::Vector2d> pixel =
+        camera.Project(Eigen::Vector3d(values[0], values[1], values[2]));
+    if (!pixel) return std::nullopt;
+    out << pixel->x() << " " << pixel->y();
+  }
+  return out.str();
 }
 
 }  // namespace
 
-int ProjectPoints(const ProjectPointsOptions& options, std::ostream& out) {
+ProjectPointsSummary RunProjectPoints(const ProjectPointsOptions& options, ProgressSink& progress) {
   options.Check();
-  Camera camera;
-  std::optional<Housing> housing;
-  LoadCamera(options, &camera, &housing);
-  const Housing* housing_ptr = housing ? &*housing : nullptr;
-
+  const HousedCamera camera = LoadCamera(options);
   std::ifstream in(options.points_path);
   if (!in) throw InputError(options.points_path + ": cannot open");
   const size_t expected = options.unproject ? 2 : 3;
-  out << std::setprecision(17);
-  int num_invalid = 0;
+  ProjectPointsSummary summary;
   std::string line;
   for (int line_number = 1; std::getline(in, line); ++line_number) {
     const std::string trimmed = Trim(line);
@@ -90,31 +108,16 @@ int ProjectPoints(const ProjectPointsOptions& options, std::ostream& out) {
                        (options.unproject ? std::string("x y (pixels)")
                                           : std::string("X Y Z (metres, camera frame)")));
     }
-    if (options.unproject) {
-      const std::optional<Ray3d> ray =
-          UnprojectPixel(camera, housing_ptr, Eigen::Vector2d(values[0], values[1]));
-      if (!ray) {
-        out << "invalid no ray (distortion not invertible or total internal "
-               "reflection)\n";
-        ++num_invalid;
-        continue;
-      }
-      out << ray->origin.x() << " " << ray->origin.y() << " " << ray->origin.z() << " "
-          << ray->direction.x() << " " << ray->direction.y() << " "
-          << ray->direction.z() << "\n";
-    } else {
-      const std::optional<Eigen::Vector2d> pixel = ProjectPoint(
-          camera, housing_ptr, Eigen::Vector3d(values[0], values[1], values[2]));
-      if (!pixel) {
-        out << "invalid not visible (behind the camera, inside the housing or "
-               "totally reflected)\n";
-        ++num_invalid;
-        continue;
-      }
-      out << pixel->x() << " " << pixel->y() << "\n";
+    std::optional<std::string> answer = Answer(camera, values, options.unproject);
+    if (!answer) {
+      ++summary.num_invalid;
+      answer = options.unproject
+                   ? "invalid no ray (distortion not invertible or total internal reflection)"
+                   : "invalid not visible (behind the camera, inside the housing or totally reflected)";
     }
+    summary.lines.push_back(std::move(*answer));
   }
-  return num_invalid;
+  return summary;
 }
 
 }  // namespace portcal

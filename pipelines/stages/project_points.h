@@ -3,8 +3,10 @@
 // `unproject`.
 #pragma once
 
-#include <iosfwd>
 #include <string>
+#include <vector>
+
+#include "colmap_ext/util/progress.h"
 
 namespace portcal {
 
@@ -26,11 +28,16 @@ struct ProjectPointsOptions {
   void Check() const;  // throws OptionError naming the option
 };
 
-// Writes one line per input line to `out`: "x y" for a projected point,
-// "ox oy oz dx dy dz" for an unprojected pixel (origin on the port's outer
-// surface, unit direction), or "invalid <reason>" where there is no answer.
-// Returns the number of invalid lines. Throws InputError naming the file and
-// line for malformed input.
-int ProjectPoints(const ProjectPointsOptions& options, std::ostream& out);
+struct ProjectPointsSummary {
+  // One per input line (comments and blank lines skipped): "x y" for a
+  // projected point, "ox oy oz dx dy dz" for an unprojected pixel (origin on
+  // the port's outer surface, unit direction), or "invalid <reason>" where
+  // there is no answer.
+  std::vector<std::string> lines;
+  int num_invalid = 0;
+};
+
+// Throws InputError naming the file and line for malformed input.
+ProjectPointsSummary RunProjectPoints(const ProjectPointsOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

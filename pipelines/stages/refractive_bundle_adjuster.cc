@@ -262,7 +262,7 @@ SfmInputs ReadAdjusterInputs(const RefractiveBundleAdjusterOptions& options, con
 // The metric scale: the model aligned to the images' position priors, or
 // the markers' corners triangulated, as the options ask.
 void PrepareScale(const RefractiveBundleAdjusterOptions& options, bool use_priors, Reconstruction* r,
-                  std::vector<MarkerCorner>* markers, RefractiveBundleAdjusterResult* result) {
+                  std::vector<MarkerCorner>* markers, RefractiveBundleAdjusterSummary* result) {
   if (use_priors) {
     const auto alignment = AlignToPositionPriors(r, 5 * options.ba.position_prior_sigma_m);
     if (!alignment) {
@@ -355,7 +355,8 @@ void FillReport(const RefractiveBundleAdjusterOptions& options, const Reconstruc
 
 }  // namespace
 
-RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options) {
+RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options,
+                                                            ProgressSink& progress) {
   options.Check();
   const SparseModel model = ReadSparseModel(options.input_path);
   model.Validate(options.input_path);
@@ -365,7 +366,7 @@ RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundl
   }
   SfmInputs inputs = ReadAdjusterInputs(options, model);
   Reconstruction r = Reconstruction::FromSparseModel(&inputs, model);
-  RefractiveBundleAdjusterResult result;
+  RefractiveBundleAdjusterSummary result;
   const bool use_priors = options.ba.position_prior_sigma_m > 0;
   std::vector<MarkerCorner> markers;
   PrepareScale(options, use_priors, &r, &markers, &result);

@@ -17,6 +17,7 @@
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/stages/refractive_mapper.h"
 #include "pipelines/bundle_adjustment/bundle_adjustment.h"
+#include "colmap_ext/util/progress.h"
 
 namespace portcal {
 
@@ -55,7 +56,7 @@ struct RefractiveBundleAdjusterOptions {
   void Check() const;  // throws OptionError naming the option
 };
 
-struct RefractiveBundleAdjusterResult {
+struct RefractiveBundleAdjusterSummary {
   CalibrationReport report;  // of the first camera
   int num_marker_corners = 0;
   int num_position_priors = 0;  // images whose priors fixed the frame
@@ -67,6 +68,7 @@ struct RefractiveBundleAdjusterResult {
   int num_geometry_warnings = 0;
 };
 
-RefractiveBundleAdjusterResult RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options);
+RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options,
+                                                            ProgressSink& progress);
 
 }  // namespace portcal

@@ -42,7 +42,7 @@ HousedCamera CameraFor(const std::string& input_calibration, const Camera& datab
 
 }  // namespace
 
-StereoCalibrationResult CalibrateStereoStage(const StereoCalibratorOptions& options) {
+StereoCalibratorSummary RunStereoCalibrator(const StereoCalibratorOptions& options, ProgressSink& progress) {
   options.Check();
   Database database(options.database_path, Database::OpenMode::kReadOnly);
   TargetViews target_views = ReadTargetViews(&database);

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "pipelines/calibration/stereo_calibration.h"
+#include "colmap_ext/util/progress.h"
 
 namespace portcal {
 
@@ -23,6 +24,9 @@ struct StereoCalibratorOptions {
   void Check() const;  // throws OptionError naming the option
 };
 
-StereoCalibrationResult CalibrateStereoStage(const StereoCalibratorOptions& options);
+// The stage's summary is the calibration itself.
+using StereoCalibratorSummary = StereoCalibrationResult;
+
+StereoCalibratorSummary RunStereoCalibrator(const StereoCalibratorOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

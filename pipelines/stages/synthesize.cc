@@ -233,7 +233,7 @@ void WriteImage(const fs::path& path, const cv::Mat& image) {
 
 }  // namespace
 
-SynthesizeSummary Synthesize(const SynthesizeOptions& options, ProgressSink& progress) {
+SynthesizeSummary RunSynthesize(const SynthesizeOptions& options, ProgressSink& progress) {
   options.Check();
   const auto start = Clock::now();
   DatasetConfig config = ReadDatasetConfig(options.config_path);

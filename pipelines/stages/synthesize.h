@@ -27,6 +27,6 @@ struct SynthesizeSummary {
 // end: an interrupted run leaves no partial set behind. Throws InputError for
 // bad configs (naming the file and key), NumericalError when poses cannot be
 // placed, Cancelled when asked to stop.
-SynthesizeSummary Synthesize(const SynthesizeOptions& options, ProgressSink& progress);
+SynthesizeSummary RunSynthesize(const SynthesizeOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

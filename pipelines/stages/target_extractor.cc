@@ -90,7 +90,7 @@ std::string OptionsText(const TargetExtractorOptions& o) {
 
 }  // namespace
 
-TargetExtractionSummary ExtractTargets(const TargetExtractorOptions& options,
+TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
                                        ProgressSink& progress) {
   options.Check();
   StageRun run("target_extractor", OptionsText(options));
@@ -135,7 +135,7 @@ TargetExtractionSummary ExtractTargets(const TargetExtractorOptions& options,
   // One transaction: images, cameras, observations, status, log.
   Database database(options.database_path, Database::OpenMode::kCreate);
   Transaction transaction = database.BeginTransaction();
-  TargetExtractionSummary summary;
+  TargetExtractorSummary summary;
   SharedCameras shared_cameras;
   const auto metres = [](double value) {
     std::ostringstream out;

@@ -24,7 +24,7 @@ struct TargetExtractorOptions {
   void Check() const;           // throws OptionError naming the option
 };
 
-struct TargetExtractionSummary {
+struct TargetExtractorSummary {
   int num_images = 0;
   int num_found = 0;
   int64_t num_points = 0;
@@ -32,7 +32,7 @@ struct TargetExtractionSummary {
 
 // Throws InputError (bad options, no images), DatabaseError, Cancelled; the
 // database is then left as it was.
-TargetExtractionSummary ExtractTargets(const TargetExtractorOptions& options,
+TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
                                        ProgressSink& progress);
 
 }  // namespace portcal

@@ -34,7 +34,7 @@ render: {spp: 4, noise_sigma: 1.0, white: 220, black: 30, background: 110}
   options.config_path = (dir / "set.yaml").string();
   options.output_path = (dir / "set").string();
   NullProgress progress;
-  Synthesize(options, progress);
+  RunSynthesize(options, progress);
 }
 
 std::string Portcal() { return testing::PortcalBinary(); }

@@ -58,7 +58,7 @@ struct FamilyMember {
 
 struct MemberRun {
   GroundTruth truth;
-  AutoCalibrationResult result;
+  AutoCalibratorSummary result;
 };
 
 fs::path Render(const fs::path& dir, const FamilyMember& m) {
@@ -69,11 +69,11 @@ fs::path Render(const fs::path& dir, const FamilyMember& m) {
   synthesize.output_path = (dir / "set").string();
   synthesize.seed = m.seed;
   NullProgress progress;
-  Synthesize(synthesize, progress);
+  RunSynthesize(synthesize, progress);
   return dir / "set";
 }
 
-AutoCalibrationResult Calibrate(const FamilyMember& m, const fs::path& images, const fs::path& out,
+AutoCalibratorSummary Calibrate(const FamilyMember& m, const fs::path& images, const fs::path& out,
                                 int num_threads) {
   AutoCalibratorOptions options;
   options.image_path = images.string();
@@ -161,7 +161,7 @@ TEST(AutoCalibrationRealCameras, WideOffCentreLensBehindATiltedFlatPortAndTheSam
   // they finish, which moves the 9th digit; under CI's load that once
   // flipped which observations passed a threshold, and two runs differed
   // by 0.04 sigma in the port distance (docs/auto_calibration.md).
-  const AutoCalibrationResult again = Calibrate(wide, dir.path() / "set" / "images", dir.path() / "again", 1);
+  const AutoCalibratorSummary again = Calibrate(wide, dir.path() / "set" / "images", dir.path() / "again", 1);
   for (size_t i = 0; i < r.camera.params.size(); ++i) {
     EXPECT_EQ(again.refined.report.camera.params[i], r.camera.params[i]) << "parameter " << i;
   }

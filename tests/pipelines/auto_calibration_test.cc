@@ -34,11 +34,11 @@ GroundTruth Render(const fs::path& dir, const std::string& camera_and_housing) {
   synthesize.config_path = (dir / "set.yaml").string();
   synthesize.output_path = (dir / "set").string();
   NullProgress progress;
-  Synthesize(synthesize, progress);
+  RunSynthesize(synthesize, progress);
   return ReadGroundTruth(dir / "set" / "ground_truth.yaml");
 }
 
-AutoCalibrationResult Calibrate(const fs::path& images, const fs::path& out, const std::string& housing_model,
+AutoCalibratorSummary Calibrate(const fs::path& images, const fs::path& out, const std::string& housing_model,
                                 const std::string& housing_guess, const std::string& camera_params = "") {
   AutoCalibratorOptions options;
   options.camera_params = camera_params;
@@ -54,7 +54,7 @@ AutoCalibrationResult Calibrate(const fs::path& images, const fs::path& out, con
 // An own render of 15 views in `dir`, auto-calibrated; all views register.
 struct OwnRun {
   GroundTruth truth;
-  AutoCalibrationResult result;
+  AutoCalibratorSummary result;
 };
 
 OwnRun RenderAndCalibrate(const fs::path& dir, const std::string& camera_and_housing,
@@ -146,9 +146,9 @@ housing: {model: FLATPORT, params: [0.0697565, 0.0, 0.9975641, 0.015, 0.010, 1.0
   synthesize.output_path = (dir.path() / "set").string();
   synthesize.seed = 11;
   NullProgress progress;
-  Synthesize(synthesize, progress);
+  RunSynthesize(synthesize, progress);
   const GroundTruth truth = ReadGroundTruth(dir.path() / "set" / "ground_truth.yaml");
-  const AutoCalibrationResult result =
+  const AutoCalibratorSummary result =
       Calibrate(dir.path() / "set" / "images", dir.path() / "out", "FLATPORT", "0,0,1,0.015,0.010,1,1.473,1.334");
   EXPECT_EQ(result.num_registered, 12);
   const CalibrationReport& r = result.refined.report;
@@ -217,7 +217,7 @@ housing: {model: DOMEPORT, params: [0.001, -0.001, 0.010, 0.06, 0.008, 1.0, 1.52
 
   std::ostringstream intrinsics;
   for (size_t i = 0; i < truth.camera.params.size(); ++i) intrinsics << (i ? "," : "") << truth.camera.params[i];
-  const AutoCalibrationResult given = Calibrate(dir.path() / "set" / "images", dir.path() / "given", "DOMEPORT",
+  const AutoCalibratorSummary given = Calibrate(dir.path() / "set" / "images", dir.path() / "given", "DOMEPORT",
                                                 "0,0,0,0.06,0.008,1,1.52,1.334", intrinsics.str());
   const CalibrationReport& g = given.refined.report;
   ASSERT_TRUE(g.housing);
@@ -269,7 +269,7 @@ struct SharedCase {
   const char* guess;
 };
 
-AutoCalibrationResult CalibrateShared(const fs::path& shared, const SharedCase& c, const fs::path& out,
+AutoCalibratorSummary CalibrateShared(const fs::path& shared, const SharedCase& c, const fs::path& out,
                                       GroundTruth* truth) {
   const fs::path set = shared / "datasets" / "rendered" / c.set;
   *truth = ReadGroundTruth(set / "ground_truth.yaml");
@@ -280,7 +280,7 @@ TEST(AutoCalibrationShared, DomePortDecenteringAndFocalLength) {
   PORTCAL_REQUIRE_SHARED(shared);
   testing::TempDir dir;
   GroundTruth truth;
-  const AutoCalibrationResult result = CalibrateShared(
+  const AutoCalibratorSummary result = CalibrateShared(
       *shared_opt, {"target3d_domeport", "DOMEPORT", "0,0,0,0.05,0.006,1,1.473,1.334"}, dir / "out", &truth);
   const CalibrationReport& r = result.refined.report;
   ASSERT_TRUE(r.housing);
@@ -298,7 +298,7 @@ TEST(AutoCalibrationShared, FlatPortNormalDistanceAndFocalLength) {
   PORTCAL_REQUIRE_SHARED(shared);
   testing::TempDir dir;
   GroundTruth truth;
-  const AutoCalibrationResult result = CalibrateShared(
+  const AutoCalibratorSummary result = CalibrateShared(
       *shared_opt, {"target3d_flatport", "FLATPORT", "0,0,1,0.02,0.014,1,1.473,1.334"}, dir / "out", &truth);
   const CalibrationReport& r = result.refined.report;
   ASSERT_TRUE(r.housing);

@@ -37,7 +37,7 @@ Rendered RenderAndExtract(const fs::path& config, const fs::path& set, int64_t s
   synthesize.output_path = set.string();
   synthesize.seed = seed;
   NullProgress progress;
-  Synthesize(synthesize, progress);
+  RunSynthesize(synthesize, progress);
   TargetExtractorOptions extract;
   extract.database_path = (set / "db.db").string();
   extract.image_path = (set / "images").string();
@@ -47,7 +47,7 @@ Rendered RenderAndExtract(const fs::path& config, const fs::path& set, int64_t s
   extract.chessboard.cols = cols;
   extract.chessboard.rows = rows;
   extract.square_size_m = square;
-  ExtractTargets(extract, progress);
+  RunTargetExtractor(extract, progress);
   Rendered rendered;
   rendered.truth = ReadGroundTruth(set / "ground_truth.yaml");
   Database db(set / "db.db", Database::OpenMode::kReadOnly);

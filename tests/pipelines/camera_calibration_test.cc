@@ -35,7 +35,7 @@ void Extract(const fs::path& images, const fs::path& database, const std::string
   options.chessboard.rows = rows;
   options.square_size_m = square;
   NullProgress progress;
-  ExtractTargets(options, progress);
+  RunTargetExtractor(options, progress);
 }
 
 // The published tool reaches |df| 0.02 px and |dc| 0.13 px on this set;
@@ -143,7 +143,7 @@ TEST(CameraCalibration, StageWritesBothReports) {
   CameraCalibratorOptions options;
   options.database_path = (dir / "db.db").string();
   options.output_path = (dir / "out").string();
-  CalibrateCameraStage(options);
+  RunCameraCalibrator(options, NoProgress());
   const CalibrationReport report = ReadCalibrationReport(dir / "out/calibration.yaml");
   EXPECT_EQ(report.camera.ModelName(), "RADIAL");
   EXPECT_FALSE(report.housing.has_value());

@@ -97,15 +97,15 @@ void WriteDatabase(const fs::path& path, const Camera& camera, const std::vector
 
 // Stores the views, calibrates them with portcal's camera_calibrator (flat
 // board) and returns cross_check options on the result.
-CrossCheckerOptions CalibratedForCheck(const fs::path& dir, const std::vector<CalibrationView>& views,
+CrossCheckOptions CalibratedForCheck(const fs::path& dir, const std::vector<CalibrationView>& views,
                                        bool drop_outlier_views = false) {
   WriteDatabase(dir / "db.db", TruthCamera(), views);
   CameraCalibratorOptions calibrate;
   calibrate.database_path = (dir / "db.db").string();
   calibrate.output_path = (dir / "cal").string();
   calibrate.calibration.drop_outlier_views = drop_outlier_views;
-  CalibrateCameraStage(calibrate);
-  CrossCheckerOptions options;
+  RunCameraCalibrator(calibrate, NoProgress());
+  CrossCheckOptions options;
   options.database_path = calibrate.database_path;
   options.input_calibration = (dir / "cal/calibration.yaml").string();
   options.output_path = (dir / "check").string();
@@ -224,9 +224,9 @@ TEST(CrossCheck, WarpedBoardIsCaughtAndExplained) {
   testing::TempDir dir;
   const Camera truth = TruthCamera();
   const Eigen::Vector2d warp(0.0, 0.5e-3);
-  CrossCheckerOptions options = CalibratedForCheck(dir.path(), SyntheticViews(truth, warp, 0.1, 18, 4));
+  CrossCheckOptions options = CalibratedForCheck(dir.path(), SyntheticViews(truth, warp, 0.1, 18, 4));
   options.folds = 2;
-  const CrossCheckResult result = CrossCheck(options);
+  const CrossCheckResult result = RunCrossCheck(options, NoProgress());
   EXPECT_FALSE(result.pass) << result.Verdict();
   ASSERT_FALSE(result.causes.empty());
   EXPECT_EQ(result.causes.front().rfind("board warp", 0), 0u) << result.causes.front();
@@ -260,7 +260,7 @@ TEST(CrossCheck, ViewsDroppedByTheInputStayOut) {
   std::mt19937 rng(8);
   std::normal_distribution<double> blur(0, 3.0);
   for (Eigen::Vector2d& pixel : views[4].pixels) pixel += Eigen::Vector2d(blur(rng), blur(rng));
-  const CrossCheckResult result = CrossCheck(CalibratedForCheck(dir.path(), views, true));
+  const CrossCheckResult result = RunCrossCheck(CalibratedForCheck(dir.path(), views, true), NoProgress());
   EXPECT_EQ(result.num_views, 11);
   EXPECT_TRUE(result.pass) << result.Verdict();
   EXPECT_TRUE(result.causes.empty()) << result.causes.front();
@@ -269,13 +269,13 @@ TEST(CrossCheck, ViewsDroppedByTheInputStayOut) {
 TEST(CrossCheck, BadOptionsAndModelsAreNamed) {
   testing::TempDir dir;
   const Camera truth = TruthCamera();
-  CrossCheckerOptions options =
+  CrossCheckOptions options =
       CalibratedForCheck(dir.path(), SyntheticViews(truth, Eigen::Vector2d::Zero(), 0.1, 5, 5));
   options.folds = 1;
-  EXPECT_THROW(CrossCheck(options), OptionError);
+  EXPECT_THROW(RunCrossCheck(options, NoProgress()), OptionError);
   options.folds = 3;  // 5 views: folds of 2
   try {
-    CrossCheck(options);
+    RunCrossCheck(options, NoProgress());
     FAIL() << "3 folds of 5 views must be refused";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("--CrossCheck.folds"), std::string::npos) << e.what();
@@ -286,7 +286,7 @@ TEST(CrossCheck, BadOptionsAndModelsAreNamed) {
   options.folds = 0;
   options.input_calibration = (dir / "fisheye/calibration.yaml").string();
   try {
-    CrossCheck(options);
+    RunCrossCheck(options, NoProgress());
     FAIL() << "OPENCV_FISHEYE must be refused";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("nearest"), std::string::npos) << e.what();
@@ -304,17 +304,17 @@ CrossCheckResult CheckSharedSet(const fs::path& images, const std::string& model
   extract.chessboard.rows = rows;
   extract.square_size_m = square;
   NullProgress progress;
-  ExtractTargets(extract, progress);
+  RunTargetExtractor(extract, progress);
   CameraCalibratorOptions calibrate;
   calibrate.database_path = extract.database_path;
   calibrate.output_path = (dir / "cal").string();
-  CalibrateCameraStage(calibrate);
-  CrossCheckerOptions options;
+  RunCameraCalibrator(calibrate, NoProgress());
+  CrossCheckOptions options;
   options.database_path = extract.database_path;
   options.input_calibration = (dir / "cal/calibration.yaml").string();
   options.output_path = (dir / "check").string();
   options.folds = folds;
-  const CrossCheckResult result = CrossCheck(options);
+  const CrossCheckResult result = RunCrossCheck(options, NoProgress());
   std::cout << CrossCheckText(result);
   return result;
 }

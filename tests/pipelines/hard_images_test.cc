@@ -44,7 +44,7 @@ poses: {distance: [0.4, 0.8], tilt_max_deg: 30}
     SynthesizeOptions options;
     options.config_path = (dir / (std::string(name) + ".yaml")).string();
     options.output_path = (dir / name).string();
-    Synthesize(options, progress);
+    RunSynthesize(options, progress);
   }
   const GroundTruth truth = ReadGroundTruth(dir / "hard/ground_truth.yaml");
   fs::create_directories(dir / "images");
@@ -65,7 +65,7 @@ poses: {distance: [0.4, 0.8], tilt_max_deg: 30}
   extract.chessboard.cols = 9;
   extract.chessboard.rows = 6;
   extract.square_size_m = 0.025;
-  const TargetExtractionSummary summary = ExtractTargets(extract, progress);
+  const TargetExtractorSummary summary = RunTargetExtractor(extract, progress);
   EXPECT_EQ(summary.num_images, 17);
   Database db(dir / "db.db", Database::OpenMode::kReadOnly);
   for (const char* name : {"zz_other_target_1.png", "zz_other_target_2.png", "zz_nothing.png"}) {

@@ -31,7 +31,7 @@ std::vector<CalibrationView> Extract(const fs::path& images, const fs::path& dat
   options.chessboard.rows = rows;
   options.square_size_m = square;
   NullProgress progress;
-  ExtractTargets(options, progress);
+  RunTargetExtractor(options, progress);
   Database db(database, Database::OpenMode::kReadOnly);
   return ReadTargetViews(&db).by_camera.begin()->second;
 }
@@ -90,7 +90,7 @@ render: {spp: 4, noise_sigma: 1.0}
     SynthesizeOptions options;
     options.config_path = (dir / (std::string(name) + ".yaml")).string();
     options.output_path = (dir / name).string();
-    Synthesize(options, progress);
+    RunSynthesize(options, progress);
   }
   const GroundTruth truth = ReadGroundTruth(dir / "near/ground_truth.yaml");
   const auto near = Extract(dir / "near/images", dir / "near.db", 10, 7, 0.03);

@@ -24,7 +24,7 @@ std::vector<CalibrationView> ExtractViews(const fs::path& images, const fs::path
   options.reader.camera_model = "RADIAL";
   options.reader.single_camera = true;
   NullProgress progress;
-  ExtractTargets(options, progress);
+  RunTargetExtractor(options, progress);
   Database db(database, Database::OpenMode::kReadOnly);
   return ReadTargetViews(&db).by_camera.begin()->second;
 }
@@ -89,13 +89,13 @@ TEST(HousingCalibration, StageReadsTheInAirReportAndWritesTheHousing) {
   options.output_path = (dir / "water").string();
   options.housing_model = "DOMEPORT";
   options.housing_params = "0 0 0 0.05 0.006 1.0 1.473 1.334";
-  CalibrateHousingStage(options);
+  RunHousingCalibrator(options, NoProgress());
   const CalibrationReport report = ReadCalibrationReport(dir / "water/calibration.yaml");
   ASSERT_TRUE(report.housing.has_value());
   EXPECT_EQ(report.housing->ModelName(), "DOMEPORT");
   EXPECT_NEAR(report.housing->params[0], 0.01, 1e-4);
   options.housing_params = "0 0 0 0.05";
-  EXPECT_THROW(CalibrateHousingStage(options), InputError);
+  EXPECT_THROW(RunHousingCalibrator(options, NoProgress()), InputError);
 }
 
 }  // namespace

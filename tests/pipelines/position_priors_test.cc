@@ -95,7 +95,7 @@ TEST(PosePriorImporter, ImportsAllOrNothingAndNamesTheFault) {
   };
   const auto message = [](const PosePriorImporterOptions& options) {
     try {
-      ImportPosePriors(options);
+      RunPosePriorImporter(options, NoProgress());
     } catch (const std::exception& e) {
       return std::string(e.what());
     }
@@ -112,12 +112,12 @@ TEST(PosePriorImporter, ImportsAllOrNothingAndNamesTheFault) {
   EXPECT_NE(message(write("nan.txt", "a.png 1 nan 2\n")).find("nan.txt:1"), std::string::npos);
   EXPECT_NE(message(write("twice.txt", "a.png 1 2 3\na.png 1 2 3\n")).find("twice"), std::string::npos);
 
-  const PosePriorImporterSummary summary = ImportPosePriors(write("nav.txt", "# NAME X Y Z\na.png 1 2 3\nc.png -1 0.5 2\n"));
+  const PosePriorImporterSummary summary = RunPosePriorImporter(write("nav.txt", "# NAME X Y Z\na.png 1 2 3\nc.png -1 0.5 2\n"), NoProgress());
   EXPECT_EQ(summary.num_imported, 2);
   EXPECT_EQ(summary.num_images_without, 1);
   EXPECT_EQ(RawPriorColumns(path, "c.png"), "NULL NULL NULL NULL -1.000000 0.500000 2.000000");
   // Rerunning is safe.
-  EXPECT_EQ(ImportPosePriors(write("nav.txt", "a.png 1 2 3\nc.png -1 0.5 2\n")).num_imported, 2);
+  EXPECT_EQ(RunPosePriorImporter(write("nav.txt", "a.png 1 2 3\nc.png -1 0.5 2\n"), NoProgress()).num_imported, 2);
 }
 
 TEST(SpatialMatching, PairsTheNearestImagesWithinTheDistance) {

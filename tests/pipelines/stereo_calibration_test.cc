@@ -30,7 +30,7 @@ void Extract(const fs::path& images, const fs::path& database, const std::string
   options.chessboard.rows = rows;
   options.square_size_m = square;
   NullProgress progress;
-  ExtractTargets(options, progress);
+  RunTargetExtractor(options, progress);
 }
 
 double AngleDeg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
@@ -47,7 +47,7 @@ TEST(StereoCalibration, SharedInAirRigWithinItsStandardDeviations) {
   options.database_path = (dir / "db.db").string();
   options.output_path = (dir / "out").string();
   options.stereo.refine_intrinsics = true;
-  const StereoCalibrationResult result = CalibrateStereoStage(options);
+  const StereoCalibrationResult result = RunStereoCalibrator(options, NoProgress());
   const Rigid3d& t = truth.stereo->cam2_from_cam1;
   const Eigen::Vector3d dt = result.cam2_from_cam1.translation - t.translation;
   for (int i = 0; i < 3; ++i) {
@@ -78,7 +78,7 @@ TEST(StereoCalibration, OpenCVStereoSampleAgreesWithStereoCalibrate) {
   options.database_path = (dir / "db.db").string();
   options.output_path = (dir / "out").string();
   options.stereo.refine_intrinsics = true;
-  const StereoCalibrationResult ours = CalibrateStereoStage(options);
+  const StereoCalibrationResult ours = RunStereoCalibrator(options, NoProgress());
 
   // OpenCV on exactly the same corners and frames.
   Database db(dir / "db.db", Database::OpenMode::kReadOnly);
@@ -156,7 +156,7 @@ poses: {distance: [0.5, 1.0], tilt_max_deg: 35, roll_max_deg: 20}
   synthesize.config_path = (dir / "rig.yaml").string();
   synthesize.output_path = (dir / "set").string();
   NullProgress progress;
-  Synthesize(synthesize, progress);
+  RunSynthesize(synthesize, progress);
   const GroundTruth truth = ReadGroundTruth(dir / "set/ground_truth.yaml");
   Extract(dir / "set/images", dir / "db.db", "SIMPLE_RADIAL", 8, 6, 0.025);
   for (int k = 0; k < 2; ++k) {  // each camera's housing calibration, known here
@@ -170,7 +170,7 @@ poses: {distance: [0.5, 1.0], tilt_max_deg: 35, roll_max_deg: 20}
   options.output_path = (dir / "out").string();
   options.input_calibration1 = (dir / "cam1/calibration.yaml").string();
   options.input_calibration2 = (dir / "cam2/calibration.yaml").string();
-  const StereoCalibrationResult result = CalibrateStereoStage(options);
+  const StereoCalibrationResult result = RunStereoCalibrator(options, NoProgress());
   const Rigid3d& t = truth.stereo->cam2_from_cam1;
   EXPECT_LT((result.cam2_from_cam1.translation - t.translation).norm(), 1e-4);
   EXPECT_LT(AngleDeg(result.cam2_from_cam1.rotation, t.rotation), 0.005);

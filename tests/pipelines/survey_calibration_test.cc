@@ -43,7 +43,7 @@ render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
   SynthesizeOptions synthesize;
   synthesize.config_path = (dir / "survey.yaml").string();
   synthesize.output_path = (dir / "set").string();
-  Synthesize(synthesize, progress);
+  RunSynthesize(synthesize, progress);
   const GroundTruth truth = ReadGroundTruth(dir / "set" / "ground_truth.yaml");
   const std::string database = (dir / "db.db").string();
 
@@ -54,16 +54,16 @@ render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
   extract.reader.camera_model = "RADIAL";
   extract.reader.camera_params = "466.7,320,180,0,0";
   extract.sift.max_num_features = 1500;  // the strongest: a CI-sized survey
-  ExtractFeatures(extract, progress);
+  RunFeatureExtractor(extract, progress);
   PosePriorImporterOptions priors;
   priors.database_path = database;
   priors.input_path = (dir / "set" / "navigation.txt").string();
-  ASSERT_EQ(ImportPosePriors(priors).num_imported, 48);
+  ASSERT_EQ(RunPosePriorImporter(priors, NoProgress()).num_imported, 48);
   FeatureMatcherOptions match;
   match.database_path = database;
   match.mode = "spatial";
   match.spatial.max_num_neighbors = 10;
-  MatchFeatures(match, progress);
+  RunFeatureMatcher(match, progress);
 
   RefractiveMapperOptions map;
   map.database_path = database;
@@ -105,7 +105,7 @@ render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
   refine.output_path = (dir / "refined").string();
   refine.database_path = database;
   refine.ba.position_prior_sigma_m = 0.02;
-  const CalibrationReport report = RunRefractiveBundleAdjuster(refine).report;
+  const CalibrationReport report = RunRefractiveBundleAdjuster(refine, NoProgress()).report;
 
   // One model with (nearly) every image.
   EXPECT_GE(report.views.size(), 44u);

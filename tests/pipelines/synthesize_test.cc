@@ -56,7 +56,7 @@ GroundTruth Synthesize(const fs::path& config, const fs::path& output, int64_t s
   options.output_path = output.string();
   options.seed = seed;
   NullProgress progress;
-  portcal::Synthesize(options, progress);
+  portcal::RunSynthesize(options, progress);
   return ReadGroundTruth(output / "ground_truth.yaml");
 }
 

@@ -59,7 +59,7 @@ TEST_P(SharedSets, CornersWithinHundredthsOfAPixel) {
   const GroundTruth truth = ReadGroundTruth(set / "ground_truth.yaml");
   testing::TempDir dir;
   NullProgress progress;
-  const TargetExtractionSummary summary = ExtractTargets(Options(dir / "db.db", set / "images"), progress);
+  const TargetExtractorSummary summary = RunTargetExtractor(Options(dir / "db.db", set / "images"), progress);
   EXPECT_EQ(summary.num_found, 25);
   const std::vector<double> errors = ObservationErrors(dir / "db.db", truth);
   ASSERT_EQ(errors.size(), 25u * 70u);
@@ -84,17 +84,17 @@ poses: {distance: [0.4, 0.8], tilt_max_deg: 35}
   synthesize.config_path = (dir / "set.yaml").string();
   synthesize.output_path = (dir / "set").string();
   NullProgress progress;
-  Synthesize(synthesize, progress);
+  RunSynthesize(synthesize, progress);
   cv::imwrite((dir / "set/images/zz_empty.png").string(), cv::Mat(600, 800, CV_8UC1, cv::Scalar(120)));
 
   TargetExtractorOptions options = Options(dir / "db.db", dir / "set/images");
   options.chessboard.cols = 8;
   options.chessboard.rows = 6;
   options.square_size_m = 0.025;
-  const TargetExtractionSummary first = ExtractTargets(options, progress);
+  const TargetExtractorSummary first = RunTargetExtractor(options, progress);
   EXPECT_EQ(first.num_images, 4);
   EXPECT_EQ(first.num_found, 3);
-  const TargetExtractionSummary second = ExtractTargets(options, progress);
+  const TargetExtractorSummary second = RunTargetExtractor(options, progress);
   EXPECT_EQ(second.num_points, first.num_points);
   Database db(dir / "db.db", Database::OpenMode::kReadOnly);
   EXPECT_EQ(db.NumImages(), 4);
@@ -118,7 +118,7 @@ TEST(TargetExtractor, AFailedRunLeavesTheDatabaseAsItWas) {
   NullProgress progress;
   // Two image sizes with one shared camera: b.png is at fault.
   try {
-    ExtractTargets(Options(dir / "db.db", dir / "images"), progress);
+    RunTargetExtractor(Options(dir / "db.db", dir / "images"), progress);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("b.png"), std::string::npos) << e.what();
@@ -127,7 +127,7 @@ TEST(TargetExtractor, AFailedRunLeavesTheDatabaseAsItWas) {
   TargetExtractorOptions bad = Options(dir / "db.db", dir / "images");
   bad.reader.camera_params = "1, 2";
   try {
-    ExtractTargets(bad, progress);
+    RunTargetExtractor(bad, progress);
     FAIL() << "expected OptionError";
   } catch (const OptionError& e) {
     EXPECT_NE(std::string(e.what()).find("--ImageReader.camera_params"), std::string::npos);
@@ -160,7 +160,7 @@ TEST_P(MarkerBoards, ObservationsAndCalibration) {
   synthesize.config_path = (dir / "set.yaml").string();
   synthesize.output_path = (dir / "set").string();
   NullProgress progress;
-  Synthesize(synthesize, progress);
+  RunSynthesize(synthesize, progress);
   const GroundTruth truth = ReadGroundTruth(dir / "set/ground_truth.yaml");
 
   TargetExtractorOptions options = Options(dir / "db.db", dir / "set/images");
@@ -172,7 +172,7 @@ TEST_P(MarkerBoards, ObservationsAndCalibration) {
   options.markers.marker_separation_m = 0.008;
   options.markers.squares_x = 7;
   options.markers.squares_y = 5;
-  const TargetExtractionSummary summary = ExtractTargets(options, progress);
+  const TargetExtractorSummary summary = RunTargetExtractor(options, progress);
   EXPECT_EQ(summary.num_found, 10);
   Database db(dir / "db.db", Database::OpenMode::kReadOnly);
   std::vector<double> errors;
