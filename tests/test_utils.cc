@@ -1,5 +1,7 @@
 #include "tests/test_utils.h"
 
+#include "colmap_ext/util/string_utils.h"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,6 +18,11 @@ namespace portcal {
 ProgressSink& NoProgress() {
   static NullProgress progress;  // stateless, so shared safely
   return progress;
+}
+
+std::optional<Housing> HousingFromText(const std::string& model, const std::string& params) {
+  if (model.empty()) return std::nullopt;
+  return Housing::FromName(model, ParseDoubleList(params, "housing"), "housing");
 }
 namespace testing {
 

@@ -9,12 +9,16 @@
 #include <random>
 #include <string>
 
+#include "colmap_ext/housing/housing.h"
 #include "colmap_ext/util/progress.h"
 
 namespace portcal {
 
 // A progress sink that drops everything, for the stages the tests run.
 ProgressSink& NoProgress();
+// A housing as the flags write it (model name, comma-separated parameters);
+// none for an empty model.
+std::optional<Housing> HousingFromText(const std::string& model, const std::string& params);
 namespace testing {
 
 // A fresh directory removed at scope exit.

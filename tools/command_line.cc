@@ -48,12 +48,40 @@ bool CommandLine::Parse(int argc, char** argv) {
   } catch (const po::error& e) {
     throw UsageError(std::string(e.what()) + " (see portcal " + command_ + " -h)");
   }
+  for (const auto& convert : conversions_) convert();
   try {
     SetLogLevel(log_level_);
   } catch (const OptionError& e) {
     throw UsageError(e.what());
   }
   return true;
+}
+
+void CommandLine::AddTriState(const std::string& name, std::optional<bool>* value, const std::string& help) {
+  int& raw = ints_.emplace_back(value->has_value() ? static_cast<int>(**value) : -1);
+  Add(name, &raw, help);
+  conversions_.push_back([name, value, &raw] {
+    if (raw < -1 || raw > 1) throw OptionError("--" + name, std::to_string(raw), "-1, 0 or 1");
+    *value = raw == -1 ? std::nullopt : std::optional<bool>(raw == 1);
+  });
+}
+
+void CommandLine::AddHousing(std::optional<Housing>* housing, const std::string& model_help) {
+  std::string& model = strings_.emplace_back(housing->has_value() ? (*housing)->ModelName() : "");
+  std::string& params = strings_.emplace_back();
+  Add("Housing.model", &model, "FLATPORT | DOMEPORT | NONE: " + model_help);
+  Add("Housing.params", &params,
+      "the model's parameters, comma separated, metres (FLATPORT: Nx,Ny,Nz,int_dist,int_thick,na,ng,nw; "
+      "DOMEPORT: Cx,Cy,Cz,int_radius,int_thick,na,ng,nw)");
+  conversions_.push_back([housing, &model, &params] {
+    if (model.empty() || model == "NONE") {
+      if (!params.empty()) throw OptionError("--Housing.params", params, "given together with --Housing.model");
+      housing->reset();
+      return;
+    }
+    if (params.empty()) throw OptionError("--Housing.params", "''", "the parameters of --Housing.model " + model);
+    *housing = Housing::FromName(model, ParseDoubleList(params, "--Housing.params"), "--Housing.params");
+  });
 }
 
 int ReportErrors(const std::function<void()>& body) {

@@ -5,10 +5,16 @@
 
 #include <boost/program_options.hpp>
 #include <functional>
+#include <list>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
+#include "colmap_ext/housing/housing.h"
+#include "colmap_ext/util/error.h"
 #include "colmap_ext/util/string_utils.h"
 
 namespace portcal {
@@ -47,6 +53,34 @@ class CommandLine {
                            help.c_str());
   }
 
+  // --name as one of `choices`' names (the value's default shown by name).
+  template <typename T>
+  void AddChoice(const std::string& name, T* value, const std::vector<std::pair<std::string, T>>& choices,
+                 const std::string& help) {
+    std::string names, current;
+    for (const auto& [choice, v] : choices) {
+      names += (names.empty() ? "" : " | ") + choice;
+      if (v == *value) current = choice;
+    }
+    std::string& raw = strings_.emplace_back(current);
+    Add(name, &raw, names + ": " + help);
+    conversions_.push_back([name, value, choices, names, &raw] {
+      for (const auto& [choice, v] : choices) {
+        if (choice == raw) {
+          *value = v;
+          return;
+        }
+      }
+      throw OptionError("--" + name, raw, names);
+    });
+  }
+  // --name as -1 (nullopt: the stage decides), 0 or 1.
+  void AddTriState(const std::string& name, std::optional<bool>* value, const std::string& help);
+  // --Housing.model and --Housing.params, the same flags and help for every
+  // command; after Parse, *housing holds the housing they give (none for an
+  // empty model or NONE). `model_help` says what the housing is for here.
+  void AddHousing(std::optional<Housing>* housing, const std::string& model_help);
+
   // Parses argv (argv[0] is the command name). Returns false if help was
   // printed (caller exits 0). Throws OptionError on bad options, naming them.
   bool Parse(int argc, char** argv);
@@ -59,6 +93,10 @@ class CommandLine {
   std::string log_level_ = "info";
   std::string project_path_;
   boost::program_options::options_description options_;
+  // Conversions of parsed flags into typed fields, run at the end of Parse.
+  std::vector<std::function<void()>> conversions_;
+  std::list<std::string> strings_;  // raw flag values (stable addresses)
+  std::list<int> ints_;
 };
 
 // Runs `body`, turning exceptions into one "error: ..." line on stderr and an

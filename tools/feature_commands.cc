@@ -88,7 +88,7 @@ int ParseAndMatch(CommandLine* cli, const FeatureMatcherOptions& options, int ar
 
 int ExhaustiveMatcherCommand(int argc, char** argv) {
   FeatureMatcherOptions options;
-  options.mode = "exhaustive";
+  options.mode = PairingMode::kExhaustive;
   CommandLine cli("exhaustive_matcher",
                   "Matches every image pair (nearest neighbours, ratio and cross check) and "
                   "verifies each geometrically (E, F, H by RANSAC, COLMAP's configurations). "
@@ -99,7 +99,7 @@ int ExhaustiveMatcherCommand(int argc, char** argv) {
 
 int SequentialMatcherCommand(int argc, char** argv) {
   FeatureMatcherOptions options;
-  options.mode = "sequential";
+  options.mode = PairingMode::kSequential;
   CommandLine cli("sequential_matcher",
                   "Matches each image with the next --SequentialMatching.overlap images in name "
                   "order (and, with loop_detection, with its most similar images by a visual-word "
@@ -120,7 +120,7 @@ int SequentialMatcherCommand(int argc, char** argv) {
 
 int SpatialMatcherCommand(int argc, char** argv) {
   FeatureMatcherOptions options;
-  options.mode = "spatial";
+  options.mode = PairingMode::kSpatial;
   CommandLine cli("spatial_matcher",
                   "Matches each image with its nearest images by position prior (navigation; "
                   "pose_prior_importer), as COLMAP's spatial_matcher, then verifies each pair "

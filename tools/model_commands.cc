@@ -50,10 +50,7 @@ int ProjectPointsCommand(int argc, char** argv) {
   cli.Add("Camera.params", &options.camera_params, "parameters in COLMAP's order");
   cli.Add("Camera.width", &options.width, "image width, pixels");
   cli.Add("Camera.height", &options.height, "image height, pixels");
-  cli.Add("Housing.model", &options.housing_model, "NONE | FLATPORT | DOMEPORT");
-  cli.Add("Housing.params", &options.housing_params,
-          "FLATPORT: Nx,Ny,Nz,int_dist,int_thick,na,ng,nw; DOMEPORT: "
-          "Cx,Cy,Cz,int_radius,int_thick,na,ng,nw (metres)");
+  cli.AddHousing(&options.housing, "the housing in front of the camera (none: in air)");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
     StderrProgress progress;

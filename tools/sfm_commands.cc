@@ -62,11 +62,10 @@ int RefractiveMapperCommand(int argc, char** argv) {
   cli.AddRequired("database_path", &options.database_path, "database with verified matches");
   cli.Add("image_path", &options.image_path, "the images (accepted for COLMAP compatibility)");
   cli.AddRequired("output_path", &options.output_path, "directory for the models");
-  cli.Add("Housing.model", &options.housing.model, "FLATPORT | DOMEPORT for all cameras (default: the database's)");
-  cli.Add("Housing.params", &options.housing.params, "housing parameters in the model's order");
-  cli.Add("Mapper.init_focal_from_markers", &options.init_focal_from_markers,
+  cli.AddHousing(&options.housing, "the housing of all cameras (default: the database's)");
+  cli.AddTriState("Mapper.init_focal_from_markers", &options.init_focal_from_markers,
           "focal length from ArUco markers: -1 when the camera has no prior, 0 never, 1 always");
-  cli.Add("Mapper.init_radial_from_matches", &options.init_radial_from_matches,
+  cli.AddTriState("Mapper.init_radial_from_matches", &options.init_radial_from_matches,
           "first radial distortion term from the verified matches: -1 when the camera has no prior focal length "
           "and no distortion and is not a fisheye, 0 never, 1 always");
   RadialStartOptions& radial = options.radial_start;
@@ -114,8 +113,7 @@ int RefractiveBundleAdjusterCommand(int argc, char** argv) {
   cli.AddRequired("input_path", &options.input_path, "sparse model (+ housings.txt)");
   cli.AddRequired("output_path", &options.output_path, "directory for the model and reports");
   cli.Add("database_path", &options.database_path, "database with marker detections or position priors (scale)");
-  cli.Add("Housing.model", &options.housing.model, "FLATPORT | DOMEPORT replacing the model's housings");
-  cli.Add("Housing.params", &options.housing.params, "housing parameters (first guess)");
+  cli.AddHousing(&options.housing, "replaces the model's housings (first guess)");
   cli.Add("Markers.side_length", &options.marker_scale.side_length_m, "ArUco marker side, metres (0: no scale)");
   cli.Add("Markers.side_sigma", &options.marker_scale.sigma_m, "uncertainty of a marker side, metres");
   cli.Add("Markers.corner_sigma", &options.ba.marker_sigma_px, "uncertainty of a marker corner, px");
@@ -142,20 +140,21 @@ int AutoCalibratorCommand(int argc, char** argv) {
   cli.AddRequired("output_path", &options.output_path, "directory for the results");
   cli.Add("ImageReader.camera_model", &options.camera_model, "COLMAP camera model");
   cli.Add("ImageReader.camera_params", &options.camera_params, "known intrinsics (then held)");
-  cli.Add("Housing.model", &options.housing.model, "FLATPORT | DOMEPORT (none: in air)");
-  cli.Add("Housing.params", &options.housing.params, "first guess, the model's order");
+  cli.AddHousing(&options.housing, "the housing to calibrate, with a first guess (none: in air)");
   cli.Add("Markers.dictionary", &options.marker_dictionary, "ArUco dictionary");
   cli.Add("Markers.side_length", &options.marker_side_length_m, "marker side, metres: metric scale (0: none)");
   cli.Add("Mask.enabled", &options.mask, "keep only features near markers (0 | 1)");
   cli.Add("Mask.enlargement_factor", &options.mask_enlargement_factor, "marker quad scale");
-  cli.Add("AutoCalibration.matcher", &options.matcher, "exhaustive | sequential");
-  cli.Add("AutoCalibration.refine_intrinsics", &options.refine_intrinsics,
+  cli.AddChoice("AutoCalibration.matcher", &options.matcher,
+                {{"exhaustive", PairingMode::kExhaustive}, {"sequential", PairingMode::kSequential}},
+                "pairs to match");
+  cli.AddTriState("AutoCalibration.refine_intrinsics", &options.refine_intrinsics,
           "-1: when --ImageReader.camera_params is empty; 0; 1");
-  cli.Add("AutoCalibration.refine_principal_point", &options.refine_principal_point,
+  cli.AddTriState("AutoCalibration.refine_principal_point", &options.refine_principal_point,
           "-1: with the intrinsics, held at the image centre unless the data move it beyond 3 sigma; 0; 1");
   cli.Add("SiftExtraction.max_num_features", &options.sift.max_num_features, "per image");
   cli.Add("SiftExtraction.max_image_size", &options.sift.max_image_size, "pixels");
-  cli.Add("Mapper.init_radial_from_matches", &options.init_radial_from_matches,
+  cli.AddTriState("Mapper.init_radial_from_matches", &options.init_radial_from_matches,
           "first radial distortion term from the verified matches before mapping: -1 when the intrinsics are "
           "refined and the model is not a fisheye, 0 never");
   cli.Add("AutoCalibration.max_num_starts", &options.max_num_starts,

@@ -82,10 +82,8 @@ int HousingCalibratorCommand(int argc, char** argv) {
   cli.AddRequired("database_path", &options.database_path, "database with target observations");
   cli.AddRequired("input_calibration", &options.input_calibration, "in-air calibration.yaml");
   cli.AddRequired("output_path", &options.output_path, "directory for the reports");
-  cli.AddRequired("Housing.model", &options.housing_model, "FLATPORT | DOMEPORT");
-  cli.AddRequired("Housing.params", &options.housing_params,
-                  "FLATPORT: Nx,Ny,Nz,int_dist,int_thick,na,ng,nw; DOMEPORT: "
-                  "Cx,Cy,Cz,int_radius,int_thick,na,ng,nw (metres; a guess for what is estimated)");
+  cli.AddHousing(&options.housing, "the port to calibrate (required; the parameters: its constants and a "
+                                   "guess for what is estimated)");
   cli.Add("camera_id", &options.camera_id, "camera (-1: the only one)");
   cli.Add("Calibration.refine_intrinsics", &options.calibration.refine_intrinsics,
           "refine the intrinsics jointly (0 | 1)");

@@ -23,6 +23,7 @@ struct Housing {
                           const std::string& context);
 
   std::string ModelName() const;
+  bool SameModel(const Housing& other) const { return model_id == other.model_id; }
   std::string ParamsInfo() const;
   // Throws InputError (prefixed by `context`): unknown model, wrong count,
   // non-finite values, normal not unit, camera outside the dome, ...

@@ -266,4 +266,8 @@ SparseModel Reconstruction::ToSparseModel() const {
   return model;
 }
 
+void ReplaceHousings(const Housing& housing, std::map<camera_t, HousedCamera>* cameras) {
+  for (auto& [id, camera] : *cameras) camera.housing = housing;
+}
+
 }  // namespace portcal

@@ -133,4 +133,7 @@ class Reconstruction {
   void UpdateVisibility(image_t image_id, point2D_t idx, int change);
 };
 
+// Puts `housing` in front of every camera (a user's housing for all).
+void ReplaceHousings(const Housing& housing, std::map<camera_t, HousedCamera>* cameras);
+
 }  // namespace portcal

@@ -8,6 +8,7 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "database/database.h"
+#include "pipelines/sfm/calibration_start.h"
 
 namespace fs = std::filesystem;
 
@@ -16,18 +17,9 @@ namespace portcal {
 void AutoCalibratorOptions::Check() const {
   if (image_path.empty()) throw OptionError("--image_path", "''", "a directory of images");
   if (output_path.empty()) throw OptionError("--output_path", "''", "a directory for the results");
-  if (housing.model.empty() != housing.params.empty()) {
-    throw OptionError("--Housing.params", housing.params, "given together with --Housing.model");
-  }
-  if (matcher != "exhaustive" && matcher != "sequential") {
-    throw OptionError("--AutoCalibration.matcher", matcher, "exhaustive or sequential");
-  }
-  if (refine_intrinsics < -1 || refine_intrinsics > 1) {
-    throw OptionError("--AutoCalibration.refine_intrinsics", std::to_string(refine_intrinsics), "-1, 0 or 1");
-  }
-  if (refine_principal_point < -1 || refine_principal_point > 1) {
-    throw OptionError("--AutoCalibration.refine_principal_point", std::to_string(refine_principal_point),
-                      "-1, 0 or 1");
+  if (housing) housing->Validate("--Housing.params");
+  if (matcher == PairingMode::kSpatial) {
+    throw OptionError("--AutoCalibration.matcher", "spatial", "exhaustive or sequential");
   }
   if (random_seed < 0) throw OptionError("--random_seed", std::to_string(random_seed), ">= 0");
   if (max_num_starts < 1) {
@@ -46,12 +38,12 @@ namespace {
 // the mapper gets (docs/auto_calibration.md). The markers give a far better
 // start: it is written to the database camera before matching.
 // Returns the markers' focal length (in-air equivalent), or nullopt.
-std::optional<double> StartFocalFromMarkers(const std::string& database_path, const HousingOverride& housing) {
+std::optional<double> StartFocalFromMarkers(const std::string& database_path, const std::optional<Housing>& housing) {
   Database database(database_path, Database::OpenMode::kReadWrite);
   const SfmInputs inputs = SfmInputs::Read(&database);
   std::map<camera_t, HousedCamera> cameras = inputs.cameras;
-  ApplyHousingOverride(housing, &cameras);
-  InitializeFocalFromMarkers(inputs, 1, &cameras);
+  if (housing) ReplaceHousings(*housing, &cameras);
+  StartFocalFromMarkers(inputs, true, &cameras);
   Transaction transaction = database.BeginTransaction();
   std::optional<double> focal;
   for (const auto& [id, camera] : cameras) {
@@ -146,15 +138,16 @@ RefractiveMapperOptions MapperOptions(const AutoCalibratorOptions& options, cons
   map.mapper.marker_scale.side_length_m = options.marker_side_length_m;
   map.mapper.ba_refine_focal_length = refine_intrinsics;
   map.mapper.ba_refine_extra_params = refine_intrinsics;
-  const bool refine_principal_point = refine_intrinsics && options.refine_principal_point != 0;
-  // A flat port's tilt, under the untilted guess, is absorbed by the
-  // mapper's poses and points unless the port is refined as the model
-  // grows. A dome's centred guess is close, and its axial decentering
+  const bool refine_principal_point = refine_intrinsics && options.refine_principal_point != false;
+  // A port's orientation (a flat port's tilt), under the untilted guess, is
+  // absorbed by the mapper's poses and points unless the port is refined as
+  // the model grows. A dome's centred guess is close, and its axial decentering
   // trades with the focal length on a few views, so it is left to the final
   // refinement. Only with marker scale: without it the port distance is
   // barely observed and refining it splits the models
   // (docs/auto_calibration.md).
-  map.mapper.ba_refine_housing = options.housing.model == "FLATPORT" && options.marker_side_length_m > 0;
+  map.mapper.ba_refine_housing = options.housing && !options.housing->Refinement().orientation.empty() &&
+                                 options.marker_side_length_m > 0;
   // The principal point with it: held at the image centre when it is not
   // there, the global adjustments fight the port. With the dome left to the
   // final refinement, its principal point is too (refined in the mapper,
@@ -167,14 +160,14 @@ RefractiveMapperOptions MapperOptions(const AutoCalibratorOptions& options, cons
 RefractiveBundleAdjusterOptions RefinerOptions(const AutoCalibratorOptions& options, const std::string& database_path,
                                                const std::string& input_path, const fs::path& dir,
                                                bool refine_intrinsics) {
-  const bool refine_principal_point = refine_intrinsics && options.refine_principal_point != 0;
+  const bool refine_principal_point = refine_intrinsics && options.refine_principal_point != false;
   RefractiveBundleAdjusterOptions refine;
   refine.input_path = input_path;
   refine.output_path = (dir / "refined").string();
   refine.database_path = database_path;
   refine.marker_scale.side_length_m = options.marker_side_length_m;
   refine.housing_guess = options.housing;
-  refine.ba.refine_housing = !options.housing.model.empty();
+  refine.ba.refine_housing = options.housing.has_value();
   refine.ba.refine_focal_length = refine_intrinsics;
   refine.ba.refine_extra_params = refine_intrinsics;
   // A camera's principal point is rarely exactly at the image centre, and
@@ -182,7 +175,7 @@ RefractiveBundleAdjusterOptions RefinerOptions(const AutoCalibratorOptions& opti
   // (docs/auto_calibration.md). Held at the centre again unless it lies
   // beyond 3 sigma from it.
   refine.ba.refine_principal_point = refine_principal_point;
-  refine.principal_point_test_sigmas = options.refine_principal_point == -1 ? 3.0 : 0.0;
+  refine.principal_point_test_sigmas = options.refine_principal_point.has_value() ? 0.0 : 3.0;
   refine.ba.num_threads = options.num_threads;
   return refine;
 }
@@ -220,7 +213,7 @@ AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   fs::create_directories(options.output_path);
   const std::string database_path = (fs::path(options.output_path) / "database.db").string();
   const bool intrinsics_given = !options.camera_params.empty();
-  const bool refine_intrinsics = options.refine_intrinsics == -1 ? !intrinsics_given : options.refine_intrinsics == 1;
+  const bool refine_intrinsics = options.refine_intrinsics.value_or(!intrinsics_given);
   AutoCalibratorSummary result;
   auto clock = std::chrono::steady_clock::now();
   const auto lap = [&](const std::string& stage) {
@@ -260,7 +253,7 @@ AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   match.num_threads = options.num_threads;
   match.verification.random_seed = options.random_seed;
   RunFeatureMatcher(match, progress);
-  lap(options.matcher + "_matcher");
+  lap(PairingModeName(options.matcher) + "_matcher");
 
   // Several starts when one cannot be trusted (a wrong basin, or a
   // poorly determined solution): the mapper's random choices from another

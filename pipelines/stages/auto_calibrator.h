@@ -7,6 +7,7 @@
 // calibration.yaml / calibration.txt.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "colmap_ext/util/progress.h"
@@ -15,6 +16,7 @@
 #include "pipelines/stages/feature_matcher.h"
 #include "pipelines/stages/refractive_bundle_adjuster.h"
 #include "pipelines/stages/refractive_mapper.h"
+#include "colmap_ext/housing/housing.h"
 
 namespace portcal {
 
@@ -23,27 +25,28 @@ struct AutoCalibratorOptions {
   std::string output_path;
   std::string camera_model = "RADIAL";
   std::string camera_params;  // given: intrinsics known and held
-  HousingOverride housing;    // the housing to calibrate, with a first guess
+  std::optional<Housing> housing;  // the housing to calibrate, with a first guess; none: in air
   std::string marker_dictionary = "DICT_4X4_50";
   double marker_side_length_m = 0;  // > 0: metric scale from the markers
   double mask_enlargement_factor = 3.0;
   bool mask = true;                   // keep only features near markers
-  std::string matcher = "exhaustive";  // exhaustive | sequential
+  PairingMode matcher = PairingMode::kExhaustive;  // exhaustive or sequential
   SiftExtractionOptions sift;
-  // Refine the intrinsics with the housing; -1: when camera_params is empty.
-  int refine_intrinsics = -1;
-  // With the intrinsics refined: -1 refines the principal point but holds it
-  // at the image centre again unless it moves beyond 3 sigma (see
-  // RefractiveBundleAdjusterOptions::principal_point_test_sigmas); 0 holds
-  // it; 1 refines it.
-  int refine_principal_point = -1;
+  // Refine the intrinsics with the housing; nullopt: when camera_params is
+  // empty.
+  std::optional<bool> refine_intrinsics;
+  // With the intrinsics refined: nullopt refines the principal point but
+  // holds it at the image centre again unless it moves beyond 3 sigma (see
+  // RefractiveBundleAdjusterOptions::principal_point_test_sigmas); false
+  // holds it; true refines it.
+  std::optional<bool> refine_principal_point;
   // Seeds every random choice (RANSAC in verification and mapping): the
   // same images and options give the same calibration.
   int random_seed = 0;
   // The lens's first radial term from the matches before mapping
   // (RefractiveMapperOptions::init_radial_from_matches: not for fisheye
-  // models): -1 or 0.
-  int init_radial_from_matches = -1;
+  // models): nullopt (where it applies) or false.
+  std::optional<bool> init_radial_from_matches;
   // With the intrinsics refined: starts of the mapper and refinement (each
   // from the next random seed) while a start fails or its report carries
   // a warning; the start with the fewest warnings, then the smallest

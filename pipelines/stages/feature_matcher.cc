@@ -15,6 +15,15 @@
 
 namespace portcal {
 
+std::string PairingModeName(PairingMode mode) {
+  switch (mode) {
+    case PairingMode::kExhaustive: return "exhaustive";
+    case PairingMode::kSequential: return "sequential";
+    case PairingMode::kSpatial: return "spatial";
+  }
+  return "unknown";
+}
+
 void SequentialPairingOptions::Check() const {
   if (overlap < 1) throw OptionError("--SequentialMatching.overlap", std::to_string(overlap), ">= 1");
   if (loop_detection_period < 1) {
@@ -41,9 +50,6 @@ void SpatialPairingOptions::Check() const {
 
 void FeatureMatcherOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
-  if (mode != "exhaustive" && mode != "sequential" && mode != "spatial") {
-    throw OptionError("mode", mode, "exhaustive, sequential or spatial");
-  }
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
   sequential.Check();
   spatial.Check();
@@ -112,12 +118,12 @@ std::string OptionsText(const FeatureMatcherOptions& o) {
       << "\nSiftMatching.method=" << o.matching.method
       << "\nTwoViewGeometry.max_error=" << o.verification.max_error
       << "\nTwoViewGeometry.min_num_inliers=" << o.verification.min_num_inliers;
-  if (o.mode == "spatial") {
+  if (o.mode == PairingMode::kSpatial) {
     out << "\nSpatialMatching.max_num_neighbors=" << o.spatial.max_num_neighbors
         << "\nSpatialMatching.max_distance=" << o.spatial.max_distance_m
         << "\nSpatialMatching.ignore_z=" << o.spatial.ignore_z;
   }
-  if (o.mode == "sequential") {
+  if (o.mode == PairingMode::kSequential) {
     out << "\nSequentialMatching.overlap=" << o.sequential.overlap
         << "\nSequentialMatching.quadratic_overlap=" << o.sequential.quadratic_overlap
         << "\nSequentialMatching.loop_detection=" << o.sequential.loop_detection;
@@ -166,7 +172,7 @@ std::vector<std::pair<image_t, image_t>> LoopPairs(Database* database,
 
 FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, ProgressSink& progress) {
   options.Check();
-  const std::string stage = options.mode + "_matcher";
+  const std::string stage = PairingModeName(options.mode) + "_matcher";
   StageRun run(stage, OptionsText(options));
   Database database(options.database_path, Database::OpenMode::kReadWrite);
   Transaction transaction = database.BeginTransaction();
@@ -189,9 +195,9 @@ FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, Pr
 
   FeatureMatcherSummary summary;
   std::vector<std::pair<image_t, image_t>> candidates;
-  if (options.mode == "exhaustive") {
+  if (options.mode == PairingMode::kExhaustive) {
     candidates = ExhaustivePairs(ids);
-  } else if (options.mode == "sequential") {
+  } else if (options.mode == PairingMode::kSequential) {
     candidates = SequentialPairs(ids, options.sequential);
   } else {
     std::vector<std::pair<image_t, Eigen::Vector3d>> positions;
@@ -208,7 +214,7 @@ FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, Pr
     }
     candidates = SpatialPairs(positions, options.spatial);
   }
-  if (options.mode == "sequential" && options.sequential.loop_detection) {
+  if (options.mode == PairingMode::kSequential && options.sequential.loop_detection) {
     const auto loops = LoopPairs(&database, ids, options.sequential, progress);
     summary.num_loop_pairs = static_cast<int64_t>(loops.size());
     candidates.insert(candidates.end(), loops.begin(), loops.end());

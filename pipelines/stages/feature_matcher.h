@@ -39,9 +39,16 @@ struct SpatialPairingOptions {
   void Check() const;           // throws OptionError naming --SpatialMatching.*
 };
 
+// Which image pairs are matched: every pair, neighbours in name order (and
+// loop candidates), or neighbours by position prior. One stage, three of
+// COLMAP's commands (exhaustive_matcher, sequential_matcher, spatial_matcher).
+enum class PairingMode { kExhaustive, kSequential, kSpatial };
+// "exhaustive", "sequential", "spatial".
+std::string PairingModeName(PairingMode mode);
+
 struct FeatureMatcherOptions {
   std::string database_path;
-  std::string mode = "exhaustive";  // exhaustive | sequential | spatial
+  PairingMode mode = PairingMode::kExhaustive;
   SequentialPairingOptions sequential;
   SpatialPairingOptions spatial;
   DescriptorMatchingOptions matching;

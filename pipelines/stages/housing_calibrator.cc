@@ -16,17 +16,14 @@ void HousingCalibratorOptions::Check() const {
     throw OptionError("--input_calibration", "''", "the in-air calibration.yaml");
   }
   if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
-  if (!ExistsHousingModelWithName(housing_model)) {
-    throw OptionError("--Housing.model", housing_model, "FLATPORT or DOMEPORT");
-  }
+  if (!housing) throw OptionError("--Housing.model", "''", "FLATPORT or DOMEPORT");
+  housing->Validate("--Housing.params");
   calibration.Check();
 }
 
 HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& options, ProgressSink& progress) {
   options.Check();
-  const Housing housing = Housing::FromName(
-      options.housing_model, ParseDoubleList(options.housing_params, "--Housing.params"),
-      "--Housing.params");
+  const Housing& housing = *options.housing;
   const CalibrationReport in_air = ReadCalibrationReport(options.input_calibration);
   Database database(options.database_path, Database::OpenMode::kReadOnly);
   const TargetViews target_views = ReadTargetViews(&database);

@@ -3,8 +3,10 @@
 // observations of its underwater views; writes the reports.
 #pragma once
 
+#include <optional>
 #include <string>
 
+#include "colmap_ext/housing/housing.h"
 #include "pipelines/calibration/housing_calibration.h"
 #include "colmap_ext/util/progress.h"
 
@@ -14,8 +16,7 @@ struct HousingCalibratorOptions {
   std::string database_path;
   std::string input_calibration;  // calibration.yaml (portcal or calibmar)
   std::string output_path;
-  std::string housing_model;      // FLATPORT | DOMEPORT
-  std::string housing_params;     // 8 numbers: the constants and a guess
+  std::optional<Housing> housing;  // required: the constants and a guess
   int camera_id = -1;
   HousingCalibrationSettings calibration;
   void Check() const;  // throws OptionError naming the option

@@ -32,10 +32,7 @@ void ProjectPointsOptions::Check() const {
   }
   if (width <= 0) throw OptionError("--Camera.width", std::to_string(width), "> 0");
   if (height <= 0) throw OptionError("--Camera.height", std::to_string(height), "> 0");
-  if (!housing_model.empty() && housing_model != "NONE" &&
-      !ExistsHousingModelWithName(housing_model)) {
-    throw OptionError("--Housing.model", housing_model, "NONE, FLATPORT or DOMEPORT");
-  }
+  if (housing) housing->Validate("--Housing.params");
 }
 
 namespace {
@@ -60,12 +57,7 @@ HousedCamera LoadCamera(const ProjectPointsOptions& options) {
   camera.height = options.height;
   camera.params = ParseDoubleList(options.camera_params, "--Camera.params");
   camera.Validate("--Camera.params");
-  if (!options.housing_model.empty() && options.housing_model != "NONE") {
-    housed.housing = Housing::FromName(
-        options.housing_model,
-        ParseDoubleList(options.housing_params, "--Housing.params"),
-        "--Housing.params");
-  }
+  housed.housing = options.housing;
   return housed;
 }
 

@@ -3,9 +3,11 @@
 // `unproject`.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "colmap_ext/housing/housing.h"
 #include "colmap_ext/util/progress.h"
 
 namespace portcal {
@@ -19,8 +21,7 @@ struct ProjectPointsOptions {
   std::string camera_params;  // comma/space separated, COLMAP order
   int width = 0;              // pixels, > 0
   int height = 0;
-  std::string housing_model;  // "" | NONE | FLATPORT | DOMEPORT
-  std::string housing_params;
+  std::optional<Housing> housing;  // none: in air
 
   std::string points_path;  // input text file: "X Y Z" or "x y" per line
   bool unproject = false;   // pixels -> rays instead of points -> pixels

@@ -205,14 +205,12 @@ int FilterObservations(Reconstruction* r, double max_error_px) {
 // Moves the position of every housing at a bound of the adjustment (flat:
 // distance; dome: centre) to the guess's, when the guess is of the same
 // model; the rest stays.
-void MoveHousingsOffBound(const HousingOverride& guess, Reconstruction* r) {
-  if (guess.model.empty()) return;
-  std::map<camera_t, HousedCamera> guessed = r->cameras();
-  ApplyHousingOverride(guess, &guessed);
+void MoveHousingsOffBound(const std::optional<Housing>& guess, Reconstruction* r) {
+  if (!guess) return;
+  const Housing& from = *guess;
   for (auto& [id, camera] : r->mutable_cameras()) {
     if (!camera.housing || !camera.housing->AtBound()) continue;
-    const Housing& from = *guessed.at(id).housing;
-    if (from.model_id != camera.housing->model_id) continue;
+    if (!from.SameModel(*camera.housing)) continue;
     const HousingRefinement refinement = camera.housing->Refinement();
     for (int k : refinement.position) {
       camera.housing->params[static_cast<size_t>(k)] = from.params[static_cast<size_t>(k)];
@@ -227,7 +225,7 @@ void MoveHousingsOffBound(const HousingOverride& guess, Reconstruction* r) {
 // database's marker detections, position priors and keypoint scales.
 SfmInputs ReadAdjusterInputs(const RefractiveBundleAdjusterOptions& options, const SparseModel& model) {
   SfmInputs inputs = SfmInputs::FromSparseModel(model);
-  ApplyHousingOverride(options.housing, &inputs.cameras);
+  if (options.housing) ReplaceHousings(*options.housing, &inputs.cameras);
   if (options.ba.refine_housing) {
     bool any = false;
     for (const auto& [id, camera] : inputs.cameras) any |= camera.housing.has_value();
@@ -454,7 +452,7 @@ RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBund
   // (own render, seed 11 of bench_autocal_seeds.sh: f 2.2 px off, and 63 s
   // at the bound). It starts from the guess's bound parameters instead, the
   // intrinsics first: f 0.9 px off, distance 0.6 sigma, 3 s.
-  const bool start_at_bound = joint && housing_at_bound() != kInvalidCameraId && !options.housing_guess.model.empty();
+  const bool start_at_bound = joint && housing_at_bound() != kInvalidCameraId && options.housing_guess.has_value();
   if (start_at_bound) MoveHousingsOffBound(options.housing_guess, &r);
   const Reconstruction start = r;
   const std::vector<MarkerCorner> markers_start = markers;

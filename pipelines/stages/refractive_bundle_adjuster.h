@@ -12,10 +12,11 @@
 // Writes the adjusted model and calibration.yaml / .txt.
 #pragma once
 
+#include <optional>
 #include <string>
 
+#include "colmap_ext/housing/housing.h"
 #include "pipelines/calibration/calibration_report.h"
-#include "pipelines/stages/refractive_mapper.h"
 #include "pipelines/bundle_adjustment/bundle_adjustment.h"
 #include "colmap_ext/util/progress.h"
 
@@ -25,7 +26,7 @@ struct RefractiveBundleAdjusterOptions {
   std::string input_path;     // sparse model (+ housings.txt)
   std::string output_path;    // adjusted model and reports
   std::string database_path;  // for marker detections (optional)
-  HousingOverride housing;    // replaces the model's housings
+  std::optional<Housing> housing;  // replaces the model's housings
   // The first guess of the housing, for one case only: the model's own
   // housing lies at a bound of the adjustment (a flat port's distance at its
   // 0.1 mm floor, a dome decentred to 90 % of its radius; the mapper can
@@ -33,7 +34,7 @@ struct RefractiveBundleAdjusterOptions {
   // then starts its bound parameters (flat: distance; dome: centre) from
   // this guess, the rest (a flat port's normal) from the model, and adjusts
   // the intrinsics first. auto_calibrator passes its --Housing.*.
-  HousingOverride housing_guess;
+  std::optional<Housing> housing_guess;
   BundleAdjustmentOptions ba;  // refine_housing on, exact reprojection error
   MarkerScale marker_scale;
   double max_reproj_error_px = 4.0;  // observations beyond are dropped before the final solve

@@ -5,8 +5,7 @@
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
-#include "colmap_ext/util/string_utils.h"
-#include "pipelines/reconstruction/ray_geometry.h"
+#include "pipelines/sfm/calibration_start.h"
 
 namespace fs = std::filesystem;
 
@@ -15,85 +14,9 @@ namespace portcal {
 void RefractiveMapperOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (output_path.empty()) throw OptionError("--output_path", "''", "a directory for the models");
-  if (init_focal_from_markers < -1 || init_focal_from_markers > 1) {
-    throw OptionError("--Mapper.init_focal_from_markers", std::to_string(init_focal_from_markers), "-1, 0 or 1");
-  }
-  if (init_radial_from_matches < -1 || init_radial_from_matches > 1) {
-    throw OptionError("--Mapper.init_radial_from_matches", std::to_string(init_radial_from_matches), "-1, 0 or 1");
-  }
   radial_start.Check();
-  if (housing.model.empty() != housing.params.empty()) {
-    throw OptionError("--Housing.params", housing.params, "given together with --Housing.model");
-  }
+  if (housing) housing->Validate("--Housing.params");
   mapper.Check();
-}
-
-void ApplyHousingOverride(const HousingOverride& override_housing, std::map<camera_t, HousedCamera>* cameras) {
-  if (override_housing.model.empty()) return;
-  std::vector<double> params;
-  for (const std::string& token : SplitTokens(override_housing.params, ", ")) {
-    try {
-      params.push_back(std::stod(token));
-    } catch (const std::exception&) {
-      throw OptionError("--Housing.params", override_housing.params, "numbers");
-    }
-  }
-  const Housing housing = Housing::FromName(override_housing.model, params, "--Housing.params");
-  for (auto& [id, camera] : *cameras) camera.housing = housing;
-}
-
-bool InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<camera_t, HousedCamera>* cameras) {
-  if (mode == 0) return false;
-  bool any = false;
-  for (auto& [camera_id, camera] : *cameras) {
-    if (mode == -1 && camera.camera.has_prior_focal_length) continue;
-    std::vector<MarkerQuad> quads;
-    for (const auto& [image_id, image] : inputs.images) {
-      if (image.camera_id != camera_id) continue;
-      for (const MarkerDetection& m : image.markers) quads.push_back({m.corners});
-    }
-    auto focal = FocalLengthFromMarkers(quads, camera.camera.PrincipalPointX(), camera.camera.PrincipalPointY());
-    // The markers give the focal length the camera appears to have in
-    // water (a flat port magnifies paraxial rays); bundle adjustment refines
-    // the rest.
-    if (focal && camera.housing) *focal *= camera.housing->InAirFocalRatio();
-    if (!focal) {
-      LOG(WARNING) << "camera " << camera_id << ": too few markers for a focal length; keeping "
-                   << camera.camera.MeanFocalLength() << " px";
-      continue;
-    }
-    LOG(INFO) << "camera " << camera_id << ": focal length from " << quads.size() << " markers: " << *focal
-              << " px (was " << camera.camera.MeanFocalLength() << ")";
-    for (int idx : CameraModelFocalLengthIdxs(camera.camera.model_id)) camera.camera.params[idx] = *focal;
-    any = true;
-  }
-  return any;
-}
-
-void InitializeRadialFromMatches(const SfmInputs& inputs, const RefractiveMapperOptions& options,
-                                 std::map<camera_t, HousedCamera>* cameras) {
-  const int mode = options.init_radial_from_matches;
-  if (mode == 0 || (mode == -1 && !options.mapper.ba_refine_extra_params)) return;
-  for (auto& [camera_id, camera] : *cameras) {
-    const std::vector<int> extra = CameraModelExtraParamsIdxs(camera.camera.model_id);
-    const bool undistorted = std::all_of(extra.begin(), extra.end(),
-                                         [&](int idx) { return camera.camera.params[idx] == 0; });
-    // A fisheye model at k = 0 is the equidistant projection, near what
-    // fisheye lenses are built to, where k = 0 of a pinhole model is far
-    // from a wide angle's; and for a fisheye a focal length error is not
-    // projective, so the search takes it up (docs/auto_calibration.md).
-    const bool fisheye = CameraModelIsFisheye(camera.camera.model_id);
-    if (mode == -1 && (camera.camera.has_prior_focal_length || !undistorted || fisheye)) continue;
-    const auto start = EstimateFirstRadialTerm(inputs, camera_id, camera, options.radial_start);
-    if (!start) {
-      VLOG(1) << "camera " << camera_id << ": no first radial term from the matches (no such term or too few pairs)";
-      continue;
-    }
-    LOG(INFO) << "camera " << camera_id << ": first radial term from " << start->num_matches << " matches of "
-              << start->num_pairs << " pairs: " << start->k << " (epipolar RMS " << start->residual_px
-              << " px; at the start " << start->residual_at_start_px << " px)";
-    camera.camera.params[FirstRadialParamIdx(camera.camera)] = start->k;
-  }
 }
 
 RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& options, ProgressSink& progress) {
@@ -113,12 +36,13 @@ RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& optio
                      "has nothing to use (run pose_prior_importer, or set it to 0)");
   }
   std::map<camera_t, HousedCamera> cameras = inputs.cameras;
-  ApplyHousingOverride(options.housing, &cameras);
+  if (options.housing) ReplaceHousings(*options.housing, &cameras);
   IncrementalMapperOptions mapper = options.mapper;
-  if (InitializeFocalFromMarkers(inputs, options.init_focal_from_markers, &cameras)) {
+  if (StartFocalFromMarkers(inputs, options.init_focal_from_markers, &cameras)) {
     mapper.max_focal_ratio_to_start = std::min(mapper.max_focal_ratio_to_start, kMaxFocalRatioToMarkers);
   }
-  InitializeRadialFromMatches(inputs, options, &cameras);
+  StartRadialFromMatches(inputs, options.init_radial_from_matches, options.mapper.ba_refine_extra_params,
+                         options.radial_start, &cameras);
   const std::vector<MappedModel> models = RunIncrementalMapper(inputs, cameras, mapper, progress);
   if (models.empty()) {
     throw NumericalError("refractive_mapper: no model could be initialised from " +

@@ -7,32 +7,30 @@
 // ... (binary, plus housings.txt), largest first.
 #pragma once
 
+#include <optional>
 #include <string>
 
+#include "colmap_ext/housing/housing.h"
 #include "colmap_ext/util/progress.h"
 #include "pipelines/sfm/incremental_mapper.h"
 #include "pipelines/sfm/radial_start.h"
 
 namespace portcal {
 
-struct HousingOverride {
-  std::string model;   // "" = the database's housings
-  std::string params;  // comma or space separated, the model's order
-};
-
 struct RefractiveMapperOptions {
   std::string database_path;
   std::string image_path;  // accepted for COLMAP compatibility
   std::string output_path;
   IncrementalMapperOptions mapper;
-  HousingOverride housing;
-  // -1: when the camera has no prior focal length; 0: never; 1: always.
-  int init_focal_from_markers = -1;
+  std::optional<Housing> housing;  // for every camera; none: the database's
+  // The focal length from the markers before mapping: always, never, or
+  // (nullopt) when the camera has no prior focal length.
+  std::optional<bool> init_focal_from_markers;
   // The lens's first radial term from the verified matches (radial_start.h)
-  // before mapping. -1: when the camera has no prior focal length, its
-  // distortion is all zero, the mapper refines it and the model is not a
-  // fisheye; 0: never; 1: always.
-  int init_radial_from_matches = -1;
+  // before mapping: always, never, or (nullopt) when the camera has no
+  // prior focal length, its distortion is all zero, the mapper refines it
+  // and the model is not a fisheye.
+  std::optional<bool> init_radial_from_matches;
   RadialStartOptions radial_start;
   void Check() const;  // throws OptionError naming the option
 };
@@ -45,23 +43,6 @@ struct RefractiveMapperSummary {
   // Per model: its global adjustments that refined the intrinsics or housing.
   std::vector<std::vector<CalibrationRefinement>> calibration_refinements;
 };
-
-// Sets the housing of every camera when `override.model` is given.
-void ApplyHousingOverride(const HousingOverride& override_housing, std::map<camera_t, HousedCamera>* cameras);
-
-// A focal length this far from the markers' estimate (measured within
-// 1-6 % of the truth on own and shared renders) is a wrong solution,
-// whatever its standard deviation says.
-constexpr double kMaxFocalRatioToMarkers = 1.25;
-
-// Focal lengths from the markers of each camera's images (see
-// FocalLengthFromMarkers), where `mode` asks for it. True if any was set.
-bool InitializeFocalFromMarkers(const SfmInputs& inputs, int mode, std::map<camera_t, HousedCamera>* cameras);
-
-// The first radial term of each camera from the matches
-// (EstimateFirstRadialTerm), where `options.init_radial_from_matches` asks.
-void InitializeRadialFromMatches(const SfmInputs& inputs, const RefractiveMapperOptions& options,
-                                 std::map<camera_t, HousedCamera>* cameras);
 
 RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& options, ProgressSink& progress);
 

@@ -79,8 +79,7 @@ AutoCalibratorSummary Calibrate(const FamilyMember& m, const fs::path& images, c
   options.image_path = images.string();
   options.output_path = out.string();
   options.camera_model = m.camera_model;
-  options.housing.model = m.housing_model;
-  options.housing.params = m.housing_guess;
+  options.housing = HousingFromText(m.housing_model, m.housing_guess);
   options.marker_side_length_m = 0.06;
   options.num_threads = num_threads;
   NullProgress progress;

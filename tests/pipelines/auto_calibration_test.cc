@@ -44,8 +44,7 @@ AutoCalibratorSummary Calibrate(const fs::path& images, const fs::path& out, con
   options.camera_params = camera_params;
   options.image_path = images.string();
   options.output_path = out.string();
-  options.housing.model = housing_model;
-  options.housing.params = housing_guess;
+  options.housing = HousingFromText(housing_model, housing_guess);
   options.marker_side_length_m = 0.06;
   NullProgress progress;
   return RunAutoCalibrator(options, progress);

@@ -87,15 +87,14 @@ TEST(HousingCalibration, StageReadsTheInAirReportAndWritesTheHousing) {
   options.database_path = (dir / "db.db").string();
   options.input_calibration = (dir / "air/calibration.yaml").string();
   options.output_path = (dir / "water").string();
-  options.housing_model = "DOMEPORT";
-  options.housing_params = "0 0 0 0.05 0.006 1.0 1.473 1.334";
+  options.housing = HousingFromText("DOMEPORT", "0 0 0 0.05 0.006 1.0 1.473 1.334");
   RunHousingCalibrator(options, NoProgress());
   const CalibrationReport report = ReadCalibrationReport(dir / "water/calibration.yaml");
   ASSERT_TRUE(report.housing.has_value());
   EXPECT_EQ(report.housing->ModelName(), "DOMEPORT");
   EXPECT_NEAR(report.housing->params[0], 0.01, 1e-4);
-  options.housing_params = "0 0 0 0.05";
-  EXPECT_THROW(RunHousingCalibrator(options, NoProgress()), InputError);
+  options.housing.reset();
+  EXPECT_THROW(RunHousingCalibrator(options, NoProgress()), OptionError);
 }
 
 }  // namespace

@@ -61,15 +61,14 @@ render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
   ASSERT_EQ(RunPosePriorImporter(priors, NoProgress()).num_imported, 48);
   FeatureMatcherOptions match;
   match.database_path = database;
-  match.mode = "spatial";
+  match.mode = PairingMode::kSpatial;
   match.spatial.max_num_neighbors = 10;
   RunFeatureMatcher(match, progress);
 
   RefractiveMapperOptions map;
   map.database_path = database;
   map.output_path = (dir / "sparse").string();
-  map.housing.model = "FLATPORT";
-  map.housing.params = "0,0,1,0.01,0.010,1,1.473,1.334";
+  map.housing = Housing::FromName("FLATPORT", {0, 0, 1, 0.01, 0.010, 1, 1.473, 1.334}, "test");
   map.mapper.init_scene_depth_m = 2.0;
   map.mapper.ba_refine_focal_length = false;
   map.mapper.ba_refine_extra_params = false;

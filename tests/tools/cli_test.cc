@@ -4,6 +4,8 @@
 
 #include <fstream>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "colmap_ext/housing/housing.h"
 #include "colmap_ext/io/sparse_model.h"
@@ -226,6 +228,34 @@ TEST(Cli, CrossCheckNamesWhatIsMissing) {
                               "--CrossCheck.folds 1"));
   EXPECT_EQ(result.exit_code, 1) << result.output;
   EXPECT_NE(result.output.find("--CrossCheck.folds"), std::string::npos) << result.output;
+}
+
+// The typed options (a housing, -1/0/1, a choice) are parsed in tools/ and
+// their errors name the flag.
+TEST(Cli, TypedOptionsNameTheFlagAtFault) {
+  const std::string base = "auto_calibrator --image_path a --output_path b ";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--Housing.params 0,0,1", "--Housing.params"},
+      {"--Housing.model FLATPORT", "--Housing.params"},
+      {"--Housing.model FLATPORT --Housing.params 0,0,1,0.01", "--Housing.params"},
+      {"--Housing.model CYLINDER --Housing.params 0,0,1,0.01,0.01,1,1.5,1.33", "CYLINDER"},
+      {"--AutoCalibration.refine_intrinsics 2", "--AutoCalibration.refine_intrinsics"},
+      {"--AutoCalibration.matcher spatial", "--AutoCalibration.matcher"},
+  };
+  for (const auto& [flags, named] : cases) {
+    const auto result = RunCommand(Portcal(base + flags));
+    EXPECT_EQ(result.exit_code, 1) << flags << ": " << result.output;
+    EXPECT_NE(result.output.find(named), std::string::npos) << flags << ": " << result.output;
+  }
+  // One help text for the housing flags, whichever command shows them.
+  const std::string mapper = RunCommand(Portcal("refractive_mapper -h")).output;
+  const std::string adjuster = RunCommand(Portcal("refractive_bundle_adjuster -h")).output;
+  const auto params_help = [](const std::string& help) {
+    const size_t at = help.find("--Housing.params");
+    return at == std::string::npos ? std::string() : help.substr(at, help.find('\n', at) - at);
+  };
+  EXPECT_FALSE(params_help(mapper).empty()) << mapper;
+  EXPECT_EQ(params_help(mapper), params_help(adjuster));
 }
 
 TEST(Cli, PosePriorsNameWhatIsMissing) {
