@@ -51,6 +51,21 @@ bool DomePort::AtBound(const double* port) {
   return false;
 }
 
+std::vector<std::vector<double>> DomePort::StartCandidates(const double* port, const Eigen::Vector3d& axis) {
+  std::vector<std::vector<double>> starts;
+  for (const Eigen::Vector3d& direction :
+       {axis, Eigen::Vector3d(Eigen::Vector3d::UnitX()), Eigen::Vector3d(Eigen::Vector3d::UnitY()),
+        Eigen::Vector3d(Eigen::Vector3d::UnitZ())}) {
+    for (int i = -9; i <= 9; ++i) {
+      std::vector<double> start(port, port + kNumParams);
+      const Eigen::Vector3d centre = (0.09 * i * InnerRadius(port)) * direction;
+      for (int k = 0; k < 3; ++k) start[static_cast<size_t>(k)] = centre[k];
+      starts.push_back(std::move(start));
+    }
+  }
+  return starts;
+}
+
 std::optional<std::string> DomePort::Implausibility(const double* port) {
   constexpr double kMaxPlausibleDecenteringFraction = 0.25;
   const double decentering = Center(port).norm();

@@ -56,6 +56,11 @@ struct DomePort {
   static HousingRefinement Refinement(const double* port);
   // A centre coordinate at its bound: the adjustment traded it.
   static bool AtBound(const double* port);
+  // Starts for a housing calibration given the refraction axis the views
+  // show: decenterings of up to 81 % of the inner radius along that axis
+  // and, because a nearly central dome shows its axis poorly, along the
+  // camera's own axes; the radius and constants from `port`.
+  static std::vector<std::vector<double>> StartCandidates(const double* port, const Eigen::Vector3d& axis);
   // Centred, a dome does not magnify paraxial rays; decentring's effect is
   // left to the adjustment.
   static double InAirFocalRatio(const double* /*port*/) { return 1.0; }

@@ -64,6 +64,18 @@ HousingRefinement FlatPort::Refinement(const double* /*port*/) {
 
 bool FlatPort::AtBound(const double* port) { return InterfaceDistance(port) <= 1.5 * kMinAdjustedDistance; }
 
+std::vector<std::vector<double>> FlatPort::StartCandidates(const double* port, const Eigen::Vector3d& axis) {
+  const Eigen::Vector3d normal = axis.z() < 0 ? Eigen::Vector3d(-axis) : axis;
+  std::vector<std::vector<double>> starts;
+  for (int i = 0; i < 15; ++i) {
+    std::vector<double> start(port, port + kNumParams);
+    for (int k = 0; k < 3; ++k) start[static_cast<size_t>(k)] = normal[k];
+    start[3] = 1e-3 * std::pow(150.0, i / 14.0);
+    starts.push_back(std::move(start));
+  }
+  return starts;
+}
+
 bool FlatPort::AirRayToPointValue(const double* port,
                                   const Eigen::Vector3d& point,
                                   Eigen::Vector3d* dir_in_air) {

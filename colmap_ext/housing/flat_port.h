@@ -68,6 +68,10 @@ struct FlatPort {
   static HousingRefinement Refinement(const double* port);
   // The distance at its floor: the adjustment traded it, not measured it.
   static bool AtBound(const double* port);
+  // Starts for a housing calibration given the refraction axis the views
+  // show (up to sign): that normal, facing forward, at distances from 1 mm
+  // to 15 cm on a log grid; the constants from `port`.
+  static std::vector<std::vector<double>> StartCandidates(const double* port, const Eigen::Vector3d& axis);
   // In-air focal length over the one the camera appears to have behind the
   // port near the axis: a flat port magnifies paraxial rays by nw / na
   // (tan a_air = nw / na tan a_water).

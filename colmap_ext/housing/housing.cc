@@ -114,6 +114,16 @@ bool Housing::AtBound() const {
   return at_bound;
 }
 
+std::vector<Housing> Housing::StartCandidates(const Eigen::Vector3d& axis) const {
+  std::vector<Housing> starts;
+  VisitPort(*this, [&](auto model) {
+    for (std::vector<double>& start : decltype(model)::StartCandidates(params.data(), axis)) {
+      starts.push_back(Housing{model_id, std::move(start)});
+    }
+  });
+  return starts;
+}
+
 double Housing::InAirFocalRatio() const {
   double ratio = 1;
   VisitPort(*this, [&](auto model) { ratio = decltype(model)::InAirFocalRatio(params.data()); });

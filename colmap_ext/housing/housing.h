@@ -35,6 +35,9 @@ struct Housing {
   // refines and within which bounds, whether the parameters sit at one.
   HousingRefinement Refinement() const;
   bool AtBound() const;
+  // Where a housing calibration may start, given the refraction axis the
+  // views show (the model's StartCandidates): the same model and constants.
+  std::vector<Housing> StartCandidates(const Eigen::Vector3d& axis) const;
   // In-air focal length over the one the camera appears to have behind
   // the housing near the axis (1 where the housing does not magnify).
   double InAirFocalRatio() const;

@@ -8,6 +8,7 @@
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/cost/autodiff_functor.h"
 #include "colmap_ext/cost/virtual_camera_error.h"
+#include "colmap_ext/housing/housing_manifold.h"
 #include "colmap_ext/housing/housing_models.h"
 #include "colmap_ext/housing/port_projection.h"
 #include "colmap_ext/util/error.h"
@@ -26,37 +27,20 @@ void HousingCalibrationSettings::Check() const {
 
 namespace {
 
-// Both ports share the layout [a0 a1 a2 b | thickness na ng nw]: the axis
-// block (flat: normal, dome: centre), the scalar (flat: int_dist, dome:
-// int_radius) and four constants the user gives.
-template <typename T>
-void AssemblePort(const T* axis, const T* scalar, const double* constants, T* port) {
-  port[0] = axis[0];
-  port[1] = axis[1];
-  port[2] = axis[2];
-  port[3] = scalar[0];
-  for (int i = 0; i < 4; ++i) port[4 + i] = T(constants[i]);
-}
-
 enum class Error { kVirtualCamera, kReprojection };
 
 // A fixed target point seen through lens and port. Blocks: cam_from_target
-// (7), intrinsics, axis (3), scalar (1).
+// (7), intrinsics, port (the model's parameters; what is held is the
+// manifold's business).
 template <typename CameraModel, typename Port, Error kError>
 struct BoardThroughPortError
     : AutoDiffFunctor<BoardThroughPortError<CameraModel, Port, kError>, 2, 7,
-                      CameraModel::kNumParams, 3, 1> {
-  BoardThroughPortError(const Eigen::Vector3d& point, const Eigen::Vector2d& observed,
-                        const double* constants)
-      : point_(point), observed_(observed) {
-    std::copy(constants, constants + 4, constants_);
-  }
+                      CameraModel::kNumParams, Port::kNumParams> {
+  BoardThroughPortError(const Eigen::Vector3d& point, const Eigen::Vector2d& observed)
+      : point_(point), observed_(observed) {}
 
   template <typename T>
-  bool operator()(const T* cam_from_target, const T* intrinsics, const T* axis, const T* scalar,
-                  T* residual) const {
-    T port[8];
-    AssemblePort(axis, scalar, constants_, port);
+  bool operator()(const T* cam_from_target, const T* intrinsics, const T* port, T* residual) const {
     const Eigen::Map<const Eigen::Quaternion<T>> rotation(cam_from_target);
     const Eigen::Map<const VectorT<T, 3>> translation(cam_from_target + 4);
     const VectorT<T, 3> in_cam = rotation * point_.cast<T>() + translation;
@@ -74,7 +58,6 @@ struct BoardThroughPortError
  private:
   Eigen::Vector3d point_;
   Eigen::Vector2d observed_;
-  double constants_[4];
 };
 
 using Pose = PoseBlock;
@@ -132,26 +115,23 @@ Eigen::Vector3d EstimateAxis(const std::vector<CalibrationView>& views, const Ca
 
 struct State {
   std::vector<double> intrinsics;
-  Eigen::Vector3d axis;
-  double scalar = 0;
-  double constants[4];
+  Housing housing;  // its params are the port block
   std::vector<Pose> poses;
 };
 
 template <Error kError>
-void AddResiduals(const std::vector<CalibrationView>& views, int camera_model, int port_model,
-                  State* state, ceres::Problem* problem) {
+void AddResiduals(const std::vector<CalibrationView>& views, int camera_model, State* state,
+                  ceres::Problem* problem) {
   VisitCameraModel(camera_model, [&](auto camera_tag) {
     using CameraModel = decltype(camera_tag);
-    VisitHousingModel(port_model, [&](auto port_tag) {
+    VisitHousingModel(state->housing.model_id, [&](auto port_tag) {
       using Port = decltype(port_tag);
       using Functor = BoardThroughPortError<CameraModel, Port, kError>;
       for (size_t v = 0; v < views.size(); ++v) {
         for (size_t i = 0; i < views[v].pixels.size(); ++i) {
           problem->AddResidualBlock(
-              Functor::Create(views[v].points_in_target[i], views[v].pixels[i], state->constants),
-              nullptr, state->poses[v].data(), state->intrinsics.data(), state->axis.data(),
-              &state->scalar);
+              Functor::Create(views[v].points_in_target[i], views[v].pixels[i]), nullptr,
+              state->poses[v].data(), state->intrinsics.data(), state->housing.params.data());
         }
       }
     });
@@ -159,14 +139,13 @@ void AddResiduals(const std::vector<CalibrationView>& views, int camera_model, i
 }
 
 // Solves poses only (housing and intrinsics fixed); returns the final cost.
-double PoseOnlyCost(const std::vector<CalibrationView>& views, int camera_model, int port_model,
-                    State* state, int num_threads) {
+double PoseOnlyCost(const std::vector<CalibrationView>& views, int camera_model, State* state,
+                    int num_threads) {
   ceres::Problem problem;
-  AddResiduals<Error::kReprojection>(views, camera_model, port_model, state, &problem);
+  AddResiduals<Error::kReprojection>(views, camera_model, state, &problem);
   for (Pose& pose : state->poses) problem.SetManifold(pose.data(), PoseManifold());
   problem.SetParameterBlockConstant(state->intrinsics.data());
-  problem.SetParameterBlockConstant(state->axis.data());
-  problem.SetParameterBlockConstant(&state->scalar);
+  problem.SetParameterBlockConstant(state->housing.params.data());
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_SCHUR;
   options.max_num_iterations = 30;
@@ -174,6 +153,97 @@ double PoseOnlyCost(const std::vector<CalibrationView>& views, int camera_model,
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   return summary.IsSolutionUsable() ? summary.final_cost : 1e300;
+}
+
+// The start with the smallest pose-only residual among the model's
+// candidates for the refraction axis the views show.
+State BestStart(const std::vector<CalibrationView>& views, const Camera& camera, const State& state,
+                const Eigen::Vector3d& axis, int num_threads) {
+  double best_cost = 1e300;
+  State best = state;
+  for (const Housing& candidate : state.housing.StartCandidates(axis)) {
+    State trial = state;
+    trial.housing = candidate;
+    const double cost = PoseOnlyCost(views, camera.model_id, &trial, num_threads);
+    if (cost < best_cost) {
+      best_cost = cost;
+      best = trial;
+    }
+  }
+  return best;
+}
+
+// Joint solves: virtual-camera error first, then the exact reprojection.
+// Returns the final sum of squares; `final_problem` keeps the exact one for
+// the covariance.
+double SolveJointly(const std::vector<CalibrationView>& views, int camera_model,
+                    const HousingCalibrationSettings& settings, State* state, ceres::Problem* final_problem) {
+  double sum_squares = 0;
+  for (const Error error : {Error::kVirtualCamera, Error::kReprojection}) {
+    ceres::Problem local;
+    ceres::Problem& problem = error == Error::kReprojection ? *final_problem : local;
+    if (error == Error::kVirtualCamera) {
+      AddResiduals<Error::kVirtualCamera>(views, camera_model, state, &problem);
+    } else {
+      AddResiduals<Error::kReprojection>(views, camera_model, state, &problem);
+    }
+    for (Pose& pose : state->poses) problem.SetManifold(pose.data(), PoseManifold());
+    // The intrinsics join only the final, exact solve: the virtual-camera
+    // error back-projects through them, which is ill-conditioned far from
+    // the solution.
+    if (!settings.refine_intrinsics || error == Error::kVirtualCamera) {
+      problem.SetParameterBlockConstant(state->intrinsics.data());
+    }
+    SetHousingRefinement(state->housing, true, state->housing.params.data(), &problem);
+    sum_squares = 2 * SolveCalibration(&problem, settings.max_num_iterations, settings.num_threads,
+                                       "housing calibration")
+                          .final_cost;
+  }
+  return sum_squares;
+}
+
+// The refined parameters' indices: orientation and position.
+std::vector<int> RefinedHousingParams(const Housing& housing) {
+  const HousingRefinement refinement = housing.Refinement();
+  std::vector<int> refined = refinement.orientation;
+  refined.insert(refined.end(), refinement.position.begin(), refinement.position.end());
+  return refined;
+}
+
+// Standard deviations from the covariance scaled by the residual variance;
+// -1 where the covariance is rank deficient (undetermined).
+void FillStdDevs(const HousingCalibrationSettings& settings, double variance, State* state,
+                 ceres::Problem* problem, HousingCalibrationResult* result) {
+  ceres::Covariance covariance(CalibrationCovarianceOptions(settings.num_threads));
+  double* port = state->housing.params.data();
+  std::vector<std::pair<const double*, const double*>> blocks = {{port, port}};
+  if (settings.refine_intrinsics) blocks.emplace_back(state->intrinsics.data(), state->intrinsics.data());
+  const int m = static_cast<int>(state->housing.params.size());
+  const int n = static_cast<int>(state->intrinsics.size());
+  result->housing_std_dev.assign(static_cast<size_t>(m), 0.0);
+  result->camera_std_dev.assign(static_cast<size_t>(n), 0.0);
+  const std::vector<int> refined = RefinedHousingParams(state->housing);
+  if (!covariance.Compute(blocks, problem)) {
+    // Undetermined (e.g. dome decentering refined together with the
+    // principal point): say so rather than report zeros.
+    LOG(WARNING) << "housing calibration: the covariance is rank deficient (parameters not "
+                    "separable from these views); standard deviations undetermined";
+    for (int k : refined) result->housing_std_dev[static_cast<size_t>(k)] = -1;
+    if (settings.refine_intrinsics) std::fill(result->camera_std_dev.begin(), result->camera_std_dev.end(), -1.0);
+    return;
+  }
+  std::vector<double> c(static_cast<size_t>(m * m));
+  covariance.GetCovarianceBlock(port, port, c.data());
+  for (int k : refined) {
+    result->housing_std_dev[static_cast<size_t>(k)] = std::sqrt(std::max(0.0, c[static_cast<size_t>(k * m + k)] * variance));
+  }
+  if (settings.refine_intrinsics) {
+    std::vector<double> k(static_cast<size_t>(n * n));
+    covariance.GetCovarianceBlock(state->intrinsics.data(), state->intrinsics.data(), k.data());
+    for (int i = 0; i < n; ++i) {
+      result->camera_std_dev[static_cast<size_t>(i)] = std::sqrt(std::max(0.0, k[static_cast<size_t>(i * n + i)] * variance));
+    }
+  }
 }
 
 }  // namespace
@@ -185,130 +255,36 @@ HousingCalibrationResult CalibrateHousing(const std::vector<CalibrationView>& vi
   camera.Validate("camera");
   housing.Validate("housing");
   if (views.size() < 2) throw NumericalError("housing calibration needs at least 2 views");
-  const bool flat = housing.model_id == FlatPort::kId;
   State state;
   state.intrinsics = camera.params;
-  state.axis = Eigen::Vector3d(housing.params[0], housing.params[1], housing.params[2]);
-  state.scalar = housing.params[3];
-  for (int i = 0; i < 4; ++i) state.constants[i] = housing.params[4 + i];
+  state.housing = housing;
   state.poses = InitialPoses(views, camera);
 
   HousingCalibrationResult result;
   result.initial_axis = EstimateAxis(views, camera);
   if (settings.initialize_from_data) {
-    Eigen::Vector3d axis = result.initial_axis;
-    if (flat && axis.z() < 0) axis = -axis;
-    // Coarse 1-D search of the magnitude, scored by pose-only residuals.
-    // A small decentering makes the dome nearly central, where the F
-    // matrices carry little of the axis: the dome's search also walks the
-    // camera's own axes.
-    std::vector<double> magnitudes;
-    std::vector<Eigen::Vector3d> directions = {axis};
-    if (flat) {
-      for (int i = 0; i < 15; ++i) magnitudes.push_back(1e-3 * std::pow(150.0, i / 14.0));
-    } else {
-      const double radius = housing.params[3];
-      for (int i = -9; i <= 9; ++i) magnitudes.push_back(0.09 * i * radius);
-      directions.insert(directions.end(), {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
-                                           Eigen::Vector3d::UnitZ()});
-    }
-    double best_cost = 1e300;
-    State best = state;
-    const std::vector<Pose> start_poses = state.poses;
-    for (const Eigen::Vector3d& direction : directions) {
-      for (const double magnitude : magnitudes) {
-        State trial = state;
-        trial.poses = start_poses;
-        if (flat) {
-          trial.axis = direction;
-          trial.scalar = magnitude;
-        } else {
-          trial.axis = magnitude * direction;
-        }
-        const double cost =
-            PoseOnlyCost(views, camera.model_id, housing.model_id, &trial, settings.num_threads);
-        if (cost < best_cost) {
-          best_cost = cost;
-          best = trial;
-        }
-      }
-    }
-    state = best;
-    LOG(INFO) << "housing_calibrator: axis from the views " << result.initial_axis.transpose()
-              << ", start " << state.axis.transpose() << " / " << state.scalar;
+    state = BestStart(views, camera, state, result.initial_axis, settings.num_threads);
+    LOG(INFO) << "housing_calibrator: axis from the views " << result.initial_axis.transpose() << ", start "
+              << Eigen::Map<const Eigen::VectorXd>(state.housing.params.data(),
+                                                   static_cast<Eigen::Index>(state.housing.params.size()))
+                     .transpose();
   }
-
-  // Joint solves: virtual-camera error first, then the exact reprojection.
-  double sum_squares = 0;
-  int num_free = 0;
   ceres::Problem final_problem;
-  for (const Error error : {Error::kVirtualCamera, Error::kReprojection}) {
-    ceres::Problem local;
-    ceres::Problem& problem = error == Error::kReprojection ? final_problem : local;
-    if (error == Error::kVirtualCamera) {
-      AddResiduals<Error::kVirtualCamera>(views, camera.model_id, housing.model_id, &state, &problem);
-    } else {
-      AddResiduals<Error::kReprojection>(views, camera.model_id, housing.model_id, &state, &problem);
-    }
-    for (Pose& pose : state.poses) problem.SetManifold(pose.data(), PoseManifold());
-    // The intrinsics join only the final, exact solve: the virtual-camera
-    // error back-projects through them, which is ill-conditioned far from
-    // the solution.
-    if (!settings.refine_intrinsics || error == Error::kVirtualCamera) {
-      problem.SetParameterBlockConstant(state.intrinsics.data());
-    }
-    if (flat) {
-      problem.SetManifold(state.axis.data(), new ceres::SphereManifold<3>());
-    } else {
-      problem.SetParameterBlockConstant(&state.scalar);  // the dome radius is given
-    }
-    sum_squares = 2 * SolveCalibration(&problem, settings.max_num_iterations, settings.num_threads,
-                                       "housing calibration")
-                          .final_cost;
-  }
-  // Flat: normal (2 on the sphere) + distance; dome: centre (3).
-  num_free = 6 * static_cast<int>(views.size()) + 3 +
-             (settings.refine_intrinsics ? static_cast<int>(camera.params.size()) : 0);
-  Housing calibrated = housing;
-  AssemblePort(state.axis.data(), &state.scalar, state.constants, calibrated.params.data());
+  const double sum_squares = SolveJointly(views, camera.model_id, settings, &state, &final_problem);
+  const Housing& calibrated = state.housing;
   calibrated.Validate("calibrated housing");
 
-  // Standard deviations: covariance scaled by the residual variance.
+  // Free parameters: the poses, the housing's refined ones (a unit vector
+  // has two), the intrinsics when refined.
+  const HousingRefinement refinement = calibrated.Refinement();
+  const int num_free = 6 * static_cast<int>(views.size()) + (refinement.orientation.empty() ? 0 : 2) +
+                       static_cast<int>(refinement.position.size()) +
+                       (settings.refine_intrinsics ? static_cast<int>(camera.params.size()) : 0);
   int num_points = 0;
   for (const auto& view : views) num_points += static_cast<int>(view.pixels.size());
   const double dof = 2.0 * num_points - num_free;
   const double variance = dof > 0 ? sum_squares / dof : 0;
-  ceres::Covariance covariance(CalibrationCovarianceOptions(settings.num_threads));
-  std::vector<std::pair<const double*, const double*>> blocks = {{state.axis.data(), state.axis.data()}};
-  if (flat) blocks.emplace_back(&state.scalar, &state.scalar);
-  if (settings.refine_intrinsics) blocks.emplace_back(state.intrinsics.data(), state.intrinsics.data());
-  result.housing_std_dev.assign(8, 0.0);
-  result.camera_std_dev.assign(camera.params.size(), 0.0);
-  if (covariance.Compute(blocks, &final_problem)) {
-    double c[9];
-    covariance.GetCovarianceBlock(state.axis.data(), state.axis.data(), c);
-    for (int i = 0; i < 3; ++i) result.housing_std_dev[i] = std::sqrt(std::max(0.0, c[4 * i] * variance));
-    if (flat) {
-      double d;
-      covariance.GetCovarianceBlock(&state.scalar, &state.scalar, &d);
-      result.housing_std_dev[3] = std::sqrt(std::max(0.0, d * variance));
-    }
-    if (settings.refine_intrinsics) {
-      const int n = static_cast<int>(camera.params.size());
-      std::vector<double> k(n * n);
-      covariance.GetCovarianceBlock(state.intrinsics.data(), state.intrinsics.data(), k.data());
-      for (int i = 0; i < n; ++i) result.camera_std_dev[i] = std::sqrt(std::max(0.0, k[i * n + i] * variance));
-    }
-  } else {
-    // Undetermined (e.g. dome decentering refined together with the
-    // principal point): say so rather than report zeros.
-    LOG(WARNING) << "housing calibration: the covariance is rank deficient (parameters not "
-                    "separable from these views); standard deviations undetermined";
-    for (int i = 0; i < (flat ? 4 : 3); ++i) result.housing_std_dev[i] = -1;
-    if (settings.refine_intrinsics) {
-      std::fill(result.camera_std_dev.begin(), result.camera_std_dev.end(), -1.0);
-    }
-  }
+  FillStdDevs(settings, variance, &state, &final_problem, &result);
 
   result.housing = calibrated;
   result.camera = camera;
@@ -316,21 +292,13 @@ HousingCalibrationResult CalibrateHousing(const std::vector<CalibrationView>& vi
   result.num_points = num_points;
   result.overall_rms_px = std::sqrt(sum_squares / std::max(1, num_points));
   result.residual_sigma_px = dof > 0 ? std::sqrt(sum_squares / dof) : 0;
-  // Per-view RMS with the exact projection.
+  const HousedCamera housed{result.camera, calibrated};
   for (size_t v = 0; v < views.size(); ++v) {
     CalibratedView out;
     out.image_name = views[v].image_name;
     out.num_points = static_cast<int>(views[v].pixels.size());
-    const Pose& p = state.poses[v];
-    out.cam_from_target = Rigid3d(Eigen::Quaterniond(p[3], p[0], p[1], p[2]).normalized(),
-                                  Eigen::Vector3d(p[4], p[5], p[6]));
-    double sum = 0;
-    for (size_t i = 0; i < views[v].pixels.size(); ++i) {
-      const auto pixel = ProjectPoint(result.camera, &calibrated,
-                                      out.cam_from_target * views[v].points_in_target[i]);
-      sum += pixel ? (*pixel - views[v].pixels[i]).squaredNorm() : 1e6;
-    }
-    out.rms_px = std::sqrt(sum / std::max(1, out.num_points));
+    out.cam_from_target = FromPose(state.poses[v]);
+    out.rms_px = ViewRms(views[v], housed, out.cam_from_target);
     result.views.push_back(out);
   }
   return result;

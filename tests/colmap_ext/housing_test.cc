@@ -2,6 +2,8 @@
 // total internal reflection, validation, and autodiff derivatives.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/camera/housed_camera.h"
 #include "colmap_ext/housing/housing.h"
@@ -260,6 +262,40 @@ TEST(Housing, RefinementNamesWhatAnAdjustmentMayMoveAndHowFar) {
     EXPECT_DOUBLE_EQ(b.lower, -0.045);
   }
   EXPECT_EQ(dome.InAirFocalRatio(), 1.0);
+}
+
+// A housing calibration's starts keep the model and the user's constants,
+// move only what the model refines, and stay inside the adjustment's bounds.
+TEST(Housing, StartCandidatesMoveOnlyTheRefinedParametersWithinTheBounds) {
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.05, -0.02, -1).normalized();  // sign as the views give it
+  for (const Housing& housing :
+       {Housing::FromName("FLATPORT", {0, 0, 1, 0.01, 0.008, 1, 1.473, 1.334}, "test"),
+        Housing::FromName("DOMEPORT", {0, 0, 0, 0.05, 0.006, 1, 1.473, 1.334}, "test")}) {
+    const std::vector<Housing> starts = housing.StartCandidates(axis);
+    ASSERT_GE(starts.size(), 10u) << housing.ModelName();
+    const HousingRefinement refinement = housing.Refinement();
+    std::vector<int> refined = refinement.orientation;
+    refined.insert(refined.end(), refinement.position.begin(), refinement.position.end());
+    for (const Housing& start : starts) {
+      EXPECT_TRUE(start.SameModel(housing));
+      EXPECT_NO_THROW(start.Validate("start"));
+      for (size_t k = 0; k < housing.params.size(); ++k) {
+        if (std::find(refined.begin(), refined.end(), static_cast<int>(k)) == refined.end()) {
+          EXPECT_EQ(start.params[k], housing.params[k]) << housing.ModelName() << " parameter " << k;
+        }
+      }
+      for (const HousingParamBound& bound : start.Refinement().bounds) {
+        EXPECT_GE(start.params[static_cast<size_t>(bound.index)], bound.lower) << housing.ModelName();
+        EXPECT_LE(start.params[static_cast<size_t>(bound.index)], bound.upper) << housing.ModelName();
+      }
+    }
+    if (!refinement.orientation.empty()) {
+      // A flat port's normal faces forward, along the axis up to sign.
+      const Eigen::Vector3d normal(starts[0].params[0], starts[0].params[1], starts[0].params[2]);
+      EXPECT_GT(normal.z(), 0);
+      EXPECT_NEAR(std::abs(normal.dot(axis)), 1.0, 1e-12);
+    }
+  }
 }
 
 TEST(Housing, HousedCameraProjectsThroughItsHousingOrInAir) {
