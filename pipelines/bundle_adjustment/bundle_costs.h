@@ -37,6 +37,8 @@ struct ObservationModel {
   int housing_model_id = kNoHousing;
   std::vector<double> housing;     // used as a constant where not a block
 
+  bool HasHousing() const { return housing_model_id != kNoHousing; }
+
   // The camera's (and its housing's) model and current parameters.
   static ObservationModel Of(const HousedCamera& camera) {
     ObservationModel model;

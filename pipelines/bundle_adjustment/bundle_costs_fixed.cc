@@ -127,11 +127,11 @@ ceres::CostFunction* CreateFixedRayCost(const Eigen::Vector3d& center, const Eig
 
 ceres::CostFunction* CreateFixedReprojectionCost(const ObservationModel& model, CostBlocks blocks,
                                                  const Eigen::Vector2d& observed_px, double sigma_px) {
-  PORTCAL_CHECK(blocks != CostBlocks::kAll || model.housing_model_id == kNoHousing);
+  PORTCAL_CHECK(blocks != CostBlocks::kAll || !model.HasHousing());
   ceres::CostFunction* cost = nullptr;
   VisitCameraModel(model.camera_model_id, [&](auto camera_tag) {
     using CameraModel = decltype(camera_tag);
-    if (model.housing_model_id == kNoHousing) {
+    if (!model.HasHousing()) {
       cost = Create<CameraModel, void>(model, blocks, observed_px, sigma_px);
       return;
     }

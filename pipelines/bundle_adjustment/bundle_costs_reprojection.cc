@@ -34,10 +34,10 @@ struct PosePointHousingError
 
 ceres::CostFunction* CreateReprojectionCost(const ObservationModel& model, CostBlocks blocks,
                                             const Eigen::Vector2d& observed_px, double sigma_px) {
-  PORTCAL_CHECK_MSG(blocks != CostBlocks::kPosePointHousing || model.housing_model_id != kNoHousing,
+  PORTCAL_CHECK_MSG(blocks != CostBlocks::kPosePointHousing || model.HasHousing(),
                     "a housing block without a housing");
   const bool housing_block = blocks == CostBlocks::kAll || blocks == CostBlocks::kPosePointHousing;
-  if (!housing_block || model.housing_model_id == kNoHousing) {
+  if (!housing_block || !model.HasHousing()) {
     return CreateFixedReprojectionCost(model, blocks, observed_px, sigma_px);
   }
   ceres::CostFunction* cost = nullptr;
