@@ -10,6 +10,7 @@
 
 #include "colmap_ext/io/ground_truth.h"
 #include "colmap_ext/io/sparse_model.h"
+#include "colmap_ext/camera/housed_camera.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "pipelines/synthetic/renderer.h"
@@ -231,6 +232,149 @@ void WriteImage(const fs::path& path, const cv::Mat& image) {
   if (!cv::imwrite(path.string(), image)) throw InputError(path.string() + ": cannot write image");
 }
 
+// The set's ground truth before any frame: names, cameras, housings, rig.
+GroundTruth TruthHeader(const DatasetConfig& config, const std::string& dir1, const std::string& dir2) {
+  GroundTruth truth;
+  truth.name = config.name;
+  truth.description = config.description;
+  truth.seed = static_cast<int64_t>(config.seed);
+  truth.camera = config.camera;
+  truth.housing = config.housing;
+  if (config.stereo) {
+    truth.stereo = StereoTruth{config.cam2_from_cam1, config.camera2, config.housing2,
+                               config.cam2_from_cam1.Inverse().translation.norm(),
+                               {dir1, dir2}};
+  }
+  return truth;
+}
+
+// What the frames show: a target (with clutter) or, for a survey, a
+// textured seabed along a planned path.
+struct Scene {
+  BuiltTarget target;
+  std::unique_ptr<SeabedObject> seabed;
+  SurveyPath survey;
+  std::optional<Clutter> clutter;
+};
+
+Scene BuildScene(const DatasetConfig& config, const HousedCamera& camera1, GroundTruth* truth) {
+  Scene scene;
+  if (config.survey) {
+    scene.survey = PlanSurvey(config.camera, camera1.HousingOrNull(), config.survey_options);
+    const SurveyPath& survey = scene.survey;
+    const SurveyOptions& s = config.survey_options;
+    const int cols = static_cast<int>(std::ceil((survey.area[1] - survey.area[0]) / s.texel_m));
+    const int rows = static_cast<int>(std::ceil((survey.area[3] - survey.area[2]) / s.texel_m));
+    const int shapes = static_cast<int>((survey.area[1] - survey.area[0]) * (survey.area[3] - survey.area[2]) * 600);
+    auto texture = std::make_shared<RasterTexture>(
+        RandomShapesRaster(cols, rows, shapes, s.texture_seed, 2, 10), survey.area[0], survey.area[2], s.texel_m);
+    scene.seabed = std::make_unique<SeabedObject>(texture, s.roughness_m, s.relief_wavelength_m, s.texture_seed + 1);
+    truth->target.type = "seabed";
+  } else {
+    scene.target = BuildTarget(config.target, config.render.levels);
+    truth->target = scene.target.description;
+  }
+  if (config.clutter) scene.clutter = MakeClutter(config);
+  return scene;
+}
+
+// A target view camera 1 sees; with a rig, resampled until camera 2 sees
+// the target too.
+Rigid3d SampleRigView(const DatasetConfig& config, const Scene& scene, const HousedCamera& camera1,
+                      const HousedCamera& camera2, const std::vector<Eigen::Vector3d>& check_points,
+                      std::mt19937_64* rng) {
+  for (int attempt = 0;; ++attempt) {
+    const Rigid3d cam_from_target = SampleTargetView(config.camera, camera1.HousingOrNull(), check_points,
+                                                     scene.target.center, scene.target.front_normal, config.poses, rng);
+    if (!config.stereo) return cam_from_target;
+    bool seen = true;
+    const double margin = config.poses.border_margin_px;
+    for (const Eigen::Vector3d& p : check_points) {
+      const auto pixel = camera2.Project(config.cam2_from_cam1 * cam_from_target * p);
+      seen = seen && pixel && pixel->x() >= margin && pixel->y() >= margin &&
+             pixel->x() <= config.camera2.width - margin && pixel->y() <= config.camera2.height - margin;
+    }
+    if (seen) return cam_from_target;
+    if (attempt > 200) {
+      throw NumericalError("stereo: no pose found where both cameras see the target; "
+                           "check stereo.cam2_from_cam1 and poses.distance");
+    }
+  }
+}
+
+// Renders one frame (both cameras of a rig) into the staging folder and
+// returns its truth.
+struct FrameRenderer {
+  const DatasetConfig& config;
+  const Scene& scene;
+  const HousedCamera& camera1;
+  const HousedCamera& camera2;
+  const RayMap& rays1;
+  const std::optional<RayMap>& rays2;  // with a rig
+  fs::path staging;
+  std::string dir1, dir2;
+
+  FrameTruth Render(int frame, const Rigid3d& cam_from_target, std::mt19937_64* rng) const {
+    std::vector<PlacedObject> objects;
+    objects.push_back({config.survey ? static_cast<const SceneObject*>(scene.seabed.get()) : scene.target.object.get(),
+                       cam_from_target});
+    if (scene.clutter) objects.push_back({scene.clutter->object.get(), scene.clutter->cam_from_clutter});
+    std::unique_ptr<SceneObject> occluder;
+    std::uniform_real_distribution<double> unit(0, 1);
+    if (!config.survey && unit(*rng) < config.occlusion_probability) {
+      Rigid3d cam_from_occluder;
+      occluder = MakeOccluder(scene.target, cam_from_target, config.occlusion_fraction, rng, &cam_from_occluder);
+      objects.push_back({occluder.get(), cam_from_occluder});
+    }
+    FrameTruth truth;
+    truth.frame = frame;
+    const std::string name = ImageName(frame, config.num_images);
+    const uint64_t noise_seed = config.seed * 1000003ULL + 2ULL * frame;
+    WriteImage(staging / dir1 / name, RenderImage(rays1, objects, config.render, noise_seed));
+    truth.cam1 = config.survey ? ImageTruth{}
+                               : TargetTruth(config.camera, camera1.HousingOrNull(), scene.target, cam_from_target,
+                                             objects, occluder != nullptr);
+    truth.cam1.file = dir1 + "/" + name;
+    truth.cam1.cam_from_target = cam_from_target;
+    if (config.stereo) {
+      std::vector<PlacedObject> objects2 = objects;
+      for (PlacedObject& placed : objects2) placed.cam_from_object = config.cam2_from_cam1 * placed.cam_from_object;
+      WriteImage(staging / dir2 / name, RenderImage(*rays2, objects2, config.render, noise_seed + 1));
+      const Rigid3d cam2_from_target = config.cam2_from_cam1 * cam_from_target;
+      truth.cam2 = config.survey ? ImageTruth{}
+                                 : TargetTruth(config.camera2, camera2.HousingOrNull(), scene.target,
+                                               cam2_from_target, objects2, occluder != nullptr);
+      truth.cam2->file = dir2 + "/" + name;
+      truth.cam2->cam_from_target = cam2_from_target;
+    }
+    return truth;
+  }
+};
+
+// The ground truth, navigation and dot files next to the images, then the
+// finished set moved into `output` (a failed run leaves it as it was).
+void FinishSet(const SynthesizeOptions& options, const DatasetConfig& config, const Scene& scene,
+               const GroundTruth& truth, const fs::path& staging, const fs::path& output) {
+  WriteGroundTruth(truth, staging / "ground_truth.yaml",
+                   ExtraYaml(config, scene.clutter ? &*scene.clutter : nullptr,
+                             config.survey ? &scene.survey : nullptr));
+  if (config.survey) {
+    const std::string navigation = NavigationText(truth, config.survey_options.navigation_sigma_m, config.seed);
+    WriteFileAtomically(staging / "navigation.txt", false, [&](std::ostream& out) { out << navigation; });
+  }
+  if (!config.survey && config.target.type == "target3d") {
+    const std::string csv = DotsCsv(scene.target.dots);
+    WriteFileAtomically(staging / "target_dots.csv", false, [&](std::ostream& out) { out << csv; });
+  }
+  fs::copy_file(options.config_path, staging / "config_used.yaml", fs::copy_options::overwrite_existing);
+  for (const char* entry : {"images", "ground_truth.yaml", "target_dots.csv", "config_used.yaml", "navigation.txt"}) {
+    if (!fs::exists(staging / entry)) continue;
+    fs::remove_all(output / entry);
+    fs::rename(staging / entry, output / entry);
+  }
+  fs::remove_all(staging);
+}
+
 }  // namespace
 
 SynthesizeSummary RunSynthesize(const SynthesizeOptions& options, ProgressSink& progress) {
@@ -239,8 +383,7 @@ SynthesizeSummary RunSynthesize(const SynthesizeOptions& options, ProgressSink& 
   DatasetConfig config = ReadDatasetConfig(options.config_path);
   if (options.seed >= 0) config.seed = static_cast<uint64_t>(options.seed);
   config.render.num_threads = options.num_threads;
-  const Housing* housing1 = config.housing ? &*config.housing : nullptr;
-  const Housing* housing2 = config.housing2 ? &*config.housing2 : nullptr;
+  const HousedCamera camera1{config.camera, config.housing}, camera2{config.camera2, config.housing2};
   LOG(INFO) << "synthesize: " << config.name << ", " << config.num_images << " frames of "
             << config.camera.width << "x" << config.camera.height << (config.stereo ? " (stereo)" : "")
             << ", " << (config.survey ? "survey" : config.target.type);
@@ -254,131 +397,32 @@ SynthesizeSummary RunSynthesize(const SynthesizeOptions& options, ProgressSink& 
   fs::create_directories(staging / dir1);
   if (config.stereo) fs::create_directories(staging / dir2);
 
-  GroundTruth truth;
-  truth.name = config.name;
-  truth.description = config.description;
-  truth.seed = static_cast<int64_t>(config.seed);
-  truth.camera = config.camera;
-  truth.housing = config.housing;
-  if (config.stereo) {
-    truth.stereo = StereoTruth{config.cam2_from_cam1, config.camera2, config.housing2,
-                               config.cam2_from_cam1.Inverse().translation.norm(),
-                               {dir1, dir2}};
-  }
-
+  GroundTruth truth = TruthHeader(config, dir1, dir2);
   std::mt19937_64 rng(config.seed);
-  BuiltTarget target;
-  std::unique_ptr<SeabedObject> seabed;
-  SurveyPath survey;
-  if (config.survey) {
-    survey = PlanSurvey(config.camera, housing1, config.survey_options);
-    const SurveyOptions& s = config.survey_options;
-    const int cols = static_cast<int>(std::ceil((survey.area[1] - survey.area[0]) / s.texel_m));
-    const int rows = static_cast<int>(std::ceil((survey.area[3] - survey.area[2]) / s.texel_m));
-    const int shapes = static_cast<int>((survey.area[1] - survey.area[0]) * (survey.area[3] - survey.area[2]) * 600);
-    auto texture = std::make_shared<RasterTexture>(
-        RandomShapesRaster(cols, rows, shapes, s.texture_seed, 2, 10), survey.area[0], survey.area[2], s.texel_m);
-    seabed = std::make_unique<SeabedObject>(texture, s.roughness_m, s.relief_wavelength_m, s.texture_seed + 1);
-    truth.target.type = "seabed";
-  } else {
-    target = BuildTarget(config.target, config.render.levels);
-    truth.target = target.description;
-  }
-  std::optional<Clutter> clutter;
-  if (config.clutter) clutter = MakeClutter(config);
+  const Scene scene = BuildScene(config, camera1, &truth);
 
   const auto ray_start = Clock::now();
-  const RayMap rays1(config.camera, housing1, config.render.spp, options.num_threads);
+  const RayMap rays1(config.camera, camera1.HousingOrNull(), config.render.spp, options.num_threads);
   std::optional<RayMap> rays2;
-  if (config.stereo) rays2.emplace(config.camera2, housing2, config.render.spp, options.num_threads);
+  if (config.stereo) rays2.emplace(config.camera2, camera2.HousingOrNull(), config.render.spp, options.num_threads);
   const double ray_seconds = Seconds(ray_start);
 
   progress.Begin("synthesize: frames", config.num_images);
   const auto render_start = Clock::now();
   const std::vector<Eigen::Vector3d>& check_points =
-      config.poses.visibility == "markers" ? target.marker_points : target.outline_points;
+      config.poses.visibility == "markers" ? scene.target.marker_points : scene.target.outline_points;
+  const FrameRenderer renderer{config, scene, camera1, camera2, rays1, rays2,
+                               staging, dir1, dir2};
   for (int frame = 0; frame < config.num_images; ++frame) {
     CancelFlag::ThrowIfRequested();
-    Rigid3d cam_from_target;
-    if (config.survey) {
-      cam_from_target = survey.cam_from_world[frame];
-    } else {
-      // Stereo: both cameras must see the target; resample until they do.
-      for (int attempt = 0;; ++attempt) {
-        cam_from_target = SampleTargetView(config.camera, housing1, check_points, target.center,
-                                           target.front_normal, config.poses, &rng);
-        if (!config.stereo) break;
-        bool seen = true;
-        for (const Eigen::Vector3d& p : check_points) {
-          const auto pixel = ProjectPoint(config.camera2, housing2, config.cam2_from_cam1 * cam_from_target * p);
-          seen = seen && pixel && pixel->x() >= config.poses.border_margin_px &&
-                 pixel->y() >= config.poses.border_margin_px &&
-                 pixel->x() <= config.camera2.width - config.poses.border_margin_px &&
-                 pixel->y() <= config.camera2.height - config.poses.border_margin_px;
-        }
-        if (seen) break;
-        if (attempt > 200) {
-          throw NumericalError("stereo: no pose found where both cameras see the target; "
-                               "check stereo.cam2_from_cam1 and poses.distance");
-        }
-      }
-    }
-    std::vector<PlacedObject> objects;
-    objects.push_back({config.survey ? static_cast<const SceneObject*>(seabed.get()) : target.object.get(),
-                       cam_from_target});
-    if (clutter) objects.push_back({clutter->object.get(), clutter->cam_from_clutter});
-    std::unique_ptr<SceneObject> occluder;
-    std::uniform_real_distribution<double> unit(0, 1);
-    if (!config.survey && unit(rng) < config.occlusion_probability) {
-      Rigid3d cam_from_occluder;
-      occluder = MakeOccluder(target, cam_from_target, config.occlusion_fraction, &rng, &cam_from_occluder);
-      objects.push_back({occluder.get(), cam_from_occluder});
-    }
-
-    FrameTruth frame_truth;
-    frame_truth.frame = frame;
-    const std::string name = ImageName(frame, config.num_images);
-    const uint64_t noise_seed = config.seed * 1000003ULL + 2ULL * frame;
-    WriteImage(staging / dir1 / name, RenderImage(rays1, objects, config.render, noise_seed));
-    frame_truth.cam1 = config.survey ? ImageTruth{} :
-        TargetTruth(config.camera, housing1, target, cam_from_target, objects, occluder != nullptr);
-    frame_truth.cam1.file = dir1 + "/" + name;
-    frame_truth.cam1.cam_from_target = cam_from_target;
-    if (config.stereo) {
-      std::vector<PlacedObject> objects2 = objects;
-      for (PlacedObject& placed : objects2) placed.cam_from_object = config.cam2_from_cam1 * placed.cam_from_object;
-      WriteImage(staging / dir2 / name, RenderImage(*rays2, objects2, config.render, noise_seed + 1));
-      const Rigid3d cam2_from_target = config.cam2_from_cam1 * cam_from_target;
-      frame_truth.cam2 = config.survey ? ImageTruth{} :
-          TargetTruth(config.camera2, housing2, target, cam2_from_target, objects2, occluder != nullptr);
-      frame_truth.cam2->file = dir2 + "/" + name;
-      frame_truth.cam2->cam_from_target = cam2_from_target;
-    }
-    truth.images.push_back(frame_truth);
+    const Rigid3d cam_from_target = config.survey ? scene.survey.cam_from_world[frame]
+                                                  : SampleRigView(config, scene, camera1, camera2, check_points, &rng);
+    truth.images.push_back(renderer.Render(frame, cam_from_target, &rng));
     progress.Advance(1);
   }
   progress.End();
   const double render_seconds = Seconds(render_start);
-
-  WriteGroundTruth(truth, staging / "ground_truth.yaml",
-                   ExtraYaml(config, clutter ? &*clutter : nullptr, config.survey ? &survey : nullptr));
-  if (config.survey) {
-    const std::string navigation = NavigationText(truth, config.survey_options.navigation_sigma_m, config.seed);
-    WriteFileAtomically(staging / "navigation.txt", false, [&](std::ostream& out) { out << navigation; });
-  }
-  if (!config.survey && config.target.type == "target3d") {
-    const std::string csv = DotsCsv(target.dots);
-    WriteFileAtomically(staging / "target_dots.csv", false, [&](std::ostream& out) { out << csv; });
-  }
-  fs::copy_file(options.config_path, staging / "config_used.yaml", fs::copy_options::overwrite_existing);
-
-  // Move the finished set into place.
-  for (const char* entry : {"images", "ground_truth.yaml", "target_dots.csv", "config_used.yaml", "navigation.txt"}) {
-    if (!fs::exists(staging / entry)) continue;
-    fs::remove_all(output / entry);
-    fs::rename(staging / entry, output / entry);
-  }
-  fs::remove_all(staging);
+  FinishSet(options, config, scene, truth, staging, output);
 
   SynthesizeSummary summary;
   summary.num_images = config.num_images;
