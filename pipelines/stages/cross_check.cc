@@ -130,28 +130,12 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views, const C
   return out;
 }
 
-}  // namespace
-
-void CrossCheckOptions::Check() const {
-  if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
-  if (input_calibration.empty()) throw OptionError("--input_calibration", "''", "a calibration.yaml");
-  if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
-  if (folds == 1 || folds < 0) throw OptionError("--CrossCheck.folds", std::to_string(folds), "0 or >= 2");
-  if (!(max_diff_px > 0)) throw OptionError("--CrossCheck.max_diff_px", std::to_string(max_diff_px), "> 0");
-  if (gridn_width < 3) throw OptionError("--CrossCheck.gridn_width", std::to_string(gridn_width), ">= 3");
-  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
-}
-
-CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& progress) {
-  options.Check();
-  const CalibrationReport input = ReadCalibrationReport(options.input_calibration);
-  // A model mrcal cannot express stops here, naming the nearest one.
-  const std::string lensmodel = MrcalLensModelFor(input.camera.ModelName());
-
+// The target views of the calibrated camera that the input calibration
+// used (its dropped outlier views stay out); the image size must match.
+std::vector<CalibrationView> ViewsOfInput(const CrossCheckOptions& options, const CalibrationReport& input) {
   Database database(options.database_path, Database::OpenMode::kReadOnly);
   const TargetViews target_views = ReadTargetViews(&database);
   const camera_t camera_id = ChooseCamera(target_views, options.camera_id, options.database_path);
-  // The views the input calibration used: its dropped outlier views stay out.
   std::set<std::string> dropped;
   for (const CalibratedView& view : input.views) {
     if (view.dropped) dropped.insert(view.image_name);
@@ -170,6 +154,114 @@ CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& 
                      std::to_string(camera_id) + " of " + options.database_path + " (" +
                      std::to_string(db_camera.width) + "x" + std::to_string(db_camera.height) + ")");
   }
+  return views;
+}
+
+// A cause when the input is not portcal's solution of these observations.
+void NoteResolveDifference(const Camera& input, const Camera& resolved, const ProjectionDiffOptions& diff_options,
+                           CrossCheckResult* result) {
+  ProjectionDiffOptions plain = diff_options;
+  plain.focus_radius = 1e9;  // the whole imager, unweighted
+  const ProjectionDiff resolve = ComputeProjectionDiff({input, {}}, {resolved, {}}, plain);
+  if (resolve.mean_px > 0.01) {
+    result->causes.push_back(
+        "the input calibration is not portcal's solution of these observations (re-solving "
+        "from it moves the projection by " + FormatFixed(resolve.mean_px, 3) +
+        " px on average): made from other views or settings?");
+  }
+}
+
+// mrcal's fit, outliers and board warp into the result.
+void NoteMrcalSolution(const std::vector<CalibrationView>& views, const MrcalCalibrationResult& mrcal,
+                       CrossCheckResult* result) {
+  result->num_points = mrcal.num_points;
+  result->mrcal_rms_px = mrcal.rms_px;
+  result->mrcal_outliers = mrcal.num_outliers;
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (!mrcal.outliers[v].empty()) {
+      result->mrcal_outliers_per_view.emplace_back(views[v].image_name, static_cast<int>(mrcal.outliers[v].size()));
+    }
+  }
+  result->mrcal_warp = mrcal.board_warp;
+  result->mrcal_warp_std_dev = mrcal.board_warp_std_dev;
+}
+
+// Why portcal and mrcal disagree: the differences between the two solvers'
+// problems, strongest evidence first.
+void ExplainDisagreement(const CalibrationReport& input, const std::string& lensmodel,
+                         const MrcalCalibrationResult& mrcal, bool warp_cause, bool outlier_cause,
+                         bool mrcal_regularization, CrossCheckResult* result) {
+  if (warp_cause) {
+    result->causes.push_back(
+        "board warp: mrcal finds the board bent by x " + FormatFixed(mrcal.board_warp.x() * 1e3, 2) +
+        " +- " + FormatFixed(mrcal.board_warp_std_dev.x() * 1e3, 2) + " mm, y " +
+        FormatFixed(mrcal.board_warp.y() * 1e3, 2) + " +- " + FormatFixed(mrcal.board_warp_std_dev.y() * 1e3, 2) +
+        " mm, portcal holds it flat (camera_calibrator --Calibration.estimate_board_warp 1)");
+  }
+  if (outlier_cause) {
+    result->causes.push_back("outliers: mrcal rejected " + std::to_string(mrcal.num_outliers) +
+                             " corners in " + std::to_string(result->mrcal_outliers_per_view.size()) +
+                             " views; portcal fits every corner");
+  }
+  const std::string freedom = MrcalExtraFreedom(input.camera.ModelName());
+  if (!freedom.empty()) {
+    result->causes.push_back("parameterisation: mrcal's " + lensmodel + " frees " + freedom + ", which " +
+                             input.camera.ModelName() + " holds");
+  }
+  if (mrcal_regularization) {
+    result->causes.push_back("regularisation: mrcal pulls the distortions and the principal point "
+                             "weakly towards zero and the centre (a small bias by design)");
+  }
+}
+
+// portcal re-run with what mrcal did differently (board warp, without its
+// outlier corners), compared again; returns the views it used.
+std::vector<CalibrationView> RerunAsMrcal(const std::vector<CalibrationView>& views, const Camera& camera,
+                                          const MrcalCalibrationResult& mrcal, bool outlier_cause,
+                                          const ProjectionDiffOptions& diff_options, const std::filesystem::path& dir,
+                                          CameraCalibrationSettings* rerun_settings, CrossCheckResult* result) {
+  std::vector<CalibrationView> rerun_views = views;
+  rerun_settings->estimate_board_warp = true;
+  if (outlier_cause) {
+    for (size_t v = 0; v < views.size(); ++v) {
+      std::vector<int> drop = mrcal.outliers[v];
+      std::sort(drop.rbegin(), drop.rend());
+      for (const int i : drop) {
+        rerun_views[v].pixels.erase(rerun_views[v].pixels.begin() + i);
+        rerun_views[v].points_in_target.erase(rerun_views[v].points_in_target.begin() + i);
+      }
+    }
+  }
+  result->rerun_description = std::string("portcal with board warp") +
+                              (outlier_cause ? " and without mrcal's outlier corners" : "");
+  const CameraCalibrationResult rerun = CalibrateCamera(rerun_views, camera, *rerun_settings);
+  result->rerun_diff = ComputeProjectionDiff(LensOf(rerun), LensOf(mrcal), diff_options);
+  result->rerun_parameters = CompareParameters(rerun.camera, rerun.params_std_dev, mrcal);
+  WriteProjectionDiffHeatMap(*result->rerun_diff, static_cast<int>(camera.width),
+                             static_cast<int>(camera.height), "portcal (re-run) vs mrcal",
+                             dir / "projection_diff_rerun.png");
+  return rerun_views;
+}
+
+}  // namespace
+
+void CrossCheckOptions::Check() const {
+  if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
+  if (input_calibration.empty()) throw OptionError("--input_calibration", "''", "a calibration.yaml");
+  if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
+  if (folds == 1 || folds < 0) throw OptionError("--CrossCheck.folds", std::to_string(folds), "0 or >= 2");
+  if (!(max_diff_px > 0)) throw OptionError("--CrossCheck.max_diff_px", std::to_string(max_diff_px), "> 0");
+  if (gridn_width < 3) throw OptionError("--CrossCheck.gridn_width", std::to_string(gridn_width), ">= 3");
+  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+}
+
+CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& progress) {
+  options.Check();
+  const CalibrationReport input = ReadCalibrationReport(options.input_calibration);
+  // A model mrcal cannot express stops here, naming the nearest one.
+  const std::string lensmodel = MrcalLensModelFor(input.camera.ModelName());
+
+  const std::vector<CalibrationView> views = ViewsOfInput(options, input);
   std::filesystem::create_directories(options.output_path);
 
   // portcal's solution re-solved from the input (same model, same board
@@ -194,34 +286,14 @@ CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& 
   }
   ProjectionDiffOptions diff_options;
   diff_options.gridn_width = options.gridn_width;
-  {
-    ProjectionDiffOptions plain = diff_options;
-    plain.focus_radius = 1e9;  // the whole imager, unweighted
-    const ProjectionDiff resolve = ComputeProjectionDiff({input.camera, {}}, {portcal.camera, {}}, plain);
-    if (resolve.mean_px > 0.01) {
-      result.causes.push_back(
-          "the input calibration is not portcal's solution of these observations (re-solving "
-          "from it moves the projection by " + FormatFixed(resolve.mean_px, 3) +
-          " px on average): made from other views or settings?");
-    }
-  }
+  NoteResolveDifference(input.camera, portcal.camera, diff_options, &result);
 
   MrcalCalibrationOptions mrcal_options;
   mrcal_options.estimate_board_warp = options.mrcal_board_warp;
   mrcal_options.reject_outliers = options.mrcal_outlier_rejection;
   mrcal_options.regularization = options.mrcal_regularization;
   const MrcalCalibrationResult mrcal = CalibrateWithMrcal(views, input.camera, Poses(portcal), mrcal_options);
-  result.num_points = mrcal.num_points;
-  result.mrcal_rms_px = mrcal.rms_px;
-  result.mrcal_outliers = mrcal.num_outliers;
-  for (size_t v = 0; v < views.size(); ++v) {
-    if (!mrcal.outliers[v].empty()) {
-      result.mrcal_outliers_per_view.emplace_back(views[v].image_name,
-                                                  static_cast<int>(mrcal.outliers[v].size()));
-    }
-  }
-  result.mrcal_warp = mrcal.board_warp;
-  result.mrcal_warp_std_dev = mrcal.board_warp_std_dev;
+  NoteMrcalSolution(views, mrcal, &result);
   const std::vector<double> portcal_std_dev =
       input.parameters_std_dev.size() == input.camera.params.size() ? input.parameters_std_dev
                                                                       : portcal.params_std_dev;
@@ -235,59 +307,18 @@ CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& 
   WriteMrcalCameraModel(mrcal.camera, Rigid3d(), dir / "mrcal.cameramodel");
   WriteMrcalCameraModel(input.camera, Rigid3d(), dir / "portcal.cameramodel");
 
-  // Why they disagree: the differences between the two solvers' problems,
-  // strongest evidence first.
   const double max_z = std::accumulate(result.parameters.begin(), result.parameters.end(), 0.0,
                                        [](double m, const ParameterComparison& p) { return std::max(m, std::abs(p.z)); });
   const bool warp_cause = !input.board_warp && options.mrcal_board_warp && WarpSignificant(mrcal);
   const bool outlier_cause = mrcal.num_outliers > 0;
   if (!result.pass || max_z > 3) {
-    if (warp_cause) {
-      result.causes.push_back(
-          "board warp: mrcal finds the board bent by x " + FormatFixed(mrcal.board_warp.x() * 1e3, 2) +
-          " +- " + FormatFixed(mrcal.board_warp_std_dev.x() * 1e3, 2) + " mm, y " +
-          FormatFixed(mrcal.board_warp.y() * 1e3, 2) + " +- " + FormatFixed(mrcal.board_warp_std_dev.y() * 1e3, 2) +
-          " mm, portcal holds it flat (camera_calibrator --Calibration.estimate_board_warp 1)");
-    }
-    if (outlier_cause) {
-      result.causes.push_back("outliers: mrcal rejected " + std::to_string(mrcal.num_outliers) +
-                              " corners in " + std::to_string(result.mrcal_outliers_per_view.size()) +
-                              " views; portcal fits every corner");
-    }
-    const std::string freedom = MrcalExtraFreedom(input.camera.ModelName());
-    if (!freedom.empty()) {
-      result.causes.push_back("parameterisation: mrcal's " + lensmodel + " frees " + freedom + ", which " +
-                              input.camera.ModelName() + " holds");
-    }
-    if (options.mrcal_regularization) {
-      result.causes.push_back("regularisation: mrcal pulls the distortions and the principal point "
-                              "weakly towards zero and the centre (a small bias by design)");
-    }
+    ExplainDisagreement(input, lensmodel, mrcal, warp_cause, outlier_cause, options.mrcal_regularization, &result);
   }
 
   CameraCalibrationSettings rerun_settings = settings;
   std::vector<CalibrationView> rerun_views = views;
   if ((!result.pass || max_z > 3) && (warp_cause || outlier_cause)) {
-    // Re-run portcal with what mrcal did differently, and compare again.
-    rerun_settings.estimate_board_warp = true;
-    if (outlier_cause) {
-      for (size_t v = 0; v < views.size(); ++v) {
-        std::vector<int> drop = mrcal.outliers[v];
-        std::sort(drop.rbegin(), drop.rend());
-        for (const int i : drop) {
-          rerun_views[v].pixels.erase(rerun_views[v].pixels.begin() + i);
-          rerun_views[v].points_in_target.erase(rerun_views[v].points_in_target.begin() + i);
-        }
-      }
-    }
-    result.rerun_description = std::string("portcal with board warp") +
-                               (outlier_cause ? " and without mrcal's outlier corners" : "");
-    const CameraCalibrationResult rerun = CalibrateCamera(rerun_views, input.camera, rerun_settings);
-    result.rerun_diff = ComputeProjectionDiff(LensOf(rerun), LensOf(mrcal), diff_options);
-    result.rerun_parameters = CompareParameters(rerun.camera, rerun.params_std_dev, mrcal);
-    WriteProjectionDiffHeatMap(*result.rerun_diff, static_cast<int>(input.camera.width),
-                               static_cast<int>(input.camera.height), "portcal (re-run) vs mrcal",
-                               dir / "projection_diff_rerun.png");
+    rerun_views = RerunAsMrcal(views, input.camera, mrcal, outlier_cause, diff_options, dir, &rerun_settings, &result);
   }
 
   if (options.folds >= 2) {
