@@ -168,6 +168,119 @@ std::vector<std::pair<image_t, image_t>> LoopPairs(Database* database,
   return pairs;
 }
 
+// The candidate pairs of the mode (and, sequential, the loop candidates).
+std::vector<std::pair<image_t, image_t>> CandidatePairs(const FeatureMatcherOptions& options,
+                                                        const std::vector<DatabaseImage>& images,
+                                                        const std::vector<image_t>& ids, const std::string& stage,
+                                                        Database* db, ProgressSink& progress,
+                                                        FeatureMatcherSummary* summary) {
+  std::vector<std::pair<image_t, image_t>> candidates;
+  if (options.mode == PairingMode::kExhaustive) {
+    candidates = ExhaustivePairs(ids);
+  } else if (options.mode == PairingMode::kSequential) {
+    candidates = SequentialPairs(ids, options.sequential);
+  } else {
+    std::vector<std::pair<image_t, Eigen::Vector3d>> positions;
+    for (const DatabaseImage& image : images) {
+      if (const auto position = image.PriorPosition()) positions.emplace_back(image.image_id, *position);
+    }
+    if (positions.size() < 2) {
+      throw InputError(options.database_path + ": " + std::to_string(positions.size()) +
+                       " image(s) with a position prior; spatial matching needs them (run pose_prior_importer)");
+    }
+    if (positions.size() < images.size()) {
+      LOG(WARNING) << stage << ": " << images.size() - positions.size()
+                   << " image(s) without a position prior are not matched";
+    }
+    candidates = SpatialPairs(positions, options.spatial);
+  }
+  if (options.mode == PairingMode::kSequential && options.sequential.loop_detection) {
+    const auto loops = LoopPairs(db, ids, options.sequential, progress);
+    summary->num_loop_pairs = static_cast<int64_t>(loops.size());
+    candidates.insert(candidates.end(), loops.begin(), loops.end());
+  }
+  return candidates;
+}
+
+// Unique unordered pairs, minus those already done unless `overwrite`.
+std::vector<std::pair<image_t, image_t>> PairsToMatch(const std::vector<std::pair<image_t, image_t>>& candidates,
+                                                      bool overwrite, Database* db, FeatureMatcherSummary* summary) {
+  std::unordered_set<image_pair_t> done;
+  if (!overwrite) {
+    for (image_pair_t id : db->ReadTwoViewGeometryPairIds()) done.insert(id);
+  }
+  std::vector<std::pair<image_t, image_t>> pairs;
+  std::unordered_set<image_pair_t> seen;
+  for (const auto& [a, b] : candidates) {
+    const image_pair_t id = ImagePairToPairId(a, b);
+    if (!seen.insert(id).second) continue;
+    if (done.count(id)) {
+      ++summary->num_skipped;
+      continue;
+    }
+    pairs.emplace_back(a, b);
+  }
+  summary->num_pairs = static_cast<int64_t>(seen.size());
+  return pairs;
+}
+
+// Matches and verifies `pairs` in batches and writes them; the features a
+// batch needs are loaded once, by this thread (the database connection is
+// not shared), and dropped when no later batch needs them, so memory stays
+// bounded on long surveys.
+void MatchInBatches(const FeatureMatcherOptions& options, const std::vector<std::pair<image_t, image_t>>& pairs,
+                    const std::map<image_t, camera_t>& camera_of, const std::map<camera_t, Camera>& cameras,
+                    const std::string& stage, Database* db, ProgressSink& progress, FeatureMatcherSummary* summary) {
+  constexpr size_t kBatchSize = 256;
+  std::map<image_t, size_t> last_use;
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    last_use[pairs[p].first] = p / kBatchSize;
+    last_use[pairs[p].second] = p / kBatchSize;
+  }
+  std::map<image_t, ImageFeatures> cache;
+  progress.Begin(stage + ": pairs", pairs.size());
+  for (size_t start = 0; start < pairs.size(); start += kBatchSize) {
+    const size_t batch = start / kBatchSize;
+    const size_t end = std::min(pairs.size(), start + kBatchSize);
+    for (size_t p = start; p < end; ++p) {
+      for (image_t id : {pairs[p].first, pairs[p].second}) {
+        if (cache.count(id)) continue;
+        ImageFeatures& f = cache[id];
+        f.camera_id = camera_of.at(id);
+        f.keypoints = db->ReadKeypoints(id);
+        f.descriptors = ToUnitDescriptors(db->ReadDescriptors(id));
+        if (static_cast<size_t>(f.descriptors.rows()) != f.keypoints.size()) {
+          throw InputError(options.database_path + ": image id " + std::to_string(id) + " has " +
+                           std::to_string(f.keypoints.size()) + " keypoints but " +
+                           std::to_string(f.descriptors.rows()) + " descriptors");
+        }
+      }
+    }
+    std::vector<FeatureMatches> matches(end - start);
+    std::vector<TwoViewGeometry> geometries(end - start);
+    ParallelFor(end - start, options.num_threads, [&](size_t k) {
+      const auto& [a, b] = pairs[start + k];
+      const ImageFeatures& fa = cache.at(a);
+      const ImageFeatures& fb = cache.at(b);
+      matches[k] = MatchDescriptors(fa.descriptors, fb.descriptors, options.matching);
+      geometries[k] = VerifyTwoView(cameras.at(fa.camera_id), fa.keypoints, cameras.at(fb.camera_id),
+                                    fb.keypoints, matches[k], options.verification);
+      progress.Advance(1);
+    });
+    for (size_t k = 0; k < matches.size(); ++k) {
+      const auto& [a, b] = pairs[start + k];
+      db->WriteMatches(a, b, matches[k]);
+      db->WriteTwoViewGeometry(a, b, geometries[k]);
+      ++summary->num_matched;
+      summary->num_verified += !geometries[k].inlier_matches.empty();
+    }
+    for (auto it = cache.begin(); it != cache.end();) {
+      it = last_use.at(it->first) <= batch ? cache.erase(it) : std::next(it);
+    }
+  }
+  progress.End();
+}
+
 }  // namespace
 
 FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, ProgressSink& progress) {
@@ -194,102 +307,13 @@ FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, Pr
   for (const Camera& camera : database.ReadAllCameras()) cameras[camera.camera_id] = camera;
 
   FeatureMatcherSummary summary;
-  std::vector<std::pair<image_t, image_t>> candidates;
-  if (options.mode == PairingMode::kExhaustive) {
-    candidates = ExhaustivePairs(ids);
-  } else if (options.mode == PairingMode::kSequential) {
-    candidates = SequentialPairs(ids, options.sequential);
-  } else {
-    std::vector<std::pair<image_t, Eigen::Vector3d>> positions;
-    for (const DatabaseImage& image : images) {
-      if (const auto position = image.PriorPosition()) positions.emplace_back(image.image_id, *position);
-    }
-    if (positions.size() < 2) {
-      throw InputError(options.database_path + ": " + std::to_string(positions.size()) +
-                       " image(s) with a position prior; spatial matching needs them (run pose_prior_importer)");
-    }
-    if (positions.size() < images.size()) {
-      LOG(WARNING) << stage << ": " << images.size() - positions.size()
-                   << " image(s) without a position prior are not matched";
-    }
-    candidates = SpatialPairs(positions, options.spatial);
-  }
-  if (options.mode == PairingMode::kSequential && options.sequential.loop_detection) {
-    const auto loops = LoopPairs(&database, ids, options.sequential, progress);
-    summary.num_loop_pairs = static_cast<int64_t>(loops.size());
-    candidates.insert(candidates.end(), loops.begin(), loops.end());
-  }
-  // Unique unordered pairs, minus those already done.
-  std::unordered_set<image_pair_t> done;
-  if (!options.overwrite) {
-    for (image_pair_t id : database.ReadTwoViewGeometryPairIds()) done.insert(id);
-  }
-  std::vector<std::pair<image_t, image_t>> pairs;
-  std::unordered_set<image_pair_t> seen;
-  for (const auto& [a, b] : candidates) {
-    const image_pair_t id = ImagePairToPairId(a, b);
-    if (!seen.insert(id).second) continue;
-    if (done.count(id)) {
-      ++summary.num_skipped;
-      continue;
-    }
-    pairs.emplace_back(a, b);
-  }
-  summary.num_pairs = static_cast<int64_t>(seen.size());
-  LOG(INFO) << stage << ": " << images.size() << " images, " << seen.size() << " pairs, "
+  const std::vector<std::pair<image_t, image_t>> candidates =
+      CandidatePairs(options, images, ids, stage, &database, progress, &summary);
+  const std::vector<std::pair<image_t, image_t>> pairs = PairsToMatch(candidates, options.overwrite, &database, &summary);
+  LOG(INFO) << stage << ": " << images.size() << " images, " << summary.num_pairs << " pairs, "
             << pairs.size() << " to match";
 
-  // Batches of pairs; the features a batch needs are loaded once, by this
-  // thread (the database connection is not shared), and dropped when no
-  // later batch needs them, so memory stays bounded on long surveys.
-  constexpr size_t kBatchSize = 256;
-  std::map<image_t, size_t> last_use;
-  for (size_t p = 0; p < pairs.size(); ++p) {
-    last_use[pairs[p].first] = p / kBatchSize;
-    last_use[pairs[p].second] = p / kBatchSize;
-  }
-  std::map<image_t, ImageFeatures> cache;
-  progress.Begin(stage + ": pairs", pairs.size());
-  for (size_t start = 0; start < pairs.size(); start += kBatchSize) {
-    const size_t batch = start / kBatchSize;
-    const size_t end = std::min(pairs.size(), start + kBatchSize);
-    for (size_t p = start; p < end; ++p) {
-      for (image_t id : {pairs[p].first, pairs[p].second}) {
-        if (cache.count(id)) continue;
-        ImageFeatures& f = cache[id];
-        f.camera_id = camera_of.at(id);
-        f.keypoints = database.ReadKeypoints(id);
-        f.descriptors = ToUnitDescriptors(database.ReadDescriptors(id));
-        if (static_cast<size_t>(f.descriptors.rows()) != f.keypoints.size()) {
-          throw InputError(options.database_path + ": image id " + std::to_string(id) + " has " +
-                           std::to_string(f.keypoints.size()) + " keypoints but " +
-                           std::to_string(f.descriptors.rows()) + " descriptors");
-        }
-      }
-    }
-    std::vector<FeatureMatches> matches(end - start);
-    std::vector<TwoViewGeometry> geometries(end - start);
-    ParallelFor(end - start, options.num_threads, [&](size_t k) {
-      const auto& [a, b] = pairs[start + k];
-      const ImageFeatures& fa = cache.at(a);
-      const ImageFeatures& fb = cache.at(b);
-      matches[k] = MatchDescriptors(fa.descriptors, fb.descriptors, options.matching);
-      geometries[k] = VerifyTwoView(cameras.at(fa.camera_id), fa.keypoints, cameras.at(fb.camera_id),
-                                    fb.keypoints, matches[k], options.verification);
-      progress.Advance(1);
-    });
-    for (size_t k = 0; k < matches.size(); ++k) {
-      const auto& [a, b] = pairs[start + k];
-      database.WriteMatches(a, b, matches[k]);
-      database.WriteTwoViewGeometry(a, b, geometries[k]);
-      ++summary.num_matched;
-      summary.num_verified += !geometries[k].inlier_matches.empty();
-    }
-    for (auto it = cache.begin(); it != cache.end();) {
-      it = last_use.at(it->first) <= batch ? cache.erase(it) : std::next(it);
-    }
-  }
-  progress.End();
+  MatchInBatches(options, pairs, camera_of, cameras, stage, &database, progress, &summary);
   run.Finish(&database, {{"pairs", summary.num_pairs},
                          {"matched", summary.num_matched},
                          {"skipped", summary.num_skipped},

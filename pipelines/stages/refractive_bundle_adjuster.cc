@@ -351,6 +351,168 @@ void FillReport(const RefractiveBundleAdjusterOptions& options, const Reconstruc
   }
 }
 
+// The adjustment of one model, in stages: with the intrinsics refined too,
+// the housing is first adjusted under the mapper's intrinsics (started
+// jointly from an untilted guess, the focal length and the port distance
+// trade off and the solve can slide into the distance's lower bound with a
+// wrong focal length; docs/auto_calibration.md); each solve twice, outliers
+// dropped in between; then the principal point test.
+class StagedAdjustment {
+ public:
+  StagedAdjustment(const RefractiveBundleAdjusterOptions& options, Reconstruction* r,
+                   std::vector<MarkerCorner>* markers, RefractiveBundleAdjusterSummary* result)
+      : options_(options),
+        r_(*r),
+        markers_(*markers),
+        result_(*result),
+        cameras_before_(r->cameras()),
+        joint_(options.ba.refine_housing &&
+               (options.ba.refine_focal_length || options.ba.refine_principal_point || options.ba.refine_extra_params)) {}
+
+  bool joint() const { return joint_; }
+  // The camera whose housing sits at a bound of the adjustment, if any.
+  camera_t HousingAtBound() const {
+    return options_.ba.refine_housing ? CameraWithHousingAtBound(r_.cameras()) : kInvalidCameraId;
+  }
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+  // The staged adjustment, the principal point test; returns the report's
+  // notes (warnings() has the warnings).
+  std::vector<std::string> Calibrate(bool intrinsics_first, CalibrationStdDevs* std_devs) {
+    std::vector<std::string> notes;
+    warnings_.clear();
+    if (joint_ && intrinsics_first) {
+      BundleAdjustmentOptions intrinsics = options_.ba;
+      intrinsics.refine_housing = false;
+      AdjustBundle(&r_, intrinsics, BundleAdjustmentScope(), &markers_, options_.marker_scale);
+    }
+    if (joint_) {
+      AdjustBundle(&r_, options_.ba.WithIntrinsicsHeld(), BundleAdjustmentScope(), &markers_, options_.marker_scale);
+    }
+    Solve(options_.ba, std_devs);
+    if (options_.ba.refine_principal_point) WarnIfPrincipalPointPoor(*std_devs);
+    if (options_.ba.refine_principal_point && options_.principal_point_test_sigmas > 0) {
+      notes.push_back(TestPrincipalPoint(std_devs));
+      LOG(INFO) << "refractive_bundle_adjuster: " << notes.back();
+    }
+    return notes;
+  }
+
+ private:
+  // A first solve, outliers out, then the final solve with covariance.
+  void Solve(const BundleAdjustmentOptions& ba, CalibrationStdDevs* std_devs) {
+    AdjustBundle(&r_, ba, BundleAdjustmentScope(), &markers_, options_.marker_scale);
+    for (const auto& [id, camera] : r_.cameras()) {
+      // Garbage must not pass for a calibration.
+      std::string why;
+      if (ImplausibleIntrinsics(cameras_before_.at(id).camera, camera.camera, &why)) {
+        throw NumericalError(options_.input_path + ": refining camera " + std::to_string(id) +
+                             " gave implausible intrinsics (" + why + "): the reconstruction is likely "
+                             "wrong (mean reprojection error " + std::to_string(r_.MeanReprojectionError()) +
+                             " px); give the intrinsics (--ImageReader.camera_params) or more views");
+      }
+    }
+    result_.num_filtered += FilterObservations(&r_, options_.max_reproj_error_px);
+    AdjustBundle(&r_, ba, BundleAdjustmentScope(), &markers_, options_.marker_scale, std_devs);
+  }
+
+  void WarnIfPrincipalPointPoor(const CalibrationStdDevs& std_devs) {
+    const double sigma = PoorPrincipalPointStdDev(r_.cameras(), std_devs);
+    if (!(sigma > 0)) return;
+    std::ostringstream text;
+    text << "the principal point is poorly determined (std dev " << std::setprecision(3) << sigma
+         << " px): the focal length, distortion and housing may have taken up its offset; give the in-air "
+            "intrinsics (--ImageReader.camera_params), more views, or views nearer the image corners";
+    warnings_.push_back(text.str());
+    LOG(WARNING) << "refractive_bundle_adjuster: " << warnings_.back();
+  }
+
+  // Holds the principal point at the image centre again (and solves) unless
+  // it lies beyond the test's sigmas from it; returns the note.
+  std::string TestPrincipalPoint(CalibrationStdDevs* std_devs) {
+    std::ostringstream offset;
+    if (PrincipalPointOffCentre(r_.cameras(), *std_devs, options_.principal_point_test_sigmas, &offset)) {
+      result_.principal_point_held = false;
+      return "principal point refined: off the image centre by " + offset.str();
+    }
+    CentrePrincipalPoints(&r_);
+    BundleAdjustmentOptions held = options_.ba;
+    held.refine_principal_point = false;
+    *std_devs = CalibrationStdDevs();
+    Solve(held, std_devs);
+    result_.principal_point_held = true;
+    return "principal point held at the image centre: refined, it was off by " + offset.str() + ", within " +
+           FormatSigmas(options_.principal_point_test_sigmas);
+  }
+
+  const RefractiveBundleAdjusterOptions& options_;
+  Reconstruction& r_;
+  std::vector<MarkerCorner>& markers_;
+  RefractiveBundleAdjusterSummary& result_;
+  const std::map<camera_t, HousedCamera> cameras_before_;
+  const bool joint_;
+  std::vector<std::string> warnings_;
+};
+
+// What the adjusted model cannot claim: a housing at a bound, an
+// implausible housing, intrinsics traded against the housing (warnings or,
+// below the warning factor, notes).
+void AddCalibrationWarnings(const RefractiveBundleAdjusterOptions& options, const Reconstruction& r,
+                            camera_t at_bound, const CalibrationStdDevs& std_devs, std::vector<std::string>* warnings,
+                            std::vector<std::string>* notes, RefractiveBundleAdjusterSummary* result) {
+  if (at_bound != kInvalidCameraId) {
+    // Not an estimate: its standard deviations describe a bound.
+    const Housing& housing = *r.cameras().at(at_bound).housing;
+    warnings->push_back("camera " + std::to_string(at_bound) + ": the housing ended at a bound of the adjustment (" +
+                        housing.Refinement().bound_description +
+                        "), not an estimate; the data traded it against the intrinsics: give the intrinsics, more "
+                        "views or a closer housing guess");
+    LOG(WARNING) << "refractive_bundle_adjuster: " << warnings->back();
+  }
+  if (options.ba.refine_housing) {
+    for (const std::string& warning : ImplausibleHousingWarnings(r.cameras())) {
+      warnings->push_back(warning);
+      LOG(WARNING) << "refractive_bundle_adjuster: " << warning;
+    }
+  }
+  for (const TradeOff& trade_off : TradeOffs(r.cameras(), std_devs, kTradeOffCorrelation)) {
+    if (trade_off.factor >= kTradeOffWarningFactor) {
+      warnings->push_back(trade_off.text);
+      ++result->num_geometry_warnings;
+    } else {
+      notes->push_back(trade_off.text);
+    }
+    LOG(WARNING) << "refractive_bundle_adjuster: " << trade_off.text;
+  }
+}
+
+// The adjusted model and the report of its first camera (RMS of the exact
+// reprojection error).
+void WriteAdjusted(const RefractiveBundleAdjusterOptions& options, const Reconstruction& r,
+                   const CalibrationStdDevs& std_devs, bool use_priors, std::vector<std::string> notes,
+                   std::vector<std::string> warnings, RefractiveBundleAdjusterSummary* result) {
+  const camera_t camera_id = r.cameras().begin()->first;
+  if (r.cameras().size() > 1) {
+    LOG(WARNING) << "refractive_bundle_adjuster: " << r.cameras().size()
+                 << " cameras; the report describes camera " << camera_id << " (the model has all)";
+  }
+  CalibrationReport& report = result->report;
+  FillReport(options, r, camera_id, std_devs, use_priors, &report);
+  report.notes = std::move(notes);
+  report.warnings = std::move(warnings);
+  WriteSparseModel(r.ToSparseModel(), options.output_path, ModelFormat::kBinary);
+  WriteCalibrationReport(report, options.output_path);
+  LOG(INFO) << "refractive_bundle_adjuster: RMS " << report.overall_rms_px << " px over " << report.num_points
+            << " observations; " << result->num_filtered << " observations dropped; written to "
+            << options.output_path;
+  const HousedCamera& camera = r.cameras().at(camera_id);
+  if (camera.housing) LOG(INFO) << "housing: " << camera.housing->ModelName() << " " << [&] {
+    std::string s;
+    for (double v : camera.housing->params) s += std::to_string(v) + " ";
+    return s;
+  }();
+}
+
 }  // namespace
 
 RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options,
@@ -368,157 +530,39 @@ RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBund
   const bool use_priors = options.ba.position_prior_sigma_m > 0;
   std::vector<MarkerCorner> markers;
   PrepareScale(options, use_priors, &r, &markers, &result);
-
   if (options.ba.refine_housing && options.marker_scale.side_length_m <= 0 && !use_priors) {
     LOG(WARNING) << "refractive_bundle_adjuster: no marker scale (--Markers.side_length): the model's scale "
                     "is arbitrary, so a flat port's distance and a dome's decentering are not in metres "
                     "(refraction observes the scale only weakly)";
   }
-  // With the intrinsics refined too, the housing is first adjusted under the
-  // mapper's intrinsics: started jointly from an untilted guess, the focal
-  // length and the port distance trade off and the solve can slide into the
-  // distance's lower bound with a wrong focal length (measured on own flat
-  // renders: 4 of 10 seeds, normal off by up to 2.5 deg; staged: see
-  // docs/auto_calibration.md).
-  const bool joint = options.ba.refine_housing && (options.ba.refine_focal_length ||
-                                                   options.ba.refine_principal_point ||
-                                                   options.ba.refine_extra_params);
-  const std::map<camera_t, HousedCamera> cameras_before = r.cameras();
-  // A first solve, outliers out, then the final solve with covariance.
-  const auto solve = [&](const BundleAdjustmentOptions& ba, CalibrationStdDevs* std_devs) {
-    AdjustBundle(&r, ba, BundleAdjustmentScope(), &markers, options.marker_scale);
-    for (const auto& [id, camera] : r.cameras()) {
-      // Garbage must not pass for a calibration.
-      std::string why;
-      if (ImplausibleIntrinsics(cameras_before.at(id).camera, camera.camera, &why)) {
-        throw NumericalError(options.input_path + ": refining camera " + std::to_string(id) +
-                             " gave implausible intrinsics (" + why + "): the reconstruction is likely "
-                             "wrong (mean reprojection error " + std::to_string(r.MeanReprojectionError()) +
-                             " px); give the intrinsics (--ImageReader.camera_params) or more views");
-      }
-    }
-    result.num_filtered += FilterObservations(&r, options.max_reproj_error_px);
-    AdjustBundle(&r, ba, BundleAdjustmentScope(), &markers, options.marker_scale, std_devs);
-  };
-  // The staged adjustment, the principal point test, and the report's notes.
-  std::vector<std::string> warnings;
-  const auto calibrate = [&](bool intrinsics_first, CalibrationStdDevs* std_devs) {
-    std::vector<std::string> notes;
-    warnings.clear();
-    if (joint && intrinsics_first) {
-      BundleAdjustmentOptions intrinsics = options.ba;
-      intrinsics.refine_housing = false;
-      AdjustBundle(&r, intrinsics, BundleAdjustmentScope(), &markers, options.marker_scale);
-    }
-    if (joint) {
-      AdjustBundle(&r, options.ba.WithIntrinsicsHeld(), BundleAdjustmentScope(), &markers, options.marker_scale);
-    }
-    solve(options.ba, std_devs);
-    if (options.ba.refine_principal_point) {
-      if (const double sigma = PoorPrincipalPointStdDev(r.cameras(), *std_devs); sigma > 0) {
-        std::ostringstream text;
-        text << "the principal point is poorly determined (std dev " << std::setprecision(3) << sigma
-             << " px): the focal length, distortion and housing may have taken up its offset; give the in-air "
-                "intrinsics (--ImageReader.camera_params), more views, or views nearer the image corners";
-        warnings.push_back(text.str());
-        LOG(WARNING) << "refractive_bundle_adjuster: " << warnings.back();
-      }
-    }
-    if (options.ba.refine_principal_point && options.principal_point_test_sigmas > 0) {
-      std::ostringstream offset;
-      if (!PrincipalPointOffCentre(r.cameras(), *std_devs, options.principal_point_test_sigmas, &offset)) {
-        CentrePrincipalPoints(&r);
-        BundleAdjustmentOptions held = options.ba;
-        held.refine_principal_point = false;
-        *std_devs = CalibrationStdDevs();
-        solve(held, std_devs);
-        result.principal_point_held = true;
-        notes.push_back("principal point held at the image centre: refined, it was off by " + offset.str() +
-                        ", within " + FormatSigmas(options.principal_point_test_sigmas));
-      } else {
-        result.principal_point_held = false;
-        notes.push_back("principal point refined: off the image centre by " + offset.str());
-      }
-      LOG(INFO) << "refractive_bundle_adjuster: " << notes.back();
-    }
-    return notes;
-  };
-  const auto housing_at_bound = [&] {
-    return options.ba.refine_housing ? CameraWithHousingAtBound(r.cameras()) : kInvalidCameraId;
-  };
+  StagedAdjustment adjustment(options, &r, &markers, &result);
   // The model's own housing at a bound (the mapper can slide a flat port's
   // distance into its floor under a focal length that is too long): from
-  // there the solve stayed there, even with the intrinsics adjusted first
-  // (own render, seed 11 of bench_autocal_seeds.sh: f 2.2 px off, and 63 s
-  // at the bound). It starts from the guess's bound parameters instead, the
-  // intrinsics first: f 0.9 px off, distance 0.6 sigma, 3 s.
-  const bool start_at_bound = joint && housing_at_bound() != kInvalidCameraId && options.housing_guess.has_value();
+  // there the solve stays there, even with the intrinsics adjusted first.
+  // It starts from the guess's bound parameters instead, the intrinsics
+  // first (figures: docs/auto_calibration.md).
+  const bool start_at_bound =
+      adjustment.joint() && adjustment.HousingAtBound() != kInvalidCameraId && options.housing_guess.has_value();
   if (start_at_bound) MoveHousingsOffBound(options.housing_guess, &r);
   const Reconstruction start = r;
   const std::vector<MarkerCorner> markers_start = markers;
   CalibrationStdDevs std_devs;
-  std::vector<std::string> notes = calibrate(start_at_bound, &std_devs);
-  if (joint && !start_at_bound && housing_at_bound() != kInvalidCameraId) {
-    // The housing slid into a bound under the mapper's intrinsics. Adjusting
+  std::vector<std::string> notes = adjustment.Calibrate(start_at_bound, &std_devs);
+  if (adjustment.joint() && !start_at_bound && adjustment.HousingAtBound() != kInvalidCameraId) {
+    // The housing slid into a bound under the mapper's intrinsics: adjusting
     // the intrinsics first (housing held) moves them to the right side of
-    // the trade: own 12-view render, intrinsics unknown, focal length 9 px
-    // (13 sigma) off with the distance at its floor -> 3.5 px, distance
-    // 2 mm off (1.1 sigma), the lowest cost found from the true values too.
+    // the trade (docs/auto_calibration.md).
     LOG(WARNING) << "refractive_bundle_adjuster: the housing ended at a bound; adjusting again, the intrinsics "
                     "first";
     r = start;
     markers = markers_start;
     result.num_filtered = 0;
     std_devs = CalibrationStdDevs();
-    notes = calibrate(true, &std_devs);
+    notes = adjustment.Calibrate(true, &std_devs);
   }
-  if (const camera_t id = housing_at_bound(); id != kInvalidCameraId) {
-    // Not an estimate: its standard deviations describe a bound.
-    const Housing& housing = *r.cameras().at(id).housing;
-    warnings.push_back("camera " + std::to_string(id) + ": the housing ended at a bound of the adjustment (" +
-                       housing.Refinement().bound_description +
-                       "), not an estimate; the data traded it against the intrinsics: give the intrinsics, more "
-                       "views or a closer housing guess");
-    LOG(WARNING) << "refractive_bundle_adjuster: " << warnings.back();
-  }
-  if (options.ba.refine_housing) {
-    for (const std::string& warning : ImplausibleHousingWarnings(r.cameras())) {
-      warnings.push_back(warning);
-      LOG(WARNING) << "refractive_bundle_adjuster: " << warning;
-    }
-  }
-
-  for (const TradeOff& trade_off : TradeOffs(r.cameras(), std_devs, kTradeOffCorrelation)) {
-    if (trade_off.factor >= kTradeOffWarningFactor) {
-      warnings.push_back(trade_off.text);
-      ++result.num_geometry_warnings;
-    } else {
-      notes.push_back(trade_off.text);
-    }
-    LOG(WARNING) << "refractive_bundle_adjuster: " << trade_off.text;
-  }
-
-  // Report: the first camera, RMS of the exact reprojection error.
-  const camera_t camera_id = r.cameras().begin()->first;
-  if (r.cameras().size() > 1) {
-    LOG(WARNING) << "refractive_bundle_adjuster: " << r.cameras().size()
-                 << " cameras; the report describes camera " << camera_id << " (the model has all)";
-  }
-  CalibrationReport& report = result.report;
-  FillReport(options, r, camera_id, std_devs, use_priors, &report);
-  report.notes = notes;
-  report.warnings = warnings;
-  WriteSparseModel(r.ToSparseModel(), options.output_path, ModelFormat::kBinary);
-  WriteCalibrationReport(report, options.output_path);
-  LOG(INFO) << "refractive_bundle_adjuster: RMS " << report.overall_rms_px << " px over " << report.num_points
-            << " observations; " << result.num_filtered << " observations dropped; written to "
-            << options.output_path;
-  const HousedCamera& camera = r.cameras().at(camera_id);
-  if (camera.housing) LOG(INFO) << "housing: " << camera.housing->ModelName() << " " << [&] {
-    std::string s;
-    for (double v : camera.housing->params) s += std::to_string(v) + " ";
-    return s;
-  }();
+  std::vector<std::string> warnings = adjustment.warnings();
+  AddCalibrationWarnings(options, r, adjustment.HousingAtBound(), std_devs, &warnings, &notes, &result);
+  WriteAdjusted(options, r, std_devs, use_priors, std::move(notes), std::move(warnings), &result);
   return result;
 }
 

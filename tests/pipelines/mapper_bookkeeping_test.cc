@@ -162,5 +162,32 @@ TEST(IncrementalMapperOptions, BadSettlingOptionsAreNamed) {
   }
 }
 
+TEST(IncrementalMapperOptions, GlobalFunctionToleranceIsAFractionAndNamedWhenBad) {
+  IncrementalMapperOptions options;
+  EXPECT_NO_THROW(options.Check());
+  for (const double bad : {0.0, -1e-5, 1.0, std::nan("")}) {
+    options.ba_global_function_tolerance = bad;
+    try {
+      options.Check();
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const OptionError& e) {
+      EXPECT_NE(std::string(e.what()).find("--Mapper.ba_global_function_tolerance"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(IncrementalMapperOptions, NegativeRestartsAreNamed) {
+  IncrementalMapperOptions options;
+  options.init_max_restarts = 0;
+  EXPECT_NO_THROW(options.Check());
+  options.init_max_restarts = -1;
+  try {
+    options.Check();
+    ADD_FAILURE() << "accepted -1";
+  } catch (const OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("--Mapper.init_max_restarts"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace portcal
