@@ -72,101 +72,77 @@ BoardGrid InferBoardGrid(const std::vector<CalibrationView>& views) {
   return grid;
 }
 
-MrcalCalibrationResult CalibrateWithMrcal(const std::vector<CalibrationView>& views,
-                                          const Camera& seed,
-                                          const std::vector<Rigid3d>& seed_cam_from_target,
-                                          const MrcalCalibrationOptions& options) {
-  options.Check();
-  PORTCAL_CHECK(views.size() == seed_cam_from_target.size());
-  const BoardGrid grid = InferBoardGrid(views);
-  const MrcalLens seed_lens = MrcalLensFromCamera(seed);
-  mrcal_lensmodel_t lensmodel;
-  PORTCAL_CHECK(mrcal_lensmodel_from_name(&lensmodel, seed_lens.lensmodel.c_str()));
-  const int num_intrinsics = mrcal_lensmodel_num_params(&lensmodel);
-  PORTCAL_CHECK(num_intrinsics == static_cast<int>(seed_lens.intrinsics.size()));
+namespace {
 
-  // Observations: one board observation per view, a dense (H, W) block of
-  // the pool each; corners the detector did not report are marked as
-  // outliers (weight < 0), which mrcal respects.
-  const int num_frames = static_cast<int>(views.size());
-  const int per_board = grid.width_n * grid.height_n;
-  std::vector<mrcal_point3_t> pool(static_cast<size_t>(num_frames) * per_board);
-  std::vector<std::vector<int>> pool_to_point(num_frames, std::vector<int>(per_board, -1));
-  std::vector<mrcal_observation_board_t> observations(num_frames);
-  std::vector<mrcal_pose_t> frames(num_frames);
+// mrcal's problem for one camera and its board views, and what maps it
+// back: pool entries to the views' corners, which were missing.
+struct MrcalProblem {
+  BoardGrid grid;
+  mrcal_lensmodel_t lensmodel;
+  int num_frames = 0;
+  int per_board = 0;
+  std::vector<mrcal_point3_t> pool;
+  std::vector<std::vector<int>> pool_to_point;
+  std::vector<char> missing;
+  std::vector<mrcal_observation_board_t> observations;
+  std::vector<mrcal_pose_t> frames;
+  std::vector<double> intrinsics;
+  mrcal_calobject_warp_t warp = {{0, 0}};
+  int imagersize[2] = {0, 0};
+  mrcal_problem_selections_t selections;
+  mrcal_problem_constants_t constants = {-1.0, -1.0};
   int num_points = 0;
+};
+
+// Observations: one board observation per view, a dense (H, W) block of
+// the pool each; corners the detector did not report are marked as
+// outliers (weight < 0), which mrcal respects.
+void AddBoardObservations(const std::vector<CalibrationView>& views, const std::vector<Rigid3d>& seed_cam_from_target,
+                          MrcalProblem* problem) {
+  const BoardGrid& grid = problem->grid;
+  const int num_frames = problem->num_frames;
+  const int per_board = problem->per_board;
+  problem->pool.assign(static_cast<size_t>(num_frames) * per_board, mrcal_point3_t{});
+  problem->pool_to_point.assign(num_frames, std::vector<int>(per_board, -1));
+  problem->observations.resize(num_frames);
+  problem->frames.resize(num_frames);
   for (int f = 0; f < num_frames; ++f) {
     const CalibrationView& view = views[f];
-    observations[f].icam.intrinsics = 0;
-    observations[f].icam.extrinsics = -1;  // the camera is the reference
-    observations[f].iframe = f;
-    for (int k = 0; k < per_board; ++k) pool[f * per_board + k] = {{0, 0, -1}};
+    problem->observations[f].icam.intrinsics = 0;
+    problem->observations[f].icam.extrinsics = -1;  // the camera is the reference
+    problem->observations[f].iframe = f;
+    for (int k = 0; k < per_board; ++k) problem->pool[f * per_board + k] = {{0, 0, -1}};
     for (size_t i = 0; i < view.pixels.size(); ++i) {
       const Eigen::Vector3d& p = view.points_in_target[i];
       const int col = GridIndex(p.x() - grid.origin.x(), grid.spacing, view.image_name);
       const int row = GridIndex(p.y() - grid.origin.y(), grid.spacing, view.image_name);
       const int k = row * grid.width_n + col;
       // mrcal's pixels: the top-left pixel's centre at (0, 0).
-      pool[f * per_board + k] = {{view.pixels[i].x() - 0.5, view.pixels[i].y() - 0.5, 1.0}};
-      pool_to_point[f][k] = static_cast<int>(i);
-      ++num_points;
+      problem->pool[f * per_board + k] = {{view.pixels[i].x() - 0.5, view.pixels[i].y() - 0.5, 1.0}};
+      problem->pool_to_point[f][k] = static_cast<int>(i);
+      ++problem->num_points;
     }
     // mrcal's board frame starts at the first corner.
     const Rigid3d target_from_board(Eigen::Quaterniond::Identity(),
                                     Eigen::Vector3d(grid.origin.x(), grid.origin.y(), 0));
-    frames[f] = PoseFromRigid(seed_cam_from_target[f] * target_from_board);
+    problem->frames[f] = PoseFromRigid(seed_cam_from_target[f] * target_from_board);
   }
-  std::vector<char> missing(pool.size());
-  for (size_t k = 0; k < pool.size(); ++k) missing[k] = pool[k].z < 0;
+  problem->missing.resize(problem->pool.size());
+  for (size_t k = 0; k < problem->pool.size(); ++k) problem->missing[k] = problem->pool[k].z < 0;
+}
 
-  std::vector<double> intrinsics = seed_lens.intrinsics;
-  mrcal_calobject_warp_t warp = {{0, 0}};
-  const int imagersize[2] = {static_cast<int>(seed.width), static_cast<int>(seed.height)};
-  mrcal_problem_selections_t selections;
-  selections.do_optimize_intrinsics_core = true;
-  selections.do_optimize_intrinsics_distortions = true;
-  selections.do_optimize_extrinsics = false;
-  selections.do_optimize_frames = true;
-  selections.do_optimize_calobject_warp = options.estimate_board_warp;
-  selections.do_apply_regularization = options.regularization;
-  selections.do_apply_outlier_rejection = options.reject_outliers;
-  const mrcal_problem_constants_t constants = {-1.0, -1.0};
-
-  const mrcal_stats_t stats = mrcal_optimize(
-      nullptr, 0, nullptr, 0, intrinsics.data(), nullptr, frames.data(), nullptr, &warp, 1, 0,
-      num_frames, 0, 0, observations.data(), nullptr, num_frames, 0, pool.data(), &lensmodel,
-      imagersize, selections, &constants, grid.spacing, grid.width_n, grid.height_n,
-      options.verbose, false);
-  if (!std::isfinite(stats.rms_reproj_error__pixels) || stats.rms_reproj_error__pixels < 0) {
-    throw NumericalError("mrcal_optimize failed (its message is above)");
-  }
-
-  MrcalCalibrationResult result;
-  result.lensmodel = seed_lens.lensmodel;
-  result.camera = CameraFromMrcalLens({seed_lens.lensmodel, intrinsics}, seed.width, seed.height,
-                                      "mrcal's solution");
-  result.board_warp = Eigen::Vector2d(warp.x2, warp.y2);
-  result.num_points = num_points;
-  result.outliers.resize(num_frames);
-  for (int f = 0; f < num_frames; ++f) {
-    for (int k = 0; k < per_board; ++k) {
-      if (pool[f * per_board + k].z < 0 && !missing[f * per_board + k]) {
-        result.outliers[f].push_back(pool_to_point[f][k]);
-        ++result.num_outliers;
-      }
-    }
-  }
-
-  // Covariance as mrcal's uncertainty model has it: Var(b) = s^2 (J^T J)^-1
-  // over the (packed, unitless) state, J including the regularisation terms,
-  // s^2 the residual variance of the inlier corners; then unpacked to units.
-  const int num_state = mrcal_num_states(1, 0, num_frames, 0, 0, num_frames, selections, &lensmodel);
-  const int num_meas = mrcal_num_measurements(num_frames, 0, grid.width_n, grid.height_n, 1, 0,
-                                              num_frames, 0, 0, selections, &lensmodel);
-  const int num_nonzero = _mrcal_num_j_nonzero(num_frames, 0, grid.width_n, grid.height_n, 1, 0,
-                                               num_frames, 0, 0, observations.data(), nullptr,
-                                               selections, &lensmodel);
-  std::vector<double> b_packed(num_state), x(num_meas), jt_x(num_nonzero);
+// J^T J of mrcal's (packed, unitless) state at the solution, J including
+// the regularisation terms; `x` gets the measurements.
+Eigen::MatrixXd MrcalJtJ(MrcalProblem* pr, std::vector<double>* x) {
+  const int num_frames = pr->num_frames;
+  const int num_state = mrcal_num_states(1, 0, num_frames, 0, 0, num_frames, pr->selections, &pr->lensmodel);
+  const int num_meas = mrcal_num_measurements(num_frames, 0, pr->grid.width_n, pr->grid.height_n, 1, 0,
+                                              num_frames, 0, 0, pr->selections, &pr->lensmodel);
+  const int num_nonzero = _mrcal_num_j_nonzero(num_frames, 0, pr->grid.width_n, pr->grid.height_n, 1, 0,
+                                               num_frames, 0, 0, pr->observations.data(), nullptr,
+                                               pr->selections, &pr->lensmodel);
+  std::vector<double> b_packed(num_state), jt_x(num_nonzero);
+  x->assign(num_meas, 0.0);
   std::vector<int> jt_p(num_meas + 1), jt_i(num_nonzero);
   cholmod_sparse jt = {};
   jt.nrow = num_state;
@@ -182,12 +158,12 @@ MrcalCalibrationResult CalibrateWithMrcal(const std::vector<CalibrationView>& vi
   jt.sorted = 1;
   jt.packed = 1;
   if (!mrcal_optimizer_callback(b_packed.data(), num_state * static_cast<int>(sizeof(double)),
-                                x.data(), num_meas * static_cast<int>(sizeof(double)),
-                                reinterpret_cast<cholmod_sparse_struct*>(&jt), intrinsics.data(),
-                                nullptr, frames.data(), nullptr, &warp, 1, 0, num_frames, 0, 0,
-                                observations.data(), nullptr, num_frames, 0, pool.data(),
-                                &lensmodel, imagersize, selections, &constants, grid.spacing,
-                                grid.width_n, grid.height_n, false)) {
+                                x->data(), num_meas * static_cast<int>(sizeof(double)),
+                                reinterpret_cast<cholmod_sparse_struct*>(&jt), pr->intrinsics.data(),
+                                nullptr, pr->frames.data(), nullptr, &pr->warp, 1, 0, num_frames, 0, 0,
+                                pr->observations.data(), nullptr, num_frames, 0, pr->pool.data(),
+                                &pr->lensmodel, pr->imagersize, pr->selections, &pr->constants, pr->grid.spacing,
+                                pr->grid.width_n, pr->grid.height_n, false)) {
     throw NumericalError("mrcal_optimizer_callback failed (its message is above)");
   }
   Eigen::MatrixXd jtj = Eigen::MatrixXd::Zero(num_state, num_state);
@@ -198,48 +174,112 @@ MrcalCalibrationResult CalibrateWithMrcal(const std::vector<CalibrationView>& vi
       }
     }
   }
+  return jtj;
+}
+
+// Covariance as mrcal's uncertainty model has it: Var(b) = s^2 (J^T J)^-1
+// over the packed state, s^2 the residual variance of the inlier corners;
+// then unpacked to units.
+void FillMrcalCovariance(MrcalProblem* pr, bool estimate_board_warp, MrcalCalibrationResult* result) {
+  std::vector<double> x;
+  const Eigen::MatrixXd jtj = MrcalJtJ(pr, &x);
+  const int num_state = static_cast<int>(jtj.rows());
+  const int num_frames = pr->num_frames;
+  const int num_intrinsics = static_cast<int>(pr->intrinsics.size());
   // Inlier corner residuals: the first 2 * (H * W) * frames measurements.
   double sum_squares = 0;
   int num_inliers = 0;
-  for (size_t k = 0; k < pool.size(); ++k) {
-    if (pool[k].z < 0) continue;
+  for (size_t k = 0; k < pr->pool.size(); ++k) {
+    if (pr->pool[k].z < 0) continue;
     sum_squares += x[2 * k] * x[2 * k] + x[2 * k + 1] * x[2 * k + 1];
     ++num_inliers;
   }
-  result.rms_px = std::sqrt(sum_squares / std::max(1, num_inliers));
+  result->rms_px = std::sqrt(sum_squares / std::max(1, num_inliers));
   const int dof = 2 * num_inliers - num_state;
   const double variance = dof > 0 ? sum_squares / dof : 0;
-  result.residual_sigma_px = std::sqrt(variance);
+  result->residual_sigma_px = std::sqrt(variance);
 
   std::vector<double> unpack(num_state, 1.0);
-  mrcal_unpack_solver_state_vector(unpack.data(), 1, 0, num_frames, 0, 0, selections, &lensmodel);
+  mrcal_unpack_solver_state_vector(unpack.data(), 1, 0, num_frames, 0, 0, pr->selections, &pr->lensmodel);
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(jtj);
-  result.params_covariance = Eigen::MatrixXd::Zero(num_intrinsics, num_intrinsics);
-  result.params_std_dev.assign(num_intrinsics, 0.0);
-  if (ldlt.info() == Eigen::Success && ldlt.isPositive()) {
-    const Eigen::MatrixXd inverse = ldlt.solve(Eigen::MatrixXd::Identity(num_state, num_state));
-    const int i0 = mrcal_state_index_intrinsics(0, 1, 0, num_frames, 0, 0, num_frames, selections,
-                                                &lensmodel);
-    for (int a = 0; a < num_intrinsics; ++a) {
-      for (int b = 0; b < num_intrinsics; ++b) {
-        result.params_covariance(a, b) =
-            inverse(i0 + a, i0 + b) * unpack[i0 + a] * unpack[i0 + b] * variance;
-      }
-      result.params_std_dev[a] = std::sqrt(std::max(0.0, result.params_covariance(a, a)));
-    }
-    if (options.estimate_board_warp) {
-      const int w0 = mrcal_state_index_calobject_warp(1, 0, num_frames, 0, 0, num_frames,
-                                                      selections, &lensmodel);
-      for (int a = 0; a < 2; ++a) {
-        result.board_warp_std_dev[a] =
-            std::sqrt(std::max(0.0, inverse(w0 + a, w0 + a) * variance)) * unpack[w0 + a];
-      }
-    }
-  } else {
+  result->params_covariance = Eigen::MatrixXd::Zero(num_intrinsics, num_intrinsics);
+  result->params_std_dev.assign(num_intrinsics, 0.0);
+  if (!(ldlt.info() == Eigen::Success && ldlt.isPositive())) {
     LOG(WARNING) << "mrcal: J^T J is singular; no standard deviations";
+    return;
   }
+  const Eigen::MatrixXd inverse = ldlt.solve(Eigen::MatrixXd::Identity(num_state, num_state));
+  const int i0 = mrcal_state_index_intrinsics(0, 1, 0, num_frames, 0, 0, num_frames, pr->selections,
+                                              &pr->lensmodel);
+  for (int a = 0; a < num_intrinsics; ++a) {
+    for (int b = 0; b < num_intrinsics; ++b) {
+      result->params_covariance(a, b) = inverse(i0 + a, i0 + b) * unpack[i0 + a] * unpack[i0 + b] * variance;
+    }
+    result->params_std_dev[a] = std::sqrt(std::max(0.0, result->params_covariance(a, a)));
+  }
+  if (estimate_board_warp) {
+    const int w0 = mrcal_state_index_calobject_warp(1, 0, num_frames, 0, 0, num_frames, pr->selections,
+                                                    &pr->lensmodel);
+    for (int a = 0; a < 2; ++a) {
+      result->board_warp_std_dev[a] = std::sqrt(std::max(0.0, inverse(w0 + a, w0 + a) * variance)) * unpack[w0 + a];
+    }
+  }
+}
+
+}  // namespace
+
+MrcalCalibrationResult CalibrateWithMrcal(const std::vector<CalibrationView>& views,
+                                          const Camera& seed,
+                                          const std::vector<Rigid3d>& seed_cam_from_target,
+                                          const MrcalCalibrationOptions& options) {
+  options.Check();
+  PORTCAL_CHECK(views.size() == seed_cam_from_target.size());
+  MrcalProblem pr;
+  pr.grid = InferBoardGrid(views);
+  const MrcalLens seed_lens = MrcalLensFromCamera(seed);
+  PORTCAL_CHECK(mrcal_lensmodel_from_name(&pr.lensmodel, seed_lens.lensmodel.c_str()));
+  PORTCAL_CHECK(mrcal_lensmodel_num_params(&pr.lensmodel) == static_cast<int>(seed_lens.intrinsics.size()));
+  pr.num_frames = static_cast<int>(views.size());
+  pr.per_board = pr.grid.width_n * pr.grid.height_n;
+  AddBoardObservations(views, seed_cam_from_target, &pr);
+  pr.intrinsics = seed_lens.intrinsics;
+  pr.imagersize[0] = static_cast<int>(seed.width);
+  pr.imagersize[1] = static_cast<int>(seed.height);
+  pr.selections.do_optimize_intrinsics_core = true;
+  pr.selections.do_optimize_intrinsics_distortions = true;
+  pr.selections.do_optimize_extrinsics = false;
+  pr.selections.do_optimize_frames = true;
+  pr.selections.do_optimize_calobject_warp = options.estimate_board_warp;
+  pr.selections.do_apply_regularization = options.regularization;
+  pr.selections.do_apply_outlier_rejection = options.reject_outliers;
+
+  const mrcal_stats_t stats = mrcal_optimize(
+      nullptr, 0, nullptr, 0, pr.intrinsics.data(), nullptr, pr.frames.data(), nullptr, &pr.warp, 1, 0,
+      pr.num_frames, 0, 0, pr.observations.data(), nullptr, pr.num_frames, 0, pr.pool.data(), &pr.lensmodel,
+      pr.imagersize, pr.selections, &pr.constants, pr.grid.spacing, pr.grid.width_n, pr.grid.height_n,
+      options.verbose, false);
+  if (!std::isfinite(stats.rms_reproj_error__pixels) || stats.rms_reproj_error__pixels < 0) {
+    throw NumericalError("mrcal_optimize failed (its message is above)");
+  }
+
+  MrcalCalibrationResult result;
+  result.lensmodel = seed_lens.lensmodel;
+  result.camera = CameraFromMrcalLens({seed_lens.lensmodel, pr.intrinsics}, seed.width, seed.height,
+                                      "mrcal's solution");
+  result.board_warp = Eigen::Vector2d(pr.warp.x2, pr.warp.y2);
+  result.num_points = pr.num_points;
+  result.outliers.resize(pr.num_frames);
+  for (int f = 0; f < pr.num_frames; ++f) {
+    for (int k = 0; k < pr.per_board; ++k) {
+      if (pr.pool[f * pr.per_board + k].z < 0 && !pr.missing[f * pr.per_board + k]) {
+        result.outliers[f].push_back(pr.pool_to_point[f][k]);
+        ++result.num_outliers;
+      }
+    }
+  }
+  FillMrcalCovariance(&pr, options.estimate_board_warp, &result);
   LOG(INFO) << "mrcal (" << result.lensmodel << "): RMS " << result.rms_px << " px, "
-            << result.num_outliers << " of " << num_points << " corners rejected, board warp ("
+            << result.num_outliers << " of " << pr.num_points << " corners rejected, board warp ("
             << result.board_warp.x() * 1e3 << ", " << result.board_warp.y() * 1e3 << ") mm";
   return result;
 }
