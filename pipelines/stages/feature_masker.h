@@ -9,9 +9,6 @@
 // (masking is idempotent).
 #pragma once
 
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
-#include <array>
 #include <string>
 #include <vector>
 
@@ -36,14 +33,6 @@ struct FeatureMaskerSummary {
   int64_t num_features_before = 0;
   int64_t num_features_kept = 0;
 };
-
-// The ArUco markers of `dictionary` in an 8-bit gray image, corners in
-// COLMAP pixels and OpenCV's order (sub-pixel, contour refinement).
-std::vector<MarkerDetection> DetectArucoMarkers(const cv::Mat& gray, const std::string& dictionary);
-
-// Whether `xy` lies inside the marker quad scaled about its centroid.
-bool InsideEnlargedQuad(const std::array<Eigen::Vector2d, 4>& quad, double factor,
-                        const Eigen::Vector2d& xy);
 
 FeatureMaskerSummary RunFeatureMasker(const FeatureMaskerOptions& options, ProgressSink& progress);
 

@@ -88,16 +88,10 @@ std::string OptionsText(const TargetExtractorOptions& o) {
   return out.str();
 }
 
-}  // namespace
-
-TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
-                                       ProgressSink& progress) {
-  options.Check();
-  StageRun run("target_extractor", OptionsText(options));
-  const std::vector<std::string> names = ListImages(options.image_path);
-  LOG(INFO) << "target_extractor: " << names.size() << " images, " << options.target_type;
-
-  // Detection in parallel, outside the database transaction.
+// Reads and detects every image on options.num_threads threads; the first
+// error (or a cancel) stops them all and is rethrown.
+std::vector<ImageResult> DetectAll(const TargetExtractorOptions& options, const std::vector<std::string>& names,
+                                   ProgressSink& progress) {
   std::vector<ImageResult> results(names.size());
   std::atomic<size_t> next{0};
   std::exception_ptr error;
@@ -131,20 +125,19 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
   for (std::thread& t : threads) t.join();
   if (error) std::rethrow_exception(error);
   progress.End();
+  return results;
+}
 
-  // One transaction: images, cameras, observations, status, log.
-  Database database(options.database_path, Database::OpenMode::kCreate);
-  Transaction transaction = database.BeginTransaction();
-  TargetExtractorSummary summary;
-  SharedCameras shared_cameras;
+// The target as the detection status names it, e.g. "chessboard 10x7 inner
+// corners, square 0.02 m".
+std::string TargetDescription(const TargetExtractorOptions& options) {
   const auto metres = [](double value) {
     std::ostringstream out;
     out << value << " m";
     return out.str();
   };
   const MarkerBoardOptions& m = options.markers;
-  const std::string target =
-      options.target_type == "chessboard"
+  return options.target_type == "chessboard"
           ? "chessboard " + std::to_string(options.chessboard.cols) + "x" +
                 std::to_string(options.chessboard.rows) + " inner corners, square " +
                 metres(options.square_size_m)
@@ -155,6 +148,26 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
           : "charuco " + std::to_string(m.squares_x) + "x" + std::to_string(m.squares_y) + " squares " +
                 m.dictionary + ", square " + metres(options.square_size_m) + ", marker " +
                 metres(m.marker_size_m);
+}
+
+}  // namespace
+
+TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
+                                       ProgressSink& progress) {
+  options.Check();
+  StageRun run("target_extractor", OptionsText(options));
+  const std::vector<std::string> names = ListImages(options.image_path);
+  LOG(INFO) << "target_extractor: " << names.size() << " images, " << options.target_type;
+
+  // Detection in parallel, outside the database transaction.
+  const std::vector<ImageResult> results = DetectAll(options, names, progress);
+
+  // One transaction: images, cameras, observations, status, log.
+  Database database(options.database_path, Database::OpenMode::kCreate);
+  Transaction transaction = database.BeginTransaction();
+  TargetExtractorSummary summary;
+  SharedCameras shared_cameras;
+  const std::string target = TargetDescription(options);
   for (const ImageResult& result : results) {
     if (!result.readable) {
       LOG(WARNING) << result.name << ": cannot read the image; skipped";

@@ -4,7 +4,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipelines/markers/marker_edge_refinement.h"
-#include "pipelines/stages/feature_masker.h"
+#include "pipelines/markers/aruco_markers.h"
 
 namespace portcal {
 namespace {
