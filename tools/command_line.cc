@@ -69,6 +69,9 @@ void CommandLine::AddTriState(const std::string& name, std::optional<bool>* valu
 void CommandLine::AddHousing(std::optional<Housing>* housing, const std::string& model_help) {
   std::string& model = strings_.emplace_back(housing->has_value() ? (*housing)->ModelName() : "");
   std::string& params = strings_.emplace_back();
+  if (housing->has_value()) {
+    for (const double v : (*housing)->params) params += (params.empty() ? "" : ",") + FormatShortest(v);
+  }
   Add("Housing.model", &model, "FLATPORT | DOMEPORT | NONE: " + model_help);
   Add("Housing.params", &params,
       "the model's parameters, comma separated, metres (FLATPORT: Nx,Ny,Nz,int_dist,int_thick,na,ng,nw; "
