@@ -1,7 +1,5 @@
 #include "tests/test_utils.h"
 
-#include "colmap_ext/util/string_utils.h"
-
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,6 +8,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+
+#include "colmap_ext/util/string_utils.h"
 
 namespace fs = std::filesystem;
 

@@ -1,7 +1,7 @@
 #include <iostream>
 
-#include "pipelines/stages/cross_check.h"
 #include "colmap_ext/util/progress.h"
+#include "pipelines/stages/cross_check.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 

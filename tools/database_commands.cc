@@ -1,6 +1,6 @@
+#include "colmap_ext/util/progress.h"
 #include "pipelines/stages/database_creator.h"
 #include "pipelines/stages/pose_prior_importer.h"
-#include "colmap_ext/util/progress.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 

@@ -1,8 +1,8 @@
 #include <iostream>
 
+#include "colmap_ext/util/progress.h"
 #include "pipelines/stages/model_converter.h"
 #include "pipelines/stages/project_points.h"
-#include "colmap_ext/util/progress.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 

@@ -1,9 +1,9 @@
 // Subcommands of the reconstruction back end: refractive_mapper,
 // refractive_bundle_adjuster, auto_calibrator.
+#include "colmap_ext/util/progress.h"
 #include "pipelines/stages/auto_calibrator.h"
 #include "pipelines/stages/refractive_bundle_adjuster.h"
 #include "pipelines/stages/refractive_mapper.h"
-#include "colmap_ext/util/progress.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 

@@ -9,10 +9,10 @@
 #include <set>
 
 #include "colmap_ext/camera/camera_models.h"
-#include "colmap_ext/util/error.h"
-#include "colmap_ext/util/logging.h"
 #include "colmap_ext/geometry/pose_block.h"
 #include "colmap_ext/housing/housing_manifold.h"
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
 #include "pipelines/bundle_adjustment/bundle_adjustment.h"
 #include "pipelines/bundle_adjustment/bundle_costs.h"
 #include "pipelines/bundle_adjustment/bundle_costs_fixed.h"

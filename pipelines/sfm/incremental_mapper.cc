@@ -8,16 +8,16 @@
 #include <sstream>
 
 #include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/geometry/pose_block.h"
 #include "colmap_ext/housing/flat_port.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "pipelines/bundle_adjustment/bundle_costs.h"
 #include "pipelines/bundle_adjustment/bundle_costs_fixed.h"
-#include "pipelines/sfm/camera_change.h"
-#include "pipelines/sfm/initial_pair.h"
-#include "colmap_ext/geometry/pose_block.h"
 #include "pipelines/bundle_adjustment/position_priors.h"
 #include "pipelines/reconstruction/ray_geometry.h"
+#include "pipelines/sfm/camera_change.h"
+#include "pipelines/sfm/initial_pair.h"
 
 namespace portcal {
 

@@ -7,8 +7,8 @@
 #include <set>
 #include <vector>
 
-#include "pipelines/sfm/incremental_mapper.h"
 #include "pipelines/reconstruction/reconstruction.h"
+#include "pipelines/sfm/incremental_mapper.h"
 
 namespace portcal {
 

@@ -38,7 +38,8 @@ namespace {
 // the mapper gets (docs/auto_calibration.md). The markers give a far better
 // start: it is written to the database camera before matching.
 // Returns the markers' focal length (in-air equivalent), or nullopt.
-std::optional<double> StartFocalFromMarkers(const std::string& database_path, const std::optional<Housing>& housing) {
+std::optional<double> WriteMarkersFocalToDatabase(const std::string& database_path,
+                                                  const std::optional<Housing>& housing) {
   Database database(database_path, Database::OpenMode::kReadWrite);
   const SfmInputs inputs = SfmInputs::Read(&database);
   std::map<camera_t, HousedCamera> cameras = inputs.cameras;
@@ -245,7 +246,7 @@ AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   }
 
   std::optional<double> markers_focal;
-  if (!intrinsics_given) markers_focal = StartFocalFromMarkers(database_path, options.housing);
+  if (!intrinsics_given) markers_focal = WriteMarkersFocalToDatabase(database_path, options.housing);
 
   FeatureMatcherOptions match;
   match.database_path = database_path;

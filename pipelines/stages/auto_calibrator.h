@@ -10,13 +10,13 @@
 #include <optional>
 #include <string>
 
+#include "colmap_ext/housing/housing.h"
 #include "colmap_ext/util/progress.h"
 #include "pipelines/stages/feature_extractor.h"
 #include "pipelines/stages/feature_masker.h"
 #include "pipelines/stages/feature_matcher.h"
 #include "pipelines/stages/refractive_bundle_adjuster.h"
 #include "pipelines/stages/refractive_mapper.h"
-#include "colmap_ext/housing/housing.h"
 
 namespace portcal {
 

@@ -4,8 +4,8 @@
 
 #include <string>
 
-#include "pipelines/calibration/camera_calibration.h"
 #include "colmap_ext/util/progress.h"
+#include "pipelines/calibration/camera_calibration.h"
 
 namespace portcal {
 

@@ -8,8 +8,8 @@
 
 #include <string>
 
-#include "pipelines/crosscheck/cross_check_report.h"
 #include "colmap_ext/util/progress.h"
+#include "pipelines/crosscheck/cross_check_report.h"
 
 namespace portcal {
 

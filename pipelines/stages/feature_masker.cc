@@ -7,9 +7,9 @@
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/parallel.h"
 #include "database/database.h"
+#include "database/stage_run.h"
 #include "pipelines/markers/aruco.h"
 #include "pipelines/markers/aruco_markers.h"
-#include "database/stage_run.h"
 
 namespace fs = std::filesystem;
 

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "colmap_ext/util/progress.h"
 #include "colmap_ext/feature/marker_detection.h"
+#include "colmap_ext/util/progress.h"
 
 namespace portcal {
 

@@ -10,8 +10,8 @@
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/parallel.h"
 #include "database/database.h"
-#include "pipelines/features/image_retrieval.h"
 #include "database/stage_run.h"
+#include "pipelines/features/image_retrieval.h"
 
 namespace portcal {
 

@@ -7,8 +7,8 @@
 #include <string>
 
 #include "colmap_ext/housing/housing.h"
-#include "pipelines/calibration/housing_calibration.h"
 #include "colmap_ext/util/progress.h"
+#include "pipelines/calibration/housing_calibration.h"
 
 namespace portcal {
 

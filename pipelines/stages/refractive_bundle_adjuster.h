@@ -16,9 +16,9 @@
 #include <string>
 
 #include "colmap_ext/housing/housing.h"
-#include "pipelines/calibration/calibration_report.h"
-#include "pipelines/bundle_adjustment/bundle_adjustment.h"
 #include "colmap_ext/util/progress.h"
+#include "pipelines/bundle_adjustment/bundle_adjustment.h"
+#include "pipelines/calibration/calibration_report.h"
 
 namespace portcal {
 

@@ -5,8 +5,8 @@
 
 #include <string>
 
-#include "pipelines/calibration/stereo_calibration.h"
 #include "colmap_ext/util/progress.h"
+#include "pipelines/calibration/stereo_calibration.h"
 
 namespace portcal {
 

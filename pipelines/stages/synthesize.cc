@@ -8,16 +8,16 @@
 #include <random>
 #include <sstream>
 
+#include "colmap_ext/camera/housed_camera.h"
 #include "colmap_ext/io/ground_truth.h"
 #include "colmap_ext/io/sparse_model.h"
-#include "colmap_ext/camera/housed_camera.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "pipelines/synthetic/dataset_config.h"
 #include "pipelines/synthetic/renderer.h"
 #include "pipelines/synthetic/scene.h"
-#include "pipelines/synthetic/view_sampler.h"
-#include "pipelines/synthetic/dataset_config.h"
 #include "pipelines/synthetic/target_builder.h"
+#include "pipelines/synthetic/view_sampler.h"
 
 namespace fs = std::filesystem;
 

@@ -7,8 +7,8 @@
 
 #include "colmap_ext/util/progress.h"
 #include "pipelines/images/image_reader.h"
-#include "pipelines/target/chessboard_detector.h"
 #include "pipelines/markers/marker_board_detector.h"
+#include "pipelines/target/chessboard_detector.h"
 
 namespace portcal {
 

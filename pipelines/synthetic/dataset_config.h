@@ -11,8 +11,8 @@
 #include "colmap_ext/geometry/rigid3d.h"
 #include "colmap_ext/housing/housing.h"
 #include "pipelines/synthetic/renderer.h"
-#include "pipelines/synthetic/view_sampler.h"
 #include "pipelines/synthetic/target_builder.h"
+#include "pipelines/synthetic/view_sampler.h"
 
 namespace portcal {
 

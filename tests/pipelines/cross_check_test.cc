@@ -12,9 +12,9 @@
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
+#include "pipelines/crosscheck/mrcal_calibration.h"
 #include "pipelines/stages/camera_calibrator.h"
 #include "pipelines/stages/cross_check.h"
-#include "pipelines/crosscheck/mrcal_calibration.h"
 #include "pipelines/stages/target_extractor.h"
 #include "tests/test_utils.h"
 

@@ -9,9 +9,9 @@
 
 #include "colmap_ext/camera/camera.h"
 #include "colmap_ext/util/error.h"
+#include "pipelines/reconstruction/reconstruction.h"
 #include "pipelines/sfm/camera_change.h"
 #include "pipelines/sfm/incremental_mapper.h"
-#include "pipelines/reconstruction/reconstruction.h"
 
 namespace portcal {
 namespace {

@@ -3,8 +3,8 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "pipelines/markers/marker_edge_refinement.h"
 #include "pipelines/markers/aruco_markers.h"
+#include "pipelines/markers/marker_edge_refinement.h"
 
 namespace portcal {
 namespace {

@@ -13,10 +13,10 @@
 #include "colmap_ext/housing/housing_models.h"
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
-#include "pipelines/stages/feature_matcher.h"
-#include "pipelines/stages/pose_prior_importer.h"
 #include "pipelines/bundle_adjustment/bundle_adjustment.h"
 #include "pipelines/bundle_adjustment/position_priors.h"
+#include "pipelines/stages/feature_matcher.h"
+#include "pipelines/stages/pose_prior_importer.h"
 #include "tests/test_utils.h"
 
 namespace fs = std::filesystem;

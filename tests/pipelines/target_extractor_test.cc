@@ -10,9 +10,9 @@
 #include "colmap_ext/io/ground_truth.h"
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
-#include "pipelines/stages/synthesize.h"
 #include "pipelines/calibration/camera_calibration.h"
 #include "pipelines/calibration/target_views.h"
+#include "pipelines/stages/synthesize.h"
 #include "pipelines/stages/target_extractor.h"
 #include "tests/test_utils.h"
 
