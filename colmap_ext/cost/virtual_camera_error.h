@@ -21,21 +21,6 @@
 
 namespace portcal {
 
-// The unit axis every plane of refraction contains, or false where the port
-// has none (a concentric dome: rays through the centre are not bent).
-template <typename Port, typename T>
-bool RefractionAxisOf(const T* port, VectorT<T, 3>* axis) {
-  if constexpr (Port::kId == 0) {  // FLATPORT
-    *axis = Port::Normal(port);
-    return true;
-  } else {  // DOMEPORT
-    const VectorT<T, 3> center(port[0], port[1], port[2]);
-    if (!(center.norm() > T(1e-12))) return false;
-    *axis = center.normalized();
-    return true;
-  }
-}
-
 // The virtual-camera residual (pixels, before division by sigma) of an
 // observed pixel and a point in the camera frame. False where the pixel has
 // no ray in water or the point is behind the virtual camera.
@@ -51,7 +36,7 @@ bool VirtualCameraResidual(const T* intrinsics, const T* housing, const Eigen::V
   // intersect up to rounding). A ray along the axis is not bent: centre 0.
   VectorT<T, 3> center = VectorT<T, 3>::Zero();
   VectorT<T, 3> axis;
-  if (RefractionAxisOf<Port, T>(housing, &axis)) {
+  if (Port::RefractionAxis(housing, &axis)) {
     const T cos_axis = axis.dot(dir);
     const T sin2 = T(1) - cos_axis * cos_axis;
     if (sin2 > T(1e-12)) {

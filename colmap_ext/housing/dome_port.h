@@ -30,6 +30,16 @@ struct DomePort {
   static VectorT<T, 3> Center(const T* port) {
     return {port[0], port[1], port[2]};
   }
+  // The unit axis every plane of refraction contains, through the camera
+  // centre and the dome's; false for a concentric dome, whose rays through
+  // the centre are not bent.
+  template <typename T>
+  [[nodiscard]] static bool RefractionAxis(const T* port, VectorT<T, 3>* axis) {
+    const VectorT<T, 3> center = Center(port);
+    if (!(center.norm() > T(1e-12))) return false;
+    *axis = center.normalized();
+    return true;
+  }
   template <typename T>
   static const T& InnerRadius(const T* port) { return port[3]; }
   template <typename T>

@@ -45,10 +45,12 @@ struct FlatPort {
   template <typename T>
   static const T& WaterIndex(const T* port) { return port[7]; }
 
-  // The axis every plane of refraction contains, through the camera centre.
+  // The unit axis every plane of refraction contains, through the camera
+  // centre: the normal (always there).
   template <typename T>
-  static VectorT<T, 3> RefractionAxis(const T* port) {
-    return Normal(port);
+  [[nodiscard]] static bool RefractionAxis(const T* port, VectorT<T, 3>* axis) {
+    *axis = Normal(port);
+    return true;
   }
 
   // Why these parameters describe no flat port, or nullopt if they do.

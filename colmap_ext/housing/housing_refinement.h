@@ -3,6 +3,7 @@
 // (Port::Refinement), so the adjustment holds no knowledge of port models.
 #pragma once
 
+#include <algorithm>
 #include <limits>
 #include <string>
 #include <vector>
@@ -27,6 +28,17 @@ struct HousingRefinement {
   std::vector<HousingParamBound> bounds;
   std::string position_name;      // "port distance", "decentering"
   std::string bound_description;  // "port distance 0.1 mm", ...
+
+  // Every refined parameter's index: the orientation's, then the position's.
+  std::vector<int> Refined() const {
+    std::vector<int> refined = orientation;
+    refined.insert(refined.end(), position.begin(), position.end());
+    return refined;
+  }
+  bool IsRefined(int index) const {
+    const std::vector<int> refined = Refined();
+    return std::find(refined.begin(), refined.end(), index) != refined.end();
+  }
 };
 
 }  // namespace portcal

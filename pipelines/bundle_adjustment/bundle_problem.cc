@@ -9,6 +9,7 @@
 #include <set>
 
 #include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/cost/distance_error.h"
 #include "colmap_ext/geometry/pose_block.h"
 #include "colmap_ext/housing/housing_manifold.h"
 #include "colmap_ext/util/error.h"
@@ -27,17 +28,6 @@ namespace {
 // Keypoints up to this scale (pixels) get sigma_px; coarser ones more.
 constexpr double kReferenceScale = 2.0;
 
-// |a - b| = length, in units of sigma.
-struct DistanceError {
-  DistanceError(double length, double sigma) : length_(length), inv_sigma_(1.0 / sigma) {}
-  template <typename T>
-  bool operator()(const T* a, const T* b, T* residual) const {
-    const T dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
-    residual[0] = (ceres::sqrt(dx * dx + dy * dy + dz * dz) - T(length_)) * T(inv_sigma_);
-    return true;
-  }
-  double length_, inv_sigma_;
-};
 
 // Beyond a thousand free poses the reduced camera system is factorised
 // sparsely only while it has at most this many 6x6 blocks (a survey's
@@ -245,9 +235,7 @@ void BundleProblem::AddMarkers() {
       for (int b = a + 1; b < 4; ++b) {
         if (!c[a] || !c[b]) continue;
         const double length = (b - a == 2) ? side * std::sqrt(2.0) : side;
-        problem_.AddResidualBlock(new ceres::AutoDiffCostFunction<DistanceError, 1, 3, 3>(
-                                      new DistanceError(length, marker_scale_.sigma_m)),
-                                  nullptr, c[a], c[b]);
+        problem_.AddResidualBlock(DistanceError::Create(length, marker_scale_.sigma_m), nullptr, c[a], c[b]);
       }
     }
   }

@@ -295,6 +295,124 @@ Eigen::MatrixXd SparseInverseRows(const Eigen::SparseMatrix<double>& reduced, co
   return (d_inv_sqrt.asDiagonal() * solved).transpose();
 }
 
+// The residuals and Jacobian at the solution (without the loss function),
+// the points' columns after the `num_columns` of the other blocks.
+struct Linearisation {
+  std::vector<ceres::ResidualBlockId> residual_blocks;
+  std::map<const double*, int> offset;  // tangent column of each other block
+  int num_columns = 0;
+  ceres::CRSMatrix jacobian;
+  std::vector<double> residuals;
+};
+
+Linearisation Linearise(ceres::Problem* problem, const std::vector<double*>& points,
+                        const std::vector<double*>& others) {
+  Linearisation out;
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.apply_loss_function = false;
+  evaluate.parameter_blocks = others;
+  evaluate.parameter_blocks.insert(evaluate.parameter_blocks.end(), points.begin(), points.end());
+  problem->GetResidualBlocks(&evaluate.residual_blocks);
+  for (double* block : others) {
+    out.offset[block] = out.num_columns;
+    out.num_columns += problem->ParameterBlockTangentSize(block);
+  }
+  if (out.num_columns == 0) throw NumericalError("covariance: no free parameters");
+  if (!problem->Evaluate(evaluate, nullptr, &out.residuals, nullptr, &out.jacobian)) {
+    throw NumericalError("covariance: the residuals cannot be evaluated at the solution");
+  }
+  out.residual_blocks = std::move(evaluate.residual_blocks);
+  return out;
+}
+
+// Jacobi scaling: rotations (radians), translations (metres), focal
+// lengths (pixels) and distortion differ by many orders of magnitude in
+// their information; the rank test and the inverse work on the scaled
+// system S' = D^-1/2 S D^-1/2 (D = diag S), whose diagonal is 1.
+Eigen::VectorXd JacobiScaling(const Eigen::SparseMatrix<double>& reduced, int num_columns) {
+  Eigen::VectorXd d_inv_sqrt(num_columns);
+  for (int i = 0; i < num_columns; ++i) {
+    const double d = reduced.coeff(i, i);
+    d_inv_sqrt(i) = d > 0 ? 1.0 / std::sqrt(d) : 0.0;
+  }
+  return d_inv_sqrt;
+}
+
+// Each wanted block's plus Jacobian (tangent to ambient coordinates), its
+// rows in the result, and its tangent coordinates in the reduced system.
+struct WantedTangents {
+  std::vector<Eigen::MatrixXd> plus;
+  std::vector<int> columns;      // in order; block a's start at first_row[a]
+  std::vector<int> first_row;
+  int total = 0;                 // ambient coordinates of all wanted blocks
+};
+
+WantedTangents TangentsOf(ceres::Problem* problem, const std::vector<const double*>& wanted,
+                          const std::map<const double*, int>& offset, MarginalCovariance* result) {
+  WantedTangents out;
+  for (const double* block : wanted) {
+    const int tangent = problem->ParameterBlockTangentSize(block);
+    const int ambient = problem->ParameterBlockSize(block);
+    Eigen::MatrixXd p = Eigen::MatrixXd::Identity(ambient, tangent);
+    if (const ceres::Manifold* manifold = problem->GetManifold(block)) {
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> J(ambient, tangent);
+      manifold->PlusJacobian(block, J.data());
+      p = J;
+    }
+    out.plus.push_back(p);
+    out.first_row.push_back(static_cast<int>(out.columns.size()));
+    const int start = offset.at(block);
+    for (int k = 0; k < tangent; ++k) out.columns.push_back(start + k);
+    result->offset[block] = out.total;
+    result->size[block] = ambient;
+    out.total += ambient;
+  }
+  return out;
+}
+
+// Each residual's linearised effect on the wanted blocks (ambient
+// coordinates): the gain S^-1 (wanted rows) applied to its reduced
+// gradient w r (J_c' - H_cp H_pp^+ J_p'), w = rho' -- the points' share
+// removed as in the Schur complement. A cluster's effect S^-1 u_k is the
+// sum of its residuals' effects.
+Eigen::MatrixXd ClusteredCovariance(const Linearisation& linear, const PointSchur& schur,
+                                    const std::vector<const double*>& wanted, const WantedTangents& tangents,
+                                    const Eigen::MatrixXd& inverse_rows, const std::vector<BlockClusters>& block_clusters,
+                                    const ResidualClusters& clusters, MarginalCovariance* result) {
+  const int nc = linear.num_columns;
+  Eigen::MatrixXd gain(tangents.total, nc);
+  for (size_t a = 0; a < wanted.size(); ++a) {
+    gain.middleRows(result->offset[wanted[a]], tangents.plus[a].rows()) =
+        tangents.plus[a] * inverse_rows.middleRows(tangents.first_row[a], tangents.plus[a].cols());
+  }
+  // S^-1 H_cp H_pp^+ for every point coordinate (total x 3 points).
+  const Eigen::MatrixXd point_gain = gain * schur.point_from_cameras.transpose();
+  ClusterEffects effects(tangents.total, block_clusters);
+  size_t block = 0;
+  int block_start = 0;
+  Eigen::VectorXd block_effect = Eigen::VectorXd::Zero(tangents.total);
+  const ceres::CRSMatrix& jacobian = linear.jacobian;
+  for (int row = 0; row < jacobian.num_rows; ++row) {
+    const double weighted_residual = block_clusters[block].weight * linear.residuals[static_cast<size_t>(row)];
+    for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
+      const int col = jacobian.cols[k];
+      const double value = jacobian.values[k] * weighted_residual;
+      if (col < nc) {
+        block_effect += gain.col(col) * value;
+      } else {
+        block_effect -= point_gain.col(col - nc) * value;
+      }
+    }
+    if (row + 1 == block_start + block_clusters[block].rows) {
+      effects.Add(block, block_effect);
+      block_start = row + 1;
+      ++block;
+      block_effect.setZero();
+    }
+  }
+  return effects.Covariance(clusters.residuals_per_dof, &result->num_clusters, &result->num_tracks);
+}
+
 }  // namespace
 
 std::vector<double> MarginalCovariance::StdDevs(const double* block) const {
@@ -318,41 +436,19 @@ MarginalCovariance ComputeMarginalCovariance(
     const std::vector<const double*>& wanted, double scale,
     const std::function<std::string(const double*, int)>& describe, const ResidualClusters* clusters,
     int max_dense_size) {
-  ceres::Problem::EvaluateOptions evaluate;
-  evaluate.apply_loss_function = false;
-  evaluate.parameter_blocks = others;
-  evaluate.parameter_blocks.insert(evaluate.parameter_blocks.end(), points.begin(), points.end());
-  problem->GetResidualBlocks(&evaluate.residual_blocks);
-  std::map<const double*, int> offset;  // tangent column of each other block
-  int nc = 0;
-  for (double* block : others) {
-    offset[block] = nc;
-    nc += problem->ParameterBlockTangentSize(block);
-  }
-  if (nc == 0) throw NumericalError("covariance: no free parameters");
-  ceres::CRSMatrix jacobian;
-  std::vector<double> residuals;
-  if (!problem->Evaluate(evaluate, nullptr, &residuals, nullptr, &jacobian)) {
-    throw NumericalError("covariance: the residuals cannot be evaluated at the solution");
-  }
+  const Linearisation linear = Linearise(problem, points, others);
+  const int nc = linear.num_columns;
   // Each residual block's clusters and the weight of its gradient: the
   // loss's derivative rho'(|r|^2) (at the solution the robust gradient,
   // rho' J'r, is what balances).
   std::vector<BlockClusters> block_clusters;
-  if (clusters) block_clusters = AssignClusters(problem, evaluate.residual_blocks, points, residuals, *clusters);
-
-  const PointSchur schur = ReduceOverPoints(jacobian, nc, points.size());
-  // Jacobi scaling: rotations (radians), translations (metres), focal
-  // lengths (pixels) and distortion differ by many orders of magnitude in
-  // their information; the rank test and the inverse work on the scaled
-  // system S' = D^-1/2 S D^-1/2 (D = diag S), whose diagonal is 1.
-  Eigen::VectorXd d_inv_sqrt(nc);
-  for (int i = 0; i < nc; ++i) {
-    const double d = schur.reduced.coeff(i, i);
-    d_inv_sqrt(i) = d > 0 ? 1.0 / std::sqrt(d) : 0.0;
+  if (clusters) {
+    block_clusters = AssignClusters(problem, linear.residual_blocks, points, linear.residuals, *clusters);
   }
+  const PointSchur schur = ReduceOverPoints(linear.jacobian, nc, points.size());
+  const Eigen::VectorXd d_inv_sqrt = JacobiScaling(schur.reduced, nc);
   const auto name_of = [&](Eigen::Index column) {
-    for (const auto& [block, start] : offset) {
+    for (const auto& [block, start] : linear.offset) {
       const int size = problem->ParameterBlockTangentSize(block);
       if (column >= start && column < start + size) {
         return describe(block, static_cast<int>(column) - start) + " [tangent " + std::to_string(column - start) + "]";
@@ -360,84 +456,29 @@ MarginalCovariance ComputeMarginalCovariance(
     }
     return "parameter " + std::to_string(column);
   };
-
-  // Each wanted block's plus Jacobian (tangent to ambient coordinates), its
-  // rows in the result, and its tangent coordinates in the reduced system.
   MarginalCovariance result;
-  std::vector<Eigen::MatrixXd> plus;
-  std::vector<int> wanted_tangent;  // in order; block a's start at tangent_row[a]
-  std::vector<int> tangent_row;
-  int total = 0;
-  for (const double* block : wanted) {
-    const int tangent = problem->ParameterBlockTangentSize(block);
-    const int ambient = problem->ParameterBlockSize(block);
-    Eigen::MatrixXd p = Eigen::MatrixXd::Identity(ambient, tangent);
-    if (const ceres::Manifold* manifold = problem->GetManifold(block)) {
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> J(ambient, tangent);
-      manifold->PlusJacobian(block, J.data());
-      p = J;
-    }
-    plus.push_back(p);
-    tangent_row.push_back(static_cast<int>(wanted_tangent.size()));
-    const int start = offset.at(const_cast<double*>(block));
-    for (int k = 0; k < tangent; ++k) wanted_tangent.push_back(start + k);
-    result.offset[block] = total;
-    result.size[block] = ambient;
-    total += ambient;
-  }
+  const WantedTangents tangents = TangentsOf(problem, wanted, linear.offset, &result);
   // The rows of S^-1 at the wanted coordinates.
   const Eigen::MatrixXd inverse_rows = nc <= max_dense_size
-      ? DenseInverseRows(schur.reduced, d_inv_sqrt, wanted_tangent, name_of)
-      : SparseInverseRows(schur.reduced, d_inv_sqrt, wanted_tangent, name_of);
+      ? DenseInverseRows(schur.reduced, d_inv_sqrt, tangents.columns, name_of)
+      : SparseInverseRows(schur.reduced, d_inv_sqrt, tangents.columns, name_of);
 
   // Each wanted block's tangent covariance mapped to its ambient
   // coordinates: C_ab = P_a C'_ab P_b^T.
-  result.covariance = Eigen::MatrixXd::Zero(total, total);
+  result.covariance = Eigen::MatrixXd::Zero(tangents.total, tangents.total);
   for (size_t a = 0; a < wanted.size(); ++a) {
     for (size_t b = 0; b < wanted.size(); ++b) {
-      const int tb = offset.at(const_cast<double*>(wanted[b]));
-      result.covariance.block(result.offset[wanted[a]], result.offset[wanted[b]], plus[a].rows(), plus[b].rows()) =
-          scale * scale * plus[a] * inverse_rows.block(tangent_row[a], tb, plus[a].cols(), plus[b].cols()) *
-          plus[b].transpose();
+      const Eigen::MatrixXd& pa = tangents.plus[a];
+      const Eigen::MatrixXd& pb = tangents.plus[b];
+      const int tb = linear.offset.at(wanted[b]);
+      result.covariance.block(result.offset[wanted[a]], result.offset[wanted[b]], pa.rows(), pb.rows()) =
+          scale * scale * pa * inverse_rows.block(tangents.first_row[a], tb, pa.cols(), pb.cols()) * pb.transpose();
     }
   }
-  if (!clusters) return result;
-
-  // Each residual's linearised effect on the wanted blocks (ambient
-  // coordinates): the gain S^-1 (wanted rows) applied to its reduced
-  // gradient w r (J_c' - H_cp H_pp^+ J_p'), w = rho' -- the points' share
-  // removed as in the Schur complement. A cluster's effect S^-1 u_k is the
-  // sum of its residuals' effects.
-  Eigen::MatrixXd gain(total, nc);
-  for (size_t a = 0; a < wanted.size(); ++a) {
-    gain.middleRows(result.offset[wanted[a]], plus[a].rows()) =
-        plus[a] * inverse_rows.middleRows(tangent_row[a], plus[a].cols());
+  if (clusters) {
+    result.clustered_covariance =
+        ClusteredCovariance(linear, schur, wanted, tangents, inverse_rows, block_clusters, *clusters, &result);
   }
-  // S^-1 H_cp H_pp^+ for every point coordinate (total x 3 points).
-  const Eigen::MatrixXd point_gain = gain * schur.point_from_cameras.transpose();
-  ClusterEffects effects(total, block_clusters);
-  size_t block = 0;
-  int block_start = 0;
-  Eigen::VectorXd block_effect = Eigen::VectorXd::Zero(total);
-  for (int row = 0; row < jacobian.num_rows; ++row) {
-    const double weighted_residual = block_clusters[block].weight * residuals[static_cast<size_t>(row)];
-    for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
-      const int col = jacobian.cols[k];
-      const double value = jacobian.values[k] * weighted_residual;
-      if (col < nc) {
-        block_effect += gain.col(col) * value;
-      } else {
-        block_effect -= point_gain.col(col - nc) * value;
-      }
-    }
-    if (row + 1 == block_start + block_clusters[block].rows) {
-      effects.Add(block, block_effect);
-      block_start = row + 1;
-      ++block;
-      block_effect.setZero();
-    }
-  }
-  result.clustered_covariance = effects.Covariance(clusters->residuals_per_dof, &result.num_clusters, &result.num_tracks);
   return result;
 }
 

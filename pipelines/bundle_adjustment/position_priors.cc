@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "colmap_ext/cost/position_prior_error.h"
+
 namespace portcal {
 
 namespace {
@@ -58,19 +60,6 @@ Eigen::Vector3d Apply(const Similarity3d& s, const Eigen::Vector3d& x) {
   return s.scale * (s.rotation * x) + s.translation;
 }
 
-struct PositionPriorError {
-  PositionPriorError(const Eigen::Vector3d& prior, double sigma) : prior(prior), inv_sigma(1.0 / sigma) {}
-  template <typename T>
-  bool operator()(const T* pose, T* residual) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> rotation(pose);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> translation(pose + 4);
-    const Eigen::Matrix<T, 3, 1> centre = -(rotation.conjugate() * translation);
-    for (int k = 0; k < 3; ++k) residual[k] = (centre[k] - T(prior[k])) * T(inv_sigma);
-    return true;
-  }
-  Eigen::Vector3d prior;
-  double inv_sigma;
-};
 
 }  // namespace
 
@@ -117,7 +106,7 @@ std::optional<PositionPriorAlignment> AlignToPositionPriors(Reconstruction* r, d
 }
 
 ceres::CostFunction* CreatePositionPriorCost(const Eigen::Vector3d& prior, double sigma_m) {
-  return new ceres::AutoDiffCostFunction<PositionPriorError, 3, 7>(new PositionPriorError(prior, sigma_m));
+  return PositionPriorError::Create(prior, sigma_m);
 }
 
 }  // namespace portcal

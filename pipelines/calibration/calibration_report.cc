@@ -134,10 +134,13 @@ std::string Text(const CalibrationReport& r) {
   if (r.housing) {
     const std::vector<std::string> housing_names = SplitTokens(r.housing->ParamsInfo(), ", ");
     out << "\nHousing " << r.housing->ModelName() << " (metres)\n";
+    const HousingRefinement refinement = r.housing->Refinement();
     for (size_t i = 0; i < r.housing->params.size(); ++i) {
+      // Thickness, radius, indices: the user's constants, never refined.
+      const bool constant = !refinement.IsRefined(static_cast<int>(i));
       out << "  " << std::left << std::setw(10) << housing_names[i] << std::right << std::setw(17)
           << std::setprecision(6) << r.housing->params[i]
-          << (i < r.housing_std_dev.size() && r.housing_std_dev[i] == 0 && i >= 3
+          << (i < r.housing_std_dev.size() && r.housing_std_dev[i] == 0 && constant
                   ? std::string("       (constant)")
                   : StdDevText(r.housing_std_dev, i) +
                         StdDevSourcesText(r.housing_std_dev_by_noise, r.housing_std_dev_by_clusters, i))
@@ -229,6 +232,36 @@ void WriteStereoCalibrationReport(const StereoCalibrationResult& r, const Housed
   const std::string yaml_text = yaml.str(), text_text = text.str();
   WriteFileAtomically(dir / "calibration.yaml", false, [&](std::ostream& out) { out << yaml_text; });
   WriteFileAtomically(dir / "calibration.txt", false, [&](std::ostream& out) { out << text_text; });
+}
+
+CalibrationReport ReportOf(const CameraCalibrationResult& result, bool with_board_warp, const std::string& target) {
+  CalibrationReport report;
+  report.camera = result.camera;
+  report.parameters_std_dev = result.params_std_dev;
+  report.overall_rms_px = result.overall_rms_px;
+  report.residual_sigma_px = result.residual_sigma_px;
+  report.num_points = result.num_points;
+  report.views = result.views;
+  report.target_description = target;
+  if (with_board_warp) {
+    report.board_warp = result.board_warp;
+    report.board_warp_std_dev = result.board_warp_std_dev;
+  }
+  return report;
+}
+
+CalibrationReport ReportOf(const HousingCalibrationResult& result, const std::string& target) {
+  CalibrationReport report;
+  report.camera = result.camera;
+  report.parameters_std_dev = result.camera_std_dev;
+  report.housing = result.housing;
+  report.housing_std_dev = result.housing_std_dev;
+  report.overall_rms_px = result.overall_rms_px;
+  report.residual_sigma_px = result.residual_sigma_px;
+  report.num_points = result.num_points;
+  report.views = result.views;
+  report.target_description = target;
+  return report;
 }
 
 void WriteCalibrationReport(const CalibrationReport& report, const fs::path& dir) {

@@ -11,6 +11,7 @@
 #include "colmap_ext/camera/camera.h"
 #include "colmap_ext/housing/housing.h"
 #include "pipelines/calibration/camera_calibration.h"
+#include "pipelines/calibration/housing_calibration.h"
 #include "pipelines/calibration/stereo_calibration.h"
 
 namespace portcal {
@@ -39,6 +40,11 @@ struct CalibrationReport {
   // deviation is a large fraction of it): written first in both files.
   std::vector<std::string> warnings;
 };
+
+// The report of a camera calibration (with the board warp when it was
+// estimated) and of a housing calibration, of the target `target`.
+CalibrationReport ReportOf(const CameraCalibrationResult& result, bool with_board_warp, const std::string& target);
+CalibrationReport ReportOf(const HousingCalibrationResult& result, const std::string& target);
 
 // Writes calibration.yaml and calibration.txt into `dir` (created),
 // atomically.

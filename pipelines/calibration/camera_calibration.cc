@@ -7,7 +7,7 @@
 #include <set>
 
 #include "colmap_ext/camera/camera_models.h"
-#include "colmap_ext/cost/autodiff_functor.h"
+#include "colmap_ext/cost/board_reprojection_error.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/string_utils.h"
@@ -30,38 +30,6 @@ void CameraCalibrationSettings::Check() const {
 }
 
 namespace {
-
-// Reprojection of a (possibly warped) board point, in pixels. Blocks:
-// cam_from_target (quaternion x,y,z,w + translation), intrinsics, warp.
-template <typename CameraModel>
-struct BoardReprojectionError
-    : AutoDiffFunctor<BoardReprojectionError<CameraModel>, 2, 7, CameraModel::kNumParams, 2> {
-  BoardReprojectionError(const Eigen::Vector3d& point, const Eigen::Vector2d& warp_uv,
-                         const Eigen::Vector2d& observed)
-      : point_(point), warp_uv_(warp_uv), observed_(observed) {}
-
-  template <typename T>
-  bool operator()(const T* cam_from_target, const T* intrinsics, const T* warp, T* residual) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> rotation(cam_from_target);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> translation(cam_from_target + 4);
-    Eigen::Matrix<T, 3, 1> point = point_.cast<T>();
-    point.z() += warp[0] * (1.0 - warp_uv_.x() * warp_uv_.x()) +
-                 warp[1] * (1.0 - warp_uv_.y() * warp_uv_.y());
-    const Eigen::Matrix<T, 3, 1> in_cam = rotation * point + translation;
-    T x, y;
-    if (!CameraModel::ImgFromCam(intrinsics, in_cam.x(), in_cam.y(), in_cam.z(), &x, &y)) {
-      return false;
-    }
-    residual[0] = x - observed_.x();
-    residual[1] = y - observed_.y();
-    return true;
-  }
-
- private:
-  Eigen::Vector3d point_;
-  Eigen::Vector2d warp_uv_;
-  Eigen::Vector2d observed_;
-};
 
 std::vector<int> FixedIndices(const Camera& camera, const std::vector<std::string>& names) {
   std::set<int> fixed;
@@ -99,6 +67,94 @@ struct Solution {
   int num_free = 0;
 };
 
+// A board point's coordinates scaled to [-1, 1] over the board's extent
+// (x min, x max, y min, y max): where the board warp's sag is evaluated.
+Eigen::Vector2d WarpUv(const Eigen::Vector3d& p, const Eigen::Vector4d& board_extent) {
+  return Eigen::Vector2d(
+      2 * (p.x() - board_extent[0]) / std::max(1e-12, board_extent[1] - board_extent[0]) - 1,
+      2 * (p.y() - board_extent[2]) / std::max(1e-12, board_extent[3] - board_extent[2]) - 1);
+}
+
+void AddBoardResiduals(const std::vector<const CalibrationView*>& views, int model_id,
+                       const Eigen::Vector4d& board_extent, Solution* s, ceres::Problem* problem) {
+  VisitCameraModel(model_id, [&](auto model) {
+    using Model = decltype(model);
+    for (size_t v = 0; v < views.size(); ++v) {
+      for (size_t i = 0; i < views[v]->pixels.size(); ++i) {
+        const Eigen::Vector3d& p = views[v]->points_in_target[i];
+        problem->AddResidualBlock(
+            BoardReprojectionError<Model>::Create(p, WarpUv(p, board_extent), views[v]->pixels[i]), nullptr,
+            s->poses[v].data(), s->intrinsics.data(), s->warp.data());
+      }
+    }
+  });
+}
+
+// Per-view RMS at the solution, and the sum of squares over all views.
+void ComputeViewRms(const std::vector<const CalibrationView*>& views, int model_id,
+                    const Eigen::Vector4d& board_extent, Solution* s) {
+  double total = 0;
+  int n = 0;
+  VisitCameraModel(model_id, [&](auto model) {
+    using Model = decltype(model);
+    for (size_t v = 0; v < views.size(); ++v) {
+      double sum = 0;
+      for (size_t i = 0; i < views[v]->pixels.size(); ++i) {
+        const Eigen::Quaterniond q(s->poses[v][3], s->poses[v][0], s->poses[v][1], s->poses[v][2]);
+        Eigen::Vector3d p = views[v]->points_in_target[i];
+        const Eigen::Vector2d uv = WarpUv(p, board_extent);
+        p.z() += s->warp.x() * (1 - uv.x() * uv.x()) + s->warp.y() * (1 - uv.y() * uv.y());
+        const Eigen::Vector3d in_cam = q * p + Eigen::Vector3d(s->poses[v][4], s->poses[v][5], s->poses[v][6]);
+        double x = 0, y = 0;
+        if (!Model::ImgFromCam(s->intrinsics.data(), in_cam.x(), in_cam.y(), in_cam.z(), &x, &y)) {
+          throw NumericalError(views[v]->image_name + ": a target point ends behind the camera");
+        }
+        sum += (Eigen::Vector2d(x, y) - views[v]->pixels[i]).squaredNorm();
+      }
+      s->view_rms.push_back(std::sqrt(sum / views[v]->pixels.size()));
+      total += sum;
+      n += static_cast<int>(views[v]->pixels.size());
+    }
+  });
+  s->sum_squares = total;
+  s->num_residuals = 2 * n;
+}
+
+// Covariance of the parameters, scaled by the residual variance: the
+// observations' noise is estimated from the fit, not assumed to be 1 px.
+void ComputeParamsCovariance(const std::vector<int>& fixed, const CameraCalibrationSettings& settings,
+                             ceres::Problem* problem, Solution* s) {
+  const int num_params = static_cast<int>(s->intrinsics.size());
+  const double dof = s->num_residuals - s->num_free;
+  const double variance = dof > 0 ? s->sum_squares / dof : 0;
+  ceres::Covariance covariance(CalibrationCovarianceOptions(settings.num_threads));
+  std::vector<std::pair<const double*, const double*>> blocks = {
+      {s->intrinsics.data(), s->intrinsics.data()}};
+  if (settings.estimate_board_warp) blocks.emplace_back(s->warp.data(), s->warp.data());
+  s->params_std_dev.assign(num_params, 0.0);
+  s->params_covariance = Eigen::MatrixXd::Zero(num_params, num_params);
+  if (static_cast<int>(fixed.size()) < num_params && covariance.Compute(blocks, problem)) {
+    std::vector<double> c(num_params * num_params);
+    covariance.GetCovarianceBlock(s->intrinsics.data(), s->intrinsics.data(), c.data());
+    s->params_covariance =
+        Eigen::Map<const Eigen::MatrixXd>(c.data(), num_params, num_params) * variance;
+    for (int i = 0; i < num_params; ++i) s->params_std_dev[i] = std::sqrt(std::max(0.0, c[i * num_params + i] * variance));
+    if (settings.estimate_board_warp) {
+      double w[4];
+      covariance.GetCovarianceBlock(s->warp.data(), s->warp.data(), w);
+      s->warp_std_dev = Eigen::Vector2d(std::sqrt(std::max(0.0, w[0] * variance)),
+                                        std::sqrt(std::max(0.0, w[3] * variance)));
+    }
+  } else if (static_cast<int>(fixed.size()) < num_params) {
+    // Undetermined (-1, written as null), not 0, which means "held".
+    for (int i = 0; i < num_params; ++i) {
+      if (std::find(fixed.begin(), fixed.end(), i) == fixed.end()) s->params_std_dev[i] = -1.0;
+    }
+    LOG(WARNING) << "camera calibration: the covariance is rank deficient (a parameter the views do "
+                    "not determine); standard deviations undetermined";
+  }
+}
+
 Solution Solve(const std::vector<const CalibrationView*>& views, const Camera& camera,
                std::vector<std::array<double, 7>> poses, const std::vector<int>& fixed,
                const Eigen::Vector4d& board_extent, const CameraCalibrationSettings& settings) {
@@ -106,19 +162,7 @@ Solution Solve(const std::vector<const CalibrationView*>& views, const Camera& c
   s.intrinsics = camera.params;
   s.poses = std::move(poses);
   ceres::Problem problem;
-  VisitCameraModel(camera.model_id, [&](auto model) {
-    using Model = decltype(model);
-    for (size_t v = 0; v < views.size(); ++v) {
-      for (size_t i = 0; i < views[v]->pixels.size(); ++i) {
-        const Eigen::Vector3d& p = views[v]->points_in_target[i];
-        const Eigen::Vector2d uv(
-            2 * (p.x() - board_extent[0]) / std::max(1e-12, board_extent[1] - board_extent[0]) - 1,
-            2 * (p.y() - board_extent[2]) / std::max(1e-12, board_extent[3] - board_extent[2]) - 1);
-        problem.AddResidualBlock(BoardReprojectionError<Model>::Create(p, uv, views[v]->pixels[i]),
-                                 nullptr, s.poses[v].data(), s.intrinsics.data(), s.warp.data());
-      }
-    }
-  });
+  AddBoardResiduals(views, camera.model_id, board_extent, &s, &problem);
   for (auto& pose : s.poses) {
     problem.SetManifold(pose.data(), PoseManifold());
   }
@@ -134,68 +178,158 @@ Solution Solve(const std::vector<const CalibrationView*>& views, const Camera& c
   for (double p : s.intrinsics) {
     if (!std::isfinite(p)) throw NumericalError("camera calibration produced a non-finite parameter");
   }
-  // Per-view RMS.
-  double total = 0;
-  int n = 0;
-  VisitCameraModel(camera.model_id, [&](auto model) {
-    using Model = decltype(model);
-    for (size_t v = 0; v < views.size(); ++v) {
-      double sum = 0;
-      for (size_t i = 0; i < views[v]->pixels.size(); ++i) {
-        const Eigen::Quaterniond q(s.poses[v][3], s.poses[v][0], s.poses[v][1], s.poses[v][2]);
-        Eigen::Vector3d p = views[v]->points_in_target[i];
-        const Eigen::Vector2d uv(
-            2 * (p.x() - board_extent[0]) / std::max(1e-12, board_extent[1] - board_extent[0]) - 1,
-            2 * (p.y() - board_extent[2]) / std::max(1e-12, board_extent[3] - board_extent[2]) - 1);
-        p.z() += s.warp.x() * (1 - uv.x() * uv.x()) + s.warp.y() * (1 - uv.y() * uv.y());
-        const Eigen::Vector3d in_cam = q * p + Eigen::Vector3d(s.poses[v][4], s.poses[v][5], s.poses[v][6]);
-        double x = 0, y = 0;
-        if (!Model::ImgFromCam(s.intrinsics.data(), in_cam.x(), in_cam.y(), in_cam.z(), &x, &y)) {
-          throw NumericalError(views[v]->image_name + ": a target point ends behind the camera");
-        }
-        sum += (Eigen::Vector2d(x, y) - views[v]->pixels[i]).squaredNorm();
-      }
-      s.view_rms.push_back(std::sqrt(sum / views[v]->pixels.size()));
-      total += sum;
-      n += static_cast<int>(views[v]->pixels.size());
-    }
-  });
-  s.sum_squares = total;
-  s.num_residuals = 2 * n;
+  ComputeViewRms(views, camera.model_id, board_extent, &s);
   s.num_free = (num_params - static_cast<int>(fixed.size())) + 6 * static_cast<int>(views.size()) +
                (settings.estimate_board_warp ? 2 : 0);
-
-  // Covariance of the parameters, scaled by the residual variance: the
-  // observations' noise is estimated from the fit, not assumed to be 1 px.
-  const double dof = s.num_residuals - s.num_free;
-  const double variance = dof > 0 ? s.sum_squares / dof : 0;
-  ceres::Covariance covariance(CalibrationCovarianceOptions(settings.num_threads));
-  std::vector<std::pair<const double*, const double*>> blocks = {
-      {s.intrinsics.data(), s.intrinsics.data()}};
-  if (settings.estimate_board_warp) blocks.emplace_back(s.warp.data(), s.warp.data());
-  s.params_std_dev.assign(num_params, 0.0);
-  s.params_covariance = Eigen::MatrixXd::Zero(num_params, num_params);
-  if (static_cast<int>(fixed.size()) < num_params && covariance.Compute(blocks, &problem)) {
-    std::vector<double> c(num_params * num_params);
-    covariance.GetCovarianceBlock(s.intrinsics.data(), s.intrinsics.data(), c.data());
-    s.params_covariance =
-        Eigen::Map<const Eigen::MatrixXd>(c.data(), num_params, num_params) * variance;
-    for (int i = 0; i < num_params; ++i) s.params_std_dev[i] = std::sqrt(std::max(0.0, c[i * num_params + i] * variance));
-    if (settings.estimate_board_warp) {
-      double w[4];
-      covariance.GetCovarianceBlock(s.warp.data(), s.warp.data(), w);
-      s.warp_std_dev = Eigen::Vector2d(std::sqrt(std::max(0.0, w[0] * variance)),
-                                       std::sqrt(std::max(0.0, w[3] * variance)));
-    }
-  } else if (static_cast<int>(fixed.size()) < num_params) {
-    // Undetermined (-1, written as null), not 0, which means "held".
-    for (int i = 0; i < num_params; ++i) {
-      if (std::find(fixed.begin(), fixed.end(), i) == fixed.end()) s.params_std_dev[i] = -1.0;
-    }
-    LOG(WARNING) << "camera calibration: the covariance is rank deficient (a parameter the views do "
-                    "not determine); standard deviations undetermined";
-  }
+  ComputeParamsCovariance(fixed, settings, &problem, &s);
   return s;
+}
+
+// The views with enough points, and the board's extent over them (x min,
+// x max, y min, y max).
+std::vector<const CalibrationView*> UsableViews(const std::vector<CalibrationView>& all_views,
+                                                const CameraCalibrationSettings& settings,
+                                                Eigen::Vector4d* extent) {
+  std::vector<const CalibrationView*> views;
+  *extent = Eigen::Vector4d(1e300, -1e300, 1e300, -1e300);
+  for (const CalibrationView& view : all_views) {
+    if (static_cast<int>(view.pixels.size()) < settings.min_points_per_view) continue;
+    views.push_back(&view);
+    for (const auto& p : view.points_in_target) {
+      *extent = Eigen::Vector4d(std::min((*extent)[0], p.x()), std::max((*extent)[1], p.x()),
+                                std::min((*extent)[2], p.y()), std::max((*extent)[3], p.y()));
+    }
+  }
+  if (views.size() < 2) {
+    throw NumericalError("camera calibration needs at least 2 views with >= " +
+                         std::to_string(settings.min_points_per_view) + " points, got " +
+                         std::to_string(views.size()));
+  }
+  return views;
+}
+
+// Zhang's closed form: the poses of the views and, unless held or not
+// wanted, the pinhole part of *camera.
+std::vector<std::array<double, 7>> StartFromZhang(const std::vector<const CalibrationView*>& views,
+                                                  const std::vector<int>& fixed,
+                                                  const CameraCalibrationSettings& settings, Camera* camera) {
+  std::vector<PlanarView> planar;
+  for (const CalibrationView* view : views) {
+    PlanarView p;
+    for (const auto& x : view->points_in_target) p.target_xy.push_back(x.head<2>());
+    p.pixels = view->pixels;
+    planar.push_back(p);
+  }
+  const auto pinhole = InitializePinholeFromPlanarViews(planar, static_cast<int>(camera->width),
+                                                        static_cast<int>(camera->height));
+  if (!pinhole) throw NumericalError("Zhang initialisation failed: the views are too alike or too few");
+  if (settings.initialize_from_data) {
+    const std::vector<int> focal = CameraModelFocalLengthIdxs(camera->model_id);
+    const std::vector<int> principal = CameraModelPrincipalPointIdxs(camera->model_id);
+    const auto is_fixed = [&](int i) { return std::count(fixed.begin(), fixed.end(), i) > 0; };
+    if (focal.size() == 1) {
+      if (!is_fixed(focal[0])) camera->params[focal[0]] = 0.5 * (pinhole->fx + pinhole->fy);
+    } else {
+      if (!is_fixed(focal[0])) camera->params[focal[0]] = pinhole->fx;
+      if (!is_fixed(focal[1])) camera->params[focal[1]] = pinhole->fy;
+    }
+    if (!is_fixed(principal[0])) camera->params[principal[0]] = pinhole->cx;
+    if (!is_fixed(principal[1])) camera->params[principal[1]] = pinhole->cy;
+  }
+  std::vector<std::array<double, 7>> poses;
+  for (const Rigid3d& pose : pinhole->cam_from_target) {
+    const Eigen::Quaterniond q = pose.rotation.normalized();
+    poses.push_back({q.x(), q.y(), q.z(), q.w(), pose.translation.x(), pose.translation.y(),
+                     pose.translation.z()});
+  }
+  return poses;
+}
+
+double MedianViewRms(std::vector<double> view_rms) {
+  std::sort(view_rms.begin(), view_rms.end());
+  return view_rms[view_rms.size() / 2];
+}
+
+// The views left out of the final solve, each with its RMS when it was.
+struct DroppedViews {
+  std::vector<bool> dropped;
+  std::vector<double> rms_px;
+};
+
+// Solves, and while outliers are dropped (up to 4 rounds), drops the views
+// whose RMS exceeds outlier_view_factor x the median of the kept views and
+// solves again. *camera and *poses hold the last solution.
+Solution SolveDroppingOutliers(const std::vector<const CalibrationView*>& views, const std::vector<int>& fixed,
+                               const Eigen::Vector4d& extent, const CameraCalibrationSettings& settings,
+                               Camera* camera, std::vector<std::array<double, 7>>* poses, DroppedViews* out) {
+  out->dropped.assign(views.size(), false);
+  out->rms_px.assign(views.size(), 0.0);
+  Solution solution;
+  for (int round = 0; round < 4; ++round) {
+    std::vector<const CalibrationView*> kept;
+    std::vector<std::array<double, 7>> kept_poses;
+    for (size_t v = 0; v < views.size(); ++v) {
+      if (!out->dropped[v]) {
+        kept.push_back(views[v]);
+        kept_poses.push_back((*poses)[v]);
+      }
+    }
+    if (kept.size() < 2) throw NumericalError("camera calibration: fewer than 2 views left after dropping outliers");
+    solution = Solve(kept, *camera, kept_poses, fixed, extent, settings);
+    const double median = MedianViewRms(solution.view_rms);
+    bool any_new = false;
+    size_t k = 0;
+    for (size_t v = 0; v < views.size(); ++v) {
+      if (out->dropped[v]) continue;
+      (*poses)[v] = solution.poses[k];
+      if (settings.drop_outlier_views && solution.view_rms[k] > settings.outlier_view_factor * median) {
+        out->dropped[v] = true;
+        out->rms_px[v] = solution.view_rms[k];
+        any_new = true;
+        LOG(WARNING) << views[v]->image_name << ": RMS " << solution.view_rms[k] << " px > "
+                     << settings.outlier_view_factor << " x median " << median << " px; dropped";
+      }
+      ++k;
+    }
+    camera->params = solution.intrinsics;
+    if (!any_new) break;
+  }
+  return solution;
+}
+
+CameraCalibrationResult ResultOf(const std::vector<const CalibrationView*>& views, const Camera& camera,
+                                 const Solution& solution, const std::vector<std::array<double, 7>>& poses,
+                                 const DroppedViews& dropped, const CameraCalibrationSettings& settings) {
+  CameraCalibrationResult result;
+  result.camera = camera;
+  result.params_std_dev = solution.params_std_dev;
+  result.params_covariance = solution.params_covariance;
+  result.board_warp = solution.warp;
+  result.board_warp_std_dev = solution.warp_std_dev;
+  result.num_points = solution.num_residuals / 2;
+  result.overall_rms_px = std::sqrt(solution.sum_squares / std::max(1, result.num_points));
+  const double dof = solution.num_residuals - solution.num_free;
+  result.residual_sigma_px = dof > 0 ? std::sqrt(solution.sum_squares / dof) : 0;
+  const double median = MedianViewRms(solution.view_rms);
+  size_t k = 0;
+  for (size_t v = 0; v < views.size(); ++v) {
+    CalibratedView out;
+    out.image_name = views[v]->image_name;
+    out.num_points = static_cast<int>(views[v]->pixels.size());
+    out.dropped = dropped.dropped[v];
+    const auto& p = poses[v];
+    out.cam_from_target = Rigid3d(Eigen::Quaterniond(p[3], p[0], p[1], p[2]).normalized(),
+                                  Eigen::Vector3d(p[4], p[5], p[6]));
+    if (dropped.dropped[v]) {
+      out.rms_px = dropped.rms_px[v];
+      out.outlier = true;
+    } else {
+      out.rms_px = solution.view_rms[k++];
+      out.outlier = out.rms_px > settings.outlier_view_factor * median;
+    }
+    result.views.push_back(out);
+  }
+  return result;
 }
 
 }  // namespace
@@ -206,122 +340,13 @@ CameraCalibrationResult CalibrateCamera(const std::vector<CalibrationView>& all_
   settings.Check();
   initial.Validate("initial camera");
   const std::vector<int> fixed = FixedIndices(initial, settings.fixed_params);
-  std::vector<const CalibrationView*> views;
-  Eigen::Vector4d extent(1e300, -1e300, 1e300, -1e300);
-  for (const CalibrationView& view : all_views) {
-    if (static_cast<int>(view.pixels.size()) < settings.min_points_per_view) continue;
-    views.push_back(&view);
-    for (const auto& p : view.points_in_target) {
-      extent = Eigen::Vector4d(std::min(extent[0], p.x()), std::max(extent[1], p.x()),
-                               std::min(extent[2], p.y()), std::max(extent[3], p.y()));
-    }
-  }
-  if (views.size() < 2) {
-    throw NumericalError("camera calibration needs at least 2 views with >= " +
-                         std::to_string(settings.min_points_per_view) + " points, got " +
-                         std::to_string(views.size()));
-  }
-
-  // Zhang's closed form for the pinhole part and the poses.
-  std::vector<PlanarView> planar;
-  for (const CalibrationView* view : views) {
-    PlanarView p;
-    for (const auto& x : view->points_in_target) p.target_xy.push_back(x.head<2>());
-    p.pixels = view->pixels;
-    planar.push_back(p);
-  }
-  const auto pinhole = InitializePinholeFromPlanarViews(planar, static_cast<int>(initial.width),
-                                                        static_cast<int>(initial.height));
-  if (!pinhole) throw NumericalError("Zhang initialisation failed: the views are too alike or too few");
+  Eigen::Vector4d extent;
+  const std::vector<const CalibrationView*> views = UsableViews(all_views, settings, &extent);
   Camera camera = initial;
-  if (settings.initialize_from_data) {
-    const std::vector<int> focal = CameraModelFocalLengthIdxs(camera.model_id);
-    const std::vector<int> principal = CameraModelPrincipalPointIdxs(camera.model_id);
-    const auto is_fixed = [&](int i) { return std::count(fixed.begin(), fixed.end(), i) > 0; };
-    if (focal.size() == 1) {
-      if (!is_fixed(focal[0])) camera.params[focal[0]] = 0.5 * (pinhole->fx + pinhole->fy);
-    } else {
-      if (!is_fixed(focal[0])) camera.params[focal[0]] = pinhole->fx;
-      if (!is_fixed(focal[1])) camera.params[focal[1]] = pinhole->fy;
-    }
-    if (!is_fixed(principal[0])) camera.params[principal[0]] = pinhole->cx;
-    if (!is_fixed(principal[1])) camera.params[principal[1]] = pinhole->cy;
-  }
-  std::vector<std::array<double, 7>> poses;
-  for (const Rigid3d& pose : pinhole->cam_from_target) {
-    const Eigen::Quaterniond q = pose.rotation.normalized();
-    poses.push_back({q.x(), q.y(), q.z(), q.w(), pose.translation.x(), pose.translation.y(),
-                     pose.translation.z()});
-  }
-
-  CameraCalibrationResult result;
-  std::vector<bool> dropped(views.size(), false);
-  std::vector<double> dropped_rms(views.size(), 0.0);  // RMS when dropped
-  Solution solution;
-  for (int round = 0; round < 4; ++round) {
-    std::vector<const CalibrationView*> kept;
-    std::vector<std::array<double, 7>> kept_poses;
-    for (size_t v = 0; v < views.size(); ++v) {
-      if (!dropped[v]) {
-        kept.push_back(views[v]);
-        kept_poses.push_back(poses[v]);
-      }
-    }
-    if (kept.size() < 2) throw NumericalError("camera calibration: fewer than 2 views left after dropping outliers");
-    solution = Solve(kept, camera, kept_poses, fixed, extent, settings);
-    // Outliers against the median RMS of the kept views.
-    std::vector<double> sorted = solution.view_rms;
-    std::sort(sorted.begin(), sorted.end());
-    const double median = sorted[sorted.size() / 2];
-    bool any_new = false;
-    size_t k = 0;
-    for (size_t v = 0; v < views.size(); ++v) {
-      if (dropped[v]) continue;
-      poses[v] = solution.poses[k];
-      if (settings.drop_outlier_views && solution.view_rms[k] > settings.outlier_view_factor * median) {
-        dropped[v] = true;
-        dropped_rms[v] = solution.view_rms[k];
-        any_new = true;
-        LOG(WARNING) << views[v]->image_name << ": RMS " << solution.view_rms[k] << " px > "
-                     << settings.outlier_view_factor << " x median " << median << " px; dropped";
-      }
-      ++k;
-    }
-    camera.params = solution.intrinsics;
-    if (!any_new) break;
-  }
-
-  result.camera = camera;
-  result.params_std_dev = solution.params_std_dev;
-  result.params_covariance = solution.params_covariance;
-  result.board_warp = solution.warp;
-  result.board_warp_std_dev = solution.warp_std_dev;
-  result.num_points = solution.num_residuals / 2;
-  result.overall_rms_px = std::sqrt(solution.sum_squares / std::max(1, result.num_points));
-  const double dof = solution.num_residuals - solution.num_free;
-  result.residual_sigma_px = dof > 0 ? std::sqrt(solution.sum_squares / dof) : 0;
-  std::vector<double> sorted = solution.view_rms;
-  std::sort(sorted.begin(), sorted.end());
-  const double median = sorted[sorted.size() / 2];
-  size_t k = 0;
-  for (size_t v = 0; v < views.size(); ++v) {
-    CalibratedView out;
-    out.image_name = views[v]->image_name;
-    out.num_points = static_cast<int>(views[v]->pixels.size());
-    out.dropped = dropped[v];
-    const auto& p = poses[v];
-    out.cam_from_target = Rigid3d(Eigen::Quaterniond(p[3], p[0], p[1], p[2]).normalized(),
-                                  Eigen::Vector3d(p[4], p[5], p[6]));
-    if (dropped[v]) {
-      out.rms_px = dropped_rms[v];
-      out.outlier = true;
-    } else {
-      out.rms_px = solution.view_rms[k++];
-      out.outlier = out.rms_px > settings.outlier_view_factor * median;
-    }
-    result.views.push_back(out);
-  }
-  return result;
+  std::vector<std::array<double, 7>> poses = StartFromZhang(views, fixed, settings, &camera);
+  DroppedViews dropped;
+  const Solution solution = SolveDroppingOutliers(views, fixed, extent, settings, &camera, &poses, &dropped);
+  return ResultOf(views, camera, solution, poses, dropped, settings);
 }
 
 }  // namespace portcal

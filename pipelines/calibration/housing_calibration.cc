@@ -6,8 +6,7 @@
 #include <cmath>
 
 #include "colmap_ext/camera/camera_models.h"
-#include "colmap_ext/cost/autodiff_functor.h"
-#include "colmap_ext/cost/virtual_camera_error.h"
+#include "colmap_ext/cost/board_through_port_error.h"
 #include "colmap_ext/housing/housing_manifold.h"
 #include "colmap_ext/housing/housing_models.h"
 #include "colmap_ext/housing/port_projection.h"
@@ -26,39 +25,6 @@ void HousingCalibrationSettings::Check() const {
 }
 
 namespace {
-
-enum class Error { kVirtualCamera, kReprojection };
-
-// A fixed target point seen through lens and port. Blocks: cam_from_target
-// (7), intrinsics, port (the model's parameters; what is held is the
-// manifold's business).
-template <typename CameraModel, typename Port, Error kError>
-struct BoardThroughPortError
-    : AutoDiffFunctor<BoardThroughPortError<CameraModel, Port, kError>, 2, 7,
-                      CameraModel::kNumParams, Port::kNumParams> {
-  BoardThroughPortError(const Eigen::Vector3d& point, const Eigen::Vector2d& observed)
-      : point_(point), observed_(observed) {}
-
-  template <typename T>
-  bool operator()(const T* cam_from_target, const T* intrinsics, const T* port, T* residual) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> rotation(cam_from_target);
-    const Eigen::Map<const VectorT<T, 3>> translation(cam_from_target + 4);
-    const VectorT<T, 3> in_cam = rotation * point_.cast<T>() + translation;
-    if constexpr (kError == Error::kVirtualCamera) {
-      return VirtualCameraResidual<CameraModel, Port, T>(intrinsics, port, observed_, in_cam, residual);
-    } else {
-      T x, y;
-      if (!ImgFromWater<CameraModel, Port, T>(intrinsics, port, in_cam, &x, &y)) return false;
-      residual[0] = x - observed_.x();
-      residual[1] = y - observed_.y();
-      return true;
-    }
-  }
-
- private:
-  Eigen::Vector3d point_;
-  Eigen::Vector2d observed_;
-};
 
 using Pose = PoseBlock;
 
@@ -119,7 +85,7 @@ struct State {
   std::vector<Pose> poses;
 };
 
-template <Error kError>
+template <PortErrorKind kError>
 void AddResiduals(const std::vector<CalibrationView>& views, int camera_model, State* state,
                   ceres::Problem* problem) {
   VisitCameraModel(camera_model, [&](auto camera_tag) {
@@ -142,7 +108,7 @@ void AddResiduals(const std::vector<CalibrationView>& views, int camera_model, S
 double PoseOnlyCost(const std::vector<CalibrationView>& views, int camera_model, State* state,
                     int num_threads) {
   ceres::Problem problem;
-  AddResiduals<Error::kReprojection>(views, camera_model, state, &problem);
+  AddResiduals<PortErrorKind::kReprojection>(views, camera_model, state, &problem);
   for (Pose& pose : state->poses) problem.SetManifold(pose.data(), PoseManifold());
   problem.SetParameterBlockConstant(state->intrinsics.data());
   problem.SetParameterBlockConstant(state->housing.params.data());
@@ -179,19 +145,19 @@ State BestStart(const std::vector<CalibrationView>& views, const Camera& camera,
 double SolveJointly(const std::vector<CalibrationView>& views, int camera_model,
                     const HousingCalibrationSettings& settings, State* state, ceres::Problem* final_problem) {
   double sum_squares = 0;
-  for (const Error error : {Error::kVirtualCamera, Error::kReprojection}) {
+  for (const PortErrorKind error : {PortErrorKind::kVirtualCamera, PortErrorKind::kReprojection}) {
     ceres::Problem local;
-    ceres::Problem& problem = error == Error::kReprojection ? *final_problem : local;
-    if (error == Error::kVirtualCamera) {
-      AddResiduals<Error::kVirtualCamera>(views, camera_model, state, &problem);
+    ceres::Problem& problem = error == PortErrorKind::kReprojection ? *final_problem : local;
+    if (error == PortErrorKind::kVirtualCamera) {
+      AddResiduals<PortErrorKind::kVirtualCamera>(views, camera_model, state, &problem);
     } else {
-      AddResiduals<Error::kReprojection>(views, camera_model, state, &problem);
+      AddResiduals<PortErrorKind::kReprojection>(views, camera_model, state, &problem);
     }
     for (Pose& pose : state->poses) problem.SetManifold(pose.data(), PoseManifold());
     // The intrinsics join only the final, exact solve: the virtual-camera
     // error back-projects through them, which is ill-conditioned far from
     // the solution.
-    if (!settings.refine_intrinsics || error == Error::kVirtualCamera) {
+    if (!settings.refine_intrinsics || error == PortErrorKind::kVirtualCamera) {
       problem.SetParameterBlockConstant(state->intrinsics.data());
     }
     SetHousingRefinement(state->housing, true, state->housing.params.data(), &problem);
@@ -200,14 +166,6 @@ double SolveJointly(const std::vector<CalibrationView>& views, int camera_model,
                           .final_cost;
   }
   return sum_squares;
-}
-
-// The refined parameters' indices: orientation and position.
-std::vector<int> RefinedHousingParams(const Housing& housing) {
-  const HousingRefinement refinement = housing.Refinement();
-  std::vector<int> refined = refinement.orientation;
-  refined.insert(refined.end(), refinement.position.begin(), refinement.position.end());
-  return refined;
 }
 
 // Standard deviations from the covariance scaled by the residual variance;
@@ -222,7 +180,7 @@ void FillStdDevs(const HousingCalibrationSettings& settings, double variance, St
   const int n = static_cast<int>(state->intrinsics.size());
   result->housing_std_dev.assign(static_cast<size_t>(m), 0.0);
   result->camera_std_dev.assign(static_cast<size_t>(n), 0.0);
-  const std::vector<int> refined = RefinedHousingParams(state->housing);
+  const std::vector<int> refined = state->housing.Refinement().Refined();
   if (!covariance.Compute(blocks, problem)) {
     // Undetermined (e.g. dome decentering refined together with the
     // principal point): say so rather than report zeros.

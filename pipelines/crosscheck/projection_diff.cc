@@ -219,6 +219,70 @@ const char* kRegionNames[3][3] = {{"top-left corner", "top edge", "top-right cor
                                   {"left edge", "centre", "right edge"},
                                   {"bottom-left corner", "bottom edge", "bottom-right corner"}};
 
+// Each grid point's weight in the fit of the two models' relative
+// rotation: 1 / (sigma_a sigma_b)^2 with both covariances (focus_radius
+// < 0), else 1 within focus_radius (default: a sixth of the smaller image
+// side) of the image centre.
+std::vector<double> FitWeights(const CalibratedLens& a, const CalibratedLens& b, const Grid& grid,
+                               bool with_covariance, const ProjectionDiffOptions& options) {
+  const size_t n = grid.pixels.size();
+  std::vector<double> weights(n, 0.0);
+  if (with_covariance && options.focus_radius < 0) {
+    const std::vector<double> sigma_a = ProjectionStdDev(a, grid);
+    const std::vector<double> sigma_b = ProjectionStdDev(b, grid);
+    for (size_t k = 0; k < n; ++k) {
+      const double s = sigma_a[k] * sigma_b[k];
+      weights[k] = std::isfinite(s) && s > 0 ? 1.0 / (s * s) : 0.0;
+    }
+  } else {
+    const double radius = options.focus_radius < 0
+                              ? std::min(a.camera.width, a.camera.height) / 6.0
+                              : options.focus_radius;
+    const Eigen::Vector2d centre(a.camera.width / 2.0, a.camera.height / 2.0);
+    for (size_t k = 0; k < n; ++k) weights[k] = (grid.pixels[k] - centre).norm() <= radius;
+  }
+  return weights;
+}
+
+// The ninth of the image (3 x 3 regions) with the largest mean difference.
+void FindWorstRegion(const Grid& grid, const Camera& camera, ProjectionDiff* out) {
+  double region_sum[3][3] = {}, region_count[3][3] = {};
+  for (size_t k = 0; k < grid.pixels.size(); ++k) {
+    if (!std::isfinite(out->diff_px[k])) continue;
+    const int r = std::min(2, static_cast<int>(3 * (grid.pixels[k].y() - 0.5) / camera.height));
+    const int c = std::min(2, static_cast<int>(3 * (grid.pixels[k].x() - 0.5) / camera.width));
+    region_sum[r][c] += out->diff_px[k];
+    region_count[r][c] += 1;
+  }
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      if (region_count[r][c] == 0) continue;
+      const double mean = region_sum[r][c] / region_count[r][c];
+      if (mean >= out->worst_region_mean_px) {
+        out->worst_region_mean_px = mean;
+        out->worst_region = kRegionNames[r][c];
+      }
+    }
+  }
+}
+
+// The difference the two models' uncertainties predict at each grid point.
+void PredictDiff(const CalibratedLens& a, const CalibratedLens& b, const Grid& grid,
+                 const std::vector<double>& weights, int num_valid, ProjectionDiff* out) {
+  const size_t n = grid.pixels.size();
+  std::vector<double> variance(n, 0.0);
+  AddPredictedVariance(a, true, b.camera, grid, weights, &variance);
+  AddPredictedVariance(b, false, a.camera, grid, weights, &variance);
+  out->predicted_px.resize(n);
+  double predicted_sum = 0;
+  for (size_t k = 0; k < n; ++k) {
+    out->predicted_px[k] = std::isfinite(out->diff_px[k]) ? std::sqrt(variance[k]) : kNaN;
+    if (std::isfinite(out->predicted_px[k])) predicted_sum += out->predicted_px[k];
+  }
+  out->predicted_mean_px = predicted_sum / num_valid;
+  out->predicted_p95_px = Percentile(out->predicted_px, 0.95);
+}
+
 }  // namespace
 
 void ProjectionDiffOptions::Check() const {
@@ -236,23 +300,7 @@ ProjectionDiff ComputeProjectionDiff(const CalibratedLens& a, const CalibratedLe
   const Grid grid = MakeGrid(a.camera, options.gridn_width);
   const size_t n = grid.pixels.size();
   const bool with_covariance = a.covariance.size() > 0 && b.covariance.size() > 0;
-
-  std::vector<double> weights(n, 0.0);
-  if (with_covariance && options.focus_radius < 0) {
-    const std::vector<double> sigma_a = ProjectionStdDev(a, grid);
-    const std::vector<double> sigma_b = ProjectionStdDev(b, grid);
-    for (size_t k = 0; k < n; ++k) {
-      const double s = sigma_a[k] * sigma_b[k];
-      weights[k] = std::isfinite(s) && s > 0 ? 1.0 / (s * s) : 0.0;
-    }
-  } else {
-    const double radius = options.focus_radius < 0
-                              ? std::min(a.camera.width, a.camera.height) / 6.0
-                              : options.focus_radius;
-    const Eigen::Vector2d centre(a.camera.width / 2.0, a.camera.height / 2.0);
-    for (size_t k = 0; k < n; ++k) weights[k] = (grid.pixels[k] - centre).norm() <= radius;
-  }
-
+  const std::vector<double> weights = FitWeights(a, b, grid, with_covariance, options);
   const Evaluation evaluation = Evaluate(a.camera, b.camera, grid, weights);
   ProjectionDiff out;
   out.grid_width = grid.width;
@@ -276,40 +324,8 @@ ProjectionDiff ComputeProjectionDiff(const CalibratedLens& a, const CalibratedLe
   }
   out.mean_px = sum / valid;
   out.p95_px = Percentile(out.diff_px, 0.95);
-
-  // The worst ninth of the image.
-  double region_sum[3][3] = {}, region_count[3][3] = {};
-  for (size_t k = 0; k < n; ++k) {
-    if (!std::isfinite(out.diff_px[k])) continue;
-    const int r = std::min(2, static_cast<int>(3 * (grid.pixels[k].y() - 0.5) / a.camera.height));
-    const int c = std::min(2, static_cast<int>(3 * (grid.pixels[k].x() - 0.5) / a.camera.width));
-    region_sum[r][c] += out.diff_px[k];
-    region_count[r][c] += 1;
-  }
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) {
-      if (region_count[r][c] == 0) continue;
-      const double mean = region_sum[r][c] / region_count[r][c];
-      if (mean >= out.worst_region_mean_px) {
-        out.worst_region_mean_px = mean;
-        out.worst_region = kRegionNames[r][c];
-      }
-    }
-  }
-
-  if (with_covariance) {
-    std::vector<double> variance(n, 0.0);
-    AddPredictedVariance(a, true, b.camera, grid, weights, &variance);
-    AddPredictedVariance(b, false, a.camera, grid, weights, &variance);
-    out.predicted_px.resize(n);
-    double predicted_sum = 0;
-    for (size_t k = 0; k < n; ++k) {
-      out.predicted_px[k] = std::isfinite(out.diff_px[k]) ? std::sqrt(variance[k]) : kNaN;
-      if (std::isfinite(out.predicted_px[k])) predicted_sum += out.predicted_px[k];
-    }
-    out.predicted_mean_px = predicted_sum / valid;
-    out.predicted_p95_px = Percentile(out.predicted_px, 0.95);
-  }
+  FindWorstRegion(grid, a.camera, &out);
+  if (with_covariance) PredictDiff(a, b, grid, weights, valid, &out);
   return out;
 }
 

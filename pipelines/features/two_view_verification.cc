@@ -2,6 +2,7 @@
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <optional>
 
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/random_seed.h"
@@ -37,6 +38,70 @@ FeatureMatches Inliers(const FeatureMatches& matches, const std::vector<int>& in
   return inliers;
 }
 
+// The matches' pixels as stored (COLMAP convention, like the F and H
+// COLMAP writes) and, where both back-project, their normalised image
+// coordinates.
+struct MatchedPoints {
+  std::vector<cv::Point2d> pixels1, pixels2, rays1, rays2;
+  std::vector<int> ray_index;  // match index of each normalised pair
+};
+
+MatchedPoints PointsOfMatches(const Camera& camera1, const FeatureKeypoints& keypoints1, const Camera& camera2,
+                              const FeatureKeypoints& keypoints2, const FeatureMatches& matches) {
+  MatchedPoints out;
+  for (size_t m = 0; m < matches.size(); ++m) {
+    const FeatureKeypoint& k1 = keypoints1.at(matches[m].point2D_idx1);
+    const FeatureKeypoint& k2 = keypoints2.at(matches[m].point2D_idx2);
+    out.pixels1.emplace_back(k1.x, k1.y);
+    out.pixels2.emplace_back(k2.x, k2.y);
+    const auto r1 = camera1.CamFromImg(Eigen::Vector2d(k1.x, k1.y));
+    const auto r2 = camera2.CamFromImg(Eigen::Vector2d(k2.x, k2.y));
+    if (r1 && r2) {
+      out.rays1.emplace_back(r1->x() / r1->z(), r1->y() / r1->z());
+      out.rays2.emplace_back(r2->x() / r2->z(), r2->y() / r2->z());
+      out.ray_index.push_back(static_cast<int>(m));
+    }
+  }
+  return out;
+}
+
+// The same restricted to F's inliers (`f_mask` over all matches).
+MatchedPoints FInliersOf(const MatchedPoints& all, const cv::Mat& f_mask, std::vector<int>* f_index) {
+  MatchedPoints out;
+  for (size_t k = 0; k < all.pixels1.size(); ++k) {
+    if (!f_mask.at<uchar>(static_cast<int>(k))) continue;
+    f_index->push_back(static_cast<int>(k));
+    out.pixels1.push_back(all.pixels1[k]);
+    out.pixels2.push_back(all.pixels2[k]);
+  }
+  for (size_t k = 0; k < all.ray_index.size(); ++k) {
+    const size_t m = static_cast<size_t>(all.ray_index[k]);
+    if (!f_mask.at<uchar>(static_cast<int>(m))) continue;
+    out.ray_index.push_back(all.ray_index[k]);
+    out.rays1.push_back(all.rays1[k]);
+    out.rays2.push_back(all.rays2[k]);
+  }
+  return out;
+}
+
+// Relative pose of a calibrated pair (unit baseline) from E's inliers.
+std::optional<Rigid3d> PoseFromEssential(const cv::Mat& E, const MatchedPoints& e_points, const cv::Mat& e_mask) {
+  std::vector<cv::Point2d> in1, in2;
+  for (size_t k = 0; k < e_points.ray_index.size(); ++k) {
+    if (e_mask.at<uchar>(static_cast<int>(k))) {
+      in1.push_back(e_points.rays1[k]);
+      in2.push_back(e_points.rays2[k]);
+    }
+  }
+  cv::Mat R, t;
+  if (cv::recoverPose(E, in1, in2, cv::Mat::eye(3, 3, CV_64F), R, t) <= 0) return std::nullopt;
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d translation;
+  cv::cv2eigen(R, rotation);
+  cv::cv2eigen(t, translation);
+  return Rigid3d(Eigen::Quaterniond(rotation), translation);
+}
+
 }  // namespace
 
 TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& keypoints1,
@@ -46,24 +111,7 @@ TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& key
   TwoViewGeometry geometry;
   geometry.config = TwoViewGeometryConfig::kDegenerate;
   if (static_cast<int>(matches.size()) < options.min_num_inliers) return geometry;
-
-  // Pixels as stored (COLMAP convention, like the F and H COLMAP writes)
-  // and normalised image coordinates.
-  std::vector<cv::Point2d> pixels1, pixels2, rays1, rays2;
-  std::vector<int> ray_index;  // match index of each normalised pair
-  for (size_t m = 0; m < matches.size(); ++m) {
-    const FeatureKeypoint& k1 = keypoints1.at(matches[m].point2D_idx1);
-    const FeatureKeypoint& k2 = keypoints2.at(matches[m].point2D_idx2);
-    pixels1.emplace_back(k1.x, k1.y);
-    pixels2.emplace_back(k2.x, k2.y);
-    const auto r1 = camera1.CamFromImg(Eigen::Vector2d(k1.x, k1.y));
-    const auto r2 = camera2.CamFromImg(Eigen::Vector2d(k2.x, k2.y));
-    if (r1 && r2) {
-      rays1.emplace_back(r1->x() / r1->z(), r1->y() / r1->z());
-      rays2.emplace_back(r2->x() / r2->z(), r2->y() / r2->z());
-      ray_index.push_back(static_cast<int>(m));
-    }
-  }
+  const MatchedPoints points = PointsOfMatches(camera1, keypoints1, camera2, keypoints2, matches);
   std::vector<int> all(matches.size());
   for (size_t m = 0; m < all.size(); ++m) all[m] = static_cast<int>(m);
 
@@ -74,7 +122,7 @@ TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& key
   // iterations where the 5-point solver on the raw matches would need
   // thousands.
   cv::Mat f_mask, e_mask, h_mask;
-  const cv::Mat F = cv::findFundamentalMat(pixels1, pixels2, cv::USAC_DEFAULT, options.max_error,
+  const cv::Mat F = cv::findFundamentalMat(points.pixels1, points.pixels2, cv::USAC_DEFAULT, options.max_error,
                                            options.confidence, options.max_num_trials, f_mask);
   const FeatureMatches f_inliers = F.rows == 3 ? Inliers(matches, all, f_mask) : FeatureMatches();
   // E's inliers are a subset of F's, so with fewer than the minimum here
@@ -88,33 +136,18 @@ TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& key
     return geometry;
   }
   std::vector<int> f_index;  // match indices of F's inliers
-  std::vector<cv::Point2d> f_pixels1, f_pixels2;
-  for (size_t k = 0; k < all.size(); ++k) {
-    if (!f_mask.at<uchar>(static_cast<int>(k))) continue;
-    f_index.push_back(static_cast<int>(k));
-    f_pixels1.push_back(pixels1[k]);
-    f_pixels2.push_back(pixels2[k]);
-  }
-  std::vector<int> e_index;
-  std::vector<cv::Point2d> e_rays1, e_rays2;
-  for (size_t k = 0; k < ray_index.size(); ++k) {
-    const size_t m = static_cast<size_t>(ray_index[k]);
-    if (!f_mask.at<uchar>(static_cast<int>(m))) continue;
-    e_index.push_back(ray_index[k]);
-    e_rays1.push_back(rays1[k]);
-    e_rays2.push_back(rays2[k]);
-  }
+  const MatchedPoints f_points = FInliersOf(points, f_mask, &f_index);
   cv::Mat E;
-  if (static_cast<int>(e_rays1.size()) >= options.min_num_inliers) {
+  if (static_cast<int>(f_points.rays1.size()) >= options.min_num_inliers) {
     const double focal = 0.5 * (camera1.MeanFocalLength() + camera2.MeanFocalLength());
     cv::theRNG() = cv::RNG(GeneratorState(options.random_seed));
-    E = cv::findEssentialMat(e_rays1, e_rays2, cv::Mat::eye(3, 3, CV_64F), cv::RANSAC, options.confidence,
-                             options.max_error / focal, options.max_num_trials, e_mask);
+    E = cv::findEssentialMat(f_points.rays1, f_points.rays2, cv::Mat::eye(3, 3, CV_64F), cv::RANSAC,
+                             options.confidence, options.max_error / focal, options.max_num_trials, e_mask);
   }
   cv::theRNG() = cv::RNG(GeneratorState(options.random_seed));
-  const cv::Mat H = cv::findHomography(f_pixels1, f_pixels2, cv::RANSAC, options.max_error, h_mask,
+  const cv::Mat H = cv::findHomography(f_points.pixels1, f_points.pixels2, cv::RANSAC, options.max_error, h_mask,
                                        options.max_num_trials, options.confidence);
-  const FeatureMatches e_inliers = E.rows == 3 ? Inliers(matches, e_index, e_mask) : FeatureMatches();
+  const FeatureMatches e_inliers = E.rows == 3 ? Inliers(matches, f_points.ray_index, e_mask) : FeatureMatches();
   const FeatureMatches h_inliers = H.rows == 3 ? Inliers(matches, f_index, h_mask) : FeatureMatches();
   const double nf = static_cast<double>(f_inliers.size());
   const double ne = static_cast<double>(e_inliers.size());
@@ -127,22 +160,7 @@ TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& key
     geometry.config = nh / ne > options.max_H_inlier_ratio ? TwoViewGeometryConfig::kPlanarOrPanoramic
                                                            : TwoViewGeometryConfig::kCalibrated;
     geometry.inlier_matches = e_inliers;
-    // Relative pose of the calibrated pair (unit baseline).
-    std::vector<cv::Point2d> in1, in2;
-    for (size_t k = 0; k < e_index.size(); ++k) {
-      if (e_mask.at<uchar>(static_cast<int>(k))) {
-        in1.push_back(e_rays1[k]);
-        in2.push_back(e_rays2[k]);
-      }
-    }
-    cv::Mat R, t;
-    if (cv::recoverPose(E, in1, in2, cv::Mat::eye(3, 3, CV_64F), R, t) > 0) {
-      Eigen::Matrix3d rotation;
-      Eigen::Vector3d translation;
-      cv::cv2eigen(R, rotation);
-      cv::cv2eigen(t, translation);
-      geometry.cam2_from_cam1 = Rigid3d(Eigen::Quaterniond(rotation), translation);
-    }
+    if (const auto pose = PoseFromEssential(E, f_points, e_mask)) geometry.cam2_from_cam1 = *pose;
   } else if (nf >= min_inliers) {
     geometry.config = nh / nf > options.max_H_inlier_ratio ? TwoViewGeometryConfig::kPlanarOrPanoramic
                                                            : TwoViewGeometryConfig::kUncalibrated;

@@ -17,6 +17,7 @@
 #include "pipelines/bundle_adjustment/position_priors.h"
 #include "pipelines/reconstruction/ray_geometry.h"
 #include "pipelines/sfm/camera_change.h"
+#include "pipelines/sfm/global_adjustment.h"
 #include "pipelines/sfm/initial_pair.h"
 
 namespace portcal {
@@ -67,28 +68,6 @@ void IncrementalMapperOptions::Check() const {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
-constexpr int kMinImagesForIntrinsics = 5;
-
-// COLMAP's bogus-camera test against the intrinsics before the adjustment,
-// and the focal length against the mapper's start, which a slow drift of
-// many adjustments would otherwise pass.
-bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before, const std::map<camera_t, HousedCamera>& after,
-                     const std::map<camera_t, HousedCamera>& start, double max_focal_ratio_to_start) {
-  for (const auto& [id, camera] : after) {
-    if (ImplausibleIntrinsics(before.at(id).camera, camera.camera)) return true;
-    const double ratio = camera.camera.MeanFocalLength() / start.at(id).camera.MeanFocalLength();
-    if (!(ratio < max_focal_ratio_to_start && 1 / ratio < max_focal_ratio_to_start)) return true;
-  }
-  return false;
-}
-
-// A housing with an orientation to refine apart from its position (a flat
-// port's normal).
-bool HasOrientedHousing(const Reconstruction& r) {
-  return std::any_of(r.cameras().begin(), r.cameras().end(), [](const auto& entry) {
-    return entry.second.housing && !entry.second.housing->Refinement().orientation.empty();
-  });
-}
 
 class Mapper {
  public:
@@ -110,6 +89,25 @@ class Mapper {
   int Filter(Reconstruction* r, const std::set<image_t>* images);
   void LocalAdjust(Reconstruction* r, image_t image_id);
   void GlobalAdjust(Reconstruction* r, bool refine_intrinsics);
+  // The housing's adjustments before the joint one (see GlobalAdjust).
+  void AdjustHousingFirst(Reconstruction* r, const BundleAdjustmentOptions& ba, std::vector<MarkerCorner>* markers);
+  // Records a global adjustment's refinement of the calibration and whether
+  // it has settled.
+  void NoteRefinement(const Reconstruction& r, const BundleAdjustmentOptions& ba, bool implausible,
+                      const ceres::Solver::Summary& summary, const std::map<camera_t, HousedCamera>& cameras_before);
+  // Clears what the mapper tracks about the model it grows.
+  void StartModel();
+  // Registers images one at a time, triangulating and adjusting, until none
+  // registers or the model is abandoned.
+  void GrowModel(Reconstruction* r, bool abandon_allowed, ProgressSink& progress);
+  // Triangulates, adjusts and filters a grown model once more.
+  void FinishModel(Reconstruction* r, size_t model_index);
+  // The model's intrinsics came out implausible too often in a row (own
+  // render: from 5 images on at every refinement): its start was likely wrong.
+  bool Abandon(bool abandon_allowed) const {
+    constexpr int kImplausibleInARowToAbandon = 3;
+    return abandon_allowed && num_implausible_in_a_row_ >= kImplausibleInARowToAbandon;
+  }
   std::vector<image_t> NextImages(const Reconstruction& r) const;
 
   const SfmInputs& inputs_;
@@ -157,12 +155,7 @@ std::vector<MappedModel> Mapper::Run(ProgressSink& progress) {
   bool may_abandon = true;
   while (static_cast<int>(models.size()) < options_.max_num_models) {
     Reconstruction r(&inputs_, cameras_);
-    port_converged_ = false;
-    num_implausible_in_a_row_ = 0;
-    num_settled_in_a_row_ = 0;
-    refinements_.clear();
-    failed_.clear();
-    seconds_.clear();  // per model
+    StartModel();
     image_pair_t start = 0;
     if (!Initialize(&r, &tried, &start)) {
       if (abandoned.empty() || !may_abandon) break;
@@ -173,53 +166,10 @@ std::vector<MappedModel> Mapper::Run(ProgressSink& progress) {
       continue;
     }
     const bool abandon_allowed = may_abandon && static_cast<int>(abandoned.size()) < options_.init_max_restarts;
-    // Implausible at this many refinements in a row, the model is given up
-    // (own render: from 5 images on at every one).
-    constexpr int kImplausibleInARowToAbandon = 3;
-    const auto abandon = [&] { return abandon_allowed && num_implausible_in_a_row_ >= kImplausibleInARowToAbandon; };
     progress.Advance(2);
-    size_t last_global = r.poses().size();
-    size_t last_refine = r.poses().size();
-    while (!abandon()) {
-      CancelFlag::ThrowIfRequested();
-      bool added = false;
-      for (image_t image_id : Timed("next", [&] { return NextImages(r); })) {
-        if (!Timed("register", [&] { return Register(&r, image_id); })) {
-          failed_.insert(image_id);
-          continue;
-        }
-        failed_.clear();
-        Timed("triangulate", [&] { return Triangulate(&r, image_id); });
-        Timed("local", [&] { LocalAdjust(&r, image_id); return 0; });
-        progress.Advance(1);
-        if (r.poses().size() >= options_.ba_global_images_ratio * last_global) {
-          // Intrinsics move the rays of every image (and need the exact,
-          // slower error): refine them while the model is small and then
-          // whenever it has grown by a third, until they have settled
-          // (IncrementalMapperOptions::ba_calibration_settled_px).
-          const bool refine =
-              (r.poses().size() <= 8 || r.poses().size() >= 1.33 * last_refine) && !CalibrationSettled();
-          Timed("global", [&] { GlobalAdjust(&r, refine); return 0; });
-          if (refine) last_refine = r.poses().size();
-          last_global = r.poses().size();
-        }
-        added = true;
-        break;
-      }
-      if (!added) break;
-    }
-    if (!abandon()) {
-      // Rays may have moved with the intrinsics: triangulate what is left,
-      // adjust once more and filter.
-      for (const auto& [id, pose] : std::map<image_t, Rigid3d>(r.poses())) Triangulate(&r, id);
-      GlobalAdjust(&r, true);
-      Filter(&r, nullptr);
-      GlobalAdjust(&r, true);
-      LOG(INFO) << "refractive_mapper: model " << models.size() << ": " << r.poses().size() << " images, "
-                << r.points().size() << " points, mean reprojection error " << r.MeanReprojectionError()
-                << " px";
-    }
-    if (abandon() || (abandon_allowed && num_implausible_in_a_row_ > 0)) {
+    GrowModel(&r, abandon_allowed, progress);
+    if (!Abandon(abandon_allowed)) FinishModel(&r, models.size());
+    if (Abandon(abandon_allowed) || (abandon_allowed && num_implausible_in_a_row_ > 0)) {
       LOG(WARNING) << "refractive_mapper: the intrinsics refined on " << r.poses().size() << " images of model "
                    << models.size() << " came out implausible " << num_implausible_in_a_row_
                    << " time(s) in a row: its initial pair was likely wrong; starting it again from another";
@@ -244,6 +194,59 @@ std::vector<MappedModel> Mapper::Run(ProgressSink& progress) {
     return a.reconstruction.poses().size() > b.reconstruction.poses().size();
   });
   return models;
+}
+
+void Mapper::StartModel() {
+  port_converged_ = false;
+  num_implausible_in_a_row_ = 0;
+  num_settled_in_a_row_ = 0;
+  refinements_.clear();
+  failed_.clear();
+  seconds_.clear();  // per model
+}
+
+void Mapper::GrowModel(Reconstruction* r, bool abandon_allowed, ProgressSink& progress) {
+  size_t last_global = r->poses().size();
+  size_t last_refine = r->poses().size();
+  while (!Abandon(abandon_allowed)) {
+    CancelFlag::ThrowIfRequested();
+    bool added = false;
+    for (image_t image_id : Timed("next", [&] { return NextImages(*r); })) {
+      if (!Timed("register", [&] { return Register(r, image_id); })) {
+        failed_.insert(image_id);
+        continue;
+      }
+      failed_.clear();
+      Timed("triangulate", [&] { return Triangulate(r, image_id); });
+      Timed("local", [&] { LocalAdjust(r, image_id); return 0; });
+      progress.Advance(1);
+      if (r->poses().size() >= options_.ba_global_images_ratio * last_global) {
+        // Intrinsics move the rays of every image (and need the exact,
+        // slower error): refine them while the model is small and then
+        // whenever it has grown by a third, until they have settled
+        // (IncrementalMapperOptions::ba_calibration_settled_px).
+        const bool refine =
+            (r->poses().size() <= 8 || r->poses().size() >= 1.33 * last_refine) && !CalibrationSettled();
+        Timed("global", [&] { GlobalAdjust(r, refine); return 0; });
+        if (refine) last_refine = r->poses().size();
+        last_global = r->poses().size();
+      }
+      added = true;
+      break;
+    }
+    if (!added) break;
+  }
+}
+
+void Mapper::FinishModel(Reconstruction* r, size_t model_index) {
+  // Rays may have moved with the intrinsics: triangulate what is left,
+  // adjust once more and filter.
+  for (const auto& [id, pose] : std::map<image_t, Rigid3d>(r->poses())) Triangulate(r, id);
+  GlobalAdjust(r, true);
+  Filter(r, nullptr);
+  GlobalAdjust(r, true);
+  LOG(INFO) << "refractive_mapper: model " << model_index << ": " << r->poses().size() << " images, "
+            << r->points().size() << " points, mean reprojection error " << r->MeanReprojectionError() << " px";
 }
 
 bool Mapper::Initialize(Reconstruction* r, std::set<image_pair_t>* tried, image_pair_t* start) {
@@ -478,18 +481,9 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   // bogus (COLMAP's test: focal length off by more than a factor 2 from the
   // start, a distortion parameter beyond 1) is undone and the adjustment
   // repeated with the intrinsics held.
-  refine_intrinsics = refine_intrinsics && static_cast<int>(r->poses().size()) >= kMinImagesForIntrinsics;
-  BundleAdjustmentOptions ba;
-  ba.refine_focal_length = refine_intrinsics && options_.ba_refine_focal_length;
-  ba.refine_principal_point = refine_intrinsics && options_.ba_refine_principal_point;
-  ba.refine_extra_params = refine_intrinsics && options_.ba_refine_extra_params;
-  if (static_cast<int>(r->poses().size()) < options_.ba_full_intrinsics_min_images) {
-    ba.max_num_extra_params = 1;
-  }
-  ba.refine_housing = refine_intrinsics && options_.ba_refine_housing;
-  ba.max_num_iterations = options_.ba_max_num_iterations;
-  ba.function_tolerance = options_.ba_global_function_tolerance;
-  ba.num_threads = options_.num_threads;
+  const int num_images = static_cast<int>(r->poses().size());
+  refine_intrinsics = refine_intrinsics && num_images >= kMinImagesForIntrinsics;
+  BundleAdjustmentOptions ba = GlobalAdjustmentOptions(options_, num_images, refine_intrinsics);
   if (options_.position_prior_sigma_m > 0 && options_.marker_scale.side_length_m <= 0 &&
       AlignToPositionPriors(r, 5 * options_.position_prior_sigma_m)) {
     // The model in the priors' metric frame, the priors as residuals.
@@ -499,47 +493,17 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   if (options_.marker_scale.side_length_m > 0) {
     markers = TriangulateMarkerCorners(*r, options_.filter_max_reproj_error_px * 4);
   }
-  const std::map<camera_t, HousedCamera> cameras_before = r->cameras();
-  const std::map<image_t, Rigid3d> poses_before = r->poses();
-  std::map<point3D_t, Eigen::Vector3d> points_before;
-  for (const auto& [id, point] : r->points()) points_before[id] = point.xyz;
-  const std::vector<MarkerCorner> markers_before = markers;
-  if (ba.refine_housing && !port_converged_ && HasOrientedHousing(*r)) {
-    // A flat port's normal first, its distance held, until one joint
-    // adjustment has converged: from the untilted guess the joint solve
-    // pushes the distance into its 0.1 mm floor and then creeps along the
-    // normal for the whole iteration budget (120-image survey, port tilted
-    // 3 deg: at 5 to 30 images each of 8 adjustments ended at 50 iterations,
-    // cost 711 -> 470 at 5 images, 144 s in all; normal first: 711 -> 85 in
-    // 19 iterations, the joint step then 10, 50 s in all, the port within
-    // 0.02 deg and 2.2 mm from 5 images on, the same refined result).
-    BundleAdjustmentOptions normal_first = ba.WithIntrinsicsHeld();
-    normal_first.refine_housing_position = false;
-    AdjustBundle(r, normal_first, BundleAdjustmentScope(), &markers, options_.marker_scale);
-  }
-  if (ba.refine_housing && (ba.refine_focal_length || ba.refine_principal_point || ba.refine_extra_params)) {
-    // The housing first, under the held intrinsics (see
-    // RunRefractiveBundleAdjuster: jointly from a poor start, focal length
-    // and port distance trade off).
-    AdjustBundle(r, ba.WithIntrinsicsHeld(), BundleAdjustmentScope(), &markers, options_.marker_scale);
-  }
+  const ModelSnapshot before = ModelSnapshot::Of(*r, markers);
+  AdjustHousingFirst(r, ba, &markers);
   const ceres::Solver::Summary summary =
       AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
   const bool implausible =
-      refine_intrinsics && BogusIntrinsics(cameras_before, r->cameras(), cameras_, options_.max_focal_ratio_to_start);
+      refine_intrinsics && BogusIntrinsics(before.cameras, r->cameras(), cameras_, options_.max_focal_ratio_to_start);
   if (refine_intrinsics) num_implausible_in_a_row_ = implausible ? num_implausible_in_a_row_ + 1 : 0;
   if (implausible) {
-    std::ostringstream values;
-    for (const auto& [id, camera] : r->cameras()) {
-      for (const double p : camera.camera.params) values << " " << p;
-    }
     LOG(WARNING) << "refractive_mapper: intrinsics refined on " << r->poses().size()
-                 << " images came out implausible (" << values.str() << " ); held for now";
-    r->mutable_cameras() = cameras_before;
-    r->mutable_poses() = poses_before;
-    for (const auto& [id, xyz] : points_before) r->point(id).xyz = xyz;
-    r->UpdateRays();
-    markers = markers_before;
+                 << " images came out implausible (" << CalibrationText(*r, false) << " ); held for now";
+    before.Restore(r, &markers);
     ba = ba.WithIntrinsicsHeld();
     ba.refine_housing = false;
     AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
@@ -547,36 +511,52 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   if (ba.refine_housing && summary.termination_type == ceres::CONVERGENCE) {
     port_converged_ = CameraWithHousingAtBound(r->cameras()) == kInvalidCameraId;
   }
-  const bool refined = !implausible && (ba.refine_housing || ba.refine_focal_length ||
-                                        ba.refine_principal_point || ba.refine_extra_params);
-  if (refined) refinements_.push_back({static_cast<int>(r->poses().size()), std::numeric_limits<double>::infinity()});
-  if (refined && static_cast<int>(r->poses().size()) >= options_.ba_calibration_settled_min_images) {
-    const double depth = MedianSceneDepth(*r);
-    double& shift = refinements_.back().image_shift_px;
-    if (depth > 0 && summary.termination_type == ceres::CONVERGENCE) {
-      shift = 0;
-      for (const auto& [id, camera] : r->cameras()) {
-        shift = std::max(shift, MaxImageShiftPx(cameras_before.at(id), camera, depth));
-      }
-    }
-    num_settled_in_a_row_ = shift < options_.ba_calibration_settled_px ? num_settled_in_a_row_ + 1 : 0;
-    refinements_.back().settled = CalibrationSettled();
-    VLOG(1) << "refractive_mapper: the refinement on " << r->poses().size() << " images moved the image by up to "
-            << shift << " px at the median depth " << depth << (CalibrationSettled() ? " (settled)" : "");
-  }
+  NoteRefinement(*r, ba, implausible, summary, before.cameras);
   if (VLOG_IS_ON(1) && (ba.refine_housing || ba.refine_focal_length)) {
-    std::ostringstream values;
-    for (const auto& [id, camera] : r->cameras()) {
-      values << " camera";
-      for (const double p : camera.camera.params) values << " " << p;
-      if (camera.housing) {
-        values << " housing";
-        for (const double p : camera.housing->params) values << " " << p;
-      }
-    }
-    VLOG(1) << "global adjustment of " << r->poses().size() << " images:" << values.str();
+    VLOG(1) << "global adjustment of " << r->poses().size() << " images:" << CalibrationText(*r, true);
   }
   Filter(r, nullptr);
+}
+
+void Mapper::AdjustHousingFirst(Reconstruction* r, const BundleAdjustmentOptions& ba,
+                                std::vector<MarkerCorner>* markers) {
+  if (ba.refine_housing && !port_converged_ && HasOrientedHousing(*r)) {
+    // A flat port's normal first, its distance held, until one joint
+    // adjustment has converged: from the untilted guess the joint solve
+    // pushes the distance into its floor and then creeps along the normal
+    // for the whole iteration budget (docs/benchmarks.md: the 120-image
+    // survey with the port tilted 3 deg).
+    BundleAdjustmentOptions normal_first = ba.WithIntrinsicsHeld();
+    normal_first.refine_housing_position = false;
+    AdjustBundle(r, normal_first, BundleAdjustmentScope(), markers, options_.marker_scale);
+  }
+  if (ba.refine_housing && (ba.refine_focal_length || ba.refine_principal_point || ba.refine_extra_params)) {
+    // The housing first, under the held intrinsics (see
+    // RunRefractiveBundleAdjuster: jointly from a poor start, focal length
+    // and port distance trade off).
+    AdjustBundle(r, ba.WithIntrinsicsHeld(), BundleAdjustmentScope(), markers, options_.marker_scale);
+  }
+}
+
+void Mapper::NoteRefinement(const Reconstruction& r, const BundleAdjustmentOptions& ba, bool implausible,
+                            const ceres::Solver::Summary& summary,
+                            const std::map<camera_t, HousedCamera>& cameras_before) {
+  const bool refined = !implausible && (ba.refine_housing || ba.refine_focal_length ||
+                                        ba.refine_principal_point || ba.refine_extra_params);
+  if (refined) refinements_.push_back({static_cast<int>(r.poses().size()), std::numeric_limits<double>::infinity()});
+  if (!refined || static_cast<int>(r.poses().size()) < options_.ba_calibration_settled_min_images) return;
+  const double depth = MedianSceneDepth(r);
+  double& shift = refinements_.back().image_shift_px;
+  if (depth > 0 && summary.termination_type == ceres::CONVERGENCE) {
+    shift = 0;
+    for (const auto& [id, camera] : r.cameras()) {
+      shift = std::max(shift, MaxImageShiftPx(cameras_before.at(id), camera, depth));
+    }
+  }
+  num_settled_in_a_row_ = shift < options_.ba_calibration_settled_px ? num_settled_in_a_row_ + 1 : 0;
+  refinements_.back().settled = CalibrationSettled();
+  VLOG(1) << "refractive_mapper: the refinement on " << r.poses().size() << " images moved the image by up to "
+          << shift << " px at the median depth " << depth << (CalibrationSettled() ? " (settled)" : "");
 }
 
 }  // namespace

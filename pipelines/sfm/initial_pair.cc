@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <tuple>
 
 #include "pipelines/bundle_adjustment/bundle_adjustment.h"
@@ -14,9 +15,71 @@ namespace {
 
 constexpr double kDegree = M_PI / 180.0;
 
+// The correspondences of images a and b whose keypoints both have rays.
+struct PairRays {
+  std::vector<std::pair<point2D_t, point2D_t>> pairs;
+  std::vector<Eigen::Vector3d> dirs_a, dirs_b;
+};
+
+PairRays RaysOfPair(const Reconstruction& r, image_t a, image_t b) {
+  PairRays out;
+  const SfmImage& image_a = r.inputs().images.at(a);
+  for (point2D_t k = 0; k < image_a.correspondences.size(); ++k) {
+    for (const Correspondence& c : image_a.correspondences[k]) {
+      if (c.image_id != b) continue;
+      const auto& ra = r.RayOf(a, k);
+      const auto& rb = r.RayOf(b, c.point2D_idx);
+      if (!ra || !rb) continue;
+      out.pairs.emplace_back(k, c.point2D_idx);
+      out.dirs_a.push_back(ra->direction);
+      out.dirs_b.push_back(rb->direction);
+    }
+  }
+  return out;
+}
+
+// The inlier pairs' points in a's frame (NaN where they do not triangulate
+// in front of both cameras) and the triangulation angles of those that do.
+void TriangulatePair(const Reconstruction& r, image_t a, image_t b, const PairRays& rays,
+                     const std::vector<char>& inliers, const Rigid3d& pose_b, std::vector<Eigen::Vector3d>* points,
+                     std::vector<double>* angles) {
+  points->assign(rays.pairs.size(), Eigen::Vector3d::Constant(std::nan("")));
+  angles->clear();
+  for (size_t i = 0; i < rays.pairs.size(); ++i) {
+    if (!inliers[i]) continue;
+    const std::vector<Ray3d> pair = {*r.RayOf(a, rays.pairs[i].first),
+                                     RayInWorld(*r.RayOf(b, rays.pairs[i].second), pose_b)};
+    const auto x = TriangulateRays(pair);
+    if (!x || (*x).z() <= 0 || (pose_b * *x).z() <= 0) continue;
+    (*points)[i] = *x;
+    angles->push_back(MaxTriangulationAngle(pair, *x));
+  }
+}
+
+// The factor that makes the markers both images see as large as they are:
+// the median over their sides of known / measured length (nullopt when no
+// side is seen).
+std::optional<double> MarkerScaleFactor(const Reconstruction& r, double side_length_m) {
+  const std::vector<MarkerCorner> corners = TriangulateMarkerCorners(r, 1e9);
+  std::map<int, std::map<int, Eigen::Vector3d>> by_marker;
+  for (const MarkerCorner& c : corners) by_marker[c.marker_id][c.corner] = c.xyz;
+  std::vector<double> ratios;
+  for (const auto& [id, c] : by_marker) {
+    for (int k = 0; k < 4; ++k) {
+      if (c.count(k) && c.count((k + 1) % 4)) {
+        ratios.push_back(side_length_m / (c.at(k) - c.at((k + 1) % 4)).norm());
+      }
+    }
+  }
+  if (ratios.empty()) return std::nullopt;
+  std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+  return ratios[ratios.size() / 2];
+}
+
 }  // namespace
 
-std::vector<image_pair_t> RankInitialPairs(const SfmInputs& inputs, const IncrementalMapperOptions& options,
+std::vector<image_pair_t> RankInitialPairs(
+const SfmInputs& inputs, const IncrementalMapperOptions& options,
                                            const std::set<image_t>& used, const std::set<image_pair_t>& tried) {
   // Most inlier matches first, but pairs whose geometry is a homography
   // last: a relative pose from a plane seen twice is ambiguous (two
@@ -41,43 +104,16 @@ bool StartFromPair(const IncrementalMapperOptions& options, image_t a, image_t b
   const auto focal_of = [&](image_t id) {
     return r->cameras().at(r->inputs().images.at(id).camera_id).camera.MeanFocalLength();
   };
-  const SfmImage& image_a = r->inputs().images.at(a);
-  std::vector<std::pair<point2D_t, point2D_t>> pairs;
-  std::vector<Eigen::Vector3d> dirs_a, dirs_b;
-  for (point2D_t k = 0; k < image_a.correspondences.size(); ++k) {
-    for (const Correspondence& c : image_a.correspondences[k]) {
-      if (c.image_id != b) continue;
-      const auto& ra = r->RayOf(a, k);
-      const auto& rb = r->RayOf(b, c.point2D_idx);
-      if (!ra || !rb) continue;
-      pairs.emplace_back(k, c.point2D_idx);
-      dirs_a.push_back(ra->direction);
-      dirs_b.push_back(rb->direction);
-    }
-  }
-  if (static_cast<int>(pairs.size()) < options.init_min_num_inliers) return false;
+  const PairRays rays = RaysOfPair(*r, a, b);
+  if (static_cast<int>(rays.pairs.size()) < options.init_min_num_inliers) return false;
   std::vector<char> inliers;
   const double angle = options.init_max_error_px / std::min(focal_of(a), focal_of(b));
-  const auto b_from_a = EstimateRelativePose(dirs_a, dirs_b, angle, options.random_seed, &inliers);
+  const auto b_from_a = EstimateRelativePose(rays.dirs_a, rays.dirs_b, angle, options.random_seed, &inliers);
   if (!b_from_a) return false;
-  const auto triangulate = [&](const Rigid3d& pose_b, std::vector<Eigen::Vector3d>* points,
-                               std::vector<double>* angles) {
-    points->assign(pairs.size(), Eigen::Vector3d::Constant(std::nan("")));
-    angles->clear();
-    for (size_t i = 0; i < pairs.size(); ++i) {
-      if (!inliers[i]) continue;
-      const std::vector<Ray3d> rays = {*r->RayOf(a, pairs[i].first),
-                                       RayInWorld(*r->RayOf(b, pairs[i].second), pose_b)};
-      const auto x = TriangulateRays(rays);
-      if (!x || (*x).z() <= 0 || (pose_b * *x).z() <= 0) continue;
-      (*points)[i] = *x;
-      angles->push_back(MaxTriangulationAngle(rays, *x));
-    }
-  };
   std::vector<Eigen::Vector3d> points;
   std::vector<double> angles;
   Rigid3d pose_b = *b_from_a;
-  triangulate(pose_b, &points, &angles);
+  TriangulatePair(*r, a, b, rays, inliers, pose_b, &points, &angles);
   if (static_cast<int>(angles.size()) < options.init_min_num_inliers) return false;
   std::nth_element(angles.begin(), angles.begin() + angles.size() / 2, angles.end());
   if (angles[angles.size() / 2] < options.init_min_tri_angle_deg * kDegree) return false;
@@ -93,31 +129,19 @@ bool StartFromPair(const IncrementalMapperOptions& options, image_t a, image_t b
   r->Register(b, pose_b);
   if (options.marker_scale.side_length_m > 0) {
     // Markers seen by both: their measured side against the known one.
-    const std::vector<MarkerCorner> corners = TriangulateMarkerCorners(*r, 1e9);
-    std::map<int, std::map<int, Eigen::Vector3d>> by_marker;
-    for (const MarkerCorner& c : corners) by_marker[c.marker_id][c.corner] = c.xyz;
-    std::vector<double> ratios;
-    for (const auto& [id, c] : by_marker) {
-      for (int k = 0; k < 4; ++k) {
-        if (c.count(k) && c.count((k + 1) % 4)) {
-          ratios.push_back(options.marker_scale.side_length_m / (c.at(k) - c.at((k + 1) % 4)).norm());
-        }
-      }
-    }
-    if (!ratios.empty()) {
-      std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
-      pose_b.translation *= ratios[ratios.size() / 2];
+    if (const auto factor = MarkerScaleFactor(*r, options.marker_scale.side_length_m)) {
+      pose_b.translation *= *factor;
       r->Register(b, pose_b);
     }
   }
-  triangulate(pose_b, &points, &angles);
-  for (size_t i = 0; i < pairs.size(); ++i) {
+  TriangulatePair(*r, a, b, rays, inliers, pose_b, &points, &angles);
+  for (size_t i = 0; i < rays.pairs.size(); ++i) {
     if (!points[i].allFinite()) continue;
-    if (r->ReprojectionError(a, pairs[i].first, points[i]) > options.init_max_error_px ||
-        r->ReprojectionError(b, pairs[i].second, points[i]) > options.init_max_error_px) {
+    if (r->ReprojectionError(a, rays.pairs[i].first, points[i]) > options.init_max_error_px ||
+        r->ReprojectionError(b, rays.pairs[i].second, points[i]) > options.init_max_error_px) {
       continue;
     }
-    r->AddPoint(points[i], {{a, pairs[i].first}, {b, pairs[i].second}});
+    r->AddPoint(points[i], {{a, rays.pairs[i].first}, {b, rays.pairs[i].second}});
   }
   if (static_cast<int>(r->points().size()) < options.init_min_num_inliers) {
     r->Deregister(b);

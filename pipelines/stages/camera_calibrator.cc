@@ -33,19 +33,8 @@ CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& optio
             << views.size() << " views";
   const CameraCalibrationResult result = CalibrateCamera(views, camera, options.calibration);
 
-  CalibrationReport report;
-  report.camera = result.camera;
-  report.parameters_std_dev = result.params_std_dev;
-  report.overall_rms_px = result.overall_rms_px;
-  report.residual_sigma_px = result.residual_sigma_px;
-  report.num_points = result.num_points;
-  report.views = result.views;
-  report.target_description = target_views.target;
-  if (options.calibration.estimate_board_warp) {
-    report.board_warp = result.board_warp;
-    report.board_warp_std_dev = result.board_warp_std_dev;
-  }
-  WriteCalibrationReport(report, options.output_path);
+  WriteCalibrationReport(ReportOf(result, options.calibration.estimate_board_warp, target_views.target),
+                         options.output_path);
   LOG(INFO) << "camera_calibrator: RMS " << result.overall_rms_px << " px over " << result.num_points
             << " points -> " << options.output_path;
   return result;

@@ -243,6 +243,31 @@ std::vector<CalibrationView> RerunAsMrcal(const std::vector<CalibrationView>& vi
   return rerun_views;
 }
 
+// What the report says before any comparison: the models, the threshold,
+// the views and portcal's own fit.
+CrossCheckResult ResultHeader(const CrossCheckOptions& options, const CalibrationReport& input,
+                              const std::string& lensmodel, int num_views, const CameraCalibrationResult& portcal) {
+  CrossCheckResult result;
+  result.camera_model = input.camera.ModelName();
+  result.mrcal_lensmodel = lensmodel;
+  result.max_diff_px = options.max_diff_px;
+  result.num_views = num_views;
+  result.portcal_rms_px = portcal.overall_rms_px;
+  if (input.board_warp) {
+    result.portcal_warp = input.board_warp;
+    result.portcal_warp_std_dev = input.board_warp_std_dev;
+  }
+  return result;
+}
+
+MrcalCalibrationOptions MrcalOptionsOf(const CrossCheckOptions& options) {
+  MrcalCalibrationOptions mrcal_options;
+  mrcal_options.estimate_board_warp = options.mrcal_board_warp;
+  mrcal_options.reject_outliers = options.mrcal_outlier_rejection;
+  mrcal_options.regularization = options.mrcal_regularization;
+  return mrcal_options;
+}
+
 }  // namespace
 
 void CrossCheckOptions::Check() const {
@@ -274,25 +299,13 @@ CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& 
   const CameraCalibrationResult portcal = CalibrateCamera(views, input.camera, settings);
   CalibratedLens portcal_lens{input.camera, portcal.params_covariance};
 
-  CrossCheckResult result;
-  result.camera_model = input.camera.ModelName();
-  result.mrcal_lensmodel = lensmodel;
-  result.max_diff_px = options.max_diff_px;
-  result.num_views = static_cast<int>(views.size());
-  result.portcal_rms_px = portcal.overall_rms_px;
-  if (input.board_warp) {
-    result.portcal_warp = input.board_warp;
-    result.portcal_warp_std_dev = input.board_warp_std_dev;
-  }
+  CrossCheckResult result = ResultHeader(options, input, lensmodel, static_cast<int>(views.size()), portcal);
   ProjectionDiffOptions diff_options;
   diff_options.gridn_width = options.gridn_width;
   NoteResolveDifference(input.camera, portcal.camera, diff_options, &result);
 
-  MrcalCalibrationOptions mrcal_options;
-  mrcal_options.estimate_board_warp = options.mrcal_board_warp;
-  mrcal_options.reject_outliers = options.mrcal_outlier_rejection;
-  mrcal_options.regularization = options.mrcal_regularization;
-  const MrcalCalibrationResult mrcal = CalibrateWithMrcal(views, input.camera, Poses(portcal), mrcal_options);
+  const MrcalCalibrationResult mrcal =
+      CalibrateWithMrcal(views, input.camera, Poses(portcal), MrcalOptionsOf(options));
   NoteMrcalSolution(views, mrcal, &result);
   const std::vector<double> portcal_std_dev =
       input.parameters_std_dev.size() == input.camera.params.size() ? input.parameters_std_dev

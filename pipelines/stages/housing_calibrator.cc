@@ -39,17 +39,7 @@ HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& op
             << " from " << options.input_calibration << ", " << views.size() << " views";
   const HousingCalibrationResult result = CalibrateHousing(views, in_air.camera, housing, options.calibration);
 
-  CalibrationReport report;
-  report.camera = result.camera;
-  report.parameters_std_dev = result.camera_std_dev;
-  report.housing = result.housing;
-  report.housing_std_dev = result.housing_std_dev;
-  report.overall_rms_px = result.overall_rms_px;
-  report.residual_sigma_px = result.residual_sigma_px;
-  report.num_points = result.num_points;
-  report.views = result.views;
-  report.target_description = target_views.target;
-  WriteCalibrationReport(report, options.output_path);
+  WriteCalibrationReport(ReportOf(result, target_views.target), options.output_path);
   LOG(INFO) << "housing_calibrator: RMS " << result.overall_rms_px << " px -> " << options.output_path;
   return result;
 }

@@ -1,13 +1,11 @@
 #include "pipelines/stages/target_extractor.h"
 
-#include <atomic>
-#include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
-#include <thread>
 
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/parallel.h"
 #include "database/database.h"
 #include "database/stage_run.h"
 
@@ -93,37 +91,19 @@ std::string OptionsText(const TargetExtractorOptions& o) {
 std::vector<ImageResult> DetectAll(const TargetExtractorOptions& options, const std::vector<std::string>& names,
                                    ProgressSink& progress) {
   std::vector<ImageResult> results(names.size());
-  std::atomic<size_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
   progress.Begin("target_extractor: images", names.size());
-  const auto worker = [&] {
-    for (size_t i = next++; i < names.size(); i = next++) {
-      try {
-        CancelFlag::ThrowIfRequested();
-        ImageResult& result = results[i];
-        result.name = names[i];
-        const cv::Mat gray = cv::imread((fs::path(options.image_path) / names[i]).string(),
-                                        cv::IMREAD_GRAYSCALE);
-        if (!gray.empty()) {
-          result.readable = true;
-          result.width = gray.cols;
-          result.height = gray.rows;
-          Detect(gray, options, &result);
-        }
-        progress.Advance(1);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
-        next = names.size();
-      }
+  ParallelFor(names.size(), options.num_threads, [&](size_t i) {
+    ImageResult& result = results[i];
+    result.name = names[i];
+    const cv::Mat gray = cv::imread((fs::path(options.image_path) / names[i]).string(), cv::IMREAD_GRAYSCALE);
+    if (!gray.empty()) {
+      result.readable = true;
+      result.width = gray.cols;
+      result.height = gray.rows;
+      Detect(gray, options, &result);
     }
-  };
-  std::vector<std::thread> threads;
-  for (int t = 1; t < options.num_threads; ++t) threads.emplace_back(worker);
-  worker();
-  for (std::thread& t : threads) t.join();
-  if (error) std::rethrow_exception(error);
+    progress.Advance(1);
+  });
   progress.End();
   return results;
 }

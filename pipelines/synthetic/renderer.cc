@@ -1,13 +1,12 @@
 #include "pipelines/synthetic/renderer.h"
 
-#include <atomic>
 #include <cmath>
 #include <functional>
 #include <opencv2/imgproc.hpp>
 #include <random>
-#include <thread>
 
 #include "colmap_ext/util/error.h"
+#include "colmap_ext/util/parallel.h"
 
 namespace portcal {
 
@@ -34,28 +33,6 @@ void ImageFormationOptions::Check() const {
   if (num_threads < 1) throw OptionError("num_threads", std::to_string(num_threads), ">= 1");
 }
 
-void ParallelForRows(int num_rows, int num_threads, const std::function<void(int)>& body) {
-  std::atomic<int> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  const auto worker = [&] {
-    for (int row = next++; row < num_rows; row = next++) {
-      try {
-        body(row);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
-        next = num_rows;
-      }
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int i = 1; i < num_threads; ++i) threads.emplace_back(worker);
-  worker();
-  for (std::thread& t : threads) t.join();
-  if (error) std::rethrow_exception(error);
-}
-
 Eigen::Vector2d SampleOffset(int s, int spp) {
   // Stratum centres of the spp x spp grid over the pixel [0, 1)^2 (a
   // box filter of the pixel's area, as the shared renders state).
@@ -67,7 +44,8 @@ RayMap::RayMap(const Camera& camera, const Housing* housing, int spp, int num_th
   const size_t num_samples = static_cast<size_t>(width_) * height_ * spp * spp;
   rays_.assign(6 * num_samples, 0.0f);
   cos_off_axis_.assign(static_cast<size_t>(width_) * height_, 1.0f);
-  ParallelForRows(height_, num_threads, [&](int row) {
+  ParallelFor(static_cast<size_t>(height_), num_threads, [&](size_t row_index) {
+    const int row = static_cast<int>(row_index);
     for (int col = 0; col < width_; ++col) {
       for (int s = 0; s < spp * spp; ++s) {
         const Eigen::Vector2d pixel = Eigen::Vector2d(col, row) + SampleOffset(s, spp);
@@ -120,6 +98,78 @@ std::vector<std::vector<PreparedObject>> PrepareSubframes(const std::vector<Plac
   return subframes;
 }
 
+// One pixel's gray value (before noise) and the mean length of its rays'
+// water paths (1e6 where no ray hit anything): the supersampled rays of
+// every subframe traced through the objects.
+struct ShadedPixel {
+  float value = 0;
+  float path_length = 0;
+};
+
+ShadedPixel ShadePixel(const RayMap& rays, const std::vector<std::vector<PreparedObject>>& subframes,
+                       const ImageFormationOptions& options, double background, int col, int row) {
+  const int spp2 = options.spp * options.spp;
+  double sum = 0, length_sum = 0;
+  int num_lengths = 0;
+  for (int s = 0; s < spp2; ++s) {
+    Eigen::Vector3d origin, dir;
+    if (!rays.Ray(col, row, s, &origin, &dir)) {
+      sum += subframes.size() * options.levels.invalid;
+      continue;
+    }
+    for (const auto& prepared : subframes) {
+      double t_max = 1e300;
+      Hit best;
+      bool found = false;
+      for (const PreparedObject& p : prepared) {
+        Hit hit;
+        if (p.object->Intersect(p.rotation * origin + p.translation, p.rotation * dir, t_max, &hit)) {
+          best = hit;
+          t_max = hit.t;
+          found = true;
+        }
+      }
+      if (!found) {
+        sum += background;
+        continue;
+      }
+      double gray = best.gray;
+      if (options.HasWater()) {
+        // Direct signal attenuated, plus the backscatter veil that
+        // builds up along the same path (Jaffe 1990, McGlamery 1980).
+        const double transmission = std::exp(-options.attenuation_per_m * best.t);
+        gray = gray * transmission + options.backscatter_gray * (1 - transmission);
+      }
+      sum += gray;
+      length_sum += best.t;
+      ++num_lengths;
+    }
+  }
+  ShadedPixel pixel;
+  pixel.value = static_cast<float>(sum / (spp2 * subframes.size()));
+  if (options.vignetting > 0) {
+    const double c = rays.CosOffAxis(col, row);
+    pixel.value *= static_cast<float>(1 - options.vignetting + options.vignetting * c * c * c * c);
+  }
+  pixel.path_length = num_lengths > 0 ? static_cast<float>(length_sum / num_lengths) : 1e6f;
+  return pixel;
+}
+
+// Noise added (seeded), rounded and clamped to 8 bits.
+cv::Mat Quantise(const cv::Mat& image, double noise_sigma, uint64_t noise_seed) {
+  cv::Mat out(image.rows, image.cols, CV_8UC1);
+  std::mt19937_64 rng(noise_seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (int row = 0; row < image.rows; ++row) {
+    for (int col = 0; col < image.cols; ++col) {
+      double value = image.at<float>(row, col);
+      if (noise_sigma > 0) value += noise_sigma * noise(rng);
+      out.at<uint8_t>(row, col) = static_cast<uint8_t>(std::clamp(std::lround(value), 0L, 255L));
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 cv::Mat RenderImage(const RayMap& rays, const std::vector<PlacedObject>& objects,
@@ -127,62 +177,18 @@ cv::Mat RenderImage(const RayMap& rays, const std::vector<PlacedObject>& objects
   options.Check();
   PORTCAL_CHECK(rays.spp() == options.spp);
   const int width = rays.width(), height = rays.height();
-  const int spp2 = options.spp * options.spp;
   const auto subframes = PrepareSubframes(objects, options);
   const double background =
       options.HasWater() ? options.backscatter_gray : options.levels.background;
   cv::Mat image(height, width, CV_32F), path_length(height, width, CV_32F);
-
-  ParallelForRows(height, options.num_threads, [&](int row) {
+  ParallelFor(static_cast<size_t>(height), options.num_threads, [&](size_t row_index) {
+    const int row = static_cast<int>(row_index);
     for (int col = 0; col < width; ++col) {
-      double sum = 0, length_sum = 0;
-      int num_lengths = 0;
-      for (int s = 0; s < spp2; ++s) {
-        Eigen::Vector3d origin, dir;
-        if (!rays.Ray(col, row, s, &origin, &dir)) {
-          sum += subframes.size() * options.levels.invalid;
-          continue;
-        }
-        for (const auto& prepared : subframes) {
-          double t_max = 1e300;
-          Hit best;
-          bool found = false;
-          for (const PreparedObject& p : prepared) {
-            Hit hit;
-            if (p.object->Intersect(p.rotation * origin + p.translation, p.rotation * dir, t_max,
-                                    &hit)) {
-              best = hit;
-              t_max = hit.t;
-              found = true;
-            }
-          }
-          if (!found) {
-            sum += background;
-            continue;
-          }
-          double gray = best.gray;
-          if (options.HasWater()) {
-            // Direct signal attenuated, plus the backscatter veil that
-            // builds up along the same path (Jaffe 1990, McGlamery 1980).
-            const double transmission = std::exp(-options.attenuation_per_m * best.t);
-            gray = gray * transmission + options.backscatter_gray * (1 - transmission);
-          }
-          sum += gray;
-          length_sum += best.t;
-          ++num_lengths;
-        }
-      }
-      float value = static_cast<float>(sum / (spp2 * subframes.size()));
-      if (options.vignetting > 0) {
-        const double c = rays.CosOffAxis(col, row);
-        value *= static_cast<float>(1 - options.vignetting + options.vignetting * c * c * c * c);
-      }
-      image.at<float>(row, col) = value;
-      path_length.at<float>(row, col) =
-          num_lengths > 0 ? static_cast<float>(length_sum / num_lengths) : 1e6f;
+      const ShadedPixel pixel = ShadePixel(rays, subframes, options, background, col, row);
+      image.at<float>(row, col) = pixel.value;
+      path_length.at<float>(row, col) = pixel.path_length;
     }
   });
-
   if (options.forward_scatter_per_m > 0) {
     // Small-angle forward scattering blurs more the longer the water path.
     cv::Mat blurred;
@@ -194,17 +200,7 @@ cv::Mat RenderImage(const RayMap& rays, const std::vector<PlacedObject>& objects
   if (options.blur_sigma_px > 0) {
     cv::GaussianBlur(image, image, cv::Size(0, 0), options.blur_sigma_px);
   }
-  cv::Mat out(height, width, CV_8UC1);
-  std::mt19937_64 rng(noise_seed);
-  std::normal_distribution<double> noise(0.0, 1.0);
-  for (int row = 0; row < height; ++row) {
-    for (int col = 0; col < width; ++col) {
-      double value = image.at<float>(row, col);
-      if (options.noise_sigma > 0) value += options.noise_sigma * noise(rng);
-      out.at<uint8_t>(row, col) = static_cast<uint8_t>(std::clamp(std::lround(value), 0L, 255L));
-    }
-  }
-  return out;
+  return Quantise(image, options.noise_sigma, noise_seed);
 }
 
 }  // namespace portcal

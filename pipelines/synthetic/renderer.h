@@ -76,7 +76,4 @@ Eigen::Vector2d SampleOffset(int s, int spp);
 cv::Mat RenderImage(const RayMap& rays, const std::vector<PlacedObject>& objects,
                     const ImageFormationOptions& options, uint64_t noise_seed);
 
-// Runs body(row) for rows [0, num_rows) on `num_threads` threads.
-void ParallelForRows(int num_rows, int num_threads, const std::function<void(int)>& body);
-
 }  // namespace portcal

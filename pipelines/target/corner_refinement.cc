@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "colmap_ext/cost/corner_pattern_residual.h"
 #include "colmap_ext/util/error.h"
 
 namespace portcal {
@@ -22,34 +23,6 @@ void CornerRefinementOptions::Check() const {
 }
 
 namespace {
-
-// One pixel of the window: residual = model - observed gray. The model is
-// integrated over the pixel's area (4 x 4 sub-samples): with a box filter an
-// edge spreads over one pixel only, which a single Gaussian cannot mimic
-// without trading the edge's position against its width.
-struct CornerPatternResidual {
-  CornerPatternResidual(double x, double y, double gray) : x_(x), y_(y), gray_(gray) {}
-
-  template <typename T>
-  bool operator()(const T* p, T* residual) const {
-    // p = cx, cy, theta1, theta2, m, a, log_sigma
-    const T c1 = cos(p[2]), s1 = sin(p[2]), c2 = cos(p[3]), s2 = sin(p[3]);
-    const T scale = T(1.0 / std::sqrt(2.0)) * exp(-p[6]);
-    T sum = T(0);
-    for (int i = 0; i < 4; ++i) {
-      for (int j = 0; j < 4; ++j) {
-        const T dx = T(x_ + (i + 0.5) / 4 - 0.5) - p[0];
-        const T dy = T(y_ + (j + 0.5) / 4 - 0.5) - p[1];
-        sum += erf((c1 * dx + s1 * dy) * scale) * erf((c2 * dx + s2 * dy) * scale);
-      }
-    }
-    residual[0] = p[4] + p[5] * sum / T(16) - T(gray_);
-    return true;
-  }
-
- private:
-  double x_, y_, gray_;
-};
 
 double NearestNeighbourDistance(const std::vector<Eigen::Vector2d>& corners, int cols, int rows,
                                 int index) {
@@ -101,9 +74,7 @@ std::optional<RefinedCorner> RefineCorner(const cv::Mat& gray, const Eigen::Vect
       const double value = gray.at<uint8_t>(r, c);
       sum += value;
       ++count;
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CornerPatternResidual, 1, 7>(
-                                   new CornerPatternResidual(p.x(), p.y(), value)),
-                               nullptr, params);
+      problem.AddResidualBlock(CornerPatternResidual::Create(p.x(), p.y(), value), nullptr, params);
     }
   }
   if (count < 12) return std::nullopt;

@@ -1,0 +1,71 @@
+#include "pipelines/sfm/global_adjustment.h"
+
+#include <algorithm>
+#include <sstream>
+
+
+namespace portcal {
+
+BundleAdjustmentOptions GlobalAdjustmentOptions(const IncrementalMapperOptions& options, int num_images,
+                                                bool refine_intrinsics) {
+  BundleAdjustmentOptions ba;
+  ba.refine_focal_length = refine_intrinsics && options.ba_refine_focal_length;
+  ba.refine_principal_point = refine_intrinsics && options.ba_refine_principal_point;
+  ba.refine_extra_params = refine_intrinsics && options.ba_refine_extra_params;
+  if (num_images < options.ba_full_intrinsics_min_images) {
+    ba.max_num_extra_params = 1;
+  }
+  ba.refine_housing = refine_intrinsics && options.ba_refine_housing;
+  ba.max_num_iterations = options.ba_max_num_iterations;
+  ba.function_tolerance = options.ba_global_function_tolerance;
+  ba.num_threads = options.num_threads;
+  return ba;
+}
+
+bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before, const std::map<camera_t, HousedCamera>& after,
+                     const std::map<camera_t, HousedCamera>& start, double max_focal_ratio_to_start) {
+  for (const auto& [id, camera] : after) {
+    if (ImplausibleIntrinsics(before.at(id).camera, camera.camera)) return true;
+    const double ratio = camera.camera.MeanFocalLength() / start.at(id).camera.MeanFocalLength();
+    if (!(ratio < max_focal_ratio_to_start && 1 / ratio < max_focal_ratio_to_start)) return true;
+  }
+  return false;
+}
+
+bool HasOrientedHousing(const Reconstruction& r) {
+  return std::any_of(r.cameras().begin(), r.cameras().end(), [](const auto& entry) {
+    return entry.second.housing && !entry.second.housing->Refinement().orientation.empty();
+  });
+}
+
+ModelSnapshot ModelSnapshot::Of(const Reconstruction& r, const std::vector<MarkerCorner>& markers) {
+  ModelSnapshot snapshot;
+  snapshot.cameras = r.cameras();
+  snapshot.poses = r.poses();
+  for (const auto& [id, point] : r.points()) snapshot.points[id] = point.xyz;
+  snapshot.markers = markers;
+  return snapshot;
+}
+
+void ModelSnapshot::Restore(Reconstruction* r, std::vector<MarkerCorner>* markers) const {
+  r->mutable_cameras() = cameras;
+  r->mutable_poses() = poses;
+  for (const auto& [id, xyz] : points) r->point(id).xyz = xyz;
+  r->UpdateRays();
+  *markers = this->markers;
+}
+
+std::string CalibrationText(const Reconstruction& r, bool housings) {
+  std::ostringstream values;
+  for (const auto& [id, camera] : r.cameras()) {
+    if (housings) values << " camera";
+    for (const double p : camera.camera.params) values << " " << p;
+    if (housings && camera.housing) {
+      values << " housing";
+      for (const double p : camera.housing->params) values << " " << p;
+    }
+  }
+  return values.str();
+}
+
+}  // namespace portcal

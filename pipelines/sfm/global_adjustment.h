@@ -1,0 +1,54 @@
+// The parts of the incremental mapper's global adjustment that need none of
+// the mapper's state: what an adjustment refines at a model's size, the
+// test that undoes implausible intrinsics, and a snapshot to undo it with.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "colmap_ext/camera/housed_camera.h"
+#include "pipelines/bundle_adjustment/bundle_adjustment.h"
+#include "pipelines/reconstruction/reconstruction.h"
+#include "pipelines/sfm/incremental_mapper.h"
+
+namespace portcal {
+
+// Intrinsics from a handful of views are barely constrained: a global
+// adjustment refines them from this many images on.
+constexpr int kMinImagesForIntrinsics = 5;
+
+// The options of a global adjustment of a model of `num_images` images:
+// the intrinsics and housing refined as the mapper's options say when
+// `refine_intrinsics`, only the first extra parameter below
+// ba_full_intrinsics_min_images.
+BundleAdjustmentOptions GlobalAdjustmentOptions(const IncrementalMapperOptions& options, int num_images,
+                                                bool refine_intrinsics);
+
+// COLMAP's bogus-camera test against the intrinsics before the adjustment,
+// and the focal length against the mapper's start, which a slow drift of
+// many adjustments would otherwise pass.
+bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before, const std::map<camera_t, HousedCamera>& after,
+                     const std::map<camera_t, HousedCamera>& start, double max_focal_ratio_to_start);
+
+// A housing with an orientation to refine apart from its position (a flat
+// port's normal).
+bool HasOrientedHousing(const Reconstruction& r);
+
+// What an adjustment changes, as it was before: undone when the intrinsics
+// came out implausible.
+struct ModelSnapshot {
+  std::map<camera_t, HousedCamera> cameras;
+  std::map<image_t, Rigid3d> poses;
+  std::map<point3D_t, Eigen::Vector3d> points;
+  std::vector<MarkerCorner> markers;
+
+  static ModelSnapshot Of(const Reconstruction& r, const std::vector<MarkerCorner>& markers);
+  void Restore(Reconstruction* r, std::vector<MarkerCorner>* markers) const;
+};
+
+// " p0 p1 ..." of every camera's parameters; with `housings`, each
+// camera's as " camera ... housing ...".
+std::string CalibrationText(const Reconstruction& r, bool housings);
+
+}  // namespace portcal
