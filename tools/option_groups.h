@@ -1,20 +1,38 @@
-// Option groups several subcommands share, declared once.
+// Flag groups several subcommands share, each declared once with one help
+// text: one Register per options struct (COLMAP's --Section.option names).
+// The fields keep their defaults as the flags' defaults.
 #pragma once
 
 #include "pipelines/images/image_reader.h"
+#include "pipelines/stages/feature_extractor.h"
+#include "pipelines/stages/feature_matcher.h"
+#include "pipelines/stages/refractive_bundle_adjuster.h"
+#include "pipelines/stages/refractive_mapper.h"
 #include "tools/command_line.h"
 
 namespace portcal {
 
 // --ImageReader.camera_model, single_camera, single_camera_per_folder,
-// camera_params (COLMAP's names).
-inline void AddImageReaderOptions(CommandLine* cli, ImageReaderOptions* reader) {
-  cli->Add("ImageReader.camera_model", &reader->camera_model, "COLMAP camera model");
-  cli->Add("ImageReader.single_camera", &reader->single_camera, "one camera for all images (0 | 1)");
-  cli->Add("ImageReader.single_camera_per_folder", &reader->single_camera_per_folder,
-           "one camera per sub-folder, e.g. a stereo rig's cam1/ and cam2/ (0 | 1)");
-  cli->Add("ImageReader.camera_params", &reader->camera_params,
-           "initial parameters in COLMAP's order (default: from the image size)");
-}
+// camera_params.
+void Register(CommandLine* cli, ImageReaderOptions* reader);
+// --SiftExtraction.*
+void Register(CommandLine* cli, SiftExtractionOptions* sift);
+// --SiftMatching.*
+void Register(CommandLine* cli, DescriptorMatchingOptions* matching);
+// --TwoViewGeometry.*
+void Register(CommandLine* cli, TwoViewVerificationOptions* verification);
+// --SequentialMatching.*
+void Register(CommandLine* cli, SequentialPairingOptions* sequential);
+// --SpatialMatching.*
+void Register(CommandLine* cli, SpatialPairingOptions* spatial);
+// --Markers.side_length, side_sigma: ArUco markers as the scale.
+void Register(CommandLine* cli, MarkerScale* marker_scale);
+// --Mapper.* (with --Markers.side_length, side_sigma, --PosePrior.position_sigma,
+// --random_seed and --num_threads of the mapper).
+void Register(CommandLine* cli, IncrementalMapperOptions* mapper);
+// --Mapper.init_radial_*: the search of the first radial term.
+void Register(CommandLine* cli, RadialStartOptions* radial);
+// --BundleAdjustment.* (with --num_threads of the adjustment).
+void Register(CommandLine* cli, BundleAdjustmentOptions* ba);
 
 }  // namespace portcal

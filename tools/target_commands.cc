@@ -19,7 +19,7 @@ int TargetExtractorCommand(int argc, char** argv) {
                   "outcome in portcal_target_detections. One transaction; safe to rerun.");
   cli.AddRequired("database_path", &options.database_path, "database (created if missing)");
   cli.AddRequired("image_path", &options.image_path, "directory of images");
-  AddImageReaderOptions(&cli, &options.reader);
+  Register(&cli, &options.reader);
   cli.Add("Target.type", &options.target_type, "chessboard | aruco_grid | charuco");
   cli.Add("Target.cols", &options.chessboard.cols, "inner corners per row");
   cli.Add("Target.rows", &options.chessboard.rows, "inner corners per column");

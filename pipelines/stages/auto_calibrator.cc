@@ -25,8 +25,11 @@ void AutoCalibratorOptions::Check() const {
   if (max_num_starts < 1) {
     throw OptionError("--AutoCalibration.max_num_starts", std::to_string(max_num_starts), ">= 1");
   }
-  if (marker_side_length_m < 0) {
-    throw OptionError("--Markers.side_length", std::to_string(marker_side_length_m), ">= 0 m");
+  if (marker_scale.side_length_m < 0) {
+    throw OptionError("--Markers.side_length", std::to_string(marker_scale.side_length_m), ">= 0 m");
+  }
+  if (!(marker_scale.sigma_m > 0)) {
+    throw OptionError("--Markers.side_sigma", std::to_string(marker_scale.sigma_m), "> 0 m");
   }
 }
 
@@ -136,7 +139,7 @@ RefractiveMapperOptions MapperOptions(const AutoCalibratorOptions& options, cons
   map.mapper.num_threads = options.num_threads;
   map.mapper.random_seed = random_seed;
   map.init_radial_from_matches = options.init_radial_from_matches;
-  map.mapper.marker_scale.side_length_m = options.marker_side_length_m;
+  map.mapper.marker_scale = options.marker_scale;
   map.mapper.ba_refine_focal_length = refine_intrinsics;
   map.mapper.ba_refine_extra_params = refine_intrinsics;
   const bool refine_principal_point = refine_intrinsics && options.refine_principal_point != false;
@@ -148,7 +151,7 @@ RefractiveMapperOptions MapperOptions(const AutoCalibratorOptions& options, cons
   // barely observed and refining it splits the models
   // (docs/auto_calibration.md).
   map.mapper.ba_refine_housing = options.housing && !options.housing->Refinement().orientation.empty() &&
-                                 options.marker_side_length_m > 0;
+                                 options.marker_scale.side_length_m > 0;
   // The principal point with it: held at the image centre when it is not
   // there, the global adjustments fight the port. With the dome left to the
   // final refinement, its principal point is too (refined in the mapper,
@@ -166,7 +169,7 @@ RefractiveBundleAdjusterOptions RefinerOptions(const AutoCalibratorOptions& opti
   refine.input_path = input_path;
   refine.output_path = (dir / "refined").string();
   refine.database_path = database_path;
-  refine.marker_scale.side_length_m = options.marker_side_length_m;
+  refine.marker_scale = options.marker_scale;
   refine.housing_guess = options.housing;
   refine.ba.refine_housing = options.housing.has_value();
   refine.ba.refine_focal_length = refine_intrinsics;

@@ -27,7 +27,7 @@ struct AutoCalibratorOptions {
   std::string camera_params;  // given: intrinsics known and held
   std::optional<Housing> housing;  // the housing to calibrate, with a first guess; none: in air
   std::string marker_dictionary = "DICT_4X4_50";
-  double marker_side_length_m = 0;  // > 0: metric scale from the markers
+  MarkerScale marker_scale;  // side_length_m > 0: metric scale from the markers
   double mask_enlargement_factor = 3.0;
   bool mask = true;                   // keep only features near markers
   PairingMode matcher = PairingMode::kExhaustive;  // exhaustive or sequential

@@ -2,6 +2,7 @@
 // errors naming the culprit, ini files, and the commands of the foundation.
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <fstream>
 #include <sstream>
 #include <utility>
@@ -256,6 +257,46 @@ TEST(Cli, TypedOptionsNameTheFlagAtFault) {
   };
   EXPECT_FALSE(params_help(mapper).empty()) << mapper;
   EXPECT_EQ(params_help(mapper), params_help(adjuster));
+}
+
+// A flag group that several commands expose (one Register per options
+// struct in tools/option_groups.cc) reads the same in every command's help:
+// same default, same text, whatever the column widths.
+TEST(Cli, SharedFlagGroupsReadTheSameInEveryCommand) {
+  const auto flag_help = [](const std::string& help, const std::string& flag) {
+    const size_t at = help.find("--" + flag + " ");
+    if (at == std::string::npos) return std::string();
+    const size_t end = help.find("\n  --", at);
+    std::string text = help.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    std::string folded;
+    for (const char c : text) {
+      if (std::isspace(static_cast<unsigned char>(c))) {
+        if (!folded.empty() && folded.back() != ' ') folded += ' ';
+      } else {
+        folded += c;
+      }
+    }
+    return folded;
+  };
+  const std::vector<std::pair<std::string, std::vector<std::string>>> groups = {
+      {"Markers.side_length", {"refractive_mapper", "refractive_bundle_adjuster", "auto_calibrator"}},
+      {"Markers.side_sigma", {"refractive_mapper", "refractive_bundle_adjuster", "auto_calibrator"}},
+      {"SiftExtraction.peak_threshold", {"feature_extractor", "auto_calibrator"}},
+      {"ImageReader.single_camera_per_folder", {"feature_extractor", "target_extractor"}},
+      {"SiftMatching.max_ratio", {"exhaustive_matcher", "sequential_matcher", "spatial_matcher"}},
+      {"TwoViewGeometry.max_error", {"exhaustive_matcher", "sequential_matcher", "spatial_matcher"}},
+  };
+  for (const auto& [flag, commands] : groups) {
+    const std::string first = flag_help(RunCommand(Portcal(commands.front() + " -h")).output, flag);
+    EXPECT_FALSE(first.empty()) << commands.front() << " shows no --" << flag;
+    for (size_t k = 1; k < commands.size(); ++k) {
+      EXPECT_EQ(flag_help(RunCommand(Portcal(commands[k] + " -h")).output, flag), first)
+          << "--" << flag << " in " << commands[k] << " and " << commands.front();
+    }
+  }
+  const auto result = RunCommand(Portcal("auto_calibrator --image_path a --output_path b --Markers.side_sigma 0"));
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_NE(result.output.find("--Markers.side_sigma"), std::string::npos) << result.output;
 }
 
 TEST(Cli, PosePriorsNameWhatIsMissing) {

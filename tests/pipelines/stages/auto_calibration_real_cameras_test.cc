@@ -80,7 +80,7 @@ AutoCalibratorSummary Calibrate(const FamilyMember& m, const fs::path& images, c
   options.output_path = out.string();
   options.camera_model = m.camera_model;
   options.housing = HousingFromText(m.housing_model, m.housing_guess);
-  options.marker_side_length_m = 0.06;
+  options.marker_scale.side_length_m = 0.06;
   options.num_threads = num_threads;
   NullProgress progress;
   return RunAutoCalibrator(options, progress);

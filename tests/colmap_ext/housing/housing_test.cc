@@ -274,13 +274,11 @@ TEST(Housing, StartCandidatesMoveOnlyTheRefinedParametersWithinTheBounds) {
     const std::vector<Housing> starts = housing.StartCandidates(axis);
     ASSERT_GE(starts.size(), 10u) << housing.ModelName();
     const HousingRefinement refinement = housing.Refinement();
-    std::vector<int> refined = refinement.orientation;
-    refined.insert(refined.end(), refinement.position.begin(), refinement.position.end());
     for (const Housing& start : starts) {
       EXPECT_TRUE(start.SameModel(housing));
       EXPECT_NO_THROW(start.Validate("start"));
       for (size_t k = 0; k < housing.params.size(); ++k) {
-        if (std::find(refined.begin(), refined.end(), static_cast<int>(k)) == refined.end()) {
+        if (!refinement.IsRefined(static_cast<int>(k))) {
           EXPECT_EQ(start.params[k], housing.params[k]) << housing.ModelName() << " parameter " << k;
         }
       }

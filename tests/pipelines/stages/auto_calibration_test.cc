@@ -45,7 +45,7 @@ AutoCalibratorSummary Calibrate(const fs::path& images, const fs::path& out, con
   options.image_path = images.string();
   options.output_path = out.string();
   options.housing = HousingFromText(housing_model, housing_guess);
-  options.marker_side_length_m = 0.06;
+  options.marker_scale.side_length_m = 0.06;
   NullProgress progress;
   return RunAutoCalibrator(options, progress);
 }
