@@ -13,7 +13,9 @@ namespace {
 template <typename CameraModel, typename Port>
 ceres::CostFunction* Create(const ObservationModel& model, CostBlocks blocks, const Eigen::Vector2d& observed,
                             double sigma) {
-  if (blocks == CostBlocks::kPosePoint) return PosePointError<CameraModel, Port>::Create(model.intrinsics, model.housing, observed, sigma);
+  if (blocks == CostBlocks::kPosePoint) {
+    return PosePointError<CameraModel, Port>::Create(model.intrinsics, model.housing, observed, sigma);
+  }
   return PosePointIntrinsicsError<CameraModel, Port>::Create(model.housing, observed, sigma);
 }
 

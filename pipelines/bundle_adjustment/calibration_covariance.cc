@@ -377,7 +377,8 @@ WantedTangents TangentsOf(ceres::Problem* problem, const std::vector<const doubl
 // sum of its residuals' effects.
 Eigen::MatrixXd ClusteredCovariance(const Linearisation& linear, const PointSchur& schur,
                                     const std::vector<const double*>& wanted, const WantedTangents& tangents,
-                                    const Eigen::MatrixXd& inverse_rows, const std::vector<BlockClusters>& block_clusters,
+                                    const Eigen::MatrixXd& inverse_rows,
+                                    const std::vector<BlockClusters>& block_clusters,
                                     const ResidualClusters& clusters, MarginalCovariance* result) {
   const int nc = linear.num_columns;
   Eigen::MatrixXd gain(tangents.total, nc);

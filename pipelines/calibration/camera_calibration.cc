@@ -138,7 +138,9 @@ void ComputeParamsCovariance(const std::vector<int>& fixed, const CameraCalibrat
     covariance.GetCovarianceBlock(s->intrinsics.data(), s->intrinsics.data(), c.data());
     s->params_covariance =
         Eigen::Map<const Eigen::MatrixXd>(c.data(), num_params, num_params) * variance;
-    for (int i = 0; i < num_params; ++i) s->params_std_dev[i] = std::sqrt(std::max(0.0, c[i * num_params + i] * variance));
+    for (int i = 0; i < num_params; ++i) {
+      s->params_std_dev[i] = std::sqrt(std::max(0.0, c[i * num_params + i] * variance));
+    }
     if (settings.estimate_board_warp) {
       double w[4];
       covariance.GetCovarianceBlock(s->warp.data(), s->warp.data(), w);

@@ -83,7 +83,9 @@ BoardMarkers DetectBoardMarkers(const cv::Mat& gray, const MarkerBoardOptions& o
     MarkerEdgeRefinementOptions edge_options;
     edge_options.bits_per_side = dictionary->markerSize;
     if (RefineMarkerCorners(gray, edge_options, &quad)) {
-      for (int k = 0; k < 4; ++k) corners[m][k] = cv::Point2f(static_cast<float>(quad[k].x), static_cast<float>(quad[k].y));
+      for (int k = 0; k < 4; ++k) {
+        corners[m][k] = cv::Point2f(static_cast<float>(quad[k].x), static_cast<float>(quad[k].y));
+      }
     }
     MarkerDetection marker;
     marker.dictionary = options.dictionary;

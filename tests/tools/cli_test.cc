@@ -264,8 +264,10 @@ TEST(Cli, TypedOptionsNameTheFlagAtFault) {
 // same default, same text, whatever the column widths.
 TEST(Cli, SharedFlagGroupsReadTheSameInEveryCommand) {
   const auto flag_help = [](const std::string& help, const std::string& flag) {
-    const size_t at = help.find("--" + flag + " ");
+    // The option's own line (the command's summary may name it too).
+    size_t at = help.find("\n  --" + flag + " ");
     if (at == std::string::npos) return std::string();
+    ++at;
     const size_t end = help.find("\n  --", at);
     std::string text = help.substr(at, end == std::string::npos ? std::string::npos : end - at);
     std::string folded;
