@@ -165,6 +165,19 @@ void Database::UpdateCamera(const Camera& camera) {
   stmt.Execute();
 }
 
+bool Database::DeleteCameraIfUnused(camera_t camera_id) {
+  Statement& stmt = Prepare("delete_unused_camera",
+                            "DELETE FROM cameras WHERE camera_id=? AND NOT EXISTS "
+                            "(SELECT 1 FROM images WHERE images.camera_id=?);");
+  stmt.Bind(1, static_cast<int64_t>(camera_id)).Bind(2, static_cast<int64_t>(camera_id));
+  stmt.Execute();
+  if (sqlite3_changes(db_) == 0) return false;
+  Statement& housing = Prepare("delete_housing", "DELETE FROM portcal_housings WHERE camera_id=?;");
+  housing.Bind(1, static_cast<int64_t>(camera_id));
+  housing.Execute();
+  return true;
+}
+
 namespace {
 
 Camera CameraFromRow(const Statement& stmt, const std::string& path) {
@@ -248,6 +261,16 @@ image_t Database::WriteImage(const DatabaseImage& image, bool use_image_id) {
   }
   stmt.Execute();
   return static_cast<image_t>(sqlite3_last_insert_rowid(db_));
+}
+
+void Database::UpdateImageCamera(image_t image_id, camera_t camera_id) {
+  Statement& stmt = Prepare("update_image_camera", "UPDATE images SET camera_id=? WHERE image_id=?;");
+  stmt.Bind(1, static_cast<int64_t>(camera_id)).Bind(2, static_cast<int64_t>(image_id));
+  stmt.Execute();
+  if (sqlite3_changes(db_) != 1) {
+    throw InputError(path_ + ": no image with id " + std::to_string(image_id) + " to give camera " +
+                     std::to_string(camera_id));
+  }
 }
 
 void Database::UpdatePositionPrior(image_t image_id, const std::optional<Eigen::Vector3d>& position) {

@@ -57,6 +57,11 @@ class Database {
   // full pose prior.
   void UpdatePositionPrior(image_t image_id, const std::optional<Eigen::Vector3d>& position);
   std::optional<DatabaseImage> ReadImageWithName(const std::string& name);
+  // Gives the image another camera (a rerun that imports the cameras again).
+  void UpdateImageCamera(image_t image_id, camera_t camera_id);
+  // Deletes the camera (and its housing) when no image has it any more;
+  // true if it was deleted.
+  bool DeleteCameraIfUnused(camera_t camera_id);
   std::vector<DatabaseImage> ReadAllImages();
 
   // Replaces the image's keypoints / descriptors.

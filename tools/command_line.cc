@@ -1,5 +1,6 @@
 #include "tools/command_line.h"
 
+#include <algorithm>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -23,21 +24,108 @@ CommandLine::CommandLine(std::string command, std::string summary)
       "command line takes precedence");
 }
 
-std::string CommandLine::Help() const {
+std::string CommandLine::Help(const std::string& group) const {
   std::ostringstream out;
-  out << "Usage: portcal " << command_ << " [options]\n\n" << summary_ << "\n\n"
-      << options_;
+  out << "Usage: portcal " << command_ << " [options]\n\n" << summary_ << "\n\n";
+  if (group.empty()) {
+    out << options_;
+    return out.str();
+  }
+  // Only the options of one group: --<group>.*
+  po::options_description only(group + " options", 100, 50);
+  for (const auto& option : options_.options()) {
+    if (option->long_name().rfind(group + ".", 0) == 0) only.add(option);
+  }
+  if (only.options().empty()) {
+    throw UsageError("no option group '" + group + "' (the groups: " + GroupNames() + ")");
+  }
+  out << only;
   return out.str();
 }
 
+std::string CommandLine::GroupNames() const {
+  std::vector<std::string> groups;
+  for (const auto& option : options_.options()) {
+    const std::string& name = option->long_name();
+    const size_t dot = name.find('.');
+    if (dot == std::string::npos) continue;
+    const std::string group = name.substr(0, dot);
+    if (std::find(groups.begin(), groups.end(), group) == groups.end()) groups.push_back(group);
+  }
+  std::string text;
+  for (const std::string& group : groups) text += (text.empty() ? "" : ", ") + group;
+  return text;
+}
+
+namespace {
+
+// Levenshtein distance, for "did you mean".
+size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// The group asked for after -h / --help ("portcal camera_calibrator -h
+// Calibration"), or "" for all options; nullopt without -h.
+std::optional<std::string> HelpRequest(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg != "-h" && arg != "--help") continue;
+    if (i + 1 < argc && argv[i + 1][0] != '-') return std::string(argv[i + 1]);
+    return std::string();
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::string CommandLine::Suggestions(std::string name) const {
+  while (!name.empty() && name[0] == '-') name.erase(0, 1);
+  // Options the name abbreviates, then the same option in another group
+  // (--Mask.dictionary: --Markers.dictionary), then those a few typing
+  // errors away.
+  const auto option_of = [](const std::string& flag) { return flag.substr(flag.find('.') + 1); };
+  std::vector<std::pair<size_t, std::string>> ranked;
+  for (const auto& option : options_.options()) {
+    const std::string& candidate = option->long_name();
+    if (candidate.rfind(name, 0) == 0) {
+      ranked.emplace_back(0, candidate);
+      continue;
+    }
+    if (name.find('.') != std::string::npos && option_of(candidate) == option_of(name)) {
+      ranked.emplace_back(1, candidate);
+      continue;
+    }
+    const size_t distance = EditDistance(name, candidate);
+    if (distance <= std::max<size_t>(2, name.size() / 4)) ranked.emplace_back(distance, candidate);
+  }
+  std::sort(ranked.begin(), ranked.end());
+  std::string text;
+  for (size_t k = 0; k < ranked.size() && k < 3; ++k) text += (k ? ", --" : "--") + ranked[k].second;
+  return text;
+}
+
 bool CommandLine::Parse(int argc, char** argv) {
+  if (const std::optional<std::string> group = HelpRequest(argc, argv)) {
+    std::cout << Help(*group);
+    return false;
+  }
   po::variables_map vm;
   try {
-    po::store(po::parse_command_line(argc, argv, options_), vm);
-    if (vm.count("help")) {
-      std::cout << Help();
-      return false;
-    }
+    // No guessing: an abbreviated option is an error, not silently the one
+    // it happens to abbreviate.
+    const int style = po::command_line_style::default_style & ~po::command_line_style::allow_guessing;
+    po::store(po::command_line_parser(argc, argv).options(options_).style(style).run(), vm);
     if (vm.count("project_path")) {
       const std::string path = vm["project_path"].as<std::string>();
       std::ifstream file(path);
@@ -45,6 +133,10 @@ bool CommandLine::Parse(int argc, char** argv) {
       po::store(po::parse_config_file(file, options_), vm);
     }
     po::notify(vm);
+  } catch (const po::unknown_option& e) {
+    const std::string suggestions = Suggestions(e.get_option_name());
+    throw UsageError(std::string(e.what()) + (suggestions.empty() ? "" : "; did you mean " + suggestions + "?") +
+                     " (see portcal " + command_ + " -h)");
   } catch (const po::error& e) {
     throw UsageError(std::string(e.what()) + " (see portcal " + command_ + " -h)");
   }
@@ -84,6 +176,7 @@ void CommandLine::AddHousing(std::optional<Housing>* housing, const std::string&
     }
     if (params.empty()) throw OptionError("--Housing.params", "''", "the parameters of --Housing.model " + model);
     *housing = Housing::FromName(model, ParseDoubleList(params, "--Housing.params"), "--Housing.params");
+    (*housing)->ValidateInput("--Housing.params");
   });
 }
 

@@ -82,12 +82,21 @@ class CommandLine {
   void AddHousing(std::optional<Housing>* housing, const std::string& model_help);
 
   // Parses argv (argv[0] is the command name). Returns false if help was
-  // printed (caller exits 0). Throws OptionError on bad options, naming them.
+  // printed (caller exits 0): -h prints every option, "-h GROUP" those of
+  // --GROUP.*. Throws OptionError on bad options, naming them; an unknown or
+  // abbreviated option is a UsageError suggesting the options meant.
   bool Parse(int argc, char** argv);
 
-  std::string Help() const;
+  // The usage, summary and options (only --group.* when group is given;
+  // UsageError naming the groups when there is no such group).
+  std::string Help(const std::string& group = "") const;
 
  private:
+  // "Calibration, Housing, ..." -- the groups of the --Group.option flags.
+  std::string GroupNames() const;
+  // Up to three registered options `name` abbreviates or nearly spells.
+  std::string Suggestions(std::string name) const;
+
   std::string command_;
   std::string summary_;
   std::string log_level_ = "info";

@@ -37,8 +37,8 @@ int FeatureMaskerCommand(int argc, char** argv) {
                   "Matches of changed images are deleted. One transaction; safe to rerun.");
   cli.AddRequired("database_path", &options.database_path, "database with features");
   cli.AddRequired("image_path", &options.image_path, "directory of the images");
-  cli.Add("Mask.dictionary", &options.dictionary, "ArUco dictionary, e.g. DICT_4X4_50");
-  cli.Add("Mask.enlargement_factor", &options.enlargement_factor, "quad scale about its centroid (>= 1)");
+  cli.Add("Markers.dictionary", &options.dictionary, kMarkersDictionaryHelp);
+  cli.Add("Mask.enlargement_factor", &options.enlargement_factor, kMaskEnlargementHelp);
   cli.Add("num_threads", &options.num_threads, "threads");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;

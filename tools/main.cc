@@ -67,8 +67,9 @@ const std::vector<Command>& Commands() {
 void PrintHelp() {
   std::cout << "portcal " << PORTCAL_VERSION
             << " -- camera, stereo and housing calibration for underwater "
-               "photogrammetry\n\nUsage:\n  portcal <command> [options]\n  "
-               "portcal <command> -h\n\nCommands:\n";
+               "photogrammetry\n\nUsage:\n  portcal <command> [options]\n"
+               "  portcal <command> -h [GROUP]    the command's options (with GROUP: only --GROUP.*)\n"
+               "  portcal help <command> [GROUP]  the same\n\nCommands:\n";
   // The summaries start two spaces after the longest name.
   size_t width = std::string("help").size();
   for (const Command& command : Commands()) width = std::max(width, std::string(command.name).size());
@@ -92,6 +93,17 @@ int main(int argc, char** argv) {
   portcal::InitializeLogging(argv[0]);
   std::signal(SIGINT, HandleSignal);
   std::signal(SIGTERM, HandleSignal);
+  if (argc >= 3 && std::strcmp(argv[1], "help") == 0) {
+    // "portcal help CMD [GROUP]" is "portcal CMD -h [GROUP]".
+    for (const Command& command : Commands()) {
+      if (command.name != std::string(argv[2])) continue;
+      std::vector<char*> args = {argv[2], const_cast<char*>("-h")};
+      if (argc >= 4) args.push_back(argv[3]);
+      return command.run(static_cast<int>(args.size()), args.data());
+    }
+    std::cerr << "error: unknown command '" << argv[2] << "' (portcal help lists the commands)\n";
+    return portcal::kExitUsage;
+  }
   if (argc < 2 || std::strcmp(argv[1], "help") == 0 ||
       std::strcmp(argv[1], "-h") == 0 || std::strcmp(argv[1], "--help") == 0) {
     PrintHelp();

@@ -45,12 +45,16 @@ int ProjectPointsCommand(int argc, char** argv) {
   cli.Add("unproject", &options.unproject, "pixels -> rays (0 | 1)");
   cli.Add("input_path", &options.input_path,
           "sparse model to take the camera (and housings.txt) from");
-  cli.Add("camera_id", &options.camera_id, "camera id in --input_path");
+  cli.Add("camera_id", &options.camera_id, "camera id in --input_path (-1: its only camera)");
+  cli.Add("input_calibration", &options.input_calibration,
+          "calibration file to take the camera (and housing) from: portcal's or calibmar's calibration.yaml, "
+          "OpenCV or ROS camera YAML, mrcal .cameramodel");
   cli.Add("Camera.model", &options.camera_model, "COLMAP camera model name");
   cli.Add("Camera.params", &options.camera_params, "parameters in COLMAP's order");
   cli.Add("Camera.width", &options.width, "image width, pixels");
   cli.Add("Camera.height", &options.height, "image height, pixels");
-  cli.AddHousing(&options.housing, "the housing in front of the camera (none: in air)");
+  cli.AddHousing(&options.housing,
+                 "the housing in front of the camera (none: in air; replaces --input_calibration's)");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
     StderrProgress progress;

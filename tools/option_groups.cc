@@ -9,6 +9,9 @@ void Register(CommandLine* cli, ImageReaderOptions* reader) {
            "one camera per sub-folder, e.g. a stereo rig's cam1/ and cam2/ (0 | 1)");
   cli->Add("ImageReader.camera_params", &reader->camera_params,
            "initial parameters in COLMAP's order (default: from the image size)");
+  cli->Add("ImageReader.overwrite", &reader->overwrite,
+           "on a rerun, import again the cameras of images the database holds with other reader options "
+           "(0: that is an error naming the difference)");
 }
 
 void Register(CommandLine* cli, SiftExtractionOptions* sift) {

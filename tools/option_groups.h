@@ -12,8 +12,13 @@
 
 namespace portcal {
 
+// Flags two commands give to fields of their own.
+inline constexpr const char* kMarkersDictionaryHelp = "ArUco dictionary of the markers, e.g. DICT_4X4_50";
+inline constexpr const char* kMaskEnlargementHelp =
+    "features kept within each marker's quad scaled by this about its centroid (>= 1)";
+
 // --ImageReader.camera_model, single_camera, single_camera_per_folder,
-// camera_params.
+// camera_params, overwrite.
 void Register(CommandLine* cli, ImageReaderOptions* reader);
 // --SiftExtraction.*
 void Register(CommandLine* cli, SiftExtractionOptions* sift);

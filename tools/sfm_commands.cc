@@ -68,10 +68,10 @@ int AutoCalibratorCommand(int argc, char** argv) {
   cli.Add("ImageReader.camera_model", &options.camera_model, "COLMAP camera model");
   cli.Add("ImageReader.camera_params", &options.camera_params, "known intrinsics (then held)");
   cli.AddHousing(&options.housing, "the housing to calibrate, with a first guess (none: in air)");
-  cli.Add("Markers.dictionary", &options.marker_dictionary, "ArUco dictionary");
+  cli.Add("Markers.dictionary", &options.marker_dictionary, kMarkersDictionaryHelp);
   Register(&cli, &options.marker_scale);
   cli.Add("Mask.enabled", &options.mask, "keep only features near markers (0 | 1)");
-  cli.Add("Mask.enlargement_factor", &options.mask_enlargement_factor, "marker quad scale");
+  cli.Add("Mask.enlargement_factor", &options.mask_enlargement_factor, kMaskEnlargementHelp);
   cli.AddChoice("AutoCalibration.matcher", &options.matcher,
                 {{"exhaustive", PairingMode::kExhaustive}, {"sequential", PairingMode::kSequential}},
                 "pairs to match");

@@ -62,6 +62,8 @@ int CameraCalibratorCommand(int argc, char** argv) {
           "remove views whose RMS exceeds outlier_view_factor x median, and re-solve (0 | 1)");
   cli.Add("Calibration.outlier_view_factor", &options.calibration.outlier_view_factor,
           "outlier threshold on a view's RMS, times the median");
+  cli.Add("update_database", &options.update_database,
+          "write the calibrated intrinsics into the database camera, for the next stage (0 | 1)");
   cli.Add("num_threads", &options.calibration.num_threads, "threads");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
@@ -89,6 +91,8 @@ int HousingCalibratorCommand(int argc, char** argv) {
           "refine the intrinsics jointly (0 | 1)");
   cli.Add("Calibration.initialize_from_data", &options.calibration.initialize_from_data,
           "initialise the port from the views (0: from --Housing.params)");
+  cli.Add("update_database", &options.update_database,
+          "write the housing and the intrinsics into the database, for the next stage (0 | 1)");
   cli.Add("num_threads", &options.calibration.num_threads, "threads");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;

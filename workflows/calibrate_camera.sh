@@ -1,11 +1,15 @@
 #!/usr/bin/env bash
 # Camera calibration from chessboard images, end to end. Copy and adapt.
-# Usage: workflows/calibrate_camera.sh IMAGE_DIR OUTPUT_DIR [COLS ROWS SQUARE_M MODEL]
-#   COLS x ROWS inner corners (default 10 7), square side in metres (0.02),
-#   COLMAP camera model (OPENCV).
+# Usage: workflows/calibrate_camera.sh IMAGE_DIR OUTPUT_DIR COLS ROWS SQUARE_M [MODEL]
+#   your board: COLS x ROWS inner corners, square side in metres (e.g. 0.03
+#   for 30 mm); COLMAP camera model (default OPENCV).
 set -euo pipefail
+if [ "$#" -lt 5 ]; then
+  echo "usage: $0 IMAGE_DIR OUTPUT_DIR COLS ROWS SQUARE_M [MODEL]  (your board's inner corners and square side in metres)" >&2
+  exit 2
+fi
 images="$1"; out="$2"
-cols="${3:-10}"; rows="${4:-7}"; square="${5:-0.02}"; model="${6:-OPENCV}"
+cols="$3"; rows="$4"; square="$5"; model="${6:-OPENCV}"
 portcal="$(dirname "$0")/../build/portcal"
 mkdir -p "$out"
 "$portcal" target_extractor --database_path "$out/database.db" --image_path "$images" \

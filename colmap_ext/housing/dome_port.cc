@@ -4,6 +4,7 @@
 #include <cmath>
 #include <complex>
 
+#include "colmap_ext/housing/unit_mistake.h"
 #include "colmap_ext/util/string_utils.h"
 
 namespace portcal {
@@ -64,6 +65,27 @@ std::vector<std::vector<double>> DomePort::StartCandidates(const double* port, c
     }
   }
   return starts;
+}
+
+std::optional<std::string> DomePort::UnitMistake(const double* port) {
+  if (auto mistake = LengthInMillimetres(kName, "int_radius", InnerRadius(port))) return mistake;
+  if (auto mistake = LengthInMillimetres(kName, "int_thick", port[4])) return mistake;
+  const char* const kCentre[3] = {"Cx", "Cy", "Cz"};
+  for (int k = 0; k < 3; ++k) {
+    if (auto mistake = LengthInMillimetres(kName, kCentre[k], port[k])) return mistake;
+  }
+  return std::nullopt;
+}
+
+std::string DomePort::InWords(const double* port) {
+  // The camera frame: x right, y down, z forward (the optical axis).
+  const Eigen::Vector3d c = 1000 * Center(port);
+  const auto side = [](double mm, const char* positive, const char* negative) {
+    return FormatFixed(std::abs(mm), 2) + " mm " + (mm >= 0 ? positive : negative);
+  };
+  return "the dome's centre lies " + side(c.x(), "right", "left") + ", " + side(c.y(), "down", "up") + " and " +
+         side(c.z(), "ahead of", "behind") + " the camera's projection centre (" +
+         FormatFixed(c.norm(), 2) + " mm off it)";
 }
 
 std::optional<std::string> DomePort::Implausibility(const double* port) {

@@ -60,6 +60,13 @@ struct DomePort {
   // would show it and a self-calibration that ends there has likely traded
   // the dome against the focal length.
   static std::optional<std::string> Implausibility(const double* port);
+  // A length given in millimetres where portcal takes metres (a radius,
+  // thickness or decentering of a metre or more), or nullopt.
+  static std::optional<std::string> UnitMistake(const double* port);
+  // Where the dome sits, in words a housing drawing is checked against:
+  // its centre right/left, down/up and ahead of/behind the camera's
+  // projection centre, in millimetres.
+  static std::string InWords(const double* port);
 
   // An adjustment refines the centre, each coordinate within 90 % of the
   // inner radius: the camera centre stays inside the dome.

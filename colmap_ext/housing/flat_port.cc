@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "colmap_ext/housing/unit_mistake.h"
 #include "colmap_ext/util/string_utils.h"
 
 namespace portcal {
@@ -29,6 +30,24 @@ std::optional<std::string> FlatPort::Invalidity(const double* port) {
     return "FLATPORT refractive indices must be positive";
   }
   return std::nullopt;
+}
+
+std::optional<std::string> FlatPort::UnitMistake(const double* port) {
+  if (auto mistake = LengthInMillimetres(kName, "int_dist", InterfaceDistance(port))) return mistake;
+  return LengthInMillimetres(kName, "int_thick", Thickness(port));
+}
+
+std::string FlatPort::InWords(const double* port) {
+  const Eigen::Vector3d n = Normal(port);
+  const double tilt_deg = std::acos(std::clamp(n.z(), -1.0, 1.0)) * 180.0 / M_PI;
+  // The camera frame: x right, y down, z forward (the optical axis).
+  const double right_deg = std::atan2(n.x(), n.z()) * 180.0 / M_PI;
+  const double down_deg = std::atan2(n.y(), n.z()) * 180.0 / M_PI;
+  return "the port's normal is tilted " + FormatFixed(tilt_deg, 2) + " deg from the optical axis (" +
+         FormatFixed(std::abs(right_deg), 2) + " deg towards the image's " + (right_deg >= 0 ? "right" : "left") +
+         ", " + FormatFixed(std::abs(down_deg), 2) + " deg towards its " + (down_deg >= 0 ? "bottom" : "top") +
+         "); its inner surface is " + FormatFixed(1000 * InterfaceDistance(port), 2) +
+         " mm in front of the camera's projection centre";
 }
 
 std::optional<std::string> FlatPort::Implausibility(const double* port) {

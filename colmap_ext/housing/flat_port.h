@@ -63,6 +63,13 @@ struct FlatPort {
   // that ends beyond has traded the port against the lens (issue 21: 14 deg
   // and 0.1 mm, 11.4 deg and 361 mm).
   static std::optional<std::string> Implausibility(const double* port);
+  // A length given in millimetres where portcal takes metres (a distance
+  // or thickness of a metre or more), or nullopt.
+  static std::optional<std::string> UnitMistake(const double* port);
+  // Where the port sits, in words a housing drawing is checked against: the
+  // tilt of its normal from the optical axis and towards which side, and
+  // the inner surface's distance from the projection centre.
+  static std::string InWords(const double* port);
 
   // An adjustment refines the normal (on the sphere) and the distance, down
   // to 0.1 mm: the interface is in front of the lens, and a distance the

@@ -96,10 +96,28 @@ void VisitPort(const Housing& housing, F&& f) {
 
 }  // namespace
 
+void Housing::ValidateInput(const std::string& context) const {
+  // Before Validate: a dome centre in millimetres fails its test of lying
+  // inside the dome, and the units are the mistake to name.
+  std::optional<std::string> mistake;
+  VisitModelById(HousingModelList{}, model_id, [&](auto model) {
+    using Port = decltype(model);
+    if (static_cast<int>(params.size()) == Port::kNumParams) mistake = Port::UnitMistake(params.data());
+  });
+  if (mistake) throw InputError(context + ": " + *mistake);
+  Validate(context);
+}
+
 std::optional<std::string> Housing::Implausibility() const {
   std::optional<std::string> why;
   VisitPort(*this, [&](auto model) { why = decltype(model)::Implausibility(params.data()); });
   return why;
+}
+
+std::string Housing::InWords() const {
+  std::string words;
+  VisitPort(*this, [&](auto model) { words = decltype(model)::InWords(params.data()); });
+  return words;
 }
 
 HousingRefinement Housing::Refinement() const {

@@ -28,9 +28,15 @@ struct Housing {
   // Throws InputError (prefixed by `context`): unknown model, wrong count,
   // non-finite values, normal not unit, camera outside the dome, ...
   void Validate(const std::string& context) const;
+  // Validate, and a housing a user gives (an option, a calibration file)
+  // whose lengths are in millimetres instead of metres (a dome radius of
+  // 43 m) is an error that says so.
+  void ValidateInput(const std::string& context) const;
   // Why a real housing would hardly have these valid parameters (the
   // model's own bounds of plausibility), or nullopt.
   std::optional<std::string> Implausibility() const;
+  // Where the port sits, in words (the model's InWords).
+  std::string InWords() const;
   // The model's answers for an adjustment (housing_refinement.h): what it
   // refines and within which bounds, whether the parameters sit at one.
   HousingRefinement Refinement() const;

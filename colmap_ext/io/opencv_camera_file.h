@@ -22,4 +22,17 @@ void WriteOpenCvCameraYaml(const Camera& camera, const std::filesystem::path& pa
 void WriteRosCameraInfoYaml(const Camera& camera, const std::string& camera_name,
                             const std::filesystem::path& path);
 
+// True where the file is one of the two: OpenCV's FileStorage YAML (it
+// starts with "%YAML:1.0") or a YAML file with a camera_matrix.
+bool IsOpenCvOrRosCameraYaml(const std::filesystem::path& path);
+
+// Reads either file back (OpenCV's, as cv::FileStorage or portcal writes it,
+// or ROS camera_info, as camera_calibration_parsers write it). The COLMAP
+// model is the one that holds the coefficients exactly: five plumb_bob /
+// standard coefficients with k3 = 0 -> OPENCV, k3 != 0 -> FULL_OPENCV;
+// eight (rational_polynomial) -> FULL_OPENCV; four "equidistant" / "fisheye"
+// -> OPENCV_FISHEYE; none (all zero) -> PINHOLE. Throws InputError naming
+// the file and the key that is missing or malformed.
+Camera ReadOpenCvCameraYaml(const std::filesystem::path& path);
+
 }  // namespace portcal

@@ -7,6 +7,8 @@
 #include <sstream>
 
 #include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/io/mrcal_model.h"
+#include "colmap_ext/io/opencv_camera_file.h"
 #include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/string_utils.h"
@@ -50,6 +52,21 @@ std::string StdDevText(const std::vector<double>& values, size_t i) {
   std::ostringstream out;
   out << std::fixed << std::setprecision(6) << std::setw(17) << values[i];
   return out.str();
+}
+
+// The report's two error figures, one line each: what they are, and why
+// other tools print other numbers for the same fit.
+std::string ErrorFiguresExplained(bool self_calibration) {
+  return std::string(
+             "  RMS reprojection error: the root mean square of the distances (pixels) between the observed and "
+             "the reprojected points; the mean distance, which COLMAP's model_analyzer and portcal's mapper "
+             "print, is smaller.\n") +
+         (self_calibration
+              ? "  Residual sigma: the noise of one pixel coordinate of a keypoint at SIFT's finest scales that "
+                "the fit implies (coarser keypoints count less, by their scale), corrected for the free "
+                "parameters; the standard deviations are scaled by it.\n"
+              : "  Residual sigma: the noise of one pixel coordinate that the fit implies, sqrt(sum of squared "
+                "residuals / (2 x points - free parameters)); the standard deviations are scaled by it.\n");
 }
 
 // The two estimates behind a std dev, when there are two.
@@ -103,7 +120,7 @@ std::string Yaml(const CalibrationReport& r) {
     const Eigen::Vector4d q = QuaternionToWxyz(v.cam_from_target.rotation);
     out << "- image: '" << v.image_name << "'\n  rms: " << Num(v.rms_px) << "\n  points: " << v.num_points
         << "\n  outlier: " << (v.outlier ? "true" : "false") << "\n  dropped: " << (v.dropped ? "true" : "false")
-        << "\n  cam_from_target:\n    rotation_wxyz: " << List({q[0], q[1], q[2], q[3]})
+        << "\n  cam_from_" << r.pose_frame << ":\n    rotation_wxyz: " << List({q[0], q[1], q[2], q[3]})
         << "\n    translation: "
         << List({v.cam_from_target.translation.x(), v.cam_from_target.translation.y(),
                  v.cam_from_target.translation.z()})
@@ -146,6 +163,7 @@ std::string Text(const CalibrationReport& r) {
                         StdDevSourcesText(r.housing_std_dev_by_noise, r.housing_std_dev_by_clusters, i))
           << "\n";
     }
+    out << "  In words: " << r.housing->InWords() << ".\n";
   }
   if (r.board_warp) {
     out << std::setprecision(3) << "\nBoard warp (parabolic sag): x " << r.board_warp->x() * 1000 << " +- "
@@ -154,7 +172,8 @@ std::string Text(const CalibrationReport& r) {
   }
   for (const std::string& note : r.notes) out << "\nNote: " << note << "\n";
   out << std::setprecision(4) << "\nRMS reprojection error " << r.overall_rms_px << " px over "
-      << r.num_points << " points (residual sigma " << r.residual_sigma_px << " px)\n\n"
+      << r.num_points << " points (residual sigma " << r.residual_sigma_px << " px)\n"
+      << ErrorFiguresExplained(r.pose_frame == "world") << "\n"
       << "  view                                  rms (px)  points\n";
   for (const CalibratedView& v : r.views) {
     out << "  " << std::left << std::setw(36) << v.image_name << std::right << std::setw(10)
@@ -234,6 +253,32 @@ void WriteStereoCalibrationReport(const StereoCalibrationResult& r, const Housed
   WriteFileAtomically(dir / "calibration.txt", false, [&](std::ostream& out) { out << text_text; });
 }
 
+namespace {
+
+// The names of the parameters whose standard deviation is undetermined
+// (negative: the covariance is rank deficient there).
+std::vector<std::string> UndeterminedNames(const std::vector<double>& std_dev, const std::string& params_info) {
+  const std::vector<std::string> names = SplitTokens(params_info, ", ");
+  std::vector<std::string> undetermined;
+  for (size_t i = 0; i < std_dev.size() && i < names.size(); ++i) {
+    if (std_dev[i] < 0) undetermined.push_back(names[i]);
+  }
+  return undetermined;
+}
+
+// A warning, first in the report, where the views leave parameters
+// undetermined: the values may look fine (even a lower RMS) and mean
+// nothing.
+void WarnOfUndetermined(const std::vector<std::string>& names, const std::string& remedy, CalibrationReport* report) {
+  if (names.empty()) return;
+  std::string list;
+  for (const std::string& name : names) list += (list.empty() ? "" : ", ") + name;
+  report->warnings.push_back("the views do not determine " + list +
+                             " (no finite standard deviation): their values mean nothing; " + remedy);
+}
+
+}  // namespace
+
 CalibrationReport ReportOf(const CameraCalibrationResult& result, bool with_board_warp, const std::string& target) {
   CalibrationReport report;
   report.camera = result.camera;
@@ -247,6 +292,9 @@ CalibrationReport ReportOf(const CameraCalibrationResult& result, bool with_boar
     report.board_warp = result.board_warp;
     report.board_warp_std_dev = result.board_warp_std_dev;
   }
+  WarnOfUndetermined(UndeterminedNames(result.params_std_dev, result.camera.ParamsInfo()),
+                     "hold them (--Calibration.fixed_params) or add views with more tilt and nearer the corners",
+                     &report);
   return report;
 }
 
@@ -261,6 +309,14 @@ CalibrationReport ReportOf(const HousingCalibrationResult& result, const std::st
   report.num_points = result.num_points;
   report.views = result.views;
   report.target_description = target;
+  std::vector<std::string> undetermined = UndeterminedNames(result.camera_std_dev, result.camera.ParamsInfo());
+  for (const std::string& name : UndeterminedNames(result.housing_std_dev, result.housing.ParamsInfo())) {
+    undetermined.push_back(name);
+  }
+  WarnOfUndetermined(undetermined,
+                     "hold the in-air intrinsics (--Calibration.refine_intrinsics 0), or add views with more tilt "
+                     "and nearer the image corners",
+                     &report);
   return report;
 }
 
@@ -273,12 +329,36 @@ void WriteCalibrationReport(const CalibrationReport& report, const fs::path& dir
   WriteFileAtomically(dir / "calibration.txt", false, [&](std::ostream& out) { out << text; });
 }
 
+namespace {
+
+constexpr const char* kCalibrationFormats =
+    "portcal reads portcal's and calibmar's calibration.yaml (key 'model'), OpenCV's FileStorage YAML and ROS "
+    "camera_info YAML (key 'camera_matrix'), and mrcal's .cameramodel";
+
+// A camera from another tool's file: no standard deviations, views or
+// housing.
+CalibrationReport ReportOfCamera(const Camera& camera) {
+  CalibrationReport report;
+  report.camera = camera;
+  return report;
+}
+
+}  // namespace
+
 CalibrationReport ReadCalibrationReport(const fs::path& path) {
+  if (!fs::exists(path)) throw InputError(path.string() + ": no such file");
+  if (path.extension() == ".cameramodel") return ReportOfCamera(ReadMrcalCameraModel(path).camera);
+  if (IsOpenCvOrRosCameraYaml(path)) return ReportOfCamera(ReadOpenCvCameraYaml(path));
   YAML::Node root;
   try {
     root = YAML::LoadFile(path.string());
   } catch (const YAML::Exception& e) {
-    throw InputError(path.string() + ": " + e.what());
+    throw InputError(path.string() + ": " + e.what() + " (" + kCalibrationFormats + ")");
+  }
+  for (const char* key : {"model", "width", "height", "parameters"}) {
+    if (!root.IsMap() || !root[key]) {
+      throw InputError(path.string() + ": no key '" + key + "'; " + kCalibrationFormats);
+    }
   }
   CalibrationReport report;
   try {
@@ -290,6 +370,7 @@ CalibrationReport ReadCalibrationReport(const fs::path& path) {
       report.housing = Housing::FromName(root["non_svp_model"].as<std::string>(),
                                          root["non_svp_parameters"].as<std::vector<double>>(),
                                          path.string() + ": non_svp_parameters");
+      report.housing->ValidateInput(path.string() + ": non_svp_parameters");
     }
     // portcal's own keys (absent in calibmar's files).
     if (root["parameters_std_dev"]) {

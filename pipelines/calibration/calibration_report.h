@@ -31,6 +31,10 @@ struct CalibrationReport {
   double residual_sigma_px = 0;
   int num_points = 0;
   std::vector<CalibratedView> views;
+  // The frame the views' poses map from: "target" (a calibration target),
+  // "world" (a self-calibration's reconstruction); the per-view key is
+  // cam_from_<pose_frame>.
+  std::string pose_frame = "target";
   std::string target_description;  // e.g. "chessboard 10x7, square 0.02 m"
   std::optional<Eigen::Vector2d> board_warp, board_warp_std_dev;
   // Decisions a reader needs to weigh the numbers (e.g. a parameter held
@@ -60,7 +64,10 @@ void WriteStereoCalibrationReport(const StereoCalibrationResult& result, const H
 // Reads the camera (and housing) of a calibration.yaml written by portcal or
 // calibmar, and portcal's standard deviations, board warp, target, notes and per-view table
 // (names, RMS, outlier/dropped flags; poses are not read back) when present.
-// Throws InputError naming the file and key.
+// Also reads the camera alone from OpenCV's FileStorage YAML, ROS camera_info
+// YAML and mrcal's .cameramodel (the format told by the extension and the
+// keys). Throws InputError naming the file and the missing key, and the
+// formats it reads.
 CalibrationReport ReadCalibrationReport(const std::filesystem::path& path);
 
 }  // namespace portcal

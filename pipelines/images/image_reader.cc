@@ -61,10 +61,56 @@ Camera NewCamera(const ImageReaderOptions& options, int width, int height) {
 
 }  // namespace
 
+namespace {
+
+// How the existing image's camera differs from what the options would give
+// it in this import, or "" where it does not.
+std::string ImportDifference(const Camera& camera, const ImageReaderOptions& options, const std::string& folder,
+                             const SharedCameras& shared) {
+  if (camera.ModelName() != options.camera_model) {
+    return "its camera is " + camera.ModelName() + ", --ImageReader.camera_model asks for " + options.camera_model;
+  }
+  const bool sharing = options.single_camera || options.single_camera_per_folder;
+  const auto it = shared.by_folder.find(folder);
+  if (sharing && it != shared.by_folder.end() && it->second != camera.camera_id) {
+    return std::string("it has a camera of its own, --ImageReader.single_camera") +
+           (options.single_camera ? "" : "_per_folder") + " asks for one shared camera";
+  }
+  if (!sharing && shared.given.count(camera.camera_id)) {
+    return "it shares camera " + std::to_string(camera.camera_id) +
+           " with another image, the options ask for one camera per image (--ImageReader.single_camera 0)";
+  }
+  return "";
+}
+
+// The camera a new (or re-imported) image gets: its folder's shared one, or
+// a new one.
+camera_t CameraForImport(Database* database, const ImageReaderOptions& options, const std::string& name,
+                         const std::string& folder, int width, int height, SharedCameras* shared) {
+  const bool sharing = options.single_camera || options.single_camera_per_folder;
+  if (sharing && shared->by_folder.count(folder)) {
+    const camera_t camera_id = shared->by_folder.at(folder);
+    const std::optional<Camera> camera = database->ReadCamera(camera_id);
+    if (camera && (camera->width != static_cast<uint64_t>(width) ||
+                   camera->height != static_cast<uint64_t>(height))) {
+      throw InputError(name + ": " + std::to_string(width) + "x" + std::to_string(height) +
+                       " pixels, but it shares a " + std::to_string(camera->width) + "x" +
+                       std::to_string(camera->height) + " camera (--ImageReader.single_camera" +
+                       (options.single_camera ? "" : "_per_folder") + ")");
+    }
+    return camera_id;
+  }
+  const camera_t camera_id = database->WriteCamera(NewCamera(options, width, height));
+  if (sharing) shared->by_folder.emplace(folder, camera_id);
+  return camera_id;
+}
+
+}  // namespace
+
 image_t ImportImage(Database* database, const ImageReaderOptions& options,
                     const std::string& name, int width, int height, SharedCameras* shared) {
   const bool sharing = options.single_camera || options.single_camera_per_folder;
-  const std::string key =
+  const std::string folder =
       options.single_camera ? std::string() : fs::path(name).parent_path().generic_string();
   if (const std::optional<DatabaseImage> existing = database->ReadImageWithName(name)) {
     const std::optional<Camera> camera = database->ReadCamera(existing->camera_id);
@@ -74,27 +120,26 @@ image_t ImportImage(Database* database, const ImageReaderOptions& options,
                        " pixels, but its camera in the database is " +
                        std::to_string(camera->width) + "x" + std::to_string(camera->height));
     }
-    if (sharing) shared->emplace(key, existing->camera_id);
-    return existing->image_id;
-  }
-  camera_t camera_id = kInvalidCameraId;
-  if (sharing && shared->count(key)) {
-    camera_id = shared->at(key);
-    const std::optional<Camera> camera = database->ReadCamera(camera_id);
-    if (camera && (camera->width != static_cast<uint64_t>(width) ||
-                   camera->height != static_cast<uint64_t>(height))) {
-      throw InputError(name + ": " + std::to_string(width) + "x" + std::to_string(height) +
-                       " pixels, but it shares a " + std::to_string(camera->width) + "x" +
-                       std::to_string(camera->height) + " camera (--ImageReader.single_camera" +
-                       (options.single_camera ? "" : "_per_folder") + ")");
+    const std::string difference = camera ? ImportDifference(*camera, options, folder, *shared) : "";
+    if (difference.empty()) {
+      if (sharing) shared->by_folder.emplace(folder, existing->camera_id);
+      shared->given.insert(existing->camera_id);
+      return existing->image_id;
     }
-  } else {
-    camera_id = database->WriteCamera(NewCamera(options, width, height));
-    if (sharing) shared->emplace(key, camera_id);
+    if (!options.overwrite) {
+      throw InputError(name + ": imported before, and " + difference +
+                       "; rerun with --ImageReader.overwrite 1 to import its camera again, or use a new database");
+    }
+    const camera_t camera_id = CameraForImport(database, options, name, folder, width, height, shared);
+    database->UpdateImageCamera(existing->image_id, camera_id);
+    database->DeleteCameraIfUnused(existing->camera_id);
+    shared->given.insert(camera_id);
+    return existing->image_id;
   }
   DatabaseImage image;
   image.name = name;
-  image.camera_id = camera_id;
+  image.camera_id = CameraForImport(database, options, name, folder, width, height, shared);
+  shared->given.insert(image.camera_id);
   return database->WriteImage(image);
 }
 

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,12 @@ struct ImageReaderOptions {
   std::string camera_params;                   // "" = default from the image size
   // Default focal length = factor * max(width, height) (COLMAP's 1.2).
   double default_focal_length_factor = 1.2;
+  // A rerun meets images the database already holds: where their cameras
+  // differ from these options (model, one camera per image / folder / all),
+  // true imports the cameras again (the images keep their ids and data;
+  // cameras no image has any more are deleted), false is an error naming
+  // the difference.
+  bool overwrite = false;
   void Check() const;  // throws OptionError naming --ImageReader.*
 };
 
@@ -26,13 +33,18 @@ struct ImageReaderOptions {
 // sorted, as paths relative to `dir`. Throws InputError if there are none.
 std::vector<std::string> ListImages(const std::filesystem::path& dir);
 
-// Cameras shared between images of one import (single_camera, or per
-// folder).
-using SharedCameras = std::map<std::string, camera_t>;
+// The cameras of one import: shared between images (single_camera, or per
+// folder), and every camera an image was given.
+struct SharedCameras {
+  std::map<std::string, camera_t> by_folder;  // "" with single_camera
+  std::set<camera_t> given;
+};
 
 // Adds (or finds, on a rerun) the image and its camera. Call inside the
 // stage's transaction. Throws InputError naming the image when its size does
-// not match its shared or existing camera.
+// not match its shared or existing camera, and, without options.overwrite,
+// when the image is in the database with a camera other than the options
+// would give it (another model, or shared otherwise).
 image_t ImportImage(Database* database, const ImageReaderOptions& options,
                     const std::string& name, int width, int height, SharedCameras* shared);
 

@@ -17,7 +17,7 @@ namespace portcal {
 void AutoCalibratorOptions::Check() const {
   if (image_path.empty()) throw OptionError("--image_path", "''", "a directory of images");
   if (output_path.empty()) throw OptionError("--output_path", "''", "a directory for the results");
-  if (housing) housing->Validate("--Housing.params");
+  if (housing) housing->ValidateInput("--Housing.params");
   if (matcher == PairingMode::kSpatial) {
     throw OptionError("--AutoCalibration.matcher", "spatial", "exhaustive or sequential");
   }

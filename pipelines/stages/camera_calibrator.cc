@@ -20,7 +20,8 @@ void CameraCalibratorOptions::Check() const {
 
 CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& options, ProgressSink& progress) {
   options.Check();
-  Database database(options.database_path, Database::OpenMode::kReadOnly);
+  Database database(options.database_path,
+                    options.update_database ? Database::OpenMode::kReadWrite : Database::OpenMode::kReadOnly);
   const TargetViews target_views = ReadTargetViews(&database);
   const camera_t camera_id = ChooseCamera(target_views, options.camera_id, options.database_path);
   const std::vector<CalibrationView>& views = target_views.by_camera.at(camera_id);
@@ -33,8 +34,19 @@ CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& optio
             << views.size() << " views";
   const CameraCalibrationResult result = CalibrateCamera(views, camera, options.calibration);
 
-  WriteCalibrationReport(ReportOf(result, options.calibration.estimate_board_warp, target_views.target),
-                         options.output_path);
+  const CalibrationReport report = ReportOf(result, options.calibration.estimate_board_warp, target_views.target);
+  if (options.update_database) {
+    // Committed once the reports are written: a failure leaves both as they were.
+    Transaction transaction = database.BeginTransaction();
+    Camera calibrated = result.camera;
+    calibrated.camera_id = camera_id;
+    calibrated.has_prior_focal_length = true;
+    database.UpdateCamera(calibrated);
+    WriteCalibrationReport(report, options.output_path);
+    transaction.Commit();
+  } else {
+    WriteCalibrationReport(report, options.output_path);
+  }
   LOG(INFO) << "camera_calibrator: RMS " << result.overall_rms_px << " px over " << result.num_points
             << " points -> " << options.output_path;
   return result;

@@ -15,11 +15,16 @@ struct CameraCalibratorOptions {
   int camera_id = -1;        // -1: the only camera with observations
   std::string camera_model;  // "" = the database camera's model
   CameraCalibrationSettings calibration;
+  // Writes the calibrated intrinsics into the database camera (with a prior
+  // focal length), so that the next stage, portcal's or COLMAP's, starts
+  // from them.
+  bool update_database = false;
   void Check() const;  // throws OptionError naming the option
 };
 
 // Throws InputError / NumericalError / DatabaseError. Reads the database
-// only.
+// only, unless update_database (one transaction, committed after the
+// reports are written).
 // The stage's summary is the calibration itself.
 using CameraCalibratorSummary = CameraCalibrationResult;
 

@@ -1,6 +1,7 @@
 #include "pipelines/stages/feature_masker.h"
 
 #include <opencv2/imgcodecs.hpp>
+#include <map>
 #include <sstream>
 
 #include "colmap_ext/util/error.h"
@@ -69,18 +70,61 @@ void MaskImage(const FeatureMaskerOptions& options, const DatabaseImage& image,
   database->DeleteMatchesOfImage(image_id);
 }
 
+// "name=value" lines as a map.
+std::map<std::string, std::string> ParseLines(const std::string& text) {
+  std::map<std::string, std::string> values;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    const size_t eq = line.find('=');
+    if (eq != std::string::npos) values[line.substr(0, eq)] = line.substr(eq + 1);
+  }
+  return values;
+}
+
+// The mask the features carry, as "dictionary, enlargement factor": that
+// of the last feature_masker run since the last feature_extractor run that
+// extracted every image; "" for none.
+std::string MaskOfTheFeatures(Database* database) {
+  std::string mask;
+  for (const StageLogEntry& entry : database->ReadStageLog()) {
+    const std::map<std::string, std::string> counts = ParseLines(entry.counts);
+    if (entry.stage == "feature_extractor" && counts.count("extracted") && counts.count("images") &&
+        counts.at("extracted") == counts.at("images")) {
+      mask.clear();
+    }
+    if (entry.stage != "feature_masker") continue;
+    std::map<std::string, std::string> options = ParseLines(entry.options);
+    // Runs before the flag's rename logged Mask.dictionary.
+    const std::string dictionary =
+        options.count("Markers.dictionary") ? options["Markers.dictionary"] : options["Mask.dictionary"];
+    mask = dictionary + ", enlargement factor " + options["Mask.enlargement_factor"];
+  }
+  return mask;
+}
+
 }  // namespace
 
 FeatureMaskerSummary RunFeatureMasker(const FeatureMaskerOptions& options, ProgressSink& progress) {
   options.Check();
   std::ostringstream options_text;
-  options_text << "image_path=" << options.image_path << "\nMask.dictionary=" << options.dictionary
+  options_text << "image_path=" << options.image_path << "\nMarkers.dictionary=" << options.dictionary
                << "\nMask.enlargement_factor=" << options.enlargement_factor << "\n";
   StageRun run("feature_masker", options_text.str());
   Database database(options.database_path, Database::OpenMode::kReadWrite);
   Transaction transaction = database.BeginTransaction();
   const std::vector<DatabaseImage> images = database.ReadAllImages();
   if (images.empty()) throw InputError(options.database_path + ": no images; run feature_extractor first");
+  // Masking removes features: another mask over masked features cannot
+  // bring back what the first removed, and would keep only what both keep.
+  std::ostringstream asked;
+  asked << options.dictionary << ", enlargement factor " << options.enlargement_factor;
+  const std::string mask = MaskOfTheFeatures(&database);
+  if (!mask.empty() && mask != asked.str()) {
+    throw InputError(options.database_path + ": its features were masked before (" + mask +
+                     "); a mask cannot bring back what an earlier one removed, so " + asked.str() +
+                     " was not applied: extract the features again (feature_extractor --overwrite 1, or a new "
+                     "database or output folder), then mask");
+  }
 
   std::vector<std::vector<MarkerDetection>> detections(images.size());
   FeatureMaskerSummary summary;
@@ -106,8 +150,7 @@ FeatureMaskerSummary RunFeatureMasker(const FeatureMaskerOptions& options, Progr
     // Every feature would go: markers of another dictionary, most likely.
     throw InputError(options.database_path + ": no " + options.dictionary + " marker in any of the " +
                      std::to_string(summary.num_images) + " images under " + options.image_path +
-                     "; nothing was changed (markers of another dictionary? --Mask.dictionary, "
-                     "--Markers.dictionary in auto_calibrator)");
+                     "; nothing was changed (markers of another dictionary? --Markers.dictionary)");
   }
   run.Finish(&database, {{"images", summary.num_images},
                          {"without_markers", summary.num_without_markers},

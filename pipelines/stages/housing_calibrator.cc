@@ -17,7 +17,7 @@ void HousingCalibratorOptions::Check() const {
   }
   if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
   if (!housing) throw OptionError("--Housing.model", "''", "FLATPORT or DOMEPORT");
-  housing->Validate("--Housing.params");
+  housing->ValidateInput("--Housing.params");
   calibration.Check();
 }
 
@@ -25,7 +25,8 @@ HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& op
   options.Check();
   const Housing& housing = *options.housing;
   const CalibrationReport in_air = ReadCalibrationReport(options.input_calibration);
-  Database database(options.database_path, Database::OpenMode::kReadOnly);
+  Database database(options.database_path,
+                    options.update_database ? Database::OpenMode::kReadWrite : Database::OpenMode::kReadOnly);
   const TargetViews target_views = ReadTargetViews(&database);
   const camera_t camera_id = ChooseCamera(target_views, options.camera_id, options.database_path);
   const std::vector<CalibrationView>& views = target_views.by_camera.at(camera_id);
@@ -39,7 +40,20 @@ HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& op
             << " from " << options.input_calibration << ", " << views.size() << " views";
   const HousingCalibrationResult result = CalibrateHousing(views, in_air.camera, housing, options.calibration);
 
-  WriteCalibrationReport(ReportOf(result, target_views.target), options.output_path);
+  const CalibrationReport report = ReportOf(result, target_views.target);
+  if (options.update_database) {
+    // Committed once the reports are written: a failure leaves both as they were.
+    Transaction transaction = database.BeginTransaction();
+    Camera calibrated = result.camera;
+    calibrated.camera_id = camera_id;
+    calibrated.has_prior_focal_length = true;
+    database.UpdateCamera(calibrated);
+    database.WriteHousing(camera_id, result.housing);
+    WriteCalibrationReport(report, options.output_path);
+    transaction.Commit();
+  } else {
+    WriteCalibrationReport(report, options.output_path);
+  }
   LOG(INFO) << "housing_calibrator: RMS " << result.overall_rms_px << " px -> " << options.output_path;
   return result;
 }

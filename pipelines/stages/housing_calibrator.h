@@ -19,6 +19,9 @@ struct HousingCalibratorOptions {
   std::optional<Housing> housing;  // required: the constants and a guess
   int camera_id = -1;
   HousingCalibrationSettings calibration;
+  // Writes the housing (portcal_housings) and the intrinsics into the
+  // database camera, so that the next stage starts from them.
+  bool update_database = false;
   void Check() const;  // throws OptionError naming the option
 };
 

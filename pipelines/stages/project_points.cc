@@ -12,6 +12,7 @@
 #include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/string_utils.h"
+#include "pipelines/calibration/calibration_report.h"
 
 namespace portcal {
 
@@ -19,39 +20,62 @@ void ProjectPointsOptions::Check() const {
   if (points_path.empty()) {
     throw OptionError("--points_path", "''", "a text file of points or pixels");
   }
-  if (!input_path.empty()) {
-    if (camera_id < 0) {
-      throw OptionError("--camera_id", std::to_string(camera_id),
-                        "the id of a camera of --input_path");
+  const int num_sources = !input_path.empty() + !input_calibration.empty() + !camera_model.empty();
+  if (num_sources != 1) {
+    throw InputError(std::string(num_sources == 0 ? "no camera given" : "more than one camera given") +
+                     ": give one of --input_path (a sparse model), --input_calibration (a calibration file) or "
+                     "--Camera.model with --Camera.params, --Camera.width and --Camera.height");
+  }
+  if (!input_path.empty() && housing) {
+    throw OptionError("--Housing.model", housing->ModelName(), "not with --input_path (its housings.txt says)");
+  }
+  if (housing) housing->ValidateInput("--Housing.params");
+  if (!camera_model.empty()) {
+    if (!ExistsCameraModelWithName(camera_model)) {
+      throw OptionError("--Camera.model", "'" + camera_model + "'", "one of " + CameraModelNames());
     }
-    return;
+    if (width <= 0) throw OptionError("--Camera.width", std::to_string(width), "> 0");
+    if (height <= 0) throw OptionError("--Camera.height", std::to_string(height), "> 0");
   }
-  if (!ExistsCameraModelWithName(camera_model)) {
-    throw OptionError("--Camera.model", "'" + camera_model + "'",
-                      "one of " + CameraModelNames() + " (or give --input_path)");
-  }
-  if (width <= 0) throw OptionError("--Camera.width", std::to_string(width), "> 0");
-  if (height <= 0) throw OptionError("--Camera.height", std::to_string(height), "> 0");
-  if (housing) housing->Validate("--Housing.params");
 }
 
 namespace {
 
-HousedCamera LoadCamera(const ProjectPointsOptions& options) {
-  HousedCamera housed;
-  Camera& camera = housed.camera;
-  if (!options.input_path.empty()) {
-    const SparseModel model = ReadSparseModel(options.input_path);
-    const auto it = model.cameras.find(static_cast<camera_t>(options.camera_id));
-    if (it == model.cameras.end()) {
-      throw InputError(options.input_path + ": no camera with id " +
-                       std::to_string(options.camera_id));
+// The camera `camera_id` of the model (-1: its only camera), with its housing.
+HousedCamera CameraOfModel(const std::string& input_path, int camera_id) {
+  const SparseModel model = ReadSparseModel(input_path);
+  camera_t id = static_cast<camera_t>(camera_id);
+  if (camera_id < 0) {
+    if (model.cameras.size() != 1) {
+      std::string ids;
+      for (const auto& [each, camera] : model.cameras) ids += (ids.empty() ? "" : ", ") + std::to_string(each);
+      throw OptionError("--camera_id", "-1 (the only camera)",
+                        "the id of one of the " + std::to_string(model.cameras.size()) + " cameras of " +
+                            input_path + " (" + ids + ")");
     }
-    camera = it->second;
-    const auto housing_it = model.housings.find(camera.camera_id);
-    if (housing_it != model.housings.end()) housed.housing = housing_it->second;
+    id = model.cameras.begin()->first;
+  }
+  const auto it = model.cameras.find(id);
+  if (it == model.cameras.end()) {
+    throw InputError(input_path + ": no camera with id " + std::to_string(camera_id));
+  }
+  HousedCamera housed;
+  housed.camera = it->second;
+  const auto housing_it = model.housings.find(id);
+  if (housing_it != model.housings.end()) housed.housing = housing_it->second;
+  return housed;
+}
+
+HousedCamera LoadCamera(const ProjectPointsOptions& options) {
+  if (!options.input_path.empty()) return CameraOfModel(options.input_path, options.camera_id);
+  HousedCamera housed;
+  if (!options.input_calibration.empty()) {
+    const CalibrationReport report = ReadCalibrationReport(options.input_calibration);
+    housed.camera = report.camera;
+    housed.housing = options.housing ? options.housing : report.housing;
     return housed;
   }
+  Camera& camera = housed.camera;
   camera.model_id = CameraModelNameToId(options.camera_model);
   camera.width = options.width;
   camera.height = options.height;

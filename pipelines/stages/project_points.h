@@ -13,10 +13,14 @@
 namespace portcal {
 
 struct ProjectPointsOptions {
-  // The camera: either from a sparse model (input_path + camera_id, with its
-  // housings.txt) or from the Camera.* / Housing.* options.
+  // The camera, from one of: a sparse model (input_path + camera_id, with
+  // its housings.txt; camera_id -1: the model's only camera), a calibration
+  // file (input_calibration: any format ReadCalibrationReport reads, with its
+  // housing), or the Camera.* options. Housing.* adds a housing to the
+  // Camera.* options or replaces the calibration file's.
   std::string input_path;
   int camera_id = -1;
+  std::string input_calibration;
   std::string camera_model;   // COLMAP name, e.g. RADIAL
   std::string camera_params;  // comma/space separated, COLMAP order
   int width = 0;              // pixels, > 0

@@ -317,6 +317,7 @@ void FillReport(const RefractiveBundleAdjusterOptions& options, const Reconstruc
     }
   }
   report.residual_sigma_px = std_devs.sigma0;
+  report.pose_frame = "world";  // the reconstruction's frame: there is no target
   report.target_description =
       options.marker_scale.side_length_m > 0
           ? "auto-calibration (SIFT points, ArUco markers of side " +

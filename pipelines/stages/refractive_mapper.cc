@@ -15,7 +15,7 @@ void RefractiveMapperOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (output_path.empty()) throw OptionError("--output_path", "''", "a directory for the models");
   radial_start.Check();
-  if (housing) housing->Validate("--Housing.params");
+  if (housing) housing->ValidateInput("--Housing.params");
   mapper.Check();
 }
 

@@ -10,10 +10,10 @@ namespace portcal {
 void DatasetConfig::Check() const {
   if (num_images < 1) throw OptionError("num_images", std::to_string(num_images), ">= 1");
   camera.Validate("camera");
-  if (housing) housing->Validate("housing");
+  if (housing) housing->ValidateInput("housing");
   if (stereo) {
     camera2.Validate("stereo.camera2");
-    if (housing2) housing2->Validate("stereo.housing2");
+    if (housing2) housing2->ValidateInput("stereo.housing2");
   }
   if (survey) {
     survey_options.Check();

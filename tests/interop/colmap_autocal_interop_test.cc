@@ -118,10 +118,10 @@ TEST(AutoCalibrationStages, RerunSkipsAndFailedStageLeavesTheDatabaseAsItWas) {
   // Markers of another dictionary: no image has one, and masking would
   // remove every feature; an error instead, the database as it was.
   result = RunCommand(Portcal() + " feature_masker --database_path " + db + " --image_path " + images +
-                      " --Mask.dictionary DICT_5X5_100");
+                      " --Markers.dictionary DICT_5X5_100");
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("no DICT_5X5_100 marker in any of the 3 images"), std::string::npos) << result.output;
-  EXPECT_NE(result.output.find("--Mask.dictionary"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("--Markers.dictionary"), std::string::npos) << result.output;
   EXPECT_EQ(testing::ReadFileToString(db), after_rerun);
   result = RunCommand(Portcal() + " refractive_mapper --database_path " + db + " --output_path " +
                       (dir / "sparse").string());

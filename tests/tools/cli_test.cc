@@ -8,7 +8,9 @@
 #include <utility>
 #include <vector>
 
+#include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/housing/housing.h"
+#include "colmap_ext/io/opencv_camera_file.h"
 #include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/string_utils.h"
 #include "tests/test_utils.h"
@@ -130,6 +132,48 @@ TEST(Cli, ErrorsNameTheFileAndLine) {
   EXPECT_EQ(std::count(result.output.begin(), result.output.end(), '\n'), 1) << result.output;
 }
 
+// The camera from a sparse model (its only one without --camera_id) or
+// from a calibration file of another tool; without any camera, or with a
+// model of several and no --camera_id, the error names the options.
+TEST(Cli, ProjectPointsTakesTheCameraFromAModelOrACalibrationFile) {
+  testing::TempDir dir;
+  std::ofstream(dir / "points.txt") << "0 0 2\n";
+  const std::string points = "project_points --log_level error --points_path " + (dir / "points.txt").string();
+  Camera camera;
+  camera.model_id = CameraModelNameToId("PINHOLE");
+  camera.width = 640;
+  camera.height = 480;
+  camera.params = {800, 800, 320.5, 240.5};
+  WriteRosCameraInfoYaml(camera, "test", dir / "ros.yaml");
+  auto result = RunCommand(Portcal(points + " --input_calibration " + (dir / "ros.yaml").string()));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(result.output, "320.5 240.5\n");
+
+  SparseModel model;
+  camera.camera_id = 3;
+  model.cameras[3] = camera;
+  fs::create_directories(dir / "one");
+  WriteSparseModel(model, dir / "one", ModelFormat::kText);
+  result = RunCommand(Portcal(points + " --input_path " + (dir / "one").string()));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(result.output, "320.5 240.5\n");
+
+  camera.camera_id = 4;
+  model.cameras[4] = camera;
+  fs::create_directories(dir / "two");
+  WriteSparseModel(model, dir / "two", ModelFormat::kText);
+  result = RunCommand(Portcal(points + " --input_path " + (dir / "two").string()));
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_NE(result.output.find("--camera_id"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("(3, 4)"), std::string::npos) << result.output;
+
+  result = RunCommand(Portcal(points));
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  for (const char* named : {"--input_path", "--input_calibration", "--Camera.model"}) {
+    EXPECT_NE(result.output.find(named), std::string::npos) << named << ": " << result.output;
+  }
+}
+
 TEST(Cli, ProjectPathReadsOptionsFromAnIniFile) {
   testing::TempDir dir;
   std::ofstream(dir / "points.txt") << "0 0 2\n";
@@ -242,6 +286,7 @@ TEST(Cli, TypedOptionsNameTheFlagAtFault) {
       {"--Housing.model CYLINDER --Housing.params 0,0,1,0.01,0.01,1,1.5,1.33", "CYLINDER"},
       {"--AutoCalibration.refine_intrinsics 2", "--AutoCalibration.refine_intrinsics"},
       {"--AutoCalibration.matcher spatial", "--AutoCalibration.matcher"},
+      {"--Housing.model DOMEPORT --Housing.params 0,0,0,43.552,3.75,1,1.495,1.333", "portcal takes metres"},
   };
   for (const auto& [flags, named] : cases) {
     const auto result = RunCommand(Portcal(base + flags));
@@ -287,6 +332,8 @@ TEST(Cli, SharedFlagGroupsReadTheSameInEveryCommand) {
       {"ImageReader.single_camera_per_folder", {"feature_extractor", "target_extractor"}},
       {"SiftMatching.max_ratio", {"exhaustive_matcher", "sequential_matcher", "spatial_matcher"}},
       {"TwoViewGeometry.max_error", {"exhaustive_matcher", "sequential_matcher", "spatial_matcher"}},
+      {"Markers.dictionary", {"feature_masker", "auto_calibrator"}},
+      {"Mask.enlargement_factor", {"feature_masker", "auto_calibrator"}},
   };
   for (const auto& [flag, commands] : groups) {
     const std::string first = flag_help(RunCommand(Portcal(commands.front() + " -h")).output, flag);
@@ -299,6 +346,45 @@ TEST(Cli, SharedFlagGroupsReadTheSameInEveryCommand) {
   const auto result = RunCommand(Portcal("auto_calibrator --image_path a --output_path b --Markers.side_sigma 0"));
   EXPECT_EQ(result.exit_code, 1) << result.output;
   EXPECT_NE(result.output.find("--Markers.side_sigma"), std::string::npos) << result.output;
+}
+
+// Boost guesses abbreviations by default: --Calibration.estimate would turn
+// the board warp on. Here an abbreviated or unknown option is an error that
+// names the options meant, and the database is not touched.
+TEST(Cli, AbbreviatedOrUnknownOptionsAreRefusedWithSuggestions) {
+  testing::TempDir dir;
+  const std::string calibrate =
+      "camera_calibrator --database_path " + (dir / "db.db").string() + " --output_path " + (dir / "out").string();
+  auto result = RunCommand(Portcal(calibrate + " --Calibration.estimate 1"));
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("did you mean --Calibration.estimate_board_warp"), std::string::npos)
+      << result.output;
+  EXPECT_FALSE(fs::exists(dir / "db.db"));
+  result = RunCommand(Portcal(calibrate + " --Calibration.estimate_bord_warp 1"));
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("--Calibration.estimate_board_warp"), std::string::npos) << result.output;
+  // The same option under the group of another command.
+  result = RunCommand(Portcal("feature_masker --database_path a --image_path b --Mask.dictionary DICT_4X4_50"));
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("did you mean --Markers.dictionary"), std::string::npos) << result.output;
+}
+
+// "portcal help CMD" is "portcal CMD -h"; "-h GROUP" shows that group only.
+TEST(Cli, HelpOfACommandAndOfOneGroup) {
+  const auto full = RunCommand(Portcal("camera_calibrator -h"));
+  ASSERT_EQ(full.exit_code, 0) << full.output;
+  const auto via_help = RunCommand(Portcal("help camera_calibrator"));
+  EXPECT_EQ(via_help.exit_code, 0) << via_help.output;
+  EXPECT_EQ(via_help.output, full.output);
+  const auto group = RunCommand(Portcal("camera_calibrator -h Calibration"));
+  EXPECT_EQ(group.exit_code, 0) << group.output;
+  EXPECT_NE(group.output.find("--Calibration.estimate_board_warp"), std::string::npos) << group.output;
+  EXPECT_EQ(group.output.find("--database_path"), std::string::npos) << group.output;
+  EXPECT_EQ(RunCommand(Portcal("help camera_calibrator Calibration")).output, group.output);
+  const auto no_group = RunCommand(Portcal("camera_calibrator -h Nonsense"));
+  EXPECT_EQ(no_group.exit_code, 2) << no_group.output;
+  EXPECT_NE(no_group.output.find("Calibration"), std::string::npos) << no_group.output;
+  EXPECT_EQ(RunCommand(Portcal("help no_such_command")).exit_code, 2);
 }
 
 TEST(Cli, PosePriorsNameWhatIsMissing) {

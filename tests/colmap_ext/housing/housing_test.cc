@@ -226,6 +226,54 @@ TEST(Housing, ImplausibleButValidHousingsSayWhy) {
   EXPECT_NE(why_dome->find("15.0 mm"), std::string::npos) << *why_dome;
 }
 
+// Lengths in millimetres where portcal takes metres: the real dome's radius
+// (43.552 mm) and thickness, a flat port 20 mm away; an error that names
+// the parameter and the unit, where the metric values pass.
+TEST(Housing, LengthsGivenInMillimetresAreNamed) {
+  const auto message = [](const Housing& housing) {
+    try {
+      housing.ValidateInput("--Housing.params");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const Housing dome{Housing::FromName("DOMEPORT", {0, 0, 0, 0.043552, 0.00375, 1, 1.495, 1.333}, "t")};
+  EXPECT_EQ(message(dome), "");
+  Housing dome_mm = dome;
+  dome_mm.params[3] = 43.552;
+  dome_mm.params[4] = 3.75;
+  EXPECT_NE(message(dome_mm).find("int_radius = 43.552 m: portcal takes metres (43.552 mm is 0.043552 m)"),
+            std::string::npos)
+      << message(dome_mm);
+  Housing centre_mm = dome;
+  centre_mm.params[2] = -7.3;  // outside the dome too: the units are named first
+  EXPECT_NE(message(centre_mm).find("Cz = -7.3 m: portcal takes metres"), std::string::npos) << message(centre_mm);
+  const Housing flat{Housing::FromName("FLATPORT", {0, 0, 1, 0.02, 0.014, 1, 1.473, 1.334}, "t")};
+  EXPECT_EQ(message(flat), "");
+  Housing flat_mm = flat;
+  flat_mm.params[3] = 20;
+  EXPECT_NE(message(flat_mm).find("int_dist = 20 m"), std::string::npos) << message(flat_mm);
+}
+
+// The report says where the port sits in the words of a housing drawing:
+// camera frame x right, y down, z forward.
+TEST(Housing, InWordsSaysWhereThePortSits) {
+  const double tilt = 5.0 * M_PI / 180.0;
+  const std::string flat =
+      Housing::FromName("FLATPORT", {-std::sin(tilt), 0, std::cos(tilt), 0.02, 0.014, 1, 1.473, 1.334}, "t")
+          .InWords();
+  EXPECT_NE(flat.find("tilted 5.00 deg from the optical axis (5.00 deg towards the image's left, 0.00 deg towards"),
+            std::string::npos)
+      << flat;
+  EXPECT_NE(flat.find("20.00 mm in front of"), std::string::npos) << flat;
+  const std::string dome =
+      Housing::FromName("DOMEPORT", {0.004, -0.002, 0.0073, 0.043552, 0.00375, 1, 1.495, 1.333}, "t").InWords();
+  EXPECT_NE(dome.find("4.00 mm right, 2.00 mm up and 7.30 mm ahead of the camera's projection centre"),
+            std::string::npos)
+      << dome;
+}
+
 TEST(Housing, AtBoundIsTheAdjustmentsFloorOrWall) {
   // A flat port at the 0.1 mm floor of its distance, a dome decentred to
   // 90 % of its radius: bounds, not estimates.

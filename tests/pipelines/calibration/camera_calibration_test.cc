@@ -143,13 +143,24 @@ TEST(CameraCalibration, StageWritesBothReports) {
   CameraCalibratorOptions options;
   options.database_path = (dir / "db.db").string();
   options.output_path = (dir / "out").string();
+  const std::string database_before = testing::ReadFileToString(dir / "db.db");
   RunCameraCalibrator(options, NoProgress());
+  EXPECT_EQ(testing::ReadFileToString(dir / "db.db"), database_before);  // read only
   const CalibrationReport report = ReadCalibrationReport(dir / "out/calibration.yaml");
   EXPECT_EQ(report.camera.ModelName(), "RADIAL");
   EXPECT_FALSE(report.housing.has_value());
   const std::string text = testing::ReadFileToString(dir / "out/calibration.txt");
   EXPECT_NE(text.find("RMS reprojection error"), std::string::npos);
   EXPECT_NE(text.find("img_025.png"), std::string::npos);
+  // --update_database: the next stage (portcal's or COLMAP's) starts from
+  // the calibration.
+  options.update_database = true;
+  const CameraCalibrationResult result = RunCameraCalibrator(options, NoProgress());
+  Database database(dir / "db.db", Database::OpenMode::kReadOnly);
+  const std::vector<Camera> cameras = database.ReadAllCameras();
+  ASSERT_EQ(cameras.size(), 1u);
+  EXPECT_EQ(cameras[0].params, result.camera.params);
+  EXPECT_TRUE(cameras[0].has_prior_focal_length);
 }
 
 TEST(CalibrationReport, NotesAndTargetSurviveQuotesThroughYaml) {

@@ -93,6 +93,16 @@ TEST(HousingCalibration, StageReadsTheInAirReportAndWritesTheHousing) {
   ASSERT_TRUE(report.housing.has_value());
   EXPECT_EQ(report.housing->ModelName(), "DOMEPORT");
   EXPECT_NEAR(report.housing->params[0], 0.01, 1e-4);
+  // --update_database: the housing and the intrinsics for the next stage.
+  options.update_database = true;
+  const HousingCalibrationResult result = RunHousingCalibrator(options, NoProgress());
+  {
+    Database database(dir / "db.db", Database::OpenMode::kReadOnly);
+    const std::map<camera_t, Housing> housings = database.ReadAllHousings();
+    ASSERT_EQ(housings.size(), 1u);
+    EXPECT_EQ(housings.begin()->second.params, result.housing.params);
+    EXPECT_EQ(database.ReadAllCameras().at(0).params, result.camera.params);
+  }
   options.housing.reset();
   EXPECT_THROW(RunHousingCalibrator(options, NoProgress()), OptionError);
 }

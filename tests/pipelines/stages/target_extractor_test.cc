@@ -108,6 +108,51 @@ poses: {distance: [0.4, 0.8], tilt_max_deg: 35}
   EXPECT_EQ(db.ReadStageLog().size(), 2u);
 }
 
+// A rerun with other reader options meets the cameras of the first run:
+// an error naming the difference and the way out, the database untouched;
+// with --ImageReader.overwrite the cameras are imported again and the old
+// ones are gone.
+TEST(TargetExtractor, ARerunWithOtherReaderOptionsSaysSoOrImportsTheCamerasAgain) {
+  testing::TempDir dir;
+  fs::create_directories(dir / "images");
+  for (const char* name : {"a.png", "b.png", "c.png"}) {
+    cv::imwrite((dir / "images" / name).string(), cv::Mat(120, 160, CV_8UC1, cv::Scalar(90)));
+  }
+  NullProgress progress;
+  TargetExtractorOptions first = Options(dir / "db.db", dir / "images");
+  first.reader.camera_model = "SIMPLE_RADIAL";
+  first.reader.single_camera = false;  // COLMAP's default: a camera per image
+  RunTargetExtractor(first, progress);
+  const std::string before = testing::ReadFileToString(dir / "db.db");
+
+  TargetExtractorOptions second = Options(dir / "db.db", dir / "images");
+  second.reader.camera_model = "OPENCV";
+  try {
+    RunTargetExtractor(second, progress);
+    FAIL() << "a rerun with other reader options went through";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("a.png"), std::string::npos) << what;
+    EXPECT_NE(what.find("SIMPLE_RADIAL"), std::string::npos) << what;
+    EXPECT_NE(what.find("--ImageReader.overwrite 1"), std::string::npos) << what;
+  }
+  EXPECT_EQ(testing::ReadFileToString(dir / "db.db"), before);
+  second.reader.camera_model = "SIMPLE_RADIAL";  // the model agrees, the sharing does not
+  EXPECT_THROW(RunTargetExtractor(second, progress), InputError);
+  EXPECT_EQ(testing::ReadFileToString(dir / "db.db"), before);
+
+  second.reader.camera_model = "OPENCV";
+  second.reader.overwrite = true;
+  RunTargetExtractor(second, progress);
+  Database db(dir / "db.db", Database::OpenMode::kReadOnly);
+  ASSERT_EQ(db.NumCameras(), 1);
+  EXPECT_EQ(db.ReadAllCameras().front().ModelName(), "OPENCV");
+  EXPECT_EQ(db.NumImages(), 3);
+  for (const DatabaseImage& image : db.ReadAllImages()) {
+    EXPECT_EQ(image.camera_id, db.ReadAllCameras().front().camera_id) << image.name;
+  }
+}
+
 TEST(TargetExtractor, AFailedRunLeavesTheDatabaseAsItWas) {
   testing::TempDir dir;
   fs::create_directories(dir / "images");

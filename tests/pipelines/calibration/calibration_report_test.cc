@@ -1,0 +1,146 @@
+// --input_calibration in the formats users already have: portcal's own
+// exports (OpenCV FileStorage YAML, ROS camera_info YAML, mrcal's
+// .cameramodel) read back project exactly like the camera written; the real
+// set's ROS file reads as its numbers say; a file of none of the formats is
+// an error that names the formats and the missing key.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/io/mrcal_model.h"
+#include "colmap_ext/io/opencv_camera_file.h"
+#include "colmap_ext/util/error.h"
+#include "pipelines/calibration/calibration_report.h"
+#include "tests/test_utils.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+namespace {
+
+Camera MakeCamera(const std::string& model, const std::vector<double>& params) {
+  Camera camera;
+  camera.model_id = CameraModelNameToId(model);
+  camera.width = 1440;
+  camera.height = 1080;
+  camera.params = params;
+  return camera;
+}
+
+// The largest distance between the two cameras' pixels of points spread
+// over the field of view.
+double MaxProjectionDifferencePx(const Camera& a, const Camera& b) {
+  double max_diff = 0;
+  for (double x = -0.35; x <= 0.35; x += 0.05) {
+    for (double y = -0.25; y <= 0.25; y += 0.05) {
+      const Eigen::Vector3d point(x, y, 1.0);
+      const auto pa = a.ImgFromCam(point);
+      const auto pb = b.ImgFromCam(point);
+      EXPECT_TRUE(pa && pb);
+      if (pa && pb) max_diff = std::max(max_diff, (*pa - *pb).norm());
+    }
+  }
+  return max_diff;
+}
+
+TEST(ReadCalibrationReport, ReadsOpenCvRosAndMrcalFilesAsTheCameraWritten) {
+  testing::TempDir dir;
+  const std::vector<Camera> cameras = {
+      MakeCamera("OPENCV", {2412.1, 2418.7, 752.3, 571.9, -0.37, 0.21, 0.0015, 0.0004}),
+      MakeCamera("FULL_OPENCV",
+                 {2412.1, 2418.7, 752.3, 571.9, -0.37, 0.21, 0.0015, 0.0004, -0.05, 0.01, 0.02, -0.03}),
+      MakeCamera("RADIAL", {2412.1, 752.3, 571.9, -0.37, 0.21}),
+      MakeCamera("PINHOLE", {2412.1, 2418.7, 752.3, 571.9}),
+      MakeCamera("OPENCV_FISHEYE", {700.2, 701.1, 719.4, 541.2, 0.06, -0.02, 0.004, -0.001}),
+  };
+  for (const Camera& camera : cameras) {
+    const std::string model = camera.ModelName();
+    std::vector<fs::path> files = {dir / (model + "_opencv.yaml"), dir / (model + "_ros.yaml")};
+    WriteOpenCvCameraYaml(camera, files[0]);
+    WriteRosCameraInfoYaml(camera, "test", files[1]);
+    if (model != "OPENCV_FISHEYE") {  // mrcal has no COLMAP-exact fisheye
+      files.push_back(dir / (model + ".cameramodel"));
+      WriteMrcalCameraModel(camera, Rigid3d(), files.back());
+    }
+    for (const fs::path& file : files) {
+      const CalibrationReport read = ReadCalibrationReport(file);
+      EXPECT_EQ(read.camera.width, camera.width) << file;
+      EXPECT_EQ(read.camera.height, camera.height) << file;
+      EXPECT_LT(MaxProjectionDifferencePx(read.camera, camera), 1e-9)
+          << file << " read as " << read.camera.ModelName();
+      EXPECT_FALSE(read.housing) << file;
+    }
+  }
+}
+
+TEST(ReadCalibrationReport, ReadsTheRealSetsRosCameraInfo) {
+  PORTCAL_REQUIRE_SHARED(shared);
+  const CalibrationReport read = ReadCalibrationReport(shared / "datasets/real-dome/air_ost.yaml");
+  // plumb_bob with k3 = 0: OPENCV, the principal point half a pixel on
+  // (COLMAP's convention).
+  ASSERT_EQ(read.camera.ModelName(), "OPENCV");
+  const std::vector<double> expected = {2424.65845, 2430.55993, 765.71063, 570.19265,
+                                        -0.370666,  0.205071,   0.001513,  0.000373};
+  ASSERT_EQ(read.camera.params.size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i) EXPECT_DOUBLE_EQ(read.camera.params[i], expected[i]) << i;
+  EXPECT_EQ(read.camera.width, 1440u);
+  EXPECT_EQ(read.camera.height, 1080u);
+}
+
+TEST(ReadCalibrationReport, AFileOfNoKnownFormatNamesTheFormatsAndTheKey) {
+  testing::TempDir dir;
+  const fs::path file = dir / "calib.yaml";
+  std::ofstream(file) << "fx: 2400\nfy: 2400\n";
+  try {
+    ReadCalibrationReport(file);
+    FAIL() << "read a file of no known format";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    for (const char* named : {"calib.yaml", "'model'", "camera_matrix", ".cameramodel", "calibmar"}) {
+      EXPECT_NE(what.find(named), std::string::npos) << named << " not in: " << what;
+    }
+  }
+  std::ofstream(dir / "ros.yaml") << "image_width: 640\nimage_height: 480\ncamera_matrix:\n  rows: 3\n";
+  try {
+    ReadCalibrationReport(dir / "ros.yaml");
+    FAIL() << "read a camera_matrix without data";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("camera_matrix"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(ReadCalibrationReport(dir / "missing.yaml"), InputError);
+}
+
+// A housing calibration whose views leave parameters undetermined (the
+// real dome with the intrinsics refined: cx 334 px off, Cz at -23 mm, a
+// lower RMS): a warning first in the report that names them and the fix.
+TEST(ReportOf, UndeterminedParametersAreAWarningThatNamesThem) {
+  HousingCalibrationResult result;
+  result.camera = MakeCamera("OPENCV", {2412.1, 2418.7, 1054.3, 571.9, -0.37, 0.21, 0.0015, 0.0004});
+  result.camera_std_dev = {2.1, 2.2, -1, 1.7, 0.001, 0.004, 0.0001, 0.0001};
+  result.housing = Housing::FromName("DOMEPORT", {0.001, -0.002, -0.023, 0.043552, 0.00375, 1, 1.495, 1.333}, "t");
+  result.housing_std_dev = {0.0001, 0.0001, -1, 0, 0, 0, 0, 0};
+  const CalibrationReport report = ReportOf(result, "chessboard");
+  ASSERT_EQ(report.warnings.size(), 1u);
+  const std::string& warning = report.warnings.front();
+  for (const char* named : {"cx, Cz", "--Calibration.refine_intrinsics 0"}) {
+    EXPECT_NE(warning.find(named), std::string::npos) << named << ": " << warning;
+  }
+  testing::TempDir dir;
+  WriteCalibrationReport(report, dir.path());
+  const std::string text = testing::ReadFileToString(dir / "calibration.txt");
+  EXPECT_NE(text.find("WARNING: the views do not determine cx, Cz"), std::string::npos) << text;
+  // A determined calibration: no warning, and the housing said in words.
+  result.camera_std_dev[2] = 1.9;
+  result.housing_std_dev[2] = 0.0002;
+  const CalibrationReport good = ReportOf(result, "chessboard");
+  EXPECT_TRUE(good.warnings.empty());
+  WriteCalibrationReport(good, dir / "good");
+  EXPECT_NE(testing::ReadFileToString(dir / "good/calibration.txt").find("23.00 mm behind the camera's projection"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace portcal
