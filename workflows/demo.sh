@@ -43,7 +43,7 @@ echo "== 2. In air: target_extractor, camera_calibrator (RADIAL)"
   --ImageReader.single_camera 1 --Target.cols 10 --Target.rows 7 --Target.square_size 0.02
 "$portcal" camera_calibrator --log_level warn --database_path "$work/air.db" \
   --output_path "$work/air_calibration"
-sed -n '/parameter/,/^RMS/p' "$work/air_calibration/calibration.txt"
+sed -n '/^  parameter /,/^RMS/p' "$work/air_calibration/calibration.txt"
 echo "-- truth: f 648.68, cx 480, cy 270, k1 -0.08, k2 0.01"
 
 echo

@@ -298,6 +298,41 @@ CalibrationReport ReportOf(const CameraCalibrationResult& result, bool with_boar
   return report;
 }
 
+std::string BoardWarpNote(const CameraCalibrationResult& warped, const CameraCalibrationResult& flat) {
+  // A sag beyond this many standard deviations is significant.
+  constexpr double kSignificantSigmas = 3.0;
+  const Eigen::Vector2d& w = warped.board_warp;
+  const Eigen::Vector2d& sd = warped.board_warp_std_dev;
+  const auto in_sigmas = [](double value, double sigma) { return sigma > 0 ? std::abs(value) / sigma : 0.0; };
+  const double z = std::max(in_sigmas(w.x(), sd.x()), in_sigmas(w.y(), sd.y()));
+  std::ostringstream note;
+  note << std::fixed << std::setprecision(3) << "board warp: sag x " << 1000 * w.x() << " +- " << 1000 * sd.x()
+       << " mm, y " << 1000 * w.y() << " +- " << 1000 * sd.y() << " mm, "
+       << (z > kSignificantSigmas ? "significant" : "not significant") << " (" << std::setprecision(1) << z
+       << " sigma); held flat, ";
+  // The focal length and principal point parameter that would move most,
+  // in units of its standard deviation here.
+  std::vector<int> indices = CameraModelFocalLengthIdxs(warped.camera.model_id);
+  for (int i : CameraModelPrincipalPointIdxs(warped.camera.model_id)) indices.push_back(i);
+  const std::vector<std::string> names = SplitTokens(warped.camera.ParamsInfo(), ", ");
+  int worst = -1;
+  double worst_z = -1;
+  for (int i : indices) {
+    const double sigma = i < static_cast<int>(warped.params_std_dev.size()) ? warped.params_std_dev[i] : 0;
+    const double shift_z = in_sigmas(flat.camera.params[i] - warped.camera.params[i], sigma);
+    if (shift_z > worst_z) {
+      worst_z = shift_z;
+      worst = i;
+    }
+  }
+  note << names[static_cast<size_t>(worst)] << " would be " << std::setprecision(1)
+       << flat.camera.params[static_cast<size_t>(worst)] << " px (" << std::showpos
+       << flat.camera.params[static_cast<size_t>(worst)] - warped.camera.params[static_cast<size_t>(worst)]
+       << std::noshowpos << " px, " << worst_z << " sigma), the RMS " << std::setprecision(3)
+       << flat.overall_rms_px << " px instead of " << warped.overall_rms_px << " px";
+  return note.str();
+}
+
 CalibrationReport ReportOf(const HousingCalibrationResult& result, const std::string& target) {
   CalibrationReport report;
   report.camera = result.camera;

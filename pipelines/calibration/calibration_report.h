@@ -50,6 +50,12 @@ struct CalibrationReport {
 CalibrationReport ReportOf(const CameraCalibrationResult& result, bool with_board_warp, const std::string& target);
 CalibrationReport ReportOf(const HousingCalibrationResult& result, const std::string& target);
 
+// What a fitted board warp means for the calibration: the sag, whether it
+// is significant against its standard deviation, and how far the focal
+// length and principal point would move held flat (`flat`: the same views
+// calibrated with the board held flat), in pixels and standard deviations.
+std::string BoardWarpNote(const CameraCalibrationResult& warped, const CameraCalibrationResult& flat);
+
 // Writes calibration.yaml and calibration.txt into `dir` (created),
 // atomically.
 void WriteCalibrationReport(const CalibrationReport& report, const std::filesystem::path& dir);

@@ -34,7 +34,12 @@ CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& optio
             << views.size() << " views";
   const CameraCalibrationResult result = CalibrateCamera(views, camera, options.calibration);
 
-  const CalibrationReport report = ReportOf(result, options.calibration.estimate_board_warp, target_views.target);
+  CalibrationReport report = ReportOf(result, options.calibration.estimate_board_warp, target_views.target);
+  if (options.calibration.estimate_board_warp) {
+    CameraCalibrationSettings flat = options.calibration;
+    flat.estimate_board_warp = false;
+    report.notes.push_back(BoardWarpNote(result, CalibrateCamera(views, camera, flat)));
+  }
   if (options.update_database) {
     // Committed once the reports are written: a failure leaves both as they were.
     Transaction transaction = database.BeginTransaction();

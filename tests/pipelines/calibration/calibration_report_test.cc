@@ -142,5 +142,31 @@ TEST(ReportOf, UndeterminedParametersAreAWarningThatNamesThem) {
             std::string::npos);
 }
 
+// The note a fitted board warp gets: the real in-air set's figures (sag
+// 0.28 mm; held flat, fx 21.4 px lower).
+TEST(BoardWarpNote, SaysTheSagItsSignificanceAndWhatFlatWouldChange) {
+  CameraCalibrationResult warped;
+  warped.camera = MakeCamera("OPENCV", {2433.4, 2437.1, 760.5, 557.5, -0.36, 0.18, 0.0013, 0.0015});
+  warped.params_std_dev = {2.6, 2.7, 3.6, 2.9, 0.004, 0.04, 0.0002, 0.0002};
+  warped.board_warp = Eigen::Vector2d(-0.084e-3, -0.278e-3);
+  warped.board_warp_std_dev = Eigen::Vector2d(0.012e-3, 0.010e-3);
+  warped.overall_rms_px = 0.188;
+  CameraCalibrationResult flat = warped;
+  flat.camera.params[0] = 2412.0;  // fx: -21.4 px, 8.2 sigma
+  flat.camera.params[2] = 731.9;   // cx: -28.6 px, 7.9 sigma
+  flat.overall_rms_px = 0.229;
+  const std::string note = BoardWarpNote(warped, flat);
+  for (const char* said : {"sag x -0.084 +- 0.012 mm, y -0.278 +- 0.010 mm", "significant (27.8 sigma)",
+                           "held flat, fx would be 2412.0 px (-21.4 px, 8.2 sigma)", "RMS 0.229 px instead of 0.188"}) {
+    EXPECT_NE(note.find(said), std::string::npos) << said << ": " << note;
+  }
+  warped.board_warp = Eigen::Vector2d(0.01e-3, -0.02e-3);
+  flat = warped;
+  flat.camera.params[3] += 0.5;
+  const std::string small = BoardWarpNote(warped, flat);
+  EXPECT_NE(small.find("not significant (2.0 sigma)"), std::string::npos) << small;
+  EXPECT_NE(small.find("cy would be"), std::string::npos) << small;
+}
+
 }  // namespace
 }  // namespace portcal

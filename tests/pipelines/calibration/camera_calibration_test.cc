@@ -152,6 +152,10 @@ TEST(CameraCalibration, StageWritesBothReports) {
   const std::string text = testing::ReadFileToString(dir / "out/calibration.txt");
   EXPECT_NE(text.find("RMS reprojection error"), std::string::npos);
   EXPECT_NE(text.find("img_025.png"), std::string::npos);
+  // The board's sag is fitted by default and said in a note.
+  ASSERT_TRUE(report.board_warp.has_value());
+  EXPECT_NE(text.find("Note: board warp: sag"), std::string::npos) << text;
+  EXPECT_NE(text.find("held flat"), std::string::npos) << text;
   // --update_database: the next stage (portcal's or COLMAP's) starts from
   // the calibration.
   options.update_database = true;

@@ -104,6 +104,7 @@ CrossCheckOptions CalibratedForCheck(const fs::path& dir, const std::vector<Cali
   calibrate.database_path = (dir / "db.db").string();
   calibrate.output_path = (dir / "cal").string();
   calibrate.calibration.drop_outlier_views = drop_outlier_views;
+  calibrate.calibration.estimate_board_warp = false;
   RunCameraCalibrator(calibrate, NoProgress());
   CrossCheckOptions options;
   options.database_path = calibrate.database_path;
@@ -308,6 +309,7 @@ CrossCheckResult CheckSharedSet(const fs::path& images, const std::string& model
   CameraCalibratorOptions calibrate;
   calibrate.database_path = extract.database_path;
   calibrate.output_path = (dir / "cal").string();
+  calibrate.calibration.estimate_board_warp = false;  // the flat board mrcal is to catch
   RunCameraCalibrator(calibrate, NoProgress());
   CrossCheckOptions options;
   options.database_path = extract.database_path;
