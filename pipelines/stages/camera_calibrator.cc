@@ -4,6 +4,7 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "database/database.h"
+#include "pipelines/calibration/calibration_output.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
 
@@ -40,18 +41,7 @@ CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& optio
     flat.estimate_board_warp = false;
     report.notes.push_back(BoardWarpNote(result, CalibrateCamera(views, camera, flat)));
   }
-  if (options.update_database) {
-    // Committed once the reports are written: a failure leaves both as they were.
-    Transaction transaction = database.BeginTransaction();
-    Camera calibrated = result.camera;
-    calibrated.camera_id = camera_id;
-    calibrated.has_prior_focal_length = true;
-    database.UpdateCamera(calibrated);
-    WriteCalibrationReport(report, options.output_path);
-    transaction.Commit();
-  } else {
-    WriteCalibrationReport(report, options.output_path);
-  }
+  WriteCalibrationOutput(report, options.output_path, options.update_database ? &database : nullptr, camera_id);
   LOG(INFO) << "camera_calibrator: RMS " << result.overall_rms_px << " px over " << result.num_points
             << " points -> " << options.output_path;
   return result;

@@ -5,6 +5,7 @@
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/string_utils.h"
 #include "database/database.h"
+#include "pipelines/calibration/calibration_output.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
 
@@ -41,19 +42,7 @@ HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& op
   const HousingCalibrationResult result = CalibrateHousing(views, in_air.camera, housing, options.calibration);
 
   const CalibrationReport report = ReportOf(result, target_views.target);
-  if (options.update_database) {
-    // Committed once the reports are written: a failure leaves both as they were.
-    Transaction transaction = database.BeginTransaction();
-    Camera calibrated = result.camera;
-    calibrated.camera_id = camera_id;
-    calibrated.has_prior_focal_length = true;
-    database.UpdateCamera(calibrated);
-    database.WriteHousing(camera_id, result.housing);
-    WriteCalibrationReport(report, options.output_path);
-    transaction.Commit();
-  } else {
-    WriteCalibrationReport(report, options.output_path);
-  }
+  WriteCalibrationOutput(report, options.output_path, options.update_database ? &database : nullptr, camera_id);
   LOG(INFO) << "housing_calibrator: RMS " << result.overall_rms_px << " px -> " << options.output_path;
   return result;
 }
