@@ -83,11 +83,29 @@ std::string ImportDifference(const Camera& camera, const ImageReaderOptions& opt
   return "";
 }
 
+// The camera an image the database already holds in `folder` (anywhere
+// with single_camera) has, where it is what the options ask for: a new
+// image of a rerun joins it.
+std::optional<camera_t> ExistingSharedCamera(Database* database, const ImageReaderOptions& options,
+                                             const std::string& folder) {
+  for (const DatabaseImage& image : database->ReadAllImages()) {
+    if (!options.single_camera && fs::path(image.name).parent_path().generic_string() != folder) continue;
+    const std::optional<Camera> camera = database->ReadCamera(image.camera_id);
+    if (camera && camera->ModelName() == options.camera_model) return image.camera_id;
+  }
+  return std::nullopt;
+}
+
 // The camera a new (or re-imported) image gets: its folder's shared one, or
 // a new one.
 camera_t CameraForImport(Database* database, const ImageReaderOptions& options, const std::string& name,
                          const std::string& folder, int width, int height, SharedCameras* shared) {
   const bool sharing = options.single_camera || options.single_camera_per_folder;
+  if (sharing && !shared->by_folder.count(folder) && !options.overwrite) {
+    if (const std::optional<camera_t> existing = ExistingSharedCamera(database, options, folder)) {
+      shared->by_folder.emplace(folder, *existing);
+    }
+  }
   if (sharing && shared->by_folder.count(folder)) {
     const camera_t camera_id = shared->by_folder.at(folder);
     const std::optional<Camera> camera = database->ReadCamera(camera_id);

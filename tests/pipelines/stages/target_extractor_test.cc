@@ -144,13 +144,23 @@ TEST(TargetExtractor, ARerunWithOtherReaderOptionsSaysSoOrImportsTheCamerasAgain
   second.reader.camera_model = "OPENCV";
   second.reader.overwrite = true;
   RunTargetExtractor(second, progress);
-  Database db(dir / "db.db", Database::OpenMode::kReadOnly);
-  ASSERT_EQ(db.NumCameras(), 1);
-  EXPECT_EQ(db.ReadAllCameras().front().ModelName(), "OPENCV");
-  EXPECT_EQ(db.NumImages(), 3);
-  for (const DatabaseImage& image : db.ReadAllImages()) {
-    EXPECT_EQ(image.camera_id, db.ReadAllCameras().front().camera_id) << image.name;
+  {
+    Database db(dir / "db.db", Database::OpenMode::kReadOnly);
+    ASSERT_EQ(db.NumCameras(), 1);
+    EXPECT_EQ(db.ReadAllCameras().front().ModelName(), "OPENCV");
+    EXPECT_EQ(db.NumImages(), 3);
+    for (const DatabaseImage& image : db.ReadAllImages()) {
+      EXPECT_EQ(image.camera_id, db.ReadAllCameras().front().camera_id) << image.name;
+    }
   }
+  // A new image, first in name order, joins the shared camera of the
+  // images already there: no second camera, no error.
+  cv::imwrite((dir / "images/0_first.png").string(), cv::Mat(120, 160, CV_8UC1, cv::Scalar(90)));
+  second.reader.overwrite = false;
+  RunTargetExtractor(second, progress);
+  Database db(dir / "db.db", Database::OpenMode::kReadOnly);
+  EXPECT_EQ(db.NumCameras(), 1);
+  EXPECT_EQ(db.NumImages(), 4);
 }
 
 TEST(TargetExtractor, AFailedRunLeavesTheDatabaseAsItWas) {
