@@ -96,7 +96,17 @@ void Database::CheckSchema() {
     Statement stmt(db_, path_,
                    "SELECT value FROM portcal_meta WHERE key='schema_version';");
     const std::string value = stmt.Step() ? stmt.ColumnText(0) : "";
-    if (value != std::to_string(kPortcalSchemaVersion)) {
+    if (value == "1" && sqlite3_db_readonly(db_, "main") != 1) {
+      // Version 2 added a table; the others are as they were.
+      Transaction transaction(db_, path_);
+      for (const std::string& sql : PortcalSchemaSql()) ExecuteSql(db_, path_, sql + ";");
+      Statement update(db_, path_, "UPDATE portcal_meta SET value=? WHERE key='schema_version';");
+      update.Bind(1, std::to_string(kPortcalSchemaVersion)).Execute();
+      transaction.Commit();
+      return;
+    }
+    // Version 1 read-only: its tables are a subset of version 2's.
+    if (value != std::to_string(kPortcalSchemaVersion) && value != "1") {
       throw DatabaseError(path_ + ": portcal tables of schema version '" + value +
                           "', this portcal reads version " +
                           std::to_string(kPortcalSchemaVersion));

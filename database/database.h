@@ -23,7 +23,7 @@ namespace portcal {
 class Database {
  public:
   static constexpr int kColmapSchemaVersion = 3800;
-  static constexpr int kPortcalSchemaVersion = 1;
+  static constexpr int kPortcalSchemaVersion = 2;
 
   enum class OpenMode {
     kReadOnly,   // must exist
@@ -112,6 +112,14 @@ class Database {
   void WriteMarkerDetections(image_t image_id,
                              const std::vector<MarkerDetection>& rows);
   std::vector<MarkerDetection> ReadMarkerDetections(image_t image_id);
+
+  // An image's features before feature_masker first masked them.
+  void WriteUnmaskedFeatures(image_t image_id, const FeatureKeypoints& keypoints,
+                             const FeatureDescriptors& descriptors);
+  // False (the outputs untouched) where the image has none.
+  bool ReadUnmaskedFeatures(image_t image_id, FeatureKeypoints* keypoints, FeatureDescriptors* descriptors);
+  void DeleteUnmaskedFeatures(image_t image_id);
+  int64_t NumImagesWithUnmaskedFeatures();
 
   // Appends a completed run (write it inside the stage's transaction, so a
   // failed stage leaves no log row either).

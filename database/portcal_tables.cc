@@ -199,4 +199,52 @@ std::vector<StageLogEntry> Database::ReadStageLog() {
   return entries;
 }
 
+void Database::WriteUnmaskedFeatures(image_t image_id, const FeatureKeypoints& keypoints,
+                                     const FeatureDescriptors& descriptors) {
+  static_assert(sizeof(FeatureKeypoint) == 6 * sizeof(float));
+  if (static_cast<size_t>(descriptors.rows()) != keypoints.size()) {
+    throw DatabaseError(path_ + ": image " + std::to_string(image_id) + ": " + std::to_string(keypoints.size()) +
+                        " keypoints but " + std::to_string(descriptors.rows()) + " descriptors");
+  }
+  Statement& stmt = Prepare("write_unmasked",
+                            "INSERT OR REPLACE INTO portcal_unmasked_features(image_id, rows, keypoints, "
+                            "descriptors) VALUES(?, ?, ?, ?);");
+  stmt.Bind(1, static_cast<int64_t>(image_id))
+      .Bind(2, static_cast<int64_t>(keypoints.size()))
+      .BindBlob(3, keypoints.data(), keypoints.size() * sizeof(FeatureKeypoint))
+      .BindBlob(4, descriptors.data(), descriptors.size());
+  stmt.Execute();
+}
+
+bool Database::ReadUnmaskedFeatures(image_t image_id, FeatureKeypoints* keypoints,
+                                    FeatureDescriptors* descriptors) {
+  Statement& stmt = Prepare("read_unmasked",
+                            "SELECT rows, keypoints, descriptors FROM portcal_unmasked_features WHERE image_id=?;");
+  stmt.Bind(1, static_cast<int64_t>(image_id));
+  if (!stmt.Step()) return false;
+  const int64_t rows = stmt.ColumnInt64(0);
+  const std::vector<uint8_t> keypoint_bytes = stmt.ColumnBlob(1);
+  const std::vector<uint8_t> descriptor_bytes = stmt.ColumnBlob(2);
+  if (rows < 0 || static_cast<int64_t>(keypoint_bytes.size()) != rows * static_cast<int64_t>(sizeof(FeatureKeypoint)) ||
+      static_cast<int64_t>(descriptor_bytes.size()) != rows * 128) {
+    throw DatabaseError(path_ + ": unmasked features of image " + std::to_string(image_id) +
+                        " have invalid blobs (" + std::to_string(rows) + " rows)");
+  }
+  keypoints->resize(static_cast<size_t>(rows));
+  if (rows > 0) std::memcpy(keypoints->data(), keypoint_bytes.data(), keypoint_bytes.size());
+  *descriptors = FeatureDescriptors(rows, 128);
+  if (rows > 0) std::memcpy(descriptors->data(), descriptor_bytes.data(), descriptor_bytes.size());
+  return true;
+}
+
+void Database::DeleteUnmaskedFeatures(image_t image_id) {
+  Prepare("delete_unmasked", "DELETE FROM portcal_unmasked_features WHERE image_id=?;")
+      .Bind(1, static_cast<int64_t>(image_id))
+      .Execute();
+}
+
+int64_t Database::NumImagesWithUnmaskedFeatures() {
+  return QueryInt("SELECT count(*) FROM portcal_unmasked_features;");
+}
+
 }  // namespace portcal

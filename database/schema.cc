@@ -72,6 +72,16 @@ const std::vector<std::string>& PortcalSchemaSql() {
   FOREIGN KEY(image_id) REFERENCES images(image_id) ON DELETE CASCADE))sql",
       R"sql(CREATE INDEX IF NOT EXISTS portcal_marker_detections_image
   ON portcal_marker_detections(image_id))sql",
+      // The features of an image as feature_extractor made them, kept by
+      // feature_masker before it first masks the image: keypoints (rows x 6
+      // float32, COLMAP's layout) and descriptors (rows x 128 uint8). Another
+      // mask starts from them. Deleted when the image is extracted again.
+      R"sql(CREATE TABLE IF NOT EXISTS portcal_unmasked_features (
+  image_id     INTEGER PRIMARY KEY NOT NULL,
+  rows         INTEGER NOT NULL,
+  keypoints    BLOB,
+  descriptors  BLOB,
+  FOREIGN KEY(image_id) REFERENCES images(image_id) ON DELETE CASCADE))sql",
       // Completed stage runs.
       R"sql(CREATE TABLE IF NOT EXISTS portcal_stage_log (
   run_id      INTEGER PRIMARY KEY AUTOINCREMENT NOT NULL,

@@ -86,6 +86,8 @@ int AutoCalibratorCommand(int argc, char** argv) {
   cli.Add("AutoCalibration.max_num_starts", &options.max_num_starts,
           "map and refine again from the next random seed while a start fails or warns, at most this often");
   cli.Add("random_seed", &options.random_seed, "seed of every random choice (>= 0): same images, same calibration");
+  cli.Add("update_database", &options.update_database,
+          "write the calibrated camera and housing into output/database.db, for the next stage (0 | 1)");
   cli.Add("num_threads", &options.num_threads, "threads");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;

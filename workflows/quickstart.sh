@@ -33,12 +33,14 @@ echo "== 3. Under water: the dome port, the in-air intrinsics held"
   --output_path water --Housing.model DOMEPORT --Housing.params 0,0,0,0.043552,0.00375,1.0,1.495,1.333
 sed -n '/^Housing/,/^RMS/p' water/calibration.txt
 
-echo "== 4. Hand-off: OpenCV, ROS and mrcal files of the in-air camera"
+echo "== 4. Hand-off: OpenCV and ROS files of the in-air camera; mrcal's uncertainty of its solve"
 "$portcal" model_converter --input_path air/calibration.yaml --output_path air/camera_opencv.yaml \
   --output_type OPENCV_YAML
 "$portcal" model_converter --input_path air/calibration.yaml --output_path air/camera_info.yaml \
   --output_type ROS_YAML
-"$portcal" model_converter --input_path air/calibration.yaml --output_path air/camera.cameramodel \
-  --output_type CAMERAMODEL
+if command -v mrcal-show-projection-uncertainty >/dev/null; then
+  mrcal-show-projection-uncertainty air/camera.cameramodel \
+    --hardcopy air/uncertainty.png --terminal 'pngcairo size 800,600'
+fi
 ls air
 echo "Results in $work"

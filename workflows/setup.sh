@@ -13,7 +13,7 @@ packages=(
   libboost-program-options-dev
   libmrcal-dev mrcal python3-mrcal
   libgtest-dev libbenchmark-dev
-  libopengv-dev libyaml-cpp-dev
+  libopengv-dev libyaml-cpp-dev libzip-dev
   colmap
 )
 

@@ -2,11 +2,13 @@
 
 #include <Eigen/Geometry>
 #include <cstdlib>
-#include <memory>
 #include <iomanip>
+#include <memory>
+#include <stdexcept>
 #include <ostream>
 
 #include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/io/npz_archive.h"
 #include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/error.h"
 
@@ -19,6 +21,48 @@ namespace {
 
 // mrcal pixel = COLMAP pixel - 0.5 (both axes).
 constexpr double kPixelShift = 0.5;
+
+// mrcal.optimize()'s keyword arguments for `solve`, as an .npz archive
+// (mrcal's own serialisation: None is stored as '').
+std::string OptimizationInputsArchive(const MrcalLens& lens, const Camera& camera, const MrcalBoardSolve& solve) {
+  const int64_t num_frames = static_cast<int64_t>(solve.frames_rt_toref.size());
+  if (static_cast<int64_t>(solve.observations.size()) != num_frames * solve.height_n * solve.width_n * 3) {
+    throw std::invalid_argument("MrcalBoardSolve: observations do not match the frames and the board");
+  }
+  NpzArchive npz;
+  npz.AddDoubles("intrinsics", {1, static_cast<int64_t>(lens.intrinsics.size())}, lens.intrinsics);
+  npz.AddDoubles("extrinsics_rt_fromref", {0, 6}, {});
+  std::vector<double> frames;
+  std::vector<int32_t> indices;
+  for (int64_t f = 0; f < num_frames; ++f) {
+    frames.insert(frames.end(), solve.frames_rt_toref[f].begin(), solve.frames_rt_toref[f].end());
+    indices.insert(indices.end(), {static_cast<int32_t>(f), 0, -1});
+  }
+  npz.AddDoubles("frames_rt_toref", {num_frames, 6}, frames);
+  npz.AddString("points", "");
+  npz.AddDoubles("observations_board", {num_frames, solve.height_n, solve.width_n, 3}, solve.observations);
+  npz.AddInt32s("indices_frame_camintrinsics_camextrinsics", {num_frames, 3}, indices);
+  npz.AddString("observations_point", "");
+  npz.AddString("indices_point_camintrinsics_camextrinsics", "");
+  npz.AddString("lensmodel", lens.lensmodel);
+  npz.AddInt32s("imagersizes", {1, 2}, {static_cast<int32_t>(camera.width), static_cast<int32_t>(camera.height)});
+  if (solve.warp_estimated) {
+    npz.AddDoubles("calobject_warp", {2}, {solve.calobject_warp.x(), solve.calobject_warp.y()});
+  } else {
+    npz.AddString("calobject_warp", "");
+  }
+  npz.AddBool("do_optimize_intrinsics_core", solve.intrinsics_core_estimated);
+  npz.AddBool("do_optimize_intrinsics_distortions", solve.intrinsics_distortions_estimated);
+  npz.AddBool("do_optimize_extrinsics", true);  // as mrcal-calibrate-cameras; no extrinsics here
+  npz.AddBool("do_optimize_frames", true);
+  npz.AddBool("do_optimize_calobject_warp", solve.warp_estimated);
+  npz.AddDouble("calibration_object_spacing", solve.spacing);
+  npz.AddBool("do_apply_outlier_rejection", false);
+  npz.AddBool("do_apply_regularization", false);
+  npz.AddBool("verbose", false);
+  if (!solve.image_paths.empty()) npz.AddStrings("imagepaths", solve.image_paths);
+  return npz.Bytes();
+}
 
 struct CameraModelDeleter {
   void operator()(mrcal_cameramodel_t* model) const { mrcal_free_cameramodel(&model); }
@@ -139,7 +183,7 @@ MrcalCameraModelFile ReadMrcalCameraModel(const std::filesystem::path& path) {
 }
 
 void WriteMrcalCameraModel(const Camera& camera, const Rigid3d& cam_from_ref,
-                           const std::filesystem::path& path) {
+                           const std::filesystem::path& path, const MrcalBoardSolve* solve) {
   // mrcal's own writer rounds to 6 decimals (distortion terms lose digits);
   // the format is a Python dict literal, written here at full precision and
   // read back by mrcal's parser in the tests.
@@ -161,7 +205,15 @@ void WriteMrcalCameraModel(const Camera& camera, const Rigid3d& cam_from_ref,
     out << ",\n  'imagersize': [ " << camera.width << ", " << camera.height << " ],\n"
         << "  'extrinsics': ";
     list(out, extrinsics);
-    out << "\n}\n";
+    out << ",\n";
+    if (solve) {
+      out << "  'icam_intrinsics': 0,\n"
+          << "  # mrcal.optimize()'s inputs at portcal's solution (an .npz archive in base 85,\n"
+          << "  # as mrcal stores them), for mrcal's uncertainty and diagnostic tools\n"
+          << "  'optimization_inputs': b'" << EncodeBase85(OptimizationInputsArchive(lens, camera, *solve))
+          << "',\n";
+    }
+    out << "}\n";
   });
 }
 

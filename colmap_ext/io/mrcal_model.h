@@ -8,6 +8,8 @@
 // parameters in the same order (fx, fy, cx, cy, k1, k2, p1, p2[, k3..k6]).
 #pragma once
 
+#include <Eigen/Core>
+#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -49,6 +51,28 @@ Camera CameraFromMrcalLens(const MrcalLens& lens, uint64_t width, uint64_t heigh
 // Per-parameter standard deviations and covariances carry over unchanged
 // (the pixel shift is a constant), in the order of the respective model.
 
+// What mrcal's uncertainty and diagnostic tools (mrcal-show-projection-
+// uncertainty, mrcal-show-residuals-board-observation, ...) re-evaluate: a
+// single camera's board solve, as mrcal.optimize() takes it. The lens is
+// the camera's own (intrinsics, lensmodel, imagersizes are filled from it);
+// the camera is the reference frame.
+struct MrcalBoardSolve {
+  int width_n = 0;  // corners per row and column, `spacing` apart
+  int height_n = 0;
+  double spacing = 0;  // metres
+  // Per board observation: rt_ref_board (Rodrigues, translation; the board
+  // frame at corner (0, 0)) and the (height_n, width_n) corners as (x, y,
+  // weight) in mrcal's pixels (top-left pixel's centre at (0, 0)), weight < 0
+  // for a corner that was not used.
+  std::vector<std::array<double, 6>> frames_rt_toref;
+  std::vector<double> observations;
+  std::vector<std::string> image_paths;
+  Eigen::Vector2d calobject_warp = Eigen::Vector2d::Zero();  // metres
+  bool warp_estimated = false;
+  bool intrinsics_core_estimated = true;         // fx, fy, cx, cy
+  bool intrinsics_distortions_estimated = true;  // the rest
+};
+
 struct MrcalCameraModelFile {
   Camera camera;
   Rigid3d cam_from_ref;  // mrcal's "extrinsics" (rt_cam_ref)
@@ -56,8 +80,10 @@ struct MrcalCameraModelFile {
 
 // Reads a .cameramodel with mrcal's parser. Throws InputError naming the file.
 MrcalCameraModelFile ReadMrcalCameraModel(const std::filesystem::path& path);
-// Writes at full precision (mrcal's writer keeps 6 decimals), atomically.
+// Writes at full precision (mrcal's writer keeps 6 decimals), atomically;
+// with `solve`, also its optimization_inputs (regularisation and outlier
+// rejection off: portcal's solution has neither) and icam_intrinsics 0.
 void WriteMrcalCameraModel(const Camera& camera, const Rigid3d& cam_from_ref,
-                           const std::filesystem::path& path);
+                           const std::filesystem::path& path, const MrcalBoardSolve* solve = nullptr);
 
 }  // namespace portcal

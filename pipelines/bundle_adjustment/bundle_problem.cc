@@ -181,7 +181,7 @@ void BundleProblem::AddObservation(image_t image_id, const Eigen::Vector2d& pixe
 // localisation error grows with the feature's scale, and behind a port it
 // is also biased, because refraction distorts a coarse blob unevenly.
 // Sigma grows with the square of the scale above 2 px, which measured best
-// (docs/auto_calibration.md).
+// (docs/dev/auto_calibration_notes.md).
 double BundleProblem::SigmaOf(const TrackElement& e) const {
   const SfmImage& image = reconstruction_->inputs().images.at(e.image_id);
   if (!options_.scale_weighting || image.scales.empty()) return options_.sigma_px;

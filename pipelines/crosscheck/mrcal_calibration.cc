@@ -30,17 +30,6 @@ int GridIndex(double value, double spacing, const std::string& image) {
   return static_cast<int>(std::lround(index));
 }
 
-mrcal_pose_t PoseFromRigid(const Rigid3d& b_from_a) {
-  const Eigen::AngleAxisd aa(b_from_a.rotation.normalized());
-  const Eigen::Vector3d r = aa.angle() * aa.axis();
-  mrcal_pose_t pose;
-  for (int i = 0; i < 3; ++i) {
-    pose.r.xyz[i] = r[i];
-    pose.t.xyz[i] = b_from_a.translation[i];
-  }
-  return pose;
-}
-
 }  // namespace
 
 BoardGrid InferBoardGrid(const std::vector<CalibrationView>& views) {
@@ -72,6 +61,43 @@ BoardGrid InferBoardGrid(const std::vector<CalibrationView>& views) {
   return grid;
 }
 
+MrcalBoardSolve MrcalBoardSolveOf(const std::vector<CalibrationView>& views,
+                                  const std::vector<Rigid3d>& cam_from_target, const BoardGrid& grid,
+                                  std::vector<std::vector<int>>* pool_to_point) {
+  PORTCAL_CHECK(views.size() == cam_from_target.size());
+  const int per_board = grid.width_n * grid.height_n;
+  MrcalBoardSolve solve;
+  solve.width_n = grid.width_n;
+  solve.height_n = grid.height_n;
+  solve.spacing = grid.spacing;
+  solve.observations.assign(views.size() * per_board * 3, 0.0);
+  if (pool_to_point) pool_to_point->assign(views.size(), std::vector<int>(per_board, -1));
+  // mrcal's board frame starts at the first corner.
+  const Rigid3d target_from_board(Eigen::Quaterniond::Identity(), Eigen::Vector3d(grid.origin.x(), grid.origin.y(), 0));
+  for (size_t f = 0; f < views.size(); ++f) {
+    const CalibrationView& view = views[f];
+    double* block = &solve.observations[f * per_board * 3];
+    for (int k = 0; k < per_board; ++k) block[3 * k + 2] = -1;
+    for (size_t i = 0; i < view.pixels.size(); ++i) {
+      const Eigen::Vector3d& p = view.points_in_target[i];
+      const int col = GridIndex(p.x() - grid.origin.x(), grid.spacing, view.image_name);
+      const int row = GridIndex(p.y() - grid.origin.y(), grid.spacing, view.image_name);
+      const int k = row * grid.width_n + col;
+      // mrcal's pixels: the top-left pixel's centre at (0, 0).
+      block[3 * k] = view.pixels[i].x() - 0.5;
+      block[3 * k + 1] = view.pixels[i].y() - 0.5;
+      block[3 * k + 2] = 1.0;
+      if (pool_to_point) (*pool_to_point)[f][k] = static_cast<int>(i);
+    }
+    const Rigid3d cam_from_board = cam_from_target[f] * target_from_board;
+    const Eigen::AngleAxisd aa(cam_from_board.rotation.normalized());
+    const Eigen::Vector3d r = aa.angle() * aa.axis();
+    solve.frames_rt_toref.push_back(
+        {r[0], r[1], r[2], cam_from_board.translation[0], cam_from_board.translation[1], cam_from_board.translation[2]});
+  }
+  return solve;
+}
+
 namespace {
 
 // mrcal's problem for one camera and its board views, and what maps it
@@ -94,41 +120,33 @@ struct MrcalProblem {
   int num_points = 0;
 };
 
-// Observations: one board observation per view, a dense (H, W) block of
-// the pool each; corners the detector did not report are marked as
-// outliers (weight < 0), which mrcal respects.
+// One board observation per view, a dense (H, W) block of the pool each;
+// corners the detector did not report are marked as outliers (weight < 0),
+// which mrcal respects.
 void AddBoardObservations(const std::vector<CalibrationView>& views, const std::vector<Rigid3d>& seed_cam_from_target,
                           MrcalProblem* problem) {
-  const BoardGrid& grid = problem->grid;
+  const MrcalBoardSolve solve = MrcalBoardSolveOf(views, seed_cam_from_target, problem->grid, &problem->pool_to_point);
   const int num_frames = problem->num_frames;
-  const int per_board = problem->per_board;
-  problem->pool.assign(static_cast<size_t>(num_frames) * per_board, mrcal_point3_t{});
-  problem->pool_to_point.assign(num_frames, std::vector<int>(per_board, -1));
+  problem->pool.resize(static_cast<size_t>(num_frames) * problem->per_board);
+  for (size_t k = 0; k < problem->pool.size(); ++k) {
+    problem->pool[k] = {{solve.observations[3 * k], solve.observations[3 * k + 1], solve.observations[3 * k + 2]}};
+  }
   problem->observations.resize(num_frames);
   problem->frames.resize(num_frames);
   for (int f = 0; f < num_frames; ++f) {
-    const CalibrationView& view = views[f];
     problem->observations[f].icam.intrinsics = 0;
     problem->observations[f].icam.extrinsics = -1;  // the camera is the reference
     problem->observations[f].iframe = f;
-    for (int k = 0; k < per_board; ++k) problem->pool[f * per_board + k] = {{0, 0, -1}};
-    for (size_t i = 0; i < view.pixels.size(); ++i) {
-      const Eigen::Vector3d& p = view.points_in_target[i];
-      const int col = GridIndex(p.x() - grid.origin.x(), grid.spacing, view.image_name);
-      const int row = GridIndex(p.y() - grid.origin.y(), grid.spacing, view.image_name);
-      const int k = row * grid.width_n + col;
-      // mrcal's pixels: the top-left pixel's centre at (0, 0).
-      problem->pool[f * per_board + k] = {{view.pixels[i].x() - 0.5, view.pixels[i].y() - 0.5, 1.0}};
-      problem->pool_to_point[f][k] = static_cast<int>(i);
-      ++problem->num_points;
+    for (int i = 0; i < 3; ++i) {
+      problem->frames[f].r.xyz[i] = solve.frames_rt_toref[f][i];
+      problem->frames[f].t.xyz[i] = solve.frames_rt_toref[f][3 + i];
     }
-    // mrcal's board frame starts at the first corner.
-    const Rigid3d target_from_board(Eigen::Quaterniond::Identity(),
-                                    Eigen::Vector3d(grid.origin.x(), grid.origin.y(), 0));
-    problem->frames[f] = PoseFromRigid(seed_cam_from_target[f] * target_from_board);
   }
   problem->missing.resize(problem->pool.size());
-  for (size_t k = 0; k < problem->pool.size(); ++k) problem->missing[k] = problem->pool[k].z < 0;
+  for (size_t k = 0; k < problem->pool.size(); ++k) {
+    problem->missing[k] = problem->pool[k].z < 0;
+    if (!problem->missing[k]) ++problem->num_points;
+  }
 }
 
 // J^T J of mrcal's (packed, unitless) state at the solution, J including

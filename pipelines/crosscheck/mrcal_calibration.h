@@ -17,6 +17,7 @@
 
 #include "colmap_ext/camera/camera.h"
 #include "colmap_ext/geometry/rigid3d.h"
+#include "colmap_ext/io/mrcal_model.h"
 #include "pipelines/calibration/camera_calibration.h"
 
 namespace portcal {
@@ -41,6 +42,16 @@ struct BoardGrid {
 // Infers the grid from the views' target points. Throws InputError when the
 // points are not on one planar square grid (mrcal takes chessboards only).
 BoardGrid InferBoardGrid(const std::vector<CalibrationView>& views);
+
+// The views as mrcal's board observations, one frame each: the frame at
+// cam_from_target[v] moved to the grid's first corner, the corners in
+// mrcal's pixels with weight 1, the grid's other corners weight -1 (mrcal's
+// "not used"). With `pool_to_point`, for each frame and grid corner the
+// index of the view's point, -1 where the view has none. Throws InputError
+// for a point off the grid.
+MrcalBoardSolve MrcalBoardSolveOf(const std::vector<CalibrationView>& views,
+                                  const std::vector<Rigid3d>& cam_from_target, const BoardGrid& grid,
+                                  std::vector<std::vector<int>>* pool_to_point = nullptr);
 
 struct MrcalCalibrationResult {
   std::string lensmodel;  // e.g. LENSMODEL_OPENCV4

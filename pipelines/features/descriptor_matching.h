@@ -11,7 +11,7 @@
 // features per image the trees gain little (measured on two survey images:
 // 0.16 s at 32 checks, 99 % of the matches, against 0.24 s brute force
 // before its AVX2 kernel, ~0.05 s since; slower from 64 checks on), so
-// brute force is the default (docs/auto_calibration.md).
+// brute force is the default (docs/dev/auto_calibration_notes.md).
 #pragma once
 
 #include <string>

@@ -46,7 +46,7 @@ void StartRadialFromMatches(const SfmInputs& inputs, std::optional<bool> mode, b
     // A fisheye model at k = 0 is the equidistant projection, near what
     // fisheye lenses are built to, where k = 0 of a pinhole model is far
     // from a wide angle's; and for a fisheye a focal length error is not
-    // projective, so the search takes it up (docs/auto_calibration.md).
+    // projective, so the search takes it up (docs/dev/auto_calibration_notes.md).
     const bool fisheye = CameraModelIsFisheye(camera.camera.model_id);
     if (!mode && (camera.camera.has_prior_focal_length || !undistorted || fisheye)) continue;
     const auto start = EstimateFirstRadialTerm(inputs, camera_id, camera, options);

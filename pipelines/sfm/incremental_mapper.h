@@ -23,7 +23,7 @@ struct IncrementalMapperOptions {
   // A model whose intrinsics come out implausible at three refinements in a
   // row, or at the last one, grew from a wrong start (e.g. a low-parallax
   // pair on the wrong side of the bas-relief ambiguity;
-  // docs/auto_calibration.md): it is started again from the next candidate
+  // docs/dev/auto_calibration_notes.md): it is started again from the next candidate
   // pair, at most this many times; with no pair left, the first start is
   // built to the end, its intrinsics held.
   int init_max_restarts = 2;
@@ -31,7 +31,7 @@ struct IncrementalMapperOptions {
   // implausible too (COLMAP's bound, 2, against its prior). When the ArUco
   // markers gave the start, refractive_mapper tightens it to 1.25: a model
   // grown from a wrong pair can drift that far over many adjustments, none
-  // of them a factor 2 (docs/auto_calibration.md).
+  // of them a factor 2 (docs/dev/auto_calibration_notes.md).
   double max_focal_ratio_to_start = 2.0;
   double init_max_error_px = 4.0;
   // Scale of a model when markers do not give it: the initial pair's median
@@ -54,7 +54,7 @@ struct IncrementalMapperOptions {
   // Below this many images, of the distortion only the first radial term
   // is refined (the other terms held; the principal point as asked): a
   // handful of views of a small target cannot tell eight intrinsics apart,
-  // and freed together they leave the basin (docs/auto_calibration.md).
+  // and freed together they leave the basin (docs/dev/auto_calibration_notes.md).
   // 0: all from the start.
   int ba_full_intrinsics_min_images = 10;
   int ba_local_num_images = 6;

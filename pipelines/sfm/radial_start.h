@@ -7,7 +7,7 @@
 // tens of pixels, the first global adjustment that frees the port tilts it
 // to soak up the lens's distortion, and from there the intrinsics run into
 // another basin (measured: k1 -> +1.0, f 905 -> 1906 px; see
-// docs/auto_calibration.md). Radial distortion is what a projective
+// docs/dev/auto_calibration_notes.md). Radial distortion is what a projective
 // two-view model cannot express (Fitzgibbon, "Simultaneous linear
 // estimation of multiple view geometry and lens distortion", CVPR 2001):
 // for each candidate k1 the matched keypoints are turned into rays through

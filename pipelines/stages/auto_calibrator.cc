@@ -8,6 +8,7 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "database/database.h"
+#include "pipelines/calibration/calibration_output.h"
 #include "pipelines/sfm/calibration_start.h"
 
 namespace fs = std::filesystem;
@@ -38,7 +39,7 @@ namespace {
 // Without given intrinsics the database camera starts at the image reader's
 // guess (1.2 x the larger image side). Two-view verification estimates E on
 // rays normalised with it, so a wrong guess shapes which pairs and inliers
-// the mapper gets (docs/auto_calibration.md). The markers give a far better
+// the mapper gets (docs/dev/auto_calibration_notes.md). The markers give a far better
 // start: it is written to the database camera before matching.
 // Returns the markers' focal length (in-air equivalent), or nullopt.
 std::optional<double> WriteMarkersFocalToDatabase(const std::string& database_path,
@@ -149,14 +150,14 @@ RefractiveMapperOptions MapperOptions(const AutoCalibratorOptions& options, cons
   // trades with the focal length on a few views, so it is left to the final
   // refinement. Only with marker scale: without it the port distance is
   // barely observed and refining it splits the models
-  // (docs/auto_calibration.md).
+  // (docs/dev/auto_calibration_notes.md).
   map.mapper.ba_refine_housing = options.housing && !options.housing->Refinement().orientation.empty() &&
                                  options.marker_scale.side_length_m > 0;
   // The principal point with it: held at the image centre when it is not
   // there, the global adjustments fight the port. With the dome left to the
   // final refinement, its principal point is too (refined in the mapper,
   // dome renders came out worse). The final refinement decides whether it
-  // stays off the centre (docs/auto_calibration.md).
+  // stays off the centre (docs/dev/auto_calibration_notes.md).
   map.mapper.ba_refine_principal_point = refine_principal_point && map.mapper.ba_refine_housing;
   return map;
 }
@@ -176,7 +177,7 @@ RefractiveBundleAdjusterOptions RefinerOptions(const AutoCalibratorOptions& opti
   refine.ba.refine_extra_params = refine_intrinsics;
   // A camera's principal point is rarely exactly at the image centre, and
   // held there when it is not, the port absorbs the offset
-  // (docs/auto_calibration.md). Held at the centre again unless it lies
+  // (docs/dev/auto_calibration_notes.md). Held at the centre again unless it lies
   // beyond 3 sigma from it.
   refine.ba.refine_principal_point = refine_principal_point;
   refine.principal_point_test_sigmas = options.refine_principal_point.has_value() ? 0.0 : 3.0;
@@ -208,6 +209,46 @@ CalibrationStart MapAndRefine(const AutoCalibratorOptions& options, const std::s
     }
   }
   return start;
+}
+
+// Several starts when one cannot be trusted (a wrong basin, or a poorly
+// determined solution): the mapper's random choices from another seed take
+// another path; the start with the fewest warnings, then the smallest
+// residual, is kept (its files moved into the output folder). Throws the
+// first start's error when none succeeds.
+CalibrationStart BestStart(const AutoCalibratorOptions& options, const std::string& database_path,
+                           const std::optional<double>& markers_focal, bool refine_intrinsics,
+                           ProgressSink& progress) {
+  const int num_starts = refine_intrinsics ? options.max_num_starts : 1;
+  std::optional<CalibrationStart> best;
+  std::string first_error;
+  for (int k = 0; k < num_starts; ++k) {
+    try {
+      CalibrationStart start = MapAndRefine(options, database_path, k, markers_focal, refine_intrinsics, progress);
+      if (!best || BetterStart(start, *best)) best = std::move(start);
+    } catch (const NumericalError& e) {
+      if (first_error.empty()) first_error = e.what();
+      LOG(WARNING) << "auto_calibrator: start " << k + 1 << " of " << num_starts << " failed: " << e.what();
+    }
+    if (best && NumCurableWarnings(best->refined) == 0) break;
+    if (k + 1 < num_starts) {
+      LOG(WARNING) << "auto_calibrator: start " << k + 1 << " is not to be trusted; mapping again from random seed "
+                   << options.random_seed + k + 1;
+    }
+  }
+  KeepStart(options.output_path, best ? best->index : -1, num_starts);
+  if (!best) throw NumericalError(first_error);
+  return std::move(*best);
+}
+
+// The camera the stages made (one, shared by all images).
+camera_t OnlyCameraId(Database* database, const std::string& database_path) {
+  const std::vector<Camera> cameras = database->ReadAllCameras();
+  if (cameras.size() != 1) {
+    throw DatabaseError(database_path + ": " + std::to_string(cameras.size()) +
+                        " cameras; auto_calibrator writes one back");
+  }
+  return cameras.front().camera_id;
 }
 
 }  // namespace
@@ -259,33 +300,14 @@ AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   RunFeatureMatcher(match, progress);
   lap(PairingModeName(options.matcher) + "_matcher");
 
-  // Several starts when one cannot be trusted (a wrong basin, or a
-  // poorly determined solution): the mapper's random choices from another
-  // seed take another path; the start with the fewest warnings, then the
-  // smallest residual, is kept.
-  const int num_starts = refine_intrinsics ? options.max_num_starts : 1;
-  std::optional<CalibrationStart> best;
-  std::string first_error;
-  for (int k = 0; k < num_starts; ++k) {
-    try {
-      CalibrationStart start = MapAndRefine(options, database_path, k, markers_focal, refine_intrinsics, progress);
-      if (!best || BetterStart(start, *best)) best = std::move(start);
-    } catch (const NumericalError& e) {
-      if (first_error.empty()) first_error = e.what();
-      LOG(WARNING) << "auto_calibrator: start " << k + 1 << " of " << num_starts << " failed: " << e.what();
-    }
-    if (best && NumCurableWarnings(best->refined) == 0) break;
-    if (k + 1 < num_starts) {
-      LOG(WARNING) << "auto_calibrator: start " << k + 1 << " is not to be trusted; mapping again from random seed "
-                   << options.random_seed + k + 1;
-    }
-  }
-  KeepStart(options.output_path, best ? best->index : -1, num_starts);
-  if (!best) throw NumericalError(first_error);
-  result.refined = best->refined;
-  result.num_registered = best->num_registered;
+  const CalibrationStart best = BestStart(options, database_path, markers_focal, refine_intrinsics, progress);
+  result.refined = best.refined;
+  result.num_registered = best.num_registered;
   lap("refractive_mapper + refractive_bundle_adjuster");
-  WriteCalibrationReport(result.refined.report, options.output_path);
+  std::optional<Database> database;
+  if (options.update_database) database.emplace(database_path, Database::OpenMode::kReadWrite);
+  WriteCalibrationOutput(result.refined.report, options.output_path, database ? &*database : nullptr,
+                         database ? OnlyCameraId(&*database, database_path) : kInvalidCameraId);
   std::string times;
   for (const auto& [stage, seconds] : result.stage_seconds) times += " " + stage + " " + std::to_string(seconds) + " s;";
   LOG(INFO) << "auto_calibrator: " << result.num_registered << " of " << result.num_images

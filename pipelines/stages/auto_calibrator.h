@@ -53,6 +53,10 @@ struct AutoCalibratorOptions {
   // residual, is kept (own render at a knife edge between two basins:
   // residual sigma 0.170 px in the right one, 0.275 in the wrong).
   int max_num_starts = 3;
+  // Writes the calibrated camera (and housing) into output/database.db, so
+  // that a next stage there (portcal's or COLMAP's) starts from them. Off by
+  // default: a rerun into the same folder would start from them too.
+  bool update_database = false;
   int num_threads = 2;
   void Check() const;  // throws OptionError naming the option
 };

@@ -17,7 +17,9 @@ inline CameraCalibrationSettings WithBoardWarp() {
 
 struct CameraCalibratorOptions {
   std::string database_path;
-  std::string output_path;   // directory for calibration.yaml / .txt
+  // Directory for calibration.yaml / .txt and camera.cameramodel (mrcal's,
+  // with the optimization_inputs of the solve where mrcal can express it).
+  std::string output_path;
   int camera_id = -1;        // -1: the only camera with observations
   std::string camera_model;  // "" = the database camera's model
   // The board's sag is fitted by default, as mrcal does: printed boards

@@ -55,14 +55,21 @@ FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& optio
   Database database(options.database_path, Database::OpenMode::kCreate);
   Transaction transaction = database.BeginTransaction();
 
-  // Rerun: images that have features already are left alone.
+  // Rerun: images that have features already keep them, but their cameras
+  // still meet the reader options first (an error naming the difference, or
+  // with --ImageReader.overwrite the cameras imported again), before any
+  // extraction.
   std::vector<std::string> todo;
   FeatureExtractorSummary summary;
   summary.num_images = static_cast<int>(names.size());
+  SharedCameras shared_cameras;
   for (const std::string& name : names) {
     const std::optional<DatabaseImage> image = database.ReadImageWithName(name);
     if (image && !options.overwrite && database.ExistsKeypoints(image->image_id) &&
         database.ExistsDescriptors(image->image_id)) {
+      const Camera camera = *database.ReadCamera(image->camera_id);
+      ImportImage(&database, options.reader, name, static_cast<int>(camera.width), static_cast<int>(camera.height),
+                  &shared_cameras);
       ++summary.num_skipped;
     } else {
       todo.push_back(name);
@@ -72,7 +79,6 @@ FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& optio
             << " to extract, " << summary.num_skipped << " already have features";
 
   std::vector<Extracted> slots(todo.size());
-  SharedCameras shared_cameras;
   progress.Begin("feature_extractor: images", todo.size());
   OrderedParallelFor(
       todo.size(), options.num_threads, 2 * static_cast<size_t>(options.num_threads) + 2,
@@ -96,6 +102,7 @@ FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& optio
         const image_t image_id = ImportImage(&database, options.reader, todo[i], extracted.width,
                                              extracted.height, &shared_cameras);
         database.DeleteMatchesOfImage(image_id);
+        database.DeleteUnmaskedFeatures(image_id);  // a mask starts from these now
         database.WriteKeypoints(image_id, extracted.features.keypoints);
         database.WriteDescriptors(image_id, extracted.features.descriptors);
         if (extracted.features.keypoints.empty()) LOG(WARNING) << todo[i] << ": no SIFT features";

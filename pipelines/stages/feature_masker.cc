@@ -1,6 +1,7 @@
 #include "pipelines/stages/feature_masker.h"
 
 #include <opencv2/imgcodecs.hpp>
+#include <cstring>
 #include <map>
 #include <sstream>
 
@@ -28,6 +29,26 @@ void FeatureMaskerOptions::Check() const {
 
 namespace {
 
+// The features a mask starts from: those feature_extractor made, kept
+// aside at the first masking (so that another mask can start from them
+// again). Throws naming the image when the two tables disagree.
+void FeaturesBeforeMasking(const FeatureMaskerOptions& options, const DatabaseImage& image, Database* database,
+                           FeatureKeypoints* keypoints, FeatureDescriptors* descriptors) {
+  if (database->ReadUnmaskedFeatures(image.image_id, keypoints, descriptors)) return;
+  *keypoints = database->ReadKeypoints(image.image_id);
+  *descriptors = database->ReadDescriptors(image.image_id);
+  if (static_cast<size_t>(descriptors->rows()) != keypoints->size()) {
+    throw InputError(options.database_path + ": image '" + image.name + "' has " +
+                     std::to_string(keypoints->size()) + " keypoints but " +
+                     std::to_string(descriptors->rows()) + " descriptors");
+  }
+  database->WriteUnmaskedFeatures(image.image_id, *keypoints, *descriptors);
+}
+
+bool SameKeypoints(const FeatureKeypoints& a, const FeatureKeypoints& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(FeatureKeypoint)) == 0;
+}
+
 // Keeps the features of one image inside its markers' enlarged quads (and
 // deletes the image's matches if that changed its features).
 void MaskImage(const FeatureMaskerOptions& options, const DatabaseImage& image,
@@ -35,19 +56,17 @@ void MaskImage(const FeatureMaskerOptions& options, const DatabaseImage& image,
   const image_t image_id = image.image_id;
   database->WriteMarkerDetections(image_id, markers);
   summary->num_markers += static_cast<int64_t>(markers.size());
-  const FeatureKeypoints keypoints = database->ReadKeypoints(image_id);
-  const FeatureDescriptors descriptors = database->ReadDescriptors(image_id);
-  if (static_cast<size_t>(descriptors.rows()) != keypoints.size()) {
-    throw InputError(options.database_path + ": image '" + image.name + "' has " +
-                     std::to_string(keypoints.size()) + " keypoints but " +
-                     std::to_string(descriptors.rows()) + " descriptors");
-  }
-  std::vector<size_t> kept;
+  FeatureKeypoints keypoints;
+  FeatureDescriptors descriptors;
+  FeaturesBeforeMasking(options, image, database, &keypoints, &descriptors);
+  FeatureKeypoints kept_keypoints;
+  std::vector<Eigen::Index> kept;
   for (size_t k = 0; k < keypoints.size(); ++k) {
     const Eigen::Vector2d xy(keypoints[k].x, keypoints[k].y);
     for (const MarkerDetection& marker : markers) {
       if (InsideEnlargedQuad(marker.corners, options.enlargement_factor, xy)) {
-        kept.push_back(k);
+        kept.push_back(static_cast<Eigen::Index>(k));
+        kept_keypoints.push_back(keypoints[k]);
         break;
       }
     }
@@ -58,13 +77,10 @@ void MaskImage(const FeatureMaskerOptions& options, const DatabaseImage& image,
     ++summary->num_without_markers;
     LOG(WARNING) << image.name << ": no " << options.dictionary << " markers; all its features are removed";
   }
-  if (kept.size() == keypoints.size()) return;  // unchanged: its matches stay valid
-  FeatureKeypoints kept_keypoints;
+  // Unchanged (the same mask again): its matches stay valid.
+  if (SameKeypoints(kept_keypoints, database->ReadKeypoints(image_id))) return;
   FeatureDescriptors kept_descriptors(static_cast<Eigen::Index>(kept.size()), 128);
-  for (size_t r = 0; r < kept.size(); ++r) {
-    kept_keypoints.push_back(keypoints[kept[r]]);
-    kept_descriptors.row(static_cast<Eigen::Index>(r)) = descriptors.row(static_cast<Eigen::Index>(kept[r]));
-  }
+  for (size_t r = 0; r < kept.size(); ++r) kept_descriptors.row(static_cast<Eigen::Index>(r)) = descriptors.row(kept[r]);
   database->WriteKeypoints(image_id, kept_keypoints);
   database->WriteDescriptors(image_id, kept_descriptors);
   database->DeleteMatchesOfImage(image_id);
@@ -114,16 +130,17 @@ FeatureMaskerSummary RunFeatureMasker(const FeatureMaskerOptions& options, Progr
   Transaction transaction = database.BeginTransaction();
   const std::vector<DatabaseImage> images = database.ReadAllImages();
   if (images.empty()) throw InputError(options.database_path + ": no images; run feature_extractor first");
-  // Masking removes features: another mask over masked features cannot
-  // bring back what the first removed, and would keep only what both keep.
+  // Another mask starts from the features as extracted, kept aside at the
+  // first masking; a database masked by a portcal that did not keep them
+  // cannot bring back what that mask removed.
   std::ostringstream asked;
   asked << options.dictionary << ", enlargement factor " << options.enlargement_factor;
   const std::string mask = MaskOfTheFeatures(&database);
-  if (!mask.empty() && mask != asked.str()) {
+  if (!mask.empty() && mask != asked.str() && database.NumImagesWithUnmaskedFeatures() == 0) {
     throw InputError(options.database_path + ": its features were masked before (" + mask +
-                     "); a mask cannot bring back what an earlier one removed, so " + asked.str() +
-                     " was not applied: extract the features again (feature_extractor --overwrite 1, or a new "
-                     "database or output folder), then mask");
+                     ") without keeping them as extracted; a mask cannot bring back what an earlier one removed, "
+                     "so " + asked.str() + " was not applied: extract the features again (feature_extractor "
+                     "--overwrite 1, or a new database or output folder), then mask");
   }
 
   std::vector<std::vector<MarkerDetection>> detections(images.size());

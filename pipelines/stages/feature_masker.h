@@ -1,12 +1,15 @@
 // `portcal feature_masker`: keeps only the SIFT features on the calibration
 // object, i.e. near its ArUco markers. Each detected marker's quad is scaled
 // about its centroid by `enlargement_factor`; features inside any scaled
-// quad stay, the rest are deleted with their descriptors. Detections are
-// stored in portcal_marker_detections (they later pre-calibrate the
-// intrinsics and give scale). Matches and two-view geometries of every
-// image whose features change are deleted in the same transaction, so the
-// database never holds matches into re-indexed keypoints. Rerunning is safe
-// (masking is idempotent).
+// quad stay in COLMAP's keypoints and descriptors tables (what COLMAP's
+// matchers read), the rest are removed from them. The features as extracted
+// are kept in portcal_unmasked_features, so a rerun with another factor or
+// dictionary masks those again rather than what an earlier mask left.
+// Detections are stored in portcal_marker_detections (they later
+// pre-calibrate the intrinsics and give scale). Matches and two-view
+// geometries of every image whose features change are deleted in the same
+// transaction, so the database never holds matches into re-indexed
+// keypoints. Rerunning is safe (the same mask again changes nothing).
 #pragma once
 
 #include <string>
@@ -30,7 +33,7 @@ struct FeatureMaskerSummary {
   int num_images = 0;
   int num_without_markers = 0;
   int64_t num_markers = 0;
-  int64_t num_features_before = 0;
+  int64_t num_features_before = 0;  // as extracted
   int64_t num_features_kept = 0;
 };
 

@@ -88,6 +88,8 @@ ModelConverterSummary RunModelConverter(const ModelConverterOptions& options, Pr
     }
     if (options.output_type == "CAMERAMODEL") {
       WriteMrcalCameraModel(camera, Rigid3d(), options.output_path);
+      LOG(INFO) << options.output_path << " holds the lens only; the camera.cameramodel camera_calibrator "
+                << "writes also holds the solve (mrcal's optimization_inputs) for mrcal's uncertainty tools";
     } else if (options.output_type == "OPENCV_YAML") {
       WriteOpenCvCameraYaml(camera, options.output_path);
     } else {

@@ -356,7 +356,7 @@ void FillReport(const RefractiveBundleAdjusterOptions& options, const Reconstruc
 // the housing is first adjusted under the mapper's intrinsics (started
 // jointly from an untilted guess, the focal length and the port distance
 // trade off and the solve can slide into the distance's lower bound with a
-// wrong focal length; docs/auto_calibration.md); each solve twice, outliers
+// wrong focal length; docs/dev/auto_calibration_notes.md); each solve twice, outliers
 // dropped in between; then the principal point test.
 class StagedAdjustment {
  public:
@@ -541,7 +541,7 @@ RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBund
   // distance into its floor under a focal length that is too long): from
   // there the solve stays there, even with the intrinsics adjusted first.
   // It starts from the guess's bound parameters instead, the intrinsics
-  // first (figures: docs/auto_calibration.md).
+  // first (figures: docs/dev/auto_calibration_notes.md).
   const bool start_at_bound =
       adjustment.joint() && adjustment.HousingAtBound() != kInvalidCameraId && options.housing_guess.has_value();
   if (start_at_bound) MoveHousingsOffBound(options.housing_guess, &r);
@@ -552,7 +552,7 @@ RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBund
   if (adjustment.joint() && !start_at_bound && adjustment.HousingAtBound() != kInvalidCameraId) {
     // The housing slid into a bound under the mapper's intrinsics: adjusting
     // the intrinsics first (housing held) moves them to the right side of
-    // the trade (docs/auto_calibration.md).
+    // the trade (docs/dev/auto_calibration_notes.md).
     LOG(WARNING) << "refractive_bundle_adjuster: the housing ended at a bound; adjusting again, the intrinsics "
                     "first";
     r = start;

@@ -251,6 +251,26 @@ TEST(Database, ClearErrorsForBadFiles) {
   EXPECT_NE(message(dir / "p.db", Database::OpenMode::kReadWrite).find("'7'"), std::string::npos);
 }
 
+// portcal's tables of version 1 (before portcal_unmasked_features): read
+// as they are, upgraded in place when opened for writing.
+TEST(Database, PortcalTablesOfVersionOneAreUpgraded) {
+  testing::TempDir dir;
+  camera_t camera_id = 0;
+  {
+    Database db(dir / "v1.db", Database::OpenMode::kCreate);
+    camera_id = db.WriteCamera(TestCamera());
+  }
+  RawSql(dir / "v1.db", "DROP TABLE portcal_unmasked_features;");
+  RawSql(dir / "v1.db", "UPDATE portcal_meta SET value='1' WHERE key='schema_version';");
+  {
+    Database db(dir / "v1.db", Database::OpenMode::kReadOnly);
+    EXPECT_TRUE(db.ReadCamera(camera_id).has_value());
+  }
+  Database db(dir / "v1.db", Database::OpenMode::kReadWrite);
+  EXPECT_EQ(db.NumImagesWithUnmaskedFeatures(), 0);
+  EXPECT_TRUE(db.ReadCamera(camera_id).has_value());
+}
+
 TEST(Database, LockedDatabaseIsAClearError) {
   testing::TempDir dir;
   Database writer(dir / "db.db", Database::OpenMode::kCreate);

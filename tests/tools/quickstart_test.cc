@@ -1,5 +1,5 @@
 // docs/quickstart.md's commands are the ones workflows/quickstart.sh runs:
-// every portcal command of the page stands, as written, in the script, so a
+// every portcal and mrcal command of the page stands, as written, in the script, so a
 // page that drifts from what runs fails here.
 #include <gtest/gtest.h>
 
@@ -46,14 +46,17 @@ TEST(Quickstart, EveryCommandOfThePageRunsInTheWorkflowScript) {
   std::set<std::string> script;
   for (std::string command : Commands(source / "workflows/quickstart.sh", false)) {
     const std::string prefix = "\"$portcal\" ";
-    if (command.rfind(prefix, 0) != 0) continue;
-    command = "portcal " + command.substr(prefix.size());
+    if (command.rfind(prefix, 0) == 0) {
+      command = "portcal " + command.substr(prefix.size());
+    } else if (command.rfind("mrcal-", 0) != 0) {
+      continue;
+    }
     const size_t pipe = command.find(" | ");
     script.insert(command.substr(0, pipe));
   }
   int num_page_commands = 0;
   for (const std::string& command : Commands(source / "docs/quickstart.md", true)) {
-    if (command.rfind("portcal ", 0) != 0) continue;
+    if (command.rfind("portcal ", 0) != 0 && command.rfind("mrcal-", 0) != 0) continue;
     ++num_page_commands;
     EXPECT_TRUE(script.count(command.substr(0, command.find(" | "))))
         << "docs/quickstart.md runs a command workflows/quickstart.sh does not: " << command;

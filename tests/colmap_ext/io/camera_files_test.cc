@@ -11,6 +11,7 @@
 #include <random>
 
 #include "colmap_ext/io/mrcal_model.h"
+#include "colmap_ext/io/npz_archive.h"
 #include "colmap_ext/io/opencv_camera_file.h"
 #include "colmap_ext/util/error.h"
 #include "tests/test_utils.h"
@@ -177,6 +178,47 @@ TEST(OpenCvCameraFile, RosCameraInfoHasTheKeysCameraInfoManagerReads) {
   EXPECT_DOUBLE_EQ(d[3], camera.params[7]);
   EXPECT_EQ(root["projection_matrix"]["data"].as<std::vector<double>>().size(), 12u);
   EXPECT_EQ(root["rectification_matrix"]["data"].as<std::vector<double>>().size(), 9u);
+}
+
+}  // namespace
+}  // namespace portcal
+
+namespace portcal {
+namespace {
+
+// Python's base64.b85encode, on groups short and whole (values from Python).
+TEST(NpzArchive, Base85IsPythons) {
+  EXPECT_EQ(EncodeBase85(""), "");
+  EXPECT_EQ(EncodeBase85("h"), "Xa");
+  EXPECT_EQ(EncodeBase85("hello"), "Xk~0{Zv");
+  EXPECT_EQ(EncodeBase85(std::string(4, '\0')), "00000");
+  EXPECT_EQ(EncodeBase85("\xff\xfe\xfd\xfc\xfb\xfa"), "|Ni~_`}z");
+}
+
+// NumPy reads the archive back: shapes, types, values, strings and None.
+TEST(NpzArchive, NumpyReadsTheArchive) {
+  if (testing::RunCommand("/usr/bin/python3 -c 'import numpy' 2>&1").exit_code != 0) {
+    GTEST_SKIP() << "numpy is not importable by /usr/bin/python3";
+  }
+  NpzArchive npz;
+  npz.AddDoubles("m", {2, 3}, {1, 2, 3, 4, 5, 6.5});
+  npz.AddInt32s("i", {0, 6}, {});
+  npz.AddBool("b", true);
+  npz.AddDouble("d", 0.03);
+  npz.AddString("none", "");
+  npz.AddStrings("names", {"a.png", "image_10.png"});
+  testing::TempDir dir;
+  {
+    std::ofstream out(dir / "a.npz", std::ios::binary);
+    const std::string bytes = npz.Bytes();
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  const auto run = testing::RunCommand(
+      "/usr/bin/python3 -c \"import numpy as np; z = np.load('" + (dir / "a.npz").string() +
+      "', allow_pickle=False); print(z['m'].shape, z['m'][1, 2], z['i'].shape, z['i'].dtype, z['b'].item(), "
+      "z['d'].item(), repr(z['none'].item()), list(z['names']))\" 2>&1");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(run.output, "(2, 3) 6.5 (0, 6) int32 True 0.03 '' ['a.png', 'image_10.png']\n");
 }
 
 }  // namespace

@@ -92,7 +92,7 @@ TEST(RadialStart, FindsTheFirstRadialTermOfAWideLensBehindAFlatPort) {
   // the principal point at the centre (23 px off), no distortion, the
   // untilted port. The principal point's error is not projective once the
   // lens distorts, so the estimate is biased toward 0; the mapper needs a
-  // start in the right basin (the render of docs/auto_calibration.md:
+  // start in the right basin (the render of docs/dev/auto_calibration_notes.md:
   // k1 = -0.21 and -0.25 for -0.3 both converged to -0.300, 0 did not).
   HousedCamera start = WithoutDistortion(truth);
   start.camera.params = {895, 895, 960, 540, 0, 0, 0, 0};

@@ -5,7 +5,7 @@
 // distortion). Before the first radial term was estimated from the
 // matches (and a focal length drifting beyond 1.25 x the markers' made the
 // mapper start again), the wide lens behind the flat port ended with f
-// 653 px off, reported at 8 sigma (docs/auto_calibration.md). Also: the
+// 653 px off, reported at 8 sigma (docs/dev/auto_calibration_notes.md). Also: the
 // same images give the same calibration, and what the calibration cannot
 // be trusted with is said.
 #include <gtest/gtest.h>
@@ -95,7 +95,7 @@ MemberRun RenderAndCalibrate(const fs::path& dir, const FamilyMember& m, int num
   return run;
 }
 
-// Prints the errors in sigmas, for docs/auto_calibration.md.
+// Prints the errors in sigmas, for docs/dev/auto_calibration_notes.md.
 void PrintErrors(const CalibrationReport& r, const GroundTruth& truth) {
   std::cout << "errors (sigmas):";
   for (size_t i = 0; i < 5; ++i) {
@@ -159,7 +159,7 @@ TEST(AutoCalibrationRealCameras, WideOffCentreLensBehindATiltedFlatPortAndTheSam
   // (and the Schur complement's cells) of its threads in whichever order
   // they finish, which moves the 9th digit; under CI's load that once
   // flipped which observations passed a threshold, and two runs differed
-  // by 0.04 sigma in the port distance (docs/auto_calibration.md).
+  // by 0.04 sigma in the port distance (docs/dev/auto_calibration_notes.md).
   const AutoCalibratorSummary again = Calibrate(wide, dir.path() / "set" / "images", dir.path() / "again", 1);
   for (size_t i = 0; i < r.camera.params.size(); ++i) {
     EXPECT_EQ(again.refined.report.camera.params[i], r.camera.params[i]) << "parameter " << i;

@@ -13,6 +13,7 @@
 
 #include "colmap_ext/io/ground_truth.h"
 #include "colmap_ext/io/sparse_model.h"
+#include "database/database.h"
 #include "pipelines/stages/auto_calibrator.h"
 #include "pipelines/stages/synthesize.h"
 #include "tests/test_utils.h"
@@ -39,9 +40,11 @@ GroundTruth Render(const fs::path& dir, const std::string& camera_and_housing) {
 }
 
 AutoCalibratorSummary Calibrate(const fs::path& images, const fs::path& out, const std::string& housing_model,
-                                const std::string& housing_guess, const std::string& camera_params = "") {
+                                const std::string& housing_guess, const std::string& camera_params = "",
+                                bool update_database = false) {
   AutoCalibratorOptions options;
   options.camera_params = camera_params;
+  options.update_database = update_database;
   options.image_path = images.string();
   options.output_path = out.string();
   options.housing = HousingFromText(housing_model, housing_guess);
@@ -57,10 +60,11 @@ struct OwnRun {
 };
 
 OwnRun RenderAndCalibrate(const fs::path& dir, const std::string& camera_and_housing,
-                          const std::string& housing_model, const std::string& housing_guess) {
+                          const std::string& housing_model, const std::string& housing_guess,
+                          bool update_database = false) {
   OwnRun run;
   run.truth = Render(dir, camera_and_housing);
-  run.result = Calibrate(dir / "set" / "images", dir / "out", housing_model, housing_guess);
+  run.result = Calibrate(dir / "set" / "images", dir / "out", housing_model, housing_guess, "", update_database);
   EXPECT_EQ(run.result.num_registered, 15);
   return run;
 }
@@ -104,10 +108,19 @@ TEST(AutoCalibration, OwnRenderFlatPortIntrinsicsUnknown) {
   testing::TempDir dir;
   const OwnRun run = RenderAndCalibrate(dir.path(), R"(camera: {model: RADIAL, width: 960, height: 540, params: [650.0, 484.0, 266.5, 0.0, 0.0]}
 housing: {model: FLATPORT, params: [0.0697565, 0.0, 0.9975641, 0.015, 0.010, 1.0, 1.473, 1.334]}
-)", "FLATPORT", "0,0,1,0.015,0.010,1,1.473,1.334");
+)", "FLATPORT", "0,0,1,0.015,0.010,1,1.473,1.334", true);
   const GroundTruth& truth = run.truth;
   const CalibrationReport& r = run.result.refined.report;
   ASSERT_TRUE(r.housing);
+  {  // --update_database: the calibration is the database's camera and housing now
+    Database db(dir / "out" / "database.db", Database::OpenMode::kReadOnly);
+    const std::vector<Camera> cameras = db.ReadAllCameras();
+    ASSERT_EQ(cameras.size(), 1u);
+    EXPECT_EQ(cameras[0].params, r.camera.params);
+    const std::optional<Housing> housing = db.ReadHousing(cameras[0].camera_id);
+    ASSERT_TRUE(housing);
+    EXPECT_EQ(housing->params, r.housing->params);
+  }
   const double df = std::abs(r.camera.params[0] - truth.camera.params[0]);
   const double angle = NormalAngle(r.housing->params, truth.housing->params);
   const double dd = std::abs(r.housing->params[3] - truth.housing->params[3]);

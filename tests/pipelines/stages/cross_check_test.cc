@@ -119,6 +119,12 @@ std::vector<Rigid3d> Poses(const CameraCalibrationResult& result) {
   return poses;
 }
 
+// Runs `script` with Debian's Python (where mrcal imports); stdout only.
+testing::CommandResult RunPython(const fs::path& dir, const std::string& script) {
+  std::ofstream(dir / "script.py") << script;
+  return testing::RunCommand("/usr/bin/python3 " + (dir / "script.py").string() + " 2>/dev/null");
+}
+
 // Same corners, flat board, 0.1 px noise: the two solvers' lenses agree far
 // below the 0.05 px the issue asks, and mrcal's own estimate is within its
 // standard deviations of the truth (its warp within them of zero).
@@ -198,17 +204,12 @@ TEST(CrossCheck, ProjectionDiffEqualsMrcalsPython) {
   b.params[6] += 0.0005;
   WriteMrcalCameraModel(a, Rigid3d(), dir / "a.cameramodel");
   WriteMrcalCameraModel(b, Rigid3d(), dir / "b.cameramodel");
-  const std::string script =
-      "import mrcal, numpy as np\n"
-      "m = [mrcal.cameramodel('" + (dir / "a.cameramodel").string() + "'), mrcal.cameramodel('" +
-      (dir / "b.cameramodel").string() + "')]\n"
-      "d = mrcal.projection_diff(m, use_uncertainties=False)[0]\n"
-      "print('%.9f %.9f' % (np.mean(d), np.max(d)))\n";
-  {
-    std::ofstream out(dir / "diff.py");
-    out << script;
-  }
-  const auto run = testing::RunCommand("/usr/bin/python3 " + (dir / "diff.py").string() + " 2>/dev/null");
+  const auto run = RunPython(dir.path(),
+                             "import mrcal, numpy as np\n"
+                             "m = [mrcal.cameramodel('" + (dir / "a.cameramodel").string() +
+                                 "'), mrcal.cameramodel('" + (dir / "b.cameramodel").string() + "')]\n"
+                                 "d = mrcal.projection_diff(m, use_uncertainties=False)[0]\n"
+                                 "print('%.9f %.9f' % (np.mean(d), np.max(d)))\n");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   std::istringstream in(run.output);
   double mrcal_mean = 0, mrcal_max = 0;
@@ -217,6 +218,84 @@ TEST(CrossCheck, ProjectionDiffEqualsMrcalsPython) {
   EXPECT_GT(mrcal_mean, 0.1);  // a real difference to compare
   EXPECT_NEAR(ours.mean_px, mrcal_mean, 1e-4 * mrcal_mean);
   EXPECT_NEAR(ours.max_px, mrcal_max, 1e-4 * mrcal_max) << "mean " << ours.mean_px << " vs " << mrcal_mean;
+}
+
+// What mrcal's Python makes of camera.cameramodel's optimization_inputs:
+// the RMS of its own residuals, its standard deviations of the intrinsics
+// (s^2 (J^T J)^-1, s^2 over the degrees of freedom), and how far its
+// Gauss-Newton step would move each intrinsic, in those standard deviations.
+struct MrcalEvaluation {
+  bool has_inputs = false;
+  double rms_px = 0;
+  std::vector<double> std_devs;
+  double max_step_sigma = 0;
+};
+
+MrcalEvaluation EvaluateWithMrcal(const fs::path& model, const fs::path& dir) {
+  const std::string script =
+      "import mrcal, numpy as np\n"
+      "m = mrcal.cameramodel('" + model.string() + "')\n"
+      "oi = m.optimization_inputs()\n"
+      "if oi is None: print(0); raise SystemExit\n"
+      "b, x, J, f = mrcal.optimizer_callback(**oi)\n"
+      "J = J.toarray()\n"
+      "w = oi['observations_board'][..., 2].ravel()\n"
+      "r = x[:2 * w.size].reshape(-1, 2)[w > 0]\n"
+      "s2 = (r ** 2).sum() / (2 * len(r) - J.shape[1])\n"
+      "D = np.ones(J.shape[1]); mrcal.unpack_state(D, **oi)\n"
+      "inv = np.linalg.inv(J.T @ J)\n"
+      "i0 = mrcal.state_index_intrinsics(0, **oi); n = oi['intrinsics'].shape[1]\n"
+      "sd = np.sqrt(np.diag(inv) * s2)[i0:i0 + n]\n"
+      "step = -(inv @ (J.T @ x))[i0:i0 + n]\n"
+      "print(1, np.sqrt((r ** 2).sum() / len(r)), np.max(np.abs(step) / sd), ' '.join(str(v) for v in sd * D[i0:i0 + n]))\n";
+  const auto run = RunPython(dir, script);
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  std::istringstream in(run.output);
+  MrcalEvaluation evaluation;
+  in >> evaluation.has_inputs;
+  if (!evaluation.has_inputs) return evaluation;
+  in >> evaluation.rms_px >> evaluation.max_step_sigma;
+  double v = 0;
+  while (in >> v) evaluation.std_devs.push_back(v);
+  return evaluation;
+}
+
+// camera_calibrator's camera.cameramodel carries the solve (corners, poses,
+// the warp, partial views): mrcal's own evaluation of it reproduces
+// portcal's RMS and standard deviations, finds it at the optimum of its
+// cost, and mrcal's C parser still reads the file.
+TEST(MrcalExport, OptimizationInputsReproducePortcalsSolution) {
+  if (testing::RunCommand("/usr/bin/python3 -c 'import mrcal' 2>&1").exit_code != 0) {
+    GTEST_SKIP() << "mrcal's Python module is not importable by /usr/bin/python3";
+  }
+  testing::TempDir dir;
+  const auto views = SyntheticViews(TruthCamera(), Eigen::Vector2d(-0.0003, 0.0005), 0.2, 12, 9);
+  CrossCheckOptions check = CalibratedForCheck(dir.path(), views);
+  CameraCalibratorOptions calibrate;  // the defaults: the warp fitted
+  calibrate.database_path = check.database_path;
+  calibrate.output_path = (dir / "warp").string();
+  const CameraCalibrationResult result = RunCameraCalibrator(calibrate, NoProgress());
+  size_t num_partial = 0;
+  for (const CalibrationView& view : views) num_partial += view.pixels.size() < kBoardW * kBoardH;
+  ASSERT_GT(num_partial, 0u) << "the views should include boards cut by the image edge";
+
+  const MrcalEvaluation mrcal = EvaluateWithMrcal(dir / "warp/camera.cameramodel", dir.path());
+  ASSERT_TRUE(mrcal.has_inputs);
+  EXPECT_NEAR(mrcal.rms_px, result.overall_rms_px, 1e-9 * result.overall_rms_px);
+  // Same model (OPENCV = LENSMODEL_OPENCV4), same residuals: the same
+  // covariance, to the precision of the two Jacobians.
+  ASSERT_EQ(mrcal.std_devs.size(), result.params_std_dev.size());
+  for (size_t i = 0; i < mrcal.std_devs.size(); ++i) {
+    EXPECT_NEAR(mrcal.std_devs[i], result.params_std_dev[i], 1e-3 * result.params_std_dev[i]) << i;
+  }
+  EXPECT_LT(mrcal.max_step_sigma, 0.01);
+  EXPECT_EQ(ReadMrcalCameraModel(dir / "warp/camera.cameramodel").camera.ModelName(), "OPENCV");
+
+  // A held set mrcal cannot hold (k2 alone): the model, without the inputs.
+  calibrate.output_path = (dir / "held").string();
+  calibrate.calibration.fixed_params = {"k2"};
+  RunCameraCalibrator(calibrate, NoProgress());
+  EXPECT_FALSE(EvaluateWithMrcal(dir / "held/camera.cameramodel", dir.path()).has_inputs);
 }
 
 // A board bent by 0.5 mm, calibrated as flat: cross_check fails, blames the

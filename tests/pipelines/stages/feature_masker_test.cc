@@ -1,6 +1,7 @@
 // feature_masker reruns: the same mask again changes nothing; another mask
-// over masked features is refused with the reason and the way out, the
-// database untouched; after the features are extracted again, it applies.
+// starts from the features as extracted (kept aside at the first masking);
+// where they were not kept, another mask is refused with the reason and the
+// way out, the database untouched.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -17,10 +18,11 @@ namespace fs = std::filesystem;
 namespace portcal {
 namespace {
 
-TEST(FeatureMasker, AnotherMaskOverMaskedFeaturesIsRefusedWithTheReason) {
-  testing::TempDir dir;
+// Renders `num_images` views of the two-face target into dir/set and
+// extracts their features into dir/db.db; returns the extraction's options.
+FeatureExtractorOptions RenderAndExtract(const fs::path& dir, int num_images, int seed) {
   std::ofstream(dir / "set.yaml")
-      << "name: mask\nnum_images: 3\nseed: 3\n"
+      << "name: mask\nnum_images: " << num_images << "\nseed: " << seed << "\n"
       << "camera: {model: RADIAL, width: 480, height: 270, params: [330.0, 240.0, 135.0, 0.0, 0.0]}\n"
       << "housing: null\n"
       << testing::kTwoFaceTargetYaml
@@ -31,12 +33,18 @@ TEST(FeatureMasker, AnotherMaskOverMaskedFeaturesIsRefusedWithTheReason) {
   synthesize.output_path = (dir / "set").string();
   NullProgress progress;
   RunSynthesize(synthesize, progress);
-
   FeatureExtractorOptions extract;
   extract.database_path = (dir / "db.db").string();
   extract.image_path = (dir / "set/images").string();
   extract.reader.single_camera = true;
   RunFeatureExtractor(extract, progress);
+  return extract;
+}
+
+TEST(FeatureMasker, AnotherMaskStartsFromTheFeaturesAsExtracted) {
+  testing::TempDir dir;
+  FeatureExtractorOptions extract = RenderAndExtract(dir.path(), 3, 3);
+  NullProgress progress;
   FeatureMaskerOptions mask;
   mask.database_path = extract.database_path;
   mask.image_path = extract.image_path;
@@ -45,8 +53,62 @@ TEST(FeatureMasker, AnotherMaskOverMaskedFeaturesIsRefusedWithTheReason) {
   ASSERT_LT(first.num_features_kept, first.num_features_before);
   const FeatureMaskerSummary again = RunFeatureMasker(mask, progress);
   EXPECT_EQ(again.num_features_kept, first.num_features_kept);
-  EXPECT_EQ(again.num_features_before, first.num_features_kept);
+  EXPECT_EQ(again.num_features_before, first.num_features_before);  // from the features as extracted
+  const auto matched_keypoints = [&] {
+    Database db(dir / "db.db", Database::OpenMode::kReadOnly);
+    std::vector<FeatureKeypoints> keypoints;
+    for (const DatabaseImage& image : db.ReadAllImages()) keypoints.push_back(db.ReadKeypoints(image.image_id));
+    return keypoints;
+  };
+  const std::vector<FeatureKeypoints> first_keypoints = matched_keypoints();
 
+  // A wider mask starts from the features as extracted, not from what the
+  // first mask left; a narrower one after it keeps a subset.
+  mask.enlargement_factor = 5.0;
+  const FeatureMaskerSummary wider = RunFeatureMasker(mask, progress);
+  EXPECT_EQ(wider.num_features_before, first.num_features_before);
+  EXPECT_GT(wider.num_features_kept, first.num_features_kept);
+  mask.enlargement_factor = 3.0;
+  const FeatureMaskerSummary back = RunFeatureMasker(mask, progress);
+  EXPECT_EQ(back.num_features_kept, first.num_features_kept);
+  const std::vector<FeatureKeypoints> back_keypoints = matched_keypoints();
+  ASSERT_EQ(back_keypoints.size(), first_keypoints.size());
+  for (size_t i = 0; i < back_keypoints.size(); ++i) {
+    ASSERT_EQ(back_keypoints[i].size(), first_keypoints[i].size()) << i;
+    for (size_t k = 0; k < back_keypoints[i].size(); ++k) {
+      EXPECT_EQ(back_keypoints[i][k].x, first_keypoints[i][k].x);
+      EXPECT_EQ(back_keypoints[i][k].y, first_keypoints[i][k].y);
+    }
+  }
+
+  // Extracted again, the kept features are gone with the old ones: the
+  // mask starts from the new extraction.
+  extract.overwrite = true;
+  RunFeatureExtractor(extract, progress);
+  {
+    Database db(dir / "db.db", Database::OpenMode::kReadOnly);
+    EXPECT_EQ(db.NumImagesWithUnmaskedFeatures(), 0);
+  }
+  const FeatureMaskerSummary extracted_again = RunFeatureMasker(mask, progress);
+  EXPECT_EQ(extracted_again.num_features_before, first.num_features_before);
+  EXPECT_EQ(extracted_again.num_features_kept, first.num_features_kept);
+}
+
+// A database masked by a portcal that did not keep the features as
+// extracted (no portcal_unmasked_features rows): another mask is refused
+// with the reason and the way out, the database untouched.
+TEST(FeatureMasker, AnotherMaskWithoutTheExtractedFeaturesIsRefused) {
+  testing::TempDir dir;
+  const FeatureExtractorOptions extract = RenderAndExtract(dir.path(), 2, 4);
+  NullProgress progress;
+  FeatureMaskerOptions mask;
+  mask.database_path = extract.database_path;
+  mask.image_path = extract.image_path;
+  RunFeatureMasker(mask, progress);
+  {  // as an older portcal left it
+    Database db(dir / "db.db", Database::OpenMode::kReadWrite);
+    for (const DatabaseImage& image : db.ReadAllImages()) db.DeleteUnmaskedFeatures(image.image_id);
+  }
   const std::string before = testing::ReadFileToString(dir / "db.db");
   mask.enlargement_factor = 5.0;
   try {
@@ -59,12 +121,6 @@ TEST(FeatureMasker, AnotherMaskOverMaskedFeaturesIsRefusedWithTheReason) {
     }
   }
   EXPECT_EQ(testing::ReadFileToString(dir / "db.db"), before);
-
-  extract.overwrite = true;
-  RunFeatureExtractor(extract, progress);
-  const FeatureMaskerSummary wider = RunFeatureMasker(mask, progress);
-  EXPECT_EQ(wider.num_features_before, first.num_features_before);
-  EXPECT_GT(wider.num_features_kept, first.num_features_kept);
 }
 
 }  // namespace

@@ -121,7 +121,7 @@ render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
             << distance_error * 1000 << " mm (sd " << sd[3] * 1000 << ")\n";
   // The normal within the 0.05 deg, the distance within 6 mm (the
   // measured level, 4.5 mm, plus a margin: the 2 mm is met on the
-  // larger surveys, docs/auto_calibration.md), and both within 4 reported
+  // larger surveys, docs/dev/auto_calibration_notes.md), and both within 4 reported
   // sigma. Sigma by the noise alone said 0.009 deg and 0.74 mm here (3.8 and
   // 6 sigma off); by the clusters' spread (images and tracks), which the
   // report takes when it is larger, 0.040 deg and 4.8 mm.
