@@ -1,5 +1,7 @@
 // The ideal image of a chessboard-like corner (two straight edges, blurred)
-// against one pixel of a window around it, for sub-pixel corner refinement.
+// against one pixel of a window around it, by Ceres' autodiff: the
+// reference that corner_pattern_model.h (the same model with its
+// derivatives written out, which corner refinement uses) is tested against.
 // Block p (7): the corner's x and y (pixels), the two edges' angles, the
 // mean gray, the contrast and log of the blur's sigma (pixels).
 #pragma once

@@ -1,6 +1,7 @@
 // Chessboard detection: coarse corners from OpenCV on a downscaled image
-// (findChessboardCornersSB, then findChessboardCorners as a fallback), put in
-// portcal's canonical order, then refined at full resolution by the
+// (findChessboardCorners with its fast check, then findChessboardCornersSB
+// as a fallback), put in portcal's canonical order (right-handed, corner 0's
+// outer diagonal square black), then refined at full resolution by the
 // ideal-pattern fit (corner_refinement.h).
 #pragma once
 
@@ -16,8 +17,8 @@ namespace portcal {
 struct ChessboardDetectionOptions {
   int cols = 10;  // inner corners per row, >= 2
   int rows = 7;   // inner corners per column, >= 2
-  // Coarse detection runs on the image downscaled to at most this many
-  // pixels on its longer side (0: full resolution only).
+  // Coarse detection runs on the image halved (once or more) to at most
+  // this many pixels on its longer side (0: full resolution only).
   int coarse_max_image_size = 1000;
   // Views with fewer refined corners than this fraction are rejected.
   double min_refined_fraction = 0.9;

@@ -7,9 +7,10 @@
 //   s_k = n_k . (p - c),  n_k = (cos theta_k, sin theta_k)
 // integrated over each pixel's area (4 x 4 sub-samples), is point-symmetric
 // about the corner c, as the pattern is, so a mismatch in the edge profile
-// does not bias c. It is fitted to the pixels of a window
-// by Levenberg-Marquardt (Ceres, autodiff): c, both edge angles (any
-// perspective), the levels m, a and the blur sigma. Compared with the
+// does not bias c. It is fitted to the pixels of a window by
+// Levenberg-Marquardt (a fixed-size solver with the model's derivatives
+// written out, colmap_ext/cost/corner_pattern_model.h): c, both edge angles
+// (any perspective), the levels m, a and the blur sigma. Compared with the
 // gradient-orthogonality of cv::cornerSubPix it uses the whole edge profile
 // and does not assume orthogonal edges.
 #pragma once
@@ -23,13 +24,18 @@ namespace portcal {
 
 struct CornerRefinementOptions {
   // Window half size as a fraction of the distance to the nearest
-  // neighbouring corner, clamped to [min, max] pixels.
+  // neighbouring corner, clamped to [min, max] pixels. A smaller maximum
+  // (10 px) was faster, but its noisy corners made the intrinsics' standard
+  // deviations optimistic (CalibrationUncertainty, docs/benchmarks.md).
   double window_fraction = 0.4;
   double min_window_px = 3;
   double max_window_px = 15;
   // A refined corner further than this from its start is rejected.
   double max_shift_px = 2.0;
   int max_num_iterations = 50;
+  // The fit stops once a step moves the corner by less than this (or the
+  // cost by less than 1e-6 of itself).
+  double corner_tolerance_px = 2e-4;
   void Check() const;  // throws OptionError
 };
 

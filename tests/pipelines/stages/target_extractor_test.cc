@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <iostream>
 #include <opencv2/imgcodecs.hpp>
 
 #include "colmap_ext/io/ground_truth.h"
@@ -63,6 +64,7 @@ TEST_P(SharedSets, CornersWithinHundredthsOfAPixel) {
   EXPECT_EQ(summary.num_found, 25);
   const std::vector<double> errors = ObservationErrors(dir / "db.db", truth);
   ASSERT_EQ(errors.size(), 25u * 70u);
+  std::cout << GetParam() << ": median " << errors[errors.size() / 2] << " px, max " << errors.back() << " px\n";
   EXPECT_LE(errors[errors.size() / 2], 0.02) << GetParam();
   EXPECT_LE(errors.back(), 0.1) << GetParam();
 }

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Speed of chessboard detection, side by side with OpenCV in one run: for
+# each set, portcal target_extractor (images read, board found, corners
+# fitted, database written) on one and on two threads against OpenCV 4.6's
+# findChessboardCorners (adaptive threshold, normalised, fast check) +
+# cornerSubPix (11 x 11) on one thread, images read included. Prints the
+# times, the views and corners each found, and portcal's time over
+# OpenCV's (goal: <= 1.0 on one thread).
+# Usage: workflows/bench_target_detection.sh [SHARED=../shared]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+[ -x build/portcal ] || bash workflows/setup.sh >/dev/null
+shared="${1:-../shared}"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+now() { date +%s.%N; }
+elapsed() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", b - a }'; }
+
+# name, images, inner corners (cols rows), square size (m)
+sets=(
+  "real-dome/air  $shared/datasets/real-dome/air  8 6 0.03"
+  "chess_air_distorted  $shared/datasets/rendered/chess_air_distorted/images  10 7 0.02"
+  "chess_flatport  $shared/datasets/rendered/chess_flatport/images  10 7 0.02"
+)
+printf "%-22s %8s %8s %8s %12s %12s %10s\n" set portcal_1 portcal_2 opencv_1 "portcal views" "opencv views" "ratio_1"
+for entry in "${sets[@]}"; do
+  read -r name images cols rows square <<<"$entry"
+  [ -d "$images" ] || { echo "$name: $images absent, skipped"; continue; }
+  times=()
+  for threads in 1 2; do
+    db="$work/$threads.db"
+    rm -f "$db"
+    t0=$(now)
+    build/portcal target_extractor --log_level warn --database_path "$db" --image_path "$images" \
+      --Target.cols "$cols" --Target.rows "$rows" --Target.square_size "$square" --num_threads "$threads"
+    t1=$(now)
+    times+=("$(elapsed "$t0" "$t1")")
+  done
+  views=$(sqlite3 "$work/1.db" "SELECT COUNT(*) || ' / ' || (SELECT SUM(num_points) FROM portcal_target_detections WHERE found = 1) FROM portcal_target_detections WHERE found = 1;")
+  read -r opencv_s opencv_views opencv_corners < <(/usr/bin/python3 workflows/bench_target_detection.py "$images" "$cols" "$rows")
+  ratio=$(awk -v a="${times[0]}" -v b="$opencv_s" 'BEGIN { printf "%.2f", a / b }')
+  printf "%-22s %8s %8s %8s %12s %12s %10s\n" "$name" "${times[0]}" "${times[1]}" "$opencv_s" "$views" \
+    "$opencv_views / $opencv_corners" "$ratio"
+done
