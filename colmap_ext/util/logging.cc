@@ -25,7 +25,8 @@ class StderrSink : public google::LogSink {
     const bool from_ceres = IsCeresSource(full_filename);
     if (from_ceres && !debug_level) return;
     std::string text = ToString(severity, base_filename, line, time, message, message_len);
-    if (from_ceres) text.insert(text.find("] ") + 2, "(Ceres) ");
+    const size_t prefix_end = text.find("] ");
+    if (from_ceres) text.insert(prefix_end == std::string::npos ? 0 : prefix_end + 2, "(Ceres) ");
     text += '\n';
     std::fwrite(text.data(), 1, text.size(), stderr);
   }
