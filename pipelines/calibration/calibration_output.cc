@@ -3,9 +3,10 @@
 namespace portcal {
 
 void WriteCalibrationOutput(const CalibrationReport& report, const std::filesystem::path& dir, Database* database,
-                            camera_t camera_id) {
+                            camera_t camera_id, const std::function<void()>& write_beside) {
   if (database == nullptr) {
     WriteCalibrationReport(report, dir);
+    if (write_beside) write_beside();
     return;
   }
   Transaction transaction = database->BeginTransaction();
@@ -15,6 +16,7 @@ void WriteCalibrationOutput(const CalibrationReport& report, const std::filesyst
   database->UpdateCamera(calibrated);
   if (report.housing) database->WriteHousing(camera_id, *report.housing);
   WriteCalibrationReport(report, dir);
+  if (write_beside) write_beside();
   transaction.Commit();
 }
 

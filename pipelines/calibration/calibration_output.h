@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
@@ -14,7 +15,9 @@ namespace portcal {
 // focal length) and its housing into portcal_housings, in one transaction
 // committed once the reports are written: a failure leaves the database as
 // it was.
+// `write_beside` (optional) writes further files into `dir` after the
+// reports and before the commit.
 void WriteCalibrationOutput(const CalibrationReport& report, const std::filesystem::path& dir, Database* database,
-                            camera_t camera_id);
+                            camera_t camera_id, const std::function<void()>& write_beside = {});
 
 }  // namespace portcal

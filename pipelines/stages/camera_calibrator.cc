@@ -1,7 +1,5 @@
 #include "pipelines/stages/camera_calibrator.h"
 
-#include <filesystem>
-
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
@@ -44,9 +42,8 @@ CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& optio
     flat.estimate_board_warp = false;
     report.notes.push_back(BoardWarpNote(result, CalibrateCamera(views, camera, flat)));
   }
-  std::filesystem::create_directories(options.output_path);
-  WriteCalibrationCameraModel(views, result, options.calibration, options.output_path);
-  WriteCalibrationOutput(report, options.output_path, options.update_database ? &database : nullptr, camera_id);
+  WriteCalibrationOutput(report, options.output_path, options.update_database ? &database : nullptr, camera_id,
+                         [&] { WriteCalibrationCameraModel(views, result, options.calibration, options.output_path); });
   LOG(INFO) << "camera_calibrator: RMS " << result.overall_rms_px << " px over " << result.num_points
             << " points -> " << options.output_path;
   return result;
