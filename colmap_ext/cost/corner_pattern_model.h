@@ -92,9 +92,9 @@ class CornerPatternModel {
     const double centre_u1 = (c1_ * (x - cx_) + s1_ * (y - cy_)) * scale_;
     const double centre_u2 = (c2_ * (x - cx_) + s2_ * (y - cy_)) * scale_;
     const double half_extent = 0.5 - 0.5 / samples_;  // of the sub-samples about the centre
-    const double reach = half_extent * (std::abs(c1_) + std::abs(s1_)) * scale_;
+    const double reach1 = half_extent * (std::abs(c1_) + std::abs(s1_)) * scale_;
     const double reach2 = half_extent * (std::abs(c2_) + std::abs(s2_)) * scale_;
-    const bool flat1 = std::abs(centre_u1) > TabulatedErf::kRange + reach;
+    const bool flat1 = std::abs(centre_u1) > TabulatedErf::kRange + reach1;
     const bool flat2 = std::abs(centre_u2) > TabulatedErf::kRange + reach2;
     double sum = 0, d_cx = 0, d_cy = 0, d_t1 = 0, d_t2 = 0, d_log_sigma = 0;
     if (flat1 && flat2) {

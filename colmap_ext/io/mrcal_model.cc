@@ -154,6 +154,12 @@ Camera CameraFromMrcalLens(const MrcalLens& lens, uint64_t width, uint64_t heigh
   return camera;
 }
 
+std::array<double, 6> RtFromRigid(const Rigid3d& b_from_a) {
+  const Eigen::AngleAxisd aa(b_from_a.rotation.normalized());
+  const Eigen::Vector3d r = aa.angle() * aa.axis();
+  return {r[0], r[1], r[2], b_from_a.translation[0], b_from_a.translation[1], b_from_a.translation[2]};
+}
+
 MrcalCameraModelFile ReadMrcalCameraModel(const std::filesystem::path& path) {
   std::unique_ptr<mrcal_cameramodel_t, CameraModelDeleter> model(
       mrcal_read_cameramodel_file(path.c_str()));
@@ -188,10 +194,8 @@ void WriteMrcalCameraModel(const Camera& camera, const Rigid3d& cam_from_ref,
   // the format is a Python dict literal, written here at full precision and
   // read back by mrcal's parser in the tests.
   const MrcalLens lens = MrcalLensFromCamera(camera);
-  const Eigen::AngleAxisd aa(cam_from_ref.rotation.normalized());
-  const Eigen::Vector3d r = aa.angle() * aa.axis();
-  const std::vector<double> extrinsics = {r[0], r[1], r[2], cam_from_ref.translation[0],
-                                          cam_from_ref.translation[1], cam_from_ref.translation[2]};
+  const std::array<double, 6> rt = RtFromRigid(cam_from_ref);
+  const std::vector<double> extrinsics(rt.begin(), rt.end());
   const auto list = [](std::ostream& out, const std::vector<double>& values) {
     out << "[ ";
     for (const double v : values) out << v << ", ";

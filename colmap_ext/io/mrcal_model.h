@@ -78,6 +78,9 @@ struct MrcalCameraModelFile {
   Rigid3d cam_from_ref;  // mrcal's "extrinsics" (rt_cam_ref)
 };
 
+// mrcal's pose vector of b_from_a: Rodrigues rotation, then translation.
+std::array<double, 6> RtFromRigid(const Rigid3d& b_from_a);
+
 // Reads a .cameramodel with mrcal's parser. Throws InputError naming the file.
 MrcalCameraModelFile ReadMrcalCameraModel(const std::filesystem::path& path);
 // Writes at full precision (mrcal's writer keeps 6 decimals), atomically;

@@ -89,11 +89,7 @@ MrcalBoardSolve MrcalBoardSolveOf(const std::vector<CalibrationView>& views,
       block[3 * k + 2] = 1.0;
       if (pool_to_point) (*pool_to_point)[f][k] = static_cast<int>(i);
     }
-    const Rigid3d cam_from_board = cam_from_target[f] * target_from_board;
-    const Eigen::AngleAxisd aa(cam_from_board.rotation.normalized());
-    const Eigen::Vector3d r = aa.angle() * aa.axis();
-    solve.frames_rt_toref.push_back(
-        {r[0], r[1], r[2], cam_from_board.translation[0], cam_from_board.translation[1], cam_from_board.translation[2]});
+    solve.frames_rt_toref.push_back(RtFromRigid(cam_from_target[f] * target_from_board));
   }
   return solve;
 }

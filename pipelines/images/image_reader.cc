@@ -59,10 +59,6 @@ Camera NewCamera(const ImageReaderOptions& options, int width, int height) {
   return camera;
 }
 
-}  // namespace
-
-namespace {
-
 // How the existing image's camera differs from what the options would give
 // it in this import, or "" where it does not.
 std::string ImportDifference(const Camera& camera, const ImageReaderOptions& options, const std::string& folder,
