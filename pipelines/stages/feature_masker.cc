@@ -31,10 +31,12 @@ namespace {
 
 // The features a mask starts from: those feature_extractor made, kept
 // aside at the first masking (so that another mask can start from them
-// again). Throws naming the image when the two tables disagree.
-void FeaturesBeforeMasking(const FeatureMaskerOptions& options, const DatabaseImage& image, Database* database,
+// again). True where they were kept before (the image was masked), false
+// where they are the image's current features. Throws naming the image
+// when the two tables disagree.
+bool FeaturesBeforeMasking(const FeatureMaskerOptions& options, const DatabaseImage& image, Database* database,
                            FeatureKeypoints* keypoints, FeatureDescriptors* descriptors) {
-  if (database->ReadUnmaskedFeatures(image.image_id, keypoints, descriptors)) return;
+  if (database->ReadUnmaskedFeatures(image.image_id, keypoints, descriptors)) return true;
   *keypoints = database->ReadKeypoints(image.image_id);
   *descriptors = database->ReadDescriptors(image.image_id);
   if (static_cast<size_t>(descriptors->rows()) != keypoints->size()) {
@@ -43,6 +45,7 @@ void FeaturesBeforeMasking(const FeatureMaskerOptions& options, const DatabaseIm
                      std::to_string(descriptors->rows()) + " descriptors");
   }
   database->WriteUnmaskedFeatures(image.image_id, *keypoints, *descriptors);
+  return false;
 }
 
 bool SameKeypoints(const FeatureKeypoints& a, const FeatureKeypoints& b) {
@@ -58,7 +61,7 @@ void MaskImage(const FeatureMaskerOptions& options, const DatabaseImage& image,
   summary->num_markers += static_cast<int64_t>(markers.size());
   FeatureKeypoints keypoints;
   FeatureDescriptors descriptors;
-  FeaturesBeforeMasking(options, image, database, &keypoints, &descriptors);
+  const bool masked_before = FeaturesBeforeMasking(options, image, database, &keypoints, &descriptors);
   FeatureKeypoints kept_keypoints;
   std::vector<Eigen::Index> kept;
   for (size_t k = 0; k < keypoints.size(); ++k) {
@@ -78,7 +81,7 @@ void MaskImage(const FeatureMaskerOptions& options, const DatabaseImage& image,
     LOG(WARNING) << image.name << ": no " << options.dictionary << " markers; all its features are removed";
   }
   // Unchanged (the same mask again): its matches stay valid.
-  if (SameKeypoints(kept_keypoints, database->ReadKeypoints(image_id))) return;
+  if (SameKeypoints(kept_keypoints, masked_before ? database->ReadKeypoints(image_id) : keypoints)) return;
   FeatureDescriptors kept_descriptors(static_cast<Eigen::Index>(kept.size()), 128);
   for (size_t r = 0; r < kept.size(); ++r) kept_descriptors.row(static_cast<Eigen::Index>(r)) = descriptors.row(kept[r]);
   database->WriteKeypoints(image_id, kept_keypoints);
