@@ -9,6 +9,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <opencv2/imgproc.hpp>
+
 #include "colmap_ext/util/string_utils.h"
 
 namespace fs = std::filesystem;
@@ -96,6 +98,30 @@ const char* const kThreeFaceTargetYaml = R"(target:
   quiet_zone_modules: 1
   dots: {seed: 11, r_min: 0.0015, r_max: 0.009, coverage: 0.5, gray_min: 20, gray_max: 110, edge_margin: 0.004}
 )";
+
+cv::Mat ClutteredScene(int width, int height, uint64_t seed) {
+  cv::Mat scene(height, width, CV_8UC1, cv::Scalar(110));
+  cv::RNG rng(seed);
+  const int num_shapes = width * height / 1500;
+  for (int i = 0; i < num_shapes; ++i) {
+    const cv::Point centre(rng.uniform(0, width), rng.uniform(0, height));
+    const cv::Scalar gray(rng.uniform(20, 240));
+    switch (i % 3) {
+      case 0:
+        cv::rectangle(scene, cv::Rect(centre, cv::Size(rng.uniform(5, 120), rng.uniform(5, 80))), gray, cv::FILLED);
+        break;
+      case 1:
+        cv::ellipse(scene, centre, cv::Size(rng.uniform(5, 70), rng.uniform(5, 40)), rng.uniform(0, 180), 0, 360,
+                    gray, cv::FILLED);
+        break;
+      default:
+        cv::line(scene, centre, centre + cv::Point(rng.uniform(-150, 150), rng.uniform(-150, 150)), gray,
+                 rng.uniform(1, 6));
+    }
+  }
+  cv::GaussianBlur(scene, scene, cv::Size(), 1.0);
+  return scene;
+}
 
 }  // namespace testing
 }  // namespace portcal

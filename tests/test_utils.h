@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <random>
 #include <string>
@@ -51,6 +52,11 @@ struct CommandResult {
 CommandResult RunCommand(const std::string& command);
 
 std::string ReadFileToString(const std::filesystem::path& path);
+
+// Random rectangles, ellipses and lines overlapping on gray, blurred by 1
+// px, as the shared textured renders look: an image with many
+// junction-like spots and no chessboard.
+cv::Mat ClutteredScene(int width, int height, uint64_t seed);
 
 // The `target:` block of a synthesize config for the shared sets' 3-D
 // target: two faces folded at 120 deg, dots, ArUco markers 0 and 1 of

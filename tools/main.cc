@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/memory.h"
 #include "colmap_ext/util/progress.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
@@ -91,6 +92,7 @@ void HandleSignal(int signal) {
 
 int main(int argc, char** argv) {
   portcal::InitializeLogging(argv[0]);
+  portcal::KeepImageBuffersInTheHeap();
   std::signal(SIGINT, HandleSignal);
   std::signal(SIGTERM, HandleSignal);
   if (argc >= 3 && std::strcmp(argv[1], "help") == 0) {

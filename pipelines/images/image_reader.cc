@@ -39,7 +39,9 @@ std::vector<std::string> ListImages(const fs::path& dir) {
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
     if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".tif" || ext == ".tiff" ||
         ext == ".bmp") {
-      names.push_back(fs::relative(entry.path(), dir).generic_string());
+      // Lexically: a symlinked image keeps its link's name (fs::relative would
+      // resolve the link and name the target's path).
+      names.push_back(entry.path().lexically_relative(dir).generic_string());
     }
   }
   std::sort(names.begin(), names.end());

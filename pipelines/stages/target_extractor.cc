@@ -1,12 +1,16 @@
 #include "pipelines/stages/target_extractor.h"
 
 #include <opencv2/imgcodecs.hpp>
+#include <map>
+#include <mutex>
 #include <sstream>
+#include <tuple>
 
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/parallel.h"
 #include "database/database.h"
+#include "database/new_database_file.h"
 #include "database/stage_run.h"
 
 namespace fs = std::filesystem;
@@ -42,6 +46,7 @@ struct ImageResult {
   bool found = false;
   bool symmetric = false;  // chessboard that looks the same turned by 180 deg
   std::string reason;
+  std::string note;  // found, with corners left out: why
   std::vector<TargetObservation> observations;
   std::vector<MarkerDetection> markers;
 };
@@ -52,6 +57,7 @@ void Detect(const cv::Mat& gray, const TargetExtractorOptions& o, ImageResult* r
     result->found = d.found;
     result->reason = d.reason;
     result->symmetric = d.symmetric;
+    result->note = d.note;
     if (!d.found) return;
     for (size_t i = 0; i < d.corners.size(); ++i) {
       if (!d.corners[i]) continue;
@@ -86,11 +92,47 @@ std::string OptionsText(const TargetExtractorOptions& o) {
   return out.str();
 }
 
+// The status of an image where the target was found, e.g. "found; 2 of 48
+// corners left out (2 no contrast)".
+std::string FoundText(const ImageResult& result) {
+  std::string text = "found";
+  if (result.symmetric) text += " (symmetric board: order may be rotated by 180 deg)";
+  if (!result.note.empty()) text += "; " + result.note;
+  return text;
+}
+
+// Images that are to share a camera (--ImageReader.single_camera, or
+// single_camera_per_folder) must have its size: the first image of another
+// size stops the run at once, before the others are detected.
+class SharedSizes {
+ public:
+  explicit SharedSizes(const ImageReaderOptions& reader) : reader_(reader) {}
+
+  void Check(const std::string& name, int width, int height) {
+    if (!reader_.single_camera && !reader_.single_camera_per_folder) return;
+    const std::string group = reader_.single_camera ? "" : fs::path(name).parent_path().string();
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const auto [it, inserted] = first_.try_emplace(group, name, width, height);
+    const auto& [first_name, first_width, first_height] = it->second;
+    if (inserted || (first_width == width && first_height == height)) return;
+    throw InputError(name + ": " + std::to_string(width) + "x" + std::to_string(height) + ", but " +
+                     first_name + " is " + std::to_string(first_width) + "x" + std::to_string(first_height) +
+                     (reader_.single_camera ? " and --ImageReader.single_camera 1 gives them one camera"
+                                            : " and --ImageReader.single_camera_per_folder 1 gives them one camera"));
+  }
+
+ private:
+  const ImageReaderOptions& reader_;
+  std::mutex mutex_;
+  std::map<std::string, std::tuple<std::string, int, int>> first_;
+};
+
 // Reads and detects every image on options.num_threads threads; the first
 // error (or a cancel) stops them all and is rethrown.
 std::vector<ImageResult> DetectAll(const TargetExtractorOptions& options, const std::vector<std::string>& names,
                                    ProgressSink& progress) {
   std::vector<ImageResult> results(names.size());
+  SharedSizes sizes(options.reader);
   progress.Begin("target_extractor: images", names.size());
   ParallelFor(names.size(), options.num_threads, [&](size_t i) {
     ImageResult& result = results[i];
@@ -100,6 +142,7 @@ std::vector<ImageResult> DetectAll(const TargetExtractorOptions& options, const 
       result.readable = true;
       result.width = gray.cols;
       result.height = gray.rows;
+      sizes.Check(names[i], gray.cols, gray.rows);
       Detect(gray, options, &result);
     }
     progress.Advance(1);
@@ -139,11 +182,16 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
   const std::vector<std::string> names = ListImages(options.image_path);
   LOG(INFO) << "target_extractor: " << names.size() << " images, " << options.target_type;
 
+  // What can fail without the images fails first: the database opens (a
+  // directory, a corrupt file) and can be written (a lock held elsewhere).
+  NewDatabaseFile new_file(options.database_path);
+  Database database(options.database_path, Database::OpenMode::kCreate);
+  { Transaction probe = database.BeginTransaction(); }
+
   // Detection in parallel, outside the database transaction.
   const std::vector<ImageResult> results = DetectAll(options, names, progress);
 
   // One transaction: images, cameras, observations, status, log.
-  Database database(options.database_path, Database::OpenMode::kCreate);
   Transaction transaction = database.BeginTransaction();
   TargetExtractorSummary summary;
   SharedCameras shared_cameras;
@@ -163,9 +211,8 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
     status.target = target;
     status.found = result.found;
     status.num_points = static_cast<int>(observations.size());
-    status.reason = result.found ? (result.symmetric ? "found (symmetric board: order may be rotated by 180 deg)"
-                                                     : "found")
-                                 : result.reason;
+    status.reason = result.found ? FoundText(result) : result.reason;
+    if (result.found && !result.note.empty()) LOG(INFO) << result.name << ": " << result.note;
     database.WriteTargetDetectionStatus(image_id, status);
     ++summary.num_images;
     summary.num_found += result.found;
@@ -176,6 +223,7 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
                          {"points", summary.num_points}});
   CancelFlag::ThrowIfRequested();
   transaction.Commit();
+  new_file.Keep();
   LOG(INFO) << "target_extractor: target found in " << summary.num_found << " of "
             << summary.num_images << " images, " << summary.num_points << " corners";
   return summary;

@@ -1,6 +1,8 @@
 #include "pipelines/target/chessboard_detector.h"
 
+#include <map>
 #include <opencv2/calib3d.hpp>
+#include <set>
 #include <opencv2/imgproc.hpp>
 
 #include "colmap_ext/util/error.h"
@@ -13,40 +15,65 @@ void ChessboardDetectionOptions::Check() const {
   if (coarse_max_image_size < 0) {
     throw OptionError("--Target.coarse_max_image_size", std::to_string(coarse_max_image_size), ">= 0");
   }
-  if (!(min_refined_fraction > 0 && min_refined_fraction <= 1)) {
-    throw OptionError("--Target.min_refined_fraction", std::to_string(min_refined_fraction), "(0, 1]");
+  if (!(min_x_corner_fraction >= 0 && min_x_corner_fraction <= 1)) {
+    throw OptionError("--Target.min_x_corner_fraction", std::to_string(min_x_corner_fraction), "[0, 1]");
+  }
+  if (min_refined_corners < 4) {
+    throw OptionError("--Target.min_refined_corners", std::to_string(min_refined_corners), ">= 4");
   }
   refinement.Check();
 }
 
 namespace {
 
-// The board's corners in OpenCV's pixels of the image scaled by *scale.
-// OpenCV's classic detector first, on the halved image and then at full
-// resolution: on the real views it finds boards the SB detector misses, an
-// order of magnitude faster (docs/benchmarks.md), and its fast check turns
-// plain images without the board away quickly (textured ones pass it and
-// stay slow). Only then the SB detector (exhaustive) at each scale, so that
-// its cost falls on the images the classic one misses.
-bool FindCoarse(const cv::Mat& gray, const ChessboardDetectionOptions& options, std::vector<cv::Point2f>* corners,
-                double* scale) {
-  const cv::Size pattern(options.cols, options.rows);
-  std::vector<std::pair<double, cv::Mat>> levels;
+// The image halved (a power of two: INTER_AREA is then a plain box average,
+// several times faster than by any other factor) until its longer side is
+// at most `max_size`, with the factor; the image itself when it fits.
+std::pair<double, cv::Mat> CoarseLevel(const cv::Mat& gray, int max_size) {
   const int longer = std::max(gray.cols, gray.rows);
-  if (options.coarse_max_image_size > 0 && longer > options.coarse_max_image_size) {
-    // Halved until it fits: INTER_AREA by a power of two is a plain box
-    // average, several times faster than by any other factor.
-    double factor = 1.0;
-    while (longer * factor > options.coarse_max_image_size) factor /= 2;
-    cv::Mat small;
-    cv::resize(gray, small, cv::Size(), factor, factor, cv::INTER_AREA);
-    levels.emplace_back(factor, small);
+  if (max_size <= 0 || longer <= max_size) return {1.0, gray};
+  double factor = 1.0;
+  while (longer * factor > max_size) factor /= 2;
+  cv::Mat small;
+  cv::resize(gray, small, cv::Size(), factor, factor, cv::INTER_AREA);
+  return {factor, small};
+}
+
+// The board's corners in OpenCV's pixels of the image scaled by *scale; or
+// false with the reason. First the X-junction count on the coarse level:
+// an image without enough of them is not searched. Then OpenCV's classic
+// detector on the coarse level without its fast check (which misses small
+// boards there and which the count replaces), at full resolution with it;
+// the classic detector finds boards on the real views that the SB detector
+// misses, an order of magnitude faster (docs/benchmarks.md). Only then the
+// SB detector (exhaustive) at each scale, so that its cost falls on the
+// images the classic one misses.
+bool FindCoarse(const cv::Mat& gray, const ChessboardDetectionOptions& options, std::vector<cv::Point2f>* corners,
+                double* scale, std::string* reason) {
+  const cv::Size pattern(options.cols, options.rows);
+  std::vector<std::pair<double, cv::Mat>> levels = {CoarseLevel(gray, options.coarse_max_image_size)};
+  if (levels.front().first < 1) levels.emplace_back(1.0, gray);
+  const int num_crossings = std::max(options.cols - 2, 1) * std::max(options.rows - 2, 1);
+  const int needed = static_cast<int>(std::ceil(options.min_x_corner_fraction * num_crossings));
+  if (needed > 0) {
+    const int count = CountXCorners(levels.front().second, {}, needed);
+    if (count < needed) {
+      *reason = "no " + std::to_string(options.cols) + "x" + std::to_string(options.rows) +
+                " inner-corner chessboard in view (" + std::to_string(count) +
+                " chessboard-like grid junctions, fewer than " + std::to_string(needed) + ")";
+      return false;
+    }
   }
-  levels.emplace_back(1.0, gray);
-  for (const auto& [factor, image] : levels) {
-    if (cv::findChessboardCorners(image, pattern, *corners,
-                                  cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK)) {
-      *scale = factor;
+  // On the coarse level a global threshold first (a few ms where the
+  // adaptive one took up to 0.2 s on a render; docs/benchmarks.md), then
+  // the adaptive one; at full size the adaptive one with the fast check.
+  const int adaptive = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE;
+  std::vector<std::pair<size_t, int>> attempts = {{0, cv::CALIB_CB_NORMALIZE_IMAGE},
+                                                  {0, adaptive | (needed > 0 ? 0 : cv::CALIB_CB_FAST_CHECK)}};
+  if (levels.size() > 1) attempts.emplace_back(1, adaptive | cv::CALIB_CB_FAST_CHECK);
+  for (const auto& [level, flags] : attempts) {
+    if (cv::findChessboardCorners(levels[level].second, pattern, *corners, flags)) {
+      *scale = levels[level].first;
       return true;
     }
   }
@@ -56,6 +83,8 @@ bool FindCoarse(const cv::Mat& gray, const ChessboardDetectionOptions& options, 
       return true;
     }
   }
+  *reason = "no " + std::to_string(options.cols) + "x" + std::to_string(options.rows) +
+            " inner-corner chessboard found";
   return false;
 }
 
@@ -90,6 +119,31 @@ bool FarEndIsBlack(const cv::Mat& gray, const std::vector<Eigen::Vector2d>& corn
   return FirstSquareGray(gray, reversed, cols) < FirstSquareGray(gray, corners, cols);
 }
 
+// "3 of 48 corners left out (2 no contrast, 1 window beyond the image)".
+std::string LeftOutNote(const std::vector<CornerFailure>& failures) {
+  std::map<CornerFailure, int> counts;
+  for (const CornerFailure failure : failures) {
+    if (failure != CornerFailure::kNone) ++counts[failure];
+  }
+  int total = 0;
+  std::string reasons;
+  for (const auto& [failure, count] : counts) {
+    reasons += (reasons.empty() ? "" : ", ") + std::to_string(count) + " " + CornerFailureText(failure);
+    total += count;
+  }
+  return std::to_string(total) + " of " + std::to_string(failures.size()) + " corners left out" +
+         (reasons.empty() ? "" : " (" + reasons + ")");
+}
+
+// cv::cornerSubPix at full resolution on corners in COLMAP pixels.
+void PolishQuickly(const cv::Mat& gray, std::vector<Eigen::Vector2d>* corners) {
+  std::vector<cv::Point2f> points;
+  for (const Eigen::Vector2d& c : *corners) points.emplace_back(c.x() - 0.5, c.y() - 0.5);
+  cv::cornerSubPix(gray, points, cv::Size(2, 2), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 10, 0.01));
+  for (size_t i = 0; i < points.size(); ++i) (*corners)[i] = Eigen::Vector2d(points[i].x + 0.5, points[i].y + 0.5);
+}
+
 }  // namespace
 
 ChessboardDetection DetectChessboard(const cv::Mat& gray, const ChessboardDetectionOptions& options) {
@@ -98,12 +152,7 @@ ChessboardDetection DetectChessboard(const cv::Mat& gray, const ChessboardDetect
   ChessboardDetection detection;
   std::vector<cv::Point2f> coarse;
   double scale = 1.0;
-  const bool found = FindCoarse(gray, options, &coarse, &scale);
-  if (!found) {
-    detection.reason = "no " + std::to_string(options.cols) + "x" + std::to_string(options.rows) +
-                       " inner-corner chessboard found";
-    return detection;
-  }
+  if (!FindCoarse(gray, options, &coarse, &scale, &detection.reason)) return detection;
   // Back to full-resolution COLMAP pixels: OpenCV's (0, 0) is the centre of
   // the top-left pixel, also in the downscaled image.
   std::vector<Eigen::Vector2d> start;
@@ -126,21 +175,35 @@ ChessboardDetection DetectChessboard(const cv::Mat& gray, const ChessboardDetect
   detection.symmetric = squares % 2 == 0;
   if (FarEndIsBlack(gray, start, options.cols)) std::reverse(start.begin(), start.end());
 
-  const auto refined = RefineChessboardCorners(gray, start, options.cols, options.rows, options.refinement);
-  detection.corners.resize(refined.size());
-  for (size_t i = 0; i < refined.size(); ++i) {
-    if (refined[i]) {
-      detection.corners[i] = refined[i]->xy;
-      ++detection.num_refined;
-    }
+  if (!options.precise_fit) {
+    PolishQuickly(gray, &start);
+    for (const Eigen::Vector2d& corner : start) detection.corners.emplace_back(corner);
+    detection.num_refined = static_cast<int>(start.size());
+    detection.found = true;
+    return detection;
   }
-  const int needed = static_cast<int>(std::ceil(options.min_refined_fraction * refined.size()));
-  if (detection.num_refined < needed) {
-    detection.reason = "only " + std::to_string(detection.num_refined) + " of " +
-                       std::to_string(refined.size()) + " corners refined (blur, low contrast?)";
+  // The coarse corners are as good as their level's pixels: a corner may
+  // move by the refinement's maximum in those pixels.
+  CornerRefinementOptions refinement = options.refinement;
+  refinement.max_shift_px /= scale;
+  std::vector<CornerFailure> failures;
+  const auto refined = RefineChessboardCorners(gray, start, options.cols, options.rows, refinement, &failures);
+  detection.corners.resize(refined.size());
+  std::set<int> rows, cols;
+  for (size_t i = 0; i < refined.size(); ++i) {
+    if (!refined[i]) continue;
+    detection.corners[i] = refined[i]->xy;
+    ++detection.num_refined;
+    rows.insert(static_cast<int>(i) / options.cols);
+    cols.insert(static_cast<int>(i) % options.cols);
+  }
+  const std::string left_out = LeftOutNote(failures);
+  if (detection.num_refined < options.min_refined_corners || rows.size() < 2 || cols.size() < 2) {
+    detection.reason = "board found but too few corners for a pose: " + left_out;
     return detection;
   }
   detection.found = true;
+  if (detection.num_refined < static_cast<int>(refined.size())) detection.note = left_out;
   return detection;
 }
 

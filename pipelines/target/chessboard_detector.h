@@ -1,6 +1,7 @@
-// Chessboard detection: coarse corners from OpenCV on a downscaled image
-// (findChessboardCorners with its fast check, then findChessboardCornersSB
-// as a fallback), put in portcal's canonical order (right-handed, corner 0's
+// Chessboard detection: a count of X-junctions first turns away images that
+// cannot hold the board (x_corner_count.h); coarse corners from OpenCV on a
+// downscaled image (findChessboardCorners, then at full resolution, then
+// findChessboardCornersSB as a fallback), put in portcal's canonical order (right-handed, corner 0's
 // outer diagonal square black), then refined at full resolution by the
 // ideal-pattern fit (corner_refinement.h).
 #pragma once
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "pipelines/target/corner_refinement.h"
+#include "pipelines/target/x_corner_count.h"
 
 namespace portcal {
 
@@ -20,8 +22,19 @@ struct ChessboardDetectionOptions {
   // Coarse detection runs on the image halved (once or more) to at most
   // this many pixels on its longer side (0: full resolution only).
   int coarse_max_image_size = 1000;
-  // Views with fewer refined corners than this fraction are rejected.
-  double min_refined_fraction = 0.9;
+  // Images with fewer grid junctions (x_corner_count.h; at that scale or
+  // half of it) than this fraction of the board's (cols - 2) (rows - 2)
+  // are not searched (0: all are). On the shared views boards count 0.54
+  // to 1.0 of theirs, textured scenes without a board at most 0.03 of a
+  // 10 x 7 board's (docs/benchmarks.md).
+  double min_x_corner_fraction = 0.25;
+  // A view keeps the corners that refined; it is refused with fewer than
+  // this many, or when they lie on one row or one column (no pose then).
+  int min_refined_corners = 6;
+  // false: the coarse corners are only polished by cv::cornerSubPix (5 x 5
+  // window at full resolution): tenths of a pixel at video rate, for live
+  // views; true: the ideal-pattern fit (hundredths, several times slower).
+  bool precise_fit = true;
   CornerRefinementOptions refinement;
   void Check() const;  // throws OptionError
 };
@@ -37,6 +50,9 @@ struct ChessboardDetection {
   // squares in total): the order may be the rotated one.
   bool symmetric = false;
   int num_refined = 0;
+  // Found with corners left out: how many and why, e.g. "3 of 48 corners
+  // left out (2 no contrast, 1 window beyond the image)".
+  std::string note;
 };
 
 ChessboardDetection DetectChessboard(const cv::Mat& gray, const ChessboardDetectionOptions& options);

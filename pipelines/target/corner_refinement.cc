@@ -17,12 +17,26 @@ void CornerRefinementOptions::Check() const {
     throw OptionError("min_window_px", std::to_string(min_window_px), ">= 2 and <= max_window_px");
   }
   if (!(max_shift_px > 0)) throw OptionError("max_shift_px", std::to_string(max_shift_px), "> 0");
+  if (!(max_shift_fraction >= 0 && max_shift_fraction < 0.5)) {
+    throw OptionError("max_shift_fraction", std::to_string(max_shift_fraction), "[0, 0.5)");
+  }
   if (max_num_iterations < 1) {
     throw OptionError("max_num_iterations", std::to_string(max_num_iterations), ">= 1");
   }
   if (!(corner_tolerance_px > 0)) {
     throw OptionError("corner_tolerance_px", std::to_string(corner_tolerance_px), "> 0");
   }
+}
+
+const char* CornerFailureText(CornerFailure failure) {
+  switch (failure) {
+    case CornerFailure::kNone: return "refined";
+    case CornerFailure::kNearImageBorder: return "window beyond the image";
+    case CornerFailure::kNoContrast: return "no contrast";
+    case CornerFailure::kDiverged: return "fit diverged";
+    case CornerFailure::kMovedTooFar: return "moved too far from the detection";
+  }
+  return "unknown";
 }
 
 namespace {
@@ -57,25 +71,50 @@ double EdgeAngle(const std::vector<Eigen::Vector2d>& corners, int cols, int rows
 
 struct WindowPixel {
   double x, y, gray;  // the pixel's centre (COLMAP pixels) and its gray
+  CornerPatternModel::Region region = CornerPatternModel::kCorner;  // for kArea
 };
 
 using Vector7d = Eigen::Matrix<double, 7, 1>;
 using Matrix7d = Eigen::Matrix<double, 7, 7>;
 
-// J^T J, J^T r and the cost at p.
-double Linearise(const std::vector<WindowPixel>& window, const Vector7d& p, int samples_per_axis, Matrix7d* jtj,
-                 Vector7d* jtr) {
-  const CornerPatternModel model(p.data(), samples_per_axis);
+// How the model is integrated over each pixel in a fit.
+struct Integration {
+  bool area = false;  // false: the pixel's centre only
+  PixelRule corner_rule = PixelRule::Midpoint(4);  // where both edges vary over a pixel
+};
+
+// J^T J, J^T r and the cost at p. A flat pixel's gradient has two
+// entries, 1 for the mean and its sign for the contrast: their sums are
+// gathered apart, which saves a rank-one update for most pixels of a sharp
+// corner's window.
+double Linearise(const std::vector<WindowPixel>& window, const Vector7d& p, const Integration& integration,
+                 Matrix7d* jtj, Vector7d* jtr) {
+  const CornerPatternModel model(p.data(), integration.area ? integration.corner_rule : PixelRule::Midpoint(1));
   jtj->setZero();
   jtr->setZero();
   double cost = 0;
+  double flat_count = 0, flat_sign_sum = 0, flat_residual_sum = 0, flat_signed_residual_sum = 0;
   Vector7d gradient;
   for (const WindowPixel& pixel : window) {
-    const double r = model.Evaluate(pixel.x, pixel.y, gradient.data()) - pixel.gray;
+    const double value = integration.area ? model.EvaluateArea(pixel.x, pixel.y, pixel.region, gradient.data())
+                                          : model.Evaluate(pixel.x, pixel.y, gradient.data());
+    const double r = value - pixel.gray;
+    cost += 0.5 * r * r;
+    if (integration.area && pixel.region == CornerPatternModel::kFlat) {
+      flat_count += 1;
+      flat_sign_sum += gradient[5];
+      flat_residual_sum += r;
+      flat_signed_residual_sum += r * gradient[5];
+      continue;
+    }
     jtj->selfadjointView<Eigen::Lower>().rankUpdate(gradient);
     *jtr += r * gradient;
-    cost += 0.5 * r * r;
   }
+  (*jtj)(4, 4) += flat_count;
+  (*jtj)(5, 4) += flat_sign_sum;
+  (*jtj)(5, 5) += flat_count;  // sign^2
+  (*jtr)(4) += flat_residual_sum;
+  (*jtr)(5) += flat_signed_residual_sum;
   *jtj = jtj->selfadjointView<Eigen::Lower>();
   return cost;
 }
@@ -88,11 +127,11 @@ double Linearise(const std::vector<WindowPixel>& window, const Vector7d& p, int 
 // once: most steps are taken, and their cost would otherwise be evaluated
 // twice. Returns the final cost, or a negative value when the fit broke
 // down (non-finite).
-double FitCornerPattern(const std::vector<WindowPixel>& window, int samples_per_axis, int max_num_iterations,
-                        double corner_tolerance_px, Vector7d* p) {
+double FitCornerPattern(const std::vector<WindowPixel>& window, const Integration& integration,
+                        int max_num_iterations, double corner_tolerance_px, Vector7d* p) {
   Matrix7d jtj, trial_jtj;
   Vector7d jtr, trial_jtr;
-  double cost = Linearise(window, *p, samples_per_axis, &jtj, &jtr);
+  double cost = Linearise(window, *p, integration, &jtj, &jtr);
   double radius = 1e4, decrease_factor = 2;
   for (int iteration = 0; iteration < max_num_iterations; ++iteration) {
     if (!std::isfinite(cost)) return -1;
@@ -103,7 +142,7 @@ double FitCornerPattern(const std::vector<WindowPixel>& window, int samples_per_
     if (!step.allFinite()) return -1;
     if (step.norm() <= 1e-8 * (p->norm() + 1e-8)) break;
     const Vector7d trial = *p + step;
-    const double trial_cost = Linearise(window, trial, samples_per_axis, &trial_jtj, &trial_jtr);
+    const double trial_cost = Linearise(window, trial, integration, &trial_jtj, &trial_jtr);
     const double model_decrease = -(jtr.dot(step) + 0.5 * step.dot(jtj * step));
     const double rho = model_decrease > 0 ? (cost - trial_cost) / model_decrease : -1;
     if (std::isfinite(trial_cost) && rho > 1e-3) {
@@ -124,18 +163,56 @@ double FitCornerPattern(const std::vector<WindowPixel>& window, int samples_per_
   return std::isfinite(cost) ? cost : -1;
 }
 
+// The fit integrating over each pixel's area, from p near the minimum.
+// Which edges vary over which pixel is decided first (with a margin for the
+// corner's move) and kept through the fit, so that the model stays smooth;
+// should the fit end where a pixel's region no longer holds, it is decided
+// again and the fit rerun. Where both edges vary over a pixel the product
+// of their erfs is averaged by Gauss-Legendre while the edges are smooth at
+// the pixel's scale, and by 8 x 8 sub-samples when they are sharp (a few
+// pixels only then).
+double FitOverPixelAreas(const CornerRefinementOptions& options, std::vector<WindowPixel>* window, Vector7d* p) {
+  const CornerPatternModel start(p->data());
+  const double span = start.PixelSpan();
+  const Integration integration{true, span <= 1.5 ? PixelRule::GaussLegendre(3)
+                                      : span <= 3 ? PixelRule::GaussLegendre(5)
+                                                  : PixelRule::Midpoint(8)};
+  constexpr double margin = 0.5;  // erf's units: sqrt(2) sigma pixels
+  for (WindowPixel& pixel : *window) pixel.region = start.Classify(pixel.x, pixel.y, margin);
+  double cost = FitCornerPattern(*window, integration, options.max_num_iterations, options.corner_tolerance_px, p);
+  for (int refit = 0; refit < 2 && cost >= 0; ++refit) {
+    const CornerPatternModel end(p->data());
+    bool changed = false;
+    for (WindowPixel& pixel : *window) {
+      if ((end.Classify(pixel.x, pixel.y, 0) & ~pixel.region) == 0) continue;
+      pixel.region = static_cast<CornerPatternModel::Region>(pixel.region | end.Classify(pixel.x, pixel.y, margin));
+      changed = true;
+    }
+    if (!changed) break;
+    cost = FitCornerPattern(*window, integration, options.max_num_iterations, options.corner_tolerance_px, p);
+  }
+  return cost;
+}
+
 }  // namespace
 
 std::optional<RefinedCorner> RefineCorner(const cv::Mat& gray, const Eigen::Vector2d& start,
                                           double half, double normal_angle1, double normal_angle2,
-                                          const CornerRefinementOptions& options) {
+                                          const CornerRefinementOptions& options, CornerFailure* failure) {
   PORTCAL_CHECK(gray.type() == CV_8UC1);
+  CornerFailure unused;
+  if (failure == nullptr) failure = &unused;
+  *failure = CornerFailure::kNone;
+  const auto fail = [failure](CornerFailure why) {
+    *failure = why;
+    return std::nullopt;
+  };
   // Pixel centres (col + 0.5, row + 0.5) within the circular window.
   const int c0 = static_cast<int>(std::floor(start.x() - half));
   const int r0 = static_cast<int>(std::floor(start.y() - half));
   const int c1 = static_cast<int>(std::ceil(start.x() + half));
   const int r1 = static_cast<int>(std::ceil(start.y() + half));
-  if (c0 < 0 || r0 < 0 || c1 >= gray.cols || r1 >= gray.rows) return std::nullopt;
+  if (c0 < 0 || r0 < 0 || c1 >= gray.cols || r1 >= gray.rows) return fail(CornerFailure::kNearImageBorder);
   Vector7d params;
   params << start.x(), start.y(), normal_angle1, normal_angle2, 0, 0, std::log(0.8);
   std::vector<WindowPixel> window;
@@ -151,7 +228,7 @@ std::optional<RefinedCorner> RefineCorner(const cv::Mat& gray, const Eigen::Vect
     }
   }
   const double count = static_cast<double>(window.size());
-  if (count < 12) return std::nullopt;
+  if (count < 12) return fail(CornerFailure::kNearImageBorder);
   // Levels: the mean, and the contrast's sign from the quadrant between the
   // two edge normals.
   params[4] = sum / count;
@@ -160,7 +237,7 @@ std::optional<RefinedCorner> RefineCorner(const cv::Mat& gray, const Eigen::Vect
                             Eigen::Vector2d(std::cos(params[3]), std::sin(params[3])))
                                .normalized();
   params[5] = gray.at<uint8_t>(static_cast<int>(probe.y()), static_cast<int>(probe.x())) - params[4];
-  if (std::abs(params[5]) < 5) return std::nullopt;  // no contrast
+  if (std::abs(params[5]) < 5) return fail(CornerFailure::kNoContrast);
   // Most iterations with the pixel's centre only, the last ones integrating
   // over its area, from there (the blur less the pixel's box, whose
   // variance is 1/12 px^2 across any edge): the same minimum in a fraction
@@ -168,14 +245,14 @@ std::optional<RefinedCorner> RefineCorner(const cv::Mat& gray, const Eigen::Vect
   // sharp edges' curvature, which Gauss-Newton leaves out), so a fit stops
   // once the corner moves by less than a tolerance far below the corners'
   // accuracy.
-  if (FitCornerPattern(window, 1, options.max_num_iterations, 0.01, &params) < 0) return std::nullopt;
-  params[6] = 0.5 * std::log(std::max(std::exp(2 * params[6]) - 1.0 / 12, 0.01));
-  const double final_cost =
-      FitCornerPattern(window, 4, options.max_num_iterations, options.corner_tolerance_px, &params);
-  const Eigen::Vector2d xy(params[0], params[1]);
-  if (final_cost < 0 || !params.allFinite() || (xy - start).norm() > options.max_shift_px) {
-    return std::nullopt;
+  if (FitCornerPattern(window, Integration{}, options.max_num_iterations, 0.01, &params) < 0) {
+    return fail(CornerFailure::kDiverged);
   }
+  params[6] = 0.5 * std::log(std::max(std::exp(2 * params[6]) - 1.0 / 12, 0.01));
+  const double final_cost = FitOverPixelAreas(options, &window, &params);
+  const Eigen::Vector2d xy(params[0], params[1]);
+  if (final_cost < 0 || !params.allFinite()) return fail(CornerFailure::kDiverged);
+  if ((xy - start).norm() > options.max_shift_px) return fail(CornerFailure::kMovedTooFar);
   RefinedCorner corner;
   corner.xy = xy;
   corner.rms_gray = std::sqrt(2 * final_cost / count);
@@ -186,16 +263,20 @@ std::optional<RefinedCorner> RefineCorner(const cv::Mat& gray, const Eigen::Vect
 
 std::vector<std::optional<RefinedCorner>> RefineChessboardCorners(
     const cv::Mat& gray, const std::vector<Eigen::Vector2d>& corners, int cols, int rows,
-    const CornerRefinementOptions& options) {
+    const CornerRefinementOptions& options, std::vector<CornerFailure>* failures) {
   options.Check();
   PORTCAL_CHECK(static_cast<int>(corners.size()) == cols * rows);
   std::vector<std::optional<RefinedCorner>> refined(corners.size());
+  if (failures != nullptr) failures->assign(corners.size(), CornerFailure::kNone);
   for (int index = 0; index < cols * rows; ++index) {
-    const double half = std::clamp(options.window_fraction *
-                                       NearestNeighbourDistance(corners, cols, rows, index),
-                                   options.min_window_px, options.max_window_px);
+    const double neighbour_distance = NearestNeighbourDistance(corners, cols, rows, index);
+    const double half =
+        std::clamp(options.window_fraction * neighbour_distance, options.min_window_px, options.max_window_px);
+    CornerRefinementOptions corner_options = options;
+    corner_options.max_shift_px = std::max(options.max_shift_px, options.max_shift_fraction * neighbour_distance);
     refined[index] = RefineCorner(gray, corners[index], half, EdgeAngle(corners, cols, rows, index, true),
-                                  EdgeAngle(corners, cols, rows, index, false), options);
+                                  EdgeAngle(corners, cols, rows, index, false), corner_options,
+                                  failures != nullptr ? &(*failures)[index] : nullptr);
   }
   return refined;
 }

@@ -5,12 +5,12 @@
 // The model
 //   I(p) = m + a * erf(s1 / (sqrt(2) sigma)) * erf(s2 / (sqrt(2) sigma)),
 //   s_k = n_k . (p - c),  n_k = (cos theta_k, sin theta_k)
-// integrated over each pixel's area (4 x 4 sub-samples), is point-symmetric
-// about the corner c, as the pattern is, so a mismatch in the edge profile
-// does not bias c. It is fitted to the pixels of a window by
-// Levenberg-Marquardt (a fixed-size solver with the model's derivatives
-// written out, colmap_ext/cost/corner_pattern_model.h): c, both edge angles
-// (any perspective), the levels m, a and the blur sigma. Compared with the
+// integrated over each pixel's area, is point-symmetric about the corner c,
+// as the pattern is, so a mismatch in the edge profile does not bias c. It
+// is fitted to the pixels of a window by Levenberg-Marquardt (a fixed-size
+// solver with the model's derivatives written out,
+// colmap_ext/cost/corner_pattern_model.h): c, both edge angles (any
+// perspective), the levels m, a and the blur sigma. Compared with the
 // gradient-orthogonality of cv::cornerSubPix it uses the whole edge profile
 // and does not assume orthogonal edges.
 #pragma once
@@ -30,8 +30,12 @@ struct CornerRefinementOptions {
   double window_fraction = 0.4;
   double min_window_px = 3;
   double max_window_px = 15;
-  // A refined corner further than this from its start is rejected.
+  // A refined corner further than this from its start is rejected; in a
+  // grid, further than this or the fraction of the distance to the nearest
+  // neighbouring corner, whichever is larger (the coarse corners of a
+  // blurred view can be pixels off; the next junction is a square away).
   double max_shift_px = 2.0;
+  double max_shift_fraction = 0.15;
   int max_num_iterations = 50;
   // The fit stops once a step moves the corner by less than this (or the
   // cost by less than 1e-6 of itself).
@@ -46,18 +50,24 @@ struct RefinedCorner {
   double blur_sigma_px = 0;
 };
 
+// Why a corner was not refined.
+enum class CornerFailure { kNone, kNearImageBorder, kNoContrast, kDiverged, kMovedTooFar };
+const char* CornerFailureText(CornerFailure failure);  // e.g. "no contrast"
+
 // Refines one corner from `start` (COLMAP pixels) with a circular window of
 // `half_window_px` and initial edge-normal angles (radians). nullopt when the
-// fit fails.
+// fit fails, with the reason in *failure if given.
 std::optional<RefinedCorner> RefineCorner(const cv::Mat& gray, const Eigen::Vector2d& start,
                                           double half_window_px, double normal_angle1,
-                                          double normal_angle2, const CornerRefinementOptions& options);
+                                          double normal_angle2, const CornerRefinementOptions& options,
+                                          CornerFailure* failure = nullptr);
 
 // Refines corners (COLMAP pixel convention) of a grid of rows x cols inner
 // corners, index r * cols + c, in an 8-bit gray image. nullopt for corners
-// whose fit failed (no contrast, diverged, moved too far).
+// whose fit failed (no contrast, diverged, moved too far), with the reasons
+// in *failures (one per corner, kNone where refined) if given.
 std::vector<std::optional<RefinedCorner>> RefineChessboardCorners(
     const cv::Mat& gray, const std::vector<Eigen::Vector2d>& corners, int cols, int rows,
-    const CornerRefinementOptions& options = {});
+    const CornerRefinementOptions& options = {}, std::vector<CornerFailure>* failures = nullptr);
 
 }  // namespace portcal

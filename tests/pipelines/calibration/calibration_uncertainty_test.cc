@@ -1,5 +1,5 @@
-// Standard deviations that mean something: over 20 renders with different
-// seeds, (estimate - truth) / reported std dev must have an RMS between 0.7
+// Standard deviations that mean something: over 20 renders (40 for the
+// camera) with different seeds, (estimate - truth) / reported std dev must have an RMS between 0.7
 // and 1.4 for every estimated parameter — camera intrinsics, dome
 // decentering, flat-port normal and distance, stereo relative pose.
 #include <gtest/gtest.h>
@@ -22,6 +22,11 @@ namespace portcal {
 namespace {
 
 constexpr int kNumSeeds = 20;
+// The camera's five intrinsics over 40 seeds: with 20 the RMS of a
+// parameter's z-scores has a relative spread of 16 %, and one of five
+// honest parameters lands outside 0.7-1.4 about one run in seven (seen:
+// 0.67 for cy over seeds 1000-1019, 0.78 over 1000-1039).
+constexpr int kNumCameraSeeds = 40;
 
 struct Rendered {
   GroundTruth truth;
@@ -68,6 +73,9 @@ void ExpectHonest(const std::vector<std::string>& names, const std::vector<std::
   }
 }
 
+// The renders carry a lens's blur (0.5 px): without one, the renderer's 4 x 4
+// stratified samples make each sharp edge a staircase no camera shows, which
+// the corner fit's pixel-area model (rightly) does not follow.
 TEST(CalibrationUncertainty, CameraStdDevsAreHonestAcrossSeeds) {
   testing::TempDir dir;
   std::ofstream(dir / "set.yaml") << R"(name: z_scores
@@ -76,10 +84,10 @@ camera: {model: RADIAL, width: 800, height: 600, params: [700.0, 401.3, 298.7, -
 housing: null
 target: {type: chessboard, cols: 8, rows: 6, square_size: 0.025, margin: 0.015}
 poses: {distance: [0.35, 0.8], tilt_max_deg: 45, roll_max_deg: 30}
-render: {spp: 4, noise_sigma: 2.0}
+render: {spp: 4, blur_sigma: 0.5, noise_sigma: 2.0}
 )";
   std::vector<std::vector<double>> z(5);
-  for (int seed = 0; seed < kNumSeeds; ++seed) {
+  for (int seed = 0; seed < kNumCameraSeeds; ++seed) {
     const Rendered r = RenderAndExtract(dir / "set.yaml", dir / ("set" + std::to_string(seed)), 1000 + seed,
                                         "RADIAL", 8, 6, 0.025);
     const CameraCalibrationResult result = CalibrateCamera(
