@@ -34,6 +34,10 @@ int TargetExtractorCommand(int argc, char** argv) {
   cli.Add("Target.squares_y", &options.markers.squares_y, "charuco: squares per column");
   cli.Add("Target.coarse_max_image_size", &options.chessboard.coarse_max_image_size,
           "coarse detection on images downscaled to this size (0: full size)");
+  cli.Add("Target.min_x_corner_fraction", &options.chessboard.min_x_corner_fraction,
+          "images with fewer grid junctions than this fraction of the board's are not searched (0: all are)");
+  cli.Add("Target.min_refined_corners", &options.chessboard.min_refined_corners,
+          "views with fewer refined corners are refused");
   cli.Add("num_threads", &options.num_threads, "threads");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;

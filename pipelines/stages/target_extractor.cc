@@ -1,10 +1,11 @@
 #include "pipelines/stages/target_extractor.h"
 
-#include <opencv2/imgcodecs.hpp>
 #include <map>
 #include <mutex>
 #include <sstream>
 #include <tuple>
+
+#include <opencv2/imgcodecs.hpp>
 
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"

@@ -1,8 +1,9 @@
 #include "pipelines/target/chessboard_detector.h"
 
 #include <map>
-#include <opencv2/calib3d.hpp>
 #include <set>
+
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "colmap_ext/util/error.h"

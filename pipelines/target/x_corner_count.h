@@ -17,6 +17,7 @@
 #pragma once
 
 #include <limits>
+
 #include <opencv2/core.hpp>
 
 namespace portcal {
@@ -25,9 +26,10 @@ struct XCornerCountOptions {
   int ring_radius_px = 3;
   // A junction's response over the ring's spread (1 for an ideal one).
   double min_normalised_response = 0.6;
-  // And at least this response in gray levels: ~12 times the half contrast
-  // of a junction (20 gray levels from dark to light), above what noise of
-  // sigma 17 makes after the 3 x 3 average.
+  // And at least this response (16 times gray levels; an ideal junction
+  // gives ~12 to 16 times half its contrast): flat regions' noise stays
+  // below it. Pixel noise can still pass both tests, which is why only
+  // junctions on a grid are counted.
   double min_response = 20;
   // Two junctions on opposite sides of a third are on a grid line through
   // it when their distances to it, and their sum of offsets, agree within
