@@ -6,10 +6,18 @@
 #include <optional>
 #include <vector>
 
-#include "colmap_ext/cost/erf_pixel_average.h"
-
 namespace portcal {
 namespace {
+
+// Bilinear sample; nullopt outside the image.
+std::optional<double> Sample(const cv::Mat& gray, const Eigen::Vector2d& p) {
+  const double x = p.x(), y = p.y();
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= gray.cols || y0 + 1 >= gray.rows) return std::nullopt;
+  const double fx = x - x0, fy = y - y0;
+  const auto v = [&](int r, int c) { return static_cast<double>(gray.at<uint8_t>(r, c)); };
+  return (1 - fy) * ((1 - fx) * v(y0, x0) + fx * v(y0, x0 + 1)) + fy * ((1 - fx) * v(y0 + 1, x0) + fx * v(y0 + 1, x0 + 1));
+}
 
 // A side's edge in the frame of its first corner: offset along the outward
 // normal as a quadratic in the distance along the side. Lens distortion and
@@ -26,6 +34,39 @@ struct EdgeCurve {
     return (u + (coefficients(1) + 2 * t * coefficients(2)) * n).normalized();
   }
 };
+
+// Least squares with one pass dropping points beyond 3x the median
+// residual (a bit edge or a specular spot).
+std::optional<Eigen::Vector3d> FitEdge(std::vector<Eigen::Vector2d> td, bool quadratic) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (int pass = 0; pass < 2; ++pass) {
+    if (td.size() < (quadratic ? 10u : 5u)) return std::nullopt;
+    const int k = quadratic ? 3 : 2;
+    Eigen::MatrixXd A(td.size(), k);
+    Eigen::VectorXd b(td.size());
+    for (size_t i = 0; i < td.size(); ++i) {
+      A(i, 0) = 1;
+      A(i, 1) = td[i].x();
+      if (quadratic) A(i, 2) = td[i].x() * td[i].x();
+      b(i) = td[i].y();
+    }
+    const Eigen::VectorXd x = A.colPivHouseholderQr().solve(b);
+    c.setZero();
+    c.head(k) = x;
+    if (pass == 1) break;
+    std::vector<double> residuals;
+    for (size_t i = 0; i < td.size(); ++i) residuals.push_back(std::abs((A.row(i) * x)(0) - b(i)));
+    std::vector<double> sorted = residuals;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    const double limit = std::max(0.05, 3.0 * sorted[sorted.size() / 2]);
+    std::vector<Eigen::Vector2d> kept;
+    for (size_t i = 0; i < td.size(); ++i) {
+      if (residuals[i] <= limit) kept.push_back(td[i]);
+    }
+    td.swap(kept);
+  }
+  return c;
+}
 
 std::optional<Eigen::Vector2d> IntersectLines(const Eigen::Vector2d& pa, const Eigen::Vector2d& da,
                                               const Eigen::Vector2d& pb, const Eigen::Vector2d& db) {
@@ -51,117 +92,6 @@ std::optional<Eigen::Vector2d> IntersectCurves(const EdgeCurve& before, double b
   return x;
 }
 
-struct BandPixel {
-  double t, s, gray;  // along the side (over its length), along the outward normal, gray
-};
-
-// The pixels whose centres lie within `half_width` of the side and away
-// from its ends (empty where the band leaves the image).
-std::vector<BandPixel> CollectBand(const cv::Mat& gray, const Eigen::Vector2d& a, const Eigen::Vector2d& u,
-                                   const Eigen::Vector2d& n, double length, double half_width, double end_margin) {
-  std::vector<BandPixel> band;
-  const Eigen::Vector2d b = a + length * u;
-  const double reach = half_width + 1;
-  const int x0 = static_cast<int>(std::floor(std::min(a.x(), b.x()) - reach));
-  const int x1 = static_cast<int>(std::ceil(std::max(a.x(), b.x()) + reach));
-  const int y0 = static_cast<int>(std::floor(std::min(a.y(), b.y()) - reach));
-  const int y1 = static_cast<int>(std::ceil(std::max(a.y(), b.y()) + reach));
-  if (x0 < 0 || y0 < 0 || x1 >= gray.cols || y1 >= gray.rows) return band;
-  for (int y = y0; y <= y1; ++y) {
-    for (int x = x0; x <= x1; ++x) {
-      const Eigen::Vector2d p(x, y);  // OpenCV pixels: the pixel's centre
-      const double t = (p - a).dot(u), s = (p - a).dot(n);
-      if (t < end_margin * length || t > (1 - end_margin) * length || std::abs(s) > half_width) continue;
-      band.push_back({t / length, s, static_cast<double>(gray.at<uint8_t>(y, x))});
-    }
-  }
-  return band;
-}
-
-// The side's edge fitted to the pixels of a band along it: each pixel's gray
-// is m + k * (the mean over the pixel of erf(u)), u = (s - d(t)) / (sqrt(2)
-// sigma), s the pixel centre's offset along the outward normal, t along
-// the side and d(t) the edge's offset (quadratic for a long side). The
-// pixel's area is integrated in closed form (erf_pixel_average.h), the
-// blur fitted: no level is read off a profile's ends, which a blur that
-// reaches the next module would shift. Levenberg-Marquardt with the
-// derivatives written out. Returns d's coefficients in t (pixels).
-std::optional<Eigen::Vector3d> FitEdgeToPixels(const cv::Mat& gray, const Eigen::Vector2d& a, const Eigen::Vector2d& u,
-                                               const Eigen::Vector2d& n, double length, double half_width,
-                                               double end_margin, bool quadratic, double min_contrast) {
-  const std::vector<BandPixel> band = CollectBand(gray, a, u, n, length, half_width, end_margin);
-  if (band.size() < 20) return std::nullopt;
-  // q: c0, c1, c2, m, k, log sigma.
-  Eigen::Matrix<double, 6, 1> q;
-  double dark = 0, light = 0;
-  int num_dark = 0, num_light = 0;
-  for (const BandPixel& p : band) {
-    if (p.s < -0.5 * half_width) {
-      dark += p.gray;
-      ++num_dark;
-    } else if (p.s > 0.5 * half_width) {
-      light += p.gray;
-      ++num_light;
-    }
-  }
-  if (num_dark == 0 || num_light == 0) return std::nullopt;
-  dark /= num_dark;
-  light /= num_light;
-  if (light - dark < min_contrast) return std::nullopt;
-  q << 0, 0, 0, 0.5 * (dark + light), 0.5 * (light - dark), std::log(0.8);
-  const auto linearise = [&](const Eigen::Matrix<double, 6, 1>& at, Eigen::Matrix<double, 6, 6>* jtj,
-                             Eigen::Matrix<double, 6, 1>* jtr) {
-    const double w = std::exp(-at[5]) / std::sqrt(2.0);
-    const double width_x = w * n.x(), width_y = w * n.y();
-    jtj->setZero();
-    jtr->setZero();
-    double cost = 0;
-    for (const BandPixel& p : band) {
-      const double d = at[0] + p.t * (at[1] + p.t * at[2]);
-      const double u0 = (p.s - d) * w;
-      const ErfPixelAverage m = AverageErfOverPixel(u0, width_x, width_y);
-      const double r = at[3] + at[4] * m.value - p.gray;
-      Eigen::Matrix<double, 6, 1> g;
-      const double d_d = -at[4] * m.d_u0 * w;  // d value / d d
-      g << d_d, d_d * p.t, quadratic ? d_d * p.t * p.t : 0.0, 1.0, m.value,
-          -at[4] * (m.d_u0 * u0 + m.d_a * width_x + m.d_b * width_y);
-      jtj->selfadjointView<Eigen::Lower>().rankUpdate(g);
-      *jtr += r * g;
-      cost += 0.5 * r * r;
-    }
-    *jtj = jtj->selfadjointView<Eigen::Lower>();
-    if (!quadratic) (*jtj)(2, 2) = 1;  // c2 stays 0
-    return cost;
-  };
-  Eigen::Matrix<double, 6, 6> jtj;
-  Eigen::Matrix<double, 6, 1> jtr;
-  double cost = linearise(q, &jtj, &jtr);
-  double lambda = 1e-3;
-  for (int iteration = 0; iteration < 50; ++iteration) {
-    Eigen::Matrix<double, 6, 6> damped = jtj;
-    damped.diagonal() *= 1 + lambda;
-    const Eigen::Matrix<double, 6, 1> step = damped.ldlt().solve(-jtr);
-    if (!step.allFinite()) return std::nullopt;
-    Eigen::Matrix<double, 6, 6> trial_jtj;
-    Eigen::Matrix<double, 6, 1> trial_jtr;
-    const double trial_cost = linearise(q + step, &trial_jtj, &trial_jtr);
-    if (std::isfinite(trial_cost) && trial_cost < cost) {
-      q += step;
-      const bool converged = cost - trial_cost < 1e-9 * cost || std::abs(step[0]) < 1e-5;
-      cost = trial_cost;
-      jtj = trial_jtj;
-      jtr = trial_jtr;
-      lambda = std::max(1e-9, lambda / 3);
-      if (converged) break;
-    } else {
-      lambda *= 4;
-      if (lambda > 1e8) break;
-    }
-  }
-  if (!q.allFinite() || q[4] * 2 < min_contrast) return std::nullopt;
-  return Eigen::Vector3d(q[0], q[1] / length, q[2] / (length * length));
-}
-
 }  // namespace
 
 bool RefineMarkerCorners(const cv::Mat& gray, const MarkerEdgeRefinementOptions& options,
@@ -182,9 +112,43 @@ bool RefineMarkerCorners(const cv::Mat& gray, const MarkerEdgeRefinementOptions&
     // outside.
     const double module = length / (options.bits_per_side + 2);
     const double half_width = std::clamp(0.45 * module, 1.5, 6.0);
+    constexpr double kStep = 0.05;
+    std::vector<Eigen::Vector2d> edge;  // (t along the side, offset along n)
+    for (double t = options.end_margin * length; t <= (1 - options.end_margin) * length; t += 0.5) {
+      const Eigen::Vector2d p = a + t * u;
+      std::vector<double> profile;
+      bool inside_image = true;
+      for (double s = -half_width; s <= half_width + 1e-9; s += kStep) {
+        const auto v = Sample(gray, p + s * n);
+        if (!v) {
+          inside_image = false;
+          break;
+        }
+        profile.push_back(*v);
+      }
+      if (!inside_image || profile.size() < 8) continue;
+      const size_t k = std::max<size_t>(1, profile.size() / 8);
+      double dark = 0, light = 0;
+      for (size_t j = 0; j < k; ++j) {
+        dark += profile[j];
+        light += profile[profile.size() - 1 - j];
+      }
+      dark /= k;
+      light /= k;
+      if (light - dark < options.min_contrast) continue;
+      const double mid = 0.5 * (dark + light);
+      // The crossing nearest the predicted edge (s = 0).
+      double best = 1e9;
+      for (size_t j = 0; j + 1 < profile.size(); ++j) {
+        if ((profile[j] - mid) * (profile[j + 1] - mid) > 0 || profile[j] == profile[j + 1]) continue;
+        const double s = -half_width + kStep * (j + (mid - profile[j]) / (profile[j + 1] - profile[j]));
+        if (std::abs(s) < std::abs(best)) best = s;
+      }
+      if (best > 1e8) continue;
+      edge.emplace_back(t, best);
+    }
     // A bend needs a long side to be measured; short sides are lines.
-    const auto fit = FitEdgeToPixels(gray, a, u, n, length, half_width, options.end_margin, length >= 40,
-                                     options.min_contrast);
+    const auto fit = FitEdge(edge, length >= 40);
     if (!fit) return false;
     curves[i] = EdgeCurve{a, u, n, *fit};
     lengths[i] = length;

@@ -1,16 +1,13 @@
-// Sub-pixel corners of a square marker from its four outer edges: each
-// side's edge is fitted to the pixels of a band along it (within the dark
-// border module inside and the light surround outside) as a blurred step
-// integrated over each pixel's area, its offset a quadratic along the side
-// (for the bend lens distortion and refraction give long edges), its
-// levels and blur fitted with it; each corner is the intersection of its
-// two sides' curves. Unlike reading the half-level crossing off profiles,
-// no level is taken from a profile's ends, which the next module's blur
-// reaches: on rendered ArUco grids the corners' median error is 0.016 px
-// sharp and 0.021 / 0.024 / 0.060 px at a blur of 0.5 / 0.8 / 1.5 px with
-// noise sigma 2 (the crossings: 0.026, and 0.038 / 0.069 / 0.19). OpenCV's
-// ArUco corners sit ~0.1 px (cornerSubPix) to ~0.6 px (contour lines)
-// inside the outline.
+// Sub-pixel corners of a square marker from its four outer edges: along
+// each side, the edge is located at many points where the profile across it
+// crosses halfway between the dark border and the light surround, a curve
+// (quadratic across the side, for the bend lens distortion and refraction
+// give long edges) is fitted through those points, and each corner is the
+// intersection of its two sides' curves. A symmetric blur leaves the half-level crossing of a
+// straight edge in place, so the corners carry no blur-dependent bias --
+// unlike the corner detectors OpenCV's ArUco module offers, whose corners
+// of a blurred marker sit ~0.1 px (cornerSubPix) to ~0.6 px (contour lines)
+// inside the true outline (measured on the shared renders).
 #pragma once
 
 #include <array>
