@@ -86,10 +86,8 @@ class CornerPatternModel {
   // Bit 0: the first edge varies, bit 1: the second.
   enum Region : int { kFlat = 0, kEdge1 = 1, kEdge2 = 2, kCorner = 3 };
   Region Classify(double x, double y, double margin) const {
-    const double reach1 = 0.5 * (std::abs(c1_) + std::abs(s1_)) * scale_;
-    const double reach2 = 0.5 * (std::abs(c2_) + std::abs(s2_)) * scale_;
-    const bool flat1 = std::abs(U1(x, y)) > TabulatedErf::kRange + margin + reach1;
-    const bool flat2 = std::abs(U2(x, y)) > TabulatedErf::kRange + margin + reach2;
+    const bool flat1 = std::abs(U1(x, y)) > TabulatedErf::kRange + margin + Reach1(0.5);
+    const bool flat2 = std::abs(U2(x, y)) > TabulatedErf::kRange + margin + Reach2(0.5);
     return flat1 ? (flat2 ? kFlat : kEdge2) : (flat2 ? kEdge1 : kCorner);
   }
 
@@ -142,13 +140,10 @@ class CornerPatternModel {
     // its erf is the same ±1 at every sub-sample and its slope 0: the
     // sub-samples need the other line only (or nothing), with the same
     // numbers as when computed.
-    const double centre_u1 = (c1_ * (x - cx_) + s1_ * (y - cy_)) * scale_;
-    const double centre_u2 = (c2_ * (x - cx_) + s2_ * (y - cy_)) * scale_;
+    const double centre_u1 = U1(x, y), centre_u2 = U2(x, y);
     const double half_extent = rule_.nodes[rule_.n - 1];  // of the sub-samples about the centre
-    const double reach1 = half_extent * (std::abs(c1_) + std::abs(s1_)) * scale_;
-    const double reach2 = half_extent * (std::abs(c2_) + std::abs(s2_)) * scale_;
-    const bool flat1 = std::abs(centre_u1) > TabulatedErf::kRange + reach1;
-    const bool flat2 = std::abs(centre_u2) > TabulatedErf::kRange + reach2;
+    const bool flat1 = std::abs(centre_u1) > TabulatedErf::kRange + Reach1(half_extent);
+    const bool flat2 = std::abs(centre_u2) > TabulatedErf::kRange + Reach2(half_extent);
     double sum = 0, d_cx = 0, d_cy = 0, d_t1 = 0, d_t2 = 0, d_log_sigma = 0;
     if (flat1 && flat2) {
       sum = (centre_u1 > 0 ? 1.0 : -1.0) * (centre_u2 > 0 ? 1.0 : -1.0);
@@ -191,6 +186,10 @@ class CornerPatternModel {
  private:
   double U1(double x, double y) const { return (c1_ * (x - cx_) + s1_ * (y - cy_)) * scale_; }
   double U2(double x, double y) const { return (c2_ * (x - cx_) + s2_ * (y - cy_)) * scale_; }
+  // How far u changes from a pixel's centre to points `half_extent` away in
+  // x and y.
+  double Reach1(double half_extent) const { return half_extent * (std::abs(c1_) + std::abs(s1_)) * scale_; }
+  double Reach2(double half_extent) const { return half_extent * (std::abs(c2_) + std::abs(s2_)) * scale_; }
 
   PixelRule rule_;
   double cx_, cy_, c1_, s1_, c2_, s2_, mean_, contrast_, scale_;

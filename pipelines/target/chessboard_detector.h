@@ -25,7 +25,7 @@ struct ChessboardDetectionOptions {
   // Images with fewer grid junctions (x_corner_count.h; at that scale or
   // half of it) than this fraction of the board's (cols - 2) (rows - 2)
   // are not searched (0: all are). On the shared views boards count 0.54
-  // to 1.0 of theirs, textured scenes without a board at most 0.03 of a
+  // to 1.0 of theirs, textured scenes without a board at most 0.05 of a
   // 10 x 7 board's (docs/benchmarks.md).
   double min_x_corner_fraction = 0.25;
   // A view keeps the corners that refined; it is refused with fewer than

@@ -88,8 +88,8 @@ cv::Mat JunctionMask(const cv::Mat& gray, const XCornerCountOptions& options, do
 // pairs on opposite sides at about equal distances, the pairs' lines at
 // least ~30 degrees apart. All but the junctions on a board's outer rows
 // and columns are such; scattered junction-like spots in a textured scene
-// rarely are (at most 3 % of a 10 x 7 board's count on the shared
-// textured renders).
+// rarely are (0 to 2 on 9 textured renders without a chessboard, where a
+// 10 x 7 board has 40).
 int CountGridJunctions(const std::vector<cv::Point2d>& junctions, double tolerance) {
   constexpr int kNeighbours = 8;
   const int n = static_cast<int>(junctions.size());
