@@ -3,7 +3,7 @@
 #include <opencv2/aruco.hpp>
 
 #include "pipelines/markers/aruco.h"
-#include "pipelines/markers/marker_edge_refinement.h"
+#include "pipelines/markers/marker_edge_crossings.h"
 
 namespace portcal {
 
@@ -23,8 +23,8 @@ std::vector<MarkerDetection> DetectArucoMarkers(const cv::Mat& gray, const std::
     detection.marker_id = ids[m];
     std::array<cv::Point2d, 4> quad;
     for (int c = 0; c < 4; ++c) quad[c] = cv::Point2d(corners[m][c].x, corners[m][c].y);
-    // Edge-line corners where the edges allow (see marker_edge_refinement.h).
-    RefineMarkerCorners(gray, refinement, &quad);
+    // Edge-line corners where the edges allow (see marker_edge_crossings.h).
+    RefineMarkerCornersByCrossings(gray, refinement, &quad);
     for (int c = 0; c < 4; ++c) detection.corners[c] = Eigen::Vector2d(quad[c].x + 0.5, quad[c].y + 0.5);
     markers.push_back(detection);
   }

@@ -76,13 +76,14 @@ BoardMarkers DetectBoardMarkers(const cv::Mat& gray, const MarkerBoardOptions& o
     found.corners.push_back(corners[m]);
     found.ids.push_back(ids[m]);
     // The outline's edge curves give unbiased corners (OpenCV's contour
-    // corners sit ~0.6 px inside); where the edges are unusable the contour
-    // corners stay.
+    // corners sit ~0.6 px inside, and pixels off on foreshortened markers);
+    // a marker whose edges cannot be fitted gives no board points.
     std::array<cv::Point2d, 4> quad;
     for (int k = 0; k < 4; ++k) quad[k] = cv::Point2d(corners[m][k].x, corners[m][k].y);
     MarkerEdgeRefinementOptions edge_options;
     edge_options.bits_per_side = dictionary->markerSize;
-    if (RefineMarkerCorners(gray, edge_options, &quad)) {
+    const bool edges_fitted = RefineMarkerCorners(gray, edge_options, &quad);
+    if (edges_fitted) {
       for (int k = 0; k < 4; ++k) {
         corners[m][k] = cv::Point2f(static_cast<float>(quad[k].x), static_cast<float>(quad[k].y));
       }
@@ -92,7 +93,9 @@ BoardMarkers DetectBoardMarkers(const cv::Mat& gray, const MarkerBoardOptions& o
     marker.marker_id = ids[m];
     for (int k = 0; k < 4; ++k) marker.corners[k] = Colmap(corners[m][k]);
     detection->markers.push_back(marker);
-    if (options.type == "aruco_grid") {
+    if (options.type == "aruco_grid" && !edges_fitted) {
+      ++detection->num_markers_unfitted;  // its corners are pixels off: left out
+    } else if (options.type == "aruco_grid") {
       for (int k = 0; k < 4; ++k) {
         const cv::Point3f& p = board->objPoints[it->second][k];
         detection->points.push_back({static_cast<int64_t>(ids[m]) * 4 + k, Colmap(corners[m][k]),
@@ -147,7 +150,10 @@ void AddCharucoCorners(const cv::Mat& gray, const MarkerBoardOptions& options, c
                                      options.refinement.min_window_px, options.refinement.max_window_px);
       const auto refined = RefineCorner(gray, xy, half, std::atan2(dx.x(), -dx.y()),
                                         std::atan2(dy.x(), -dy.y()), options.refinement);
-      if (!refined) continue;  // no clean corner there
+      if (!refined) {  // no clean corner there
+        ++detection->num_corners_unrefined;
+        continue;
+      }
       xy = refined->xy;
     }
     detection->points.push_back({charuco_ids[i], xy, Eigen::Vector3d(p.x, p.y, p.z)});
@@ -170,6 +176,16 @@ MarkerBoardDetection DetectMarkerBoard(const cv::Mat& gray, const MarkerBoardOpt
     return detection;
   }
   detection.found = true;
+  if (detection.num_markers_unfitted > 0) {
+    const int found = static_cast<int>(markers.ids.size());
+    detection.note = std::to_string(4 * detection.num_markers_unfitted) + " of " + std::to_string(4 * found) +
+                     " marker corners left out (" + std::to_string(detection.num_markers_unfitted) +
+                     " markers too foreshortened, cut or blurred for their edges to be fitted)";
+  } else if (detection.num_corners_unrefined > 0) {
+    detection.note = std::to_string(detection.num_corners_unrefined) + " of " +
+                     std::to_string(detection.num_corners_unrefined + detection.points.size()) +
+                     " corners left out (no clean corner)";
+  }
   return detection;
 }
 

@@ -1,6 +1,7 @@
 // ArUco grid boards and ChArUco boards (OpenCV 4.6 contrib's layouts):
 // partial views allowed. ArUco grid: the 4 corners of every detected board
-// marker (OpenCV's contour-line fit). ChArUco: the chessboard corners
+// marker whose outline's edges could be fitted (marker_edge_refinement.h).
+// ChArUco: the chessboard corners
 // OpenCV interpolates from the markers, refined by portcal's ideal-pattern
 // fit.
 #pragma once
@@ -42,6 +43,11 @@ struct MarkerBoardDetection {
   std::string reason;
   std::vector<BoardPoint> points;
   std::vector<MarkerDetection> markers;  // every board marker seen
+  // Seen but left out: ArUco grid markers whose edges could not be fitted;
+  // ChArUco corners the ideal-pattern fit refused. Why, for the status.
+  int num_markers_unfitted = 0;
+  int num_corners_unrefined = 0;
+  std::string note;
 };
 
 MarkerBoardDetection DetectMarkerBoard(const cv::Mat& gray, const MarkerBoardOptions& options);

@@ -6,166 +6,229 @@
 #include <optional>
 #include <vector>
 
+#include "colmap_ext/cost/erf_pixel_average.h"
+#include "pipelines/markers/edge_curve.h"
+
 namespace portcal {
 namespace {
 
-// Bilinear sample; nullopt outside the image.
-std::optional<double> Sample(const cv::Mat& gray, const Eigen::Vector2d& p) {
-  const double x = p.x(), y = p.y();
-  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= gray.cols || y0 + 1 >= gray.rows) return std::nullopt;
-  const double fx = x - x0, fy = y - y0;
-  const auto v = [&](int r, int c) { return static_cast<double>(gray.at<uint8_t>(r, c)); };
-  return (1 - fy) * ((1 - fx) * v(y0, x0) + fx * v(y0, x0 + 1)) + fy * ((1 - fx) * v(y0 + 1, x0) + fx * v(y0 + 1, x0 + 1));
+struct BandPixel {
+  double t, s, gray;  // along the side (over its length), along the outward normal, gray
+};
+
+// The pixels whose centres lie within `half_width` of the side and away
+// from its ends (empty where the band leaves the image).
+std::vector<BandPixel> CollectBand(const cv::Mat& gray, const Eigen::Vector2d& a, const Eigen::Vector2d& u,
+                                   const Eigen::Vector2d& n, double length, double half_width, double end_margin) {
+  std::vector<BandPixel> band;
+  const Eigen::Vector2d b = a + length * u;
+  const double reach = half_width + 1;
+  const int x0 = static_cast<int>(std::floor(std::min(a.x(), b.x()) - reach));
+  const int x1 = static_cast<int>(std::ceil(std::max(a.x(), b.x()) + reach));
+  const int y0 = static_cast<int>(std::floor(std::min(a.y(), b.y()) - reach));
+  const int y1 = static_cast<int>(std::ceil(std::max(a.y(), b.y()) + reach));
+  if (x0 < 0 || y0 < 0 || x1 >= gray.cols || y1 >= gray.rows) return band;
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      const Eigen::Vector2d p(x, y);  // OpenCV pixels: the pixel's centre
+      const double t = (p - a).dot(u), s = (p - a).dot(n);
+      if (t < end_margin * length || t > (1 - end_margin) * length || std::abs(s) > half_width) continue;
+      band.push_back({t / length, s, static_cast<double>(gray.at<uint8_t>(y, x))});
+    }
+  }
+  return band;
 }
 
-// A side's edge in the frame of its first corner: offset along the outward
-// normal as a quadratic in the distance along the side. Lens distortion and
-// refraction at a port bend straight edges; the quadratic follows the bend
-// so that the corners, extrapolated to the ends, stay unbiased on large
-// markers.
-struct EdgeCurve {
-  Eigen::Vector2d origin, u, n;
-  Eigen::Vector3d coefficients = Eigen::Vector3d::Zero();  // d(t) = c0 + c1 t + c2 t^2
-  Eigen::Vector2d Point(double t) const {
-    return origin + t * u + (coefficients(0) + t * (coefficients(1) + t * coefficients(2))) * n;
+// The blurred-step model of a band's pixels and its least squares. Each
+// pixel's gray is m(t) + k(t) * (the mean over the pixel of erf(u)),
+// u = (s - d(t)) / (sqrt(2) sigma): s the pixel centre's offset along the
+// outward normal, t its place along the side (0..1), d(t) the edge's offset
+// (quadratic for a long side). The levels m and k vary linearly along the
+// side: shading across a tilted face, vignetting or a light's fall-off make
+// them, and with constant levels their trend would be taken up by the
+// edge's slope (the gray a level trend adds at a pixel correlates with t
+// times the edge's profile), turning the corners.
+struct EdgeBandModel {
+  static constexpr int kNumParams = 8;  // c0, c1, c2, m0, m1, k0, k1, log sigma
+  using Params = Eigen::Matrix<double, kNumParams, 1>;
+  using Normal = Eigen::Matrix<double, kNumParams, kNumParams>;
+  Eigen::Vector2d n;
+  bool quadratic = false;
+
+  // Gauss-Newton's normal equations at `q` over the pixels `use` marks;
+  // returns the cost.
+  double Linearise(const std::vector<BandPixel>& band, const std::vector<char>& use, const Params& q, Normal* jtj,
+                   Params* jtr) const {
+    const double w = std::exp(-q[7]) / std::sqrt(2.0);
+    const double width_x = w * n.x(), width_y = w * n.y();
+    jtj->setZero();
+    jtr->setZero();
+    double cost = 0;
+    for (size_t i = 0; i < band.size(); ++i) {
+      if (!use[i]) continue;
+      const BandPixel& p = band[i];
+      const double tc = p.t - 0.5;
+      const double d = q[0] + p.t * (q[1] + p.t * q[2]);
+      const double u0 = (p.s - d) * w;
+      const ErfPixelAverage m = AverageErfOverPixel(u0, width_x, width_y);
+      const double k = q[5] + q[6] * tc;
+      const double r = q[3] + q[4] * tc + k * m.value - p.gray;
+      const double d_d = -k * m.d_u0 * w;  // d value / d d
+      Params g;
+      g << d_d, d_d * p.t, quadratic ? d_d * p.t * p.t : 0.0, 1.0, tc, m.value, m.value * tc,
+          -k * (m.d_u0 * u0 + m.d_a * width_x + m.d_b * width_y);
+      jtj->selfadjointView<Eigen::Lower>().rankUpdate(g);
+      *jtr += r * g;
+      cost += 0.5 * r * r;
+    }
+    *jtj = jtj->selfadjointView<Eigen::Lower>();
+    if (!quadratic) (*jtj)(2, 2) = 1;  // c2 stays 0
+    return cost;
   }
-  Eigen::Vector2d Tangent(double t) const {
-    return (u + (coefficients(1) + 2 * t * coefficients(2)) * n).normalized();
+
+  double Residual(const BandPixel& p, const Params& q) const {
+    const double w = std::exp(-q[7]) / std::sqrt(2.0);
+    const double tc = p.t - 0.5;
+    const double u0 = (p.s - (q[0] + p.t * (q[1] + p.t * q[2]))) * w;
+    return q[3] + q[4] * tc + (q[5] + q[6] * tc) * AverageErfOverPixel(u0, w * n.x(), w * n.y()).value - p.gray;
   }
 };
 
-// Least squares with one pass dropping points beyond 3x the median
-// residual (a bit edge or a specular spot).
-std::optional<Eigen::Vector3d> FitEdge(std::vector<Eigen::Vector2d> td, bool quadratic) {
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (int pass = 0; pass < 2; ++pass) {
-    if (td.size() < (quadratic ? 10u : 5u)) return std::nullopt;
-    const int k = quadratic ? 3 : 2;
-    Eigen::MatrixXd A(td.size(), k);
-    Eigen::VectorXd b(td.size());
-    for (size_t i = 0; i < td.size(); ++i) {
-      A(i, 0) = 1;
-      A(i, 1) = td[i].x();
-      if (quadratic) A(i, 2) = td[i].x() * td[i].x();
-      b(i) = td[i].y();
+// Levenberg-Marquardt from `q`; false where a step is not finite.
+bool MinimiseBand(const EdgeBandModel& model, const std::vector<BandPixel>& band, const std::vector<char>& use,
+                  EdgeBandModel::Params* q) {
+  EdgeBandModel::Normal jtj, trial_jtj;
+  EdgeBandModel::Params jtr, trial_jtr;
+  double cost = model.Linearise(band, use, *q, &jtj, &jtr);
+  double lambda = 1e-3;
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    EdgeBandModel::Normal damped = jtj;
+    damped.diagonal() *= 1 + lambda;
+    const EdgeBandModel::Params step = damped.ldlt().solve(-jtr);
+    if (!step.allFinite()) return false;
+    const double trial_cost = model.Linearise(band, use, *q + step, &trial_jtj, &trial_jtr);
+    if (std::isfinite(trial_cost) && trial_cost < cost) {
+      *q += step;
+      const bool converged = cost - trial_cost < 1e-9 * cost || std::abs(step[0]) < 1e-5;
+      cost = trial_cost;
+      jtj = trial_jtj;
+      jtr = trial_jtr;
+      lambda = std::max(1e-9, lambda / 3);
+      if (converged) break;
+    } else {
+      lambda *= 4;
+      if (lambda > 1e8) break;
     }
-    const Eigen::VectorXd x = A.colPivHouseholderQr().solve(b);
-    c.setZero();
-    c.head(k) = x;
-    if (pass == 1) break;
-    std::vector<double> residuals;
-    for (size_t i = 0; i < td.size(); ++i) residuals.push_back(std::abs((A.row(i) * x)(0) - b(i)));
-    std::vector<double> sorted = residuals;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    const double limit = std::max(0.05, 3.0 * sorted[sorted.size() / 2]);
-    std::vector<Eigen::Vector2d> kept;
-    for (size_t i = 0; i < td.size(); ++i) {
-      if (residuals[i] <= limit) kept.push_back(td[i]);
-    }
-    td.swap(kept);
   }
-  return c;
+  return q->allFinite();
 }
 
-std::optional<Eigen::Vector2d> IntersectLines(const Eigen::Vector2d& pa, const Eigen::Vector2d& da,
-                                              const Eigen::Vector2d& pb, const Eigen::Vector2d& db) {
-  Eigen::Matrix2d A;
-  A << da, -db;
-  if (std::abs(A.determinant()) < 1e-6) return std::nullopt;
-  const Eigen::Vector2d t = A.colPivHouseholderQr().solve(pb - pa);
-  return pa + t(0) * da;
+// The side's edge fitted to the pixels of a band along it (EdgeBandModel),
+// the pixel's area integrated in closed form (erf_pixel_average.h) and the
+// blur fitted: no level is read off a profile's ends, which a blur that
+// reaches the next module would shift. A second fit leaves out the pixels
+// beyond 4 robust sigmas of the first (a bit's corner or a specular spot
+// reaching into the band). Returns d's coefficients in t (pixels).
+std::optional<Eigen::Vector3d> FitEdgeToPixels(const cv::Mat& gray, const Eigen::Vector2d& a, const Eigen::Vector2d& u,
+                                               const Eigen::Vector2d& n, double length, double half_width,
+                                               double end_margin, bool quadratic, double min_contrast) {
+  const std::vector<BandPixel> band = CollectBand(gray, a, u, n, length, half_width, end_margin);
+  if (band.size() < 20) return std::nullopt;
+  double dark = 0, light = 0;
+  int num_dark = 0, num_light = 0;
+  for (const BandPixel& p : band) {
+    if (p.s < -0.5 * half_width) {
+      dark += p.gray;
+      ++num_dark;
+    } else if (p.s > 0.5 * half_width) {
+      light += p.gray;
+      ++num_light;
+    }
+  }
+  if (num_dark == 0 || num_light == 0) return std::nullopt;
+  dark /= num_dark;
+  light /= num_light;
+  if (light - dark < min_contrast) return std::nullopt;
+  const EdgeBandModel model{n, quadratic};
+  EdgeBandModel::Params q;
+  q << 0, 0, 0, 0.5 * (dark + light), 0, 0.5 * (light - dark), 0, std::log(0.8);
+  std::vector<char> use(band.size(), 1);
+  if (!MinimiseBand(model, band, use, &q)) return std::nullopt;
+  std::vector<double> residuals(band.size());
+  for (size_t i = 0; i < band.size(); ++i) residuals[i] = std::abs(model.Residual(band[i], q));
+  std::vector<double> sorted = residuals;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double limit = std::max(1.0, 4 * 1.4826 * sorted[sorted.size() / 2]);
+  int num_left_out = 0;
+  for (size_t i = 0; i < band.size(); ++i) {
+    use[i] = residuals[i] <= limit;
+    num_left_out += !use[i];
+  }
+  if (num_left_out > 0 && !MinimiseBand(model, band, use, &q)) return std::nullopt;
+  if (q[5] * 2 < min_contrast) return std::nullopt;
+  return Eigen::Vector3d(q[0], q[1] / length, q[2] / (length * length));
 }
 
-// Where the end of `before` meets the start of `after`: tangent lines at
-// the current estimates, intersected, a few times over.
-std::optional<Eigen::Vector2d> IntersectCurves(const EdgeCurve& before, double before_length,
-                                               const EdgeCurve& after) {
-  double t1 = before_length, t2 = 0;
-  std::optional<Eigen::Vector2d> x;
-  for (int iteration = 0; iteration < 5; ++iteration) {
-    x = IntersectLines(before.Point(t1), before.Tangent(t1), after.Point(t2), after.Tangent(t2));
-    if (!x) return std::nullopt;
-    t1 = (*x - before.origin).dot(before.u);
-    t2 = (*x - after.origin).dot(after.u);
+// Each side's curve fitted in a band about the line through the corners
+// `c`; false where a side cannot be fitted.
+bool FitSides(const cv::Mat& gray, const MarkerEdgeRefinementOptions& options, const std::array<Eigen::Vector2d, 4>& c,
+              std::array<EdgeCurve, 4>* curves, std::array<double, 4>* lengths) {
+  for (int i = 0; i < 4; ++i) {
+    const QuadSide side = SideOfQuad(c, i);
+    const Eigen::Vector2d a = side.a, u = side.u, n = side.n;
+    const double length = side.length;
+    if (length < 8) return false;
+    // Stay within the black border module inside and the light module
+    // outside: a module's width across this side, which foreshortening
+    // makes smaller than along it (the marker's depth from this side, over
+    // its modules).
+    const double depth = std::min(-(c[(i + 2) % 4] - a).dot(n), -(c[(i + 3) % 4] - a).dot(n));
+    const double module = depth / (options.bits_per_side + 2);
+    if (module < options.min_module_px) return false;
+    const double half_width = std::clamp(0.45 * module, 1.5, 6.0);
+    // A bend needs a long side to be measured; short sides are lines.
+    const auto fit = FitEdgeToPixels(gray, a, u, n, length, half_width, options.end_margin, length >= 40,
+                                     options.min_contrast);
+    if (!fit) return false;
+    (*curves)[i] = EdgeCurve{a, u, n, *fit};
+    (*lengths)[i] = length;
   }
-  return x;
+  return true;
 }
 
 }  // namespace
 
 bool RefineMarkerCorners(const cv::Mat& gray, const MarkerEdgeRefinementOptions& options,
                          std::array<cv::Point2d, 4>* corners) {
-  std::array<Eigen::Vector2d, 4> c;
-  for (int i = 0; i < 4; ++i) c[i] = Eigen::Vector2d((*corners)[i].x, (*corners)[i].y);
-  const Eigen::Vector2d centroid = 0.25 * (c[0] + c[1] + c[2] + c[3]);
+  std::array<Eigen::Vector2d, 4> start, c;
+  for (int i = 0; i < 4; ++i) start[i] = c[i] = Eigen::Vector2d((*corners)[i].x, (*corners)[i].y);
   std::array<EdgeCurve, 4> curves;
   std::array<double, 4> lengths;
-  for (int i = 0; i < 4; ++i) {
-    const Eigen::Vector2d a = c[i], b = c[(i + 1) % 4];
-    const double length = (b - a).norm();
-    if (length < 8) return false;
-    const Eigen::Vector2d u = (b - a) / length;
-    Eigen::Vector2d n(-u.y(), u.x());
-    if (n.dot(0.5 * (a + b) - centroid) < 0) n = -n;  // outward
-    // Stay within the black border module inside and the light module
-    // outside.
-    const double module = length / (options.bits_per_side + 2);
-    const double half_width = std::clamp(0.45 * module, 1.5, 6.0);
-    constexpr double kStep = 0.05;
-    std::vector<Eigen::Vector2d> edge;  // (t along the side, offset along n)
-    for (double t = options.end_margin * length; t <= (1 - options.end_margin) * length; t += 0.5) {
-      const Eigen::Vector2d p = a + t * u;
-      std::vector<double> profile;
-      bool inside_image = true;
-      for (double s = -half_width; s <= half_width + 1e-9; s += kStep) {
-        const auto v = Sample(gray, p + s * n);
-        if (!v) {
-          inside_image = false;
-          break;
-        }
-        profile.push_back(*v);
-      }
-      if (!inside_image || profile.size() < 8) continue;
-      const size_t k = std::max<size_t>(1, profile.size() / 8);
-      double dark = 0, light = 0;
-      for (size_t j = 0; j < k; ++j) {
-        dark += profile[j];
-        light += profile[profile.size() - 1 - j];
-      }
-      dark /= k;
-      light /= k;
-      if (light - dark < options.min_contrast) continue;
-      const double mid = 0.5 * (dark + light);
-      // The crossing nearest the predicted edge (s = 0).
-      double best = 1e9;
-      for (size_t j = 0; j + 1 < profile.size(); ++j) {
-        if ((profile[j] - mid) * (profile[j + 1] - mid) > 0 || profile[j] == profile[j + 1]) continue;
-        const double s = -half_width + kStep * (j + (mid - profile[j]) / (profile[j + 1] - profile[j]));
-        if (std::abs(s) < std::abs(best)) best = s;
-      }
-      if (best > 1e8) continue;
-      edge.emplace_back(t, best);
+  // OpenCV's corners of a small, oblique marker can be pixels off, and a
+  // band laid about such a line holds the edge off-centre (or a bit's edge
+  // too): the bands are laid again about the fitted corners until these
+  // stay put.
+  for (int pass = 0; pass < options.max_passes; ++pass) {
+    if (!FitSides(gray, options, c, &curves, &lengths)) return false;
+    std::array<Eigen::Vector2d, 4> next;
+    double largest_move = 0;
+    for (int i = 0; i < 4; ++i) {
+      // Corner i joins side i-1 (c[i-1] -> c[i]) and side i (c[i] -> c[i+1]).
+      const int before = (i + 3) % 4;
+      const auto x = IntersectCurves(curves[before], lengths[before], curves[i]);
+      if (!x) return false;
+      next[i] = *x;
+      largest_move = std::max(largest_move, (next[i] - c[i]).norm());
     }
-    // A bend needs a long side to be measured; short sides are lines.
-    const auto fit = FitEdge(edge, length >= 40);
-    if (!fit) return false;
-    curves[i] = EdgeCurve{a, u, n, *fit};
-    lengths[i] = length;
+    c = next;
+    if (largest_move < 0.01) break;
   }
-  // OpenCV's corner of a small, oblique marker can be pixels off; allow a
-  // tenth of the side.
   const double max_shift =
       std::max(options.max_corner_shift_px, 0.025 * (lengths[0] + lengths[1] + lengths[2] + lengths[3]));
-  std::array<cv::Point2d, 4> refined;
   for (int i = 0; i < 4; ++i) {
-    // Corner i joins side i-1 (c[i-1] -> c[i]) and side i (c[i] -> c[i+1]).
-    const int before = (i + 3) % 4;
-    const auto x = IntersectCurves(curves[before], lengths[before], curves[i]);
-    if (!x || (*x - c[i]).norm() > max_shift) return false;
-    refined[i] = cv::Point2d(x->x(), x->y());
+    if ((c[i] - start[i]).norm() > max_shift) return false;
   }
-  *corners = refined;
+  for (int i = 0; i < 4; ++i) (*corners)[i] = cv::Point2d(c[i].x(), c[i].y());
   return true;
 }
 

@@ -78,6 +78,7 @@ void Detect(const cv::Mat& gray, const TargetExtractorOptions& o, ImageResult* r
   result->found = d.found;
   result->reason = d.reason;
   result->markers = d.markers;
+  result->note = d.note;
   if (!d.found) return;
   for (const BoardPoint& p : d.points) result->observations.push_back({p.point_id, p.xy, p.point_in_target});
 }
