@@ -7,6 +7,7 @@
 
 #include "colmap_ext/util/error.h"
 #include "pipelines/markers/aruco.h"
+#include "pipelines/markers/marker_edge_crossings.h"
 #include "pipelines/markers/marker_edge_refinement.h"
 
 namespace portcal {
@@ -77,12 +78,15 @@ BoardMarkers DetectBoardMarkers(const cv::Mat& gray, const MarkerBoardOptions& o
     found.ids.push_back(ids[m]);
     // The outline's edge curves give unbiased corners (OpenCV's contour
     // corners sit ~0.6 px inside, and pixels off on foreshortened markers);
-    // a marker whose edges cannot be fitted gives no board points.
+    // an ArUco grid marker whose edges cannot be fitted gives no board
+    // points. A ChArUco board's markers give none anyway: the quicker
+    // crossings (marker_edge_crossings.h) do for their detections.
     std::array<cv::Point2d, 4> quad;
     for (int k = 0; k < 4; ++k) quad[k] = cv::Point2d(corners[m][k].x, corners[m][k].y);
     MarkerEdgeRefinementOptions edge_options;
     edge_options.bits_per_side = dictionary->markerSize;
-    const bool edges_fitted = RefineMarkerCorners(gray, edge_options, &quad);
+    const bool edges_fitted = options.type == "aruco_grid" ? RefineMarkerCorners(gray, edge_options, &quad)
+                                                           : RefineMarkerCornersByCrossings(gray, edge_options, &quad);
     if (edges_fitted) {
       for (int k = 0; k < 4; ++k) {
         corners[m][k] = cv::Point2f(static_cast<float>(quad[k].x), static_cast<float>(quad[k].y));
