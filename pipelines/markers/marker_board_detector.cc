@@ -97,9 +97,10 @@ BoardMarkers DetectBoardMarkers(const cv::Mat& gray, const MarkerBoardOptions& o
     marker.marker_id = ids[m];
     for (int k = 0; k < 4; ++k) marker.corners[k] = Colmap(corners[m][k]);
     detection->markers.push_back(marker);
-    if (options.type == "aruco_grid" && !edges_fitted) {
+    if (options.type != "aruco_grid") continue;
+    if (!edges_fitted) {
       ++detection->num_markers_unfitted;  // its corners are pixels off: left out
-    } else if (options.type == "aruco_grid") {
+    } else {
       for (int k = 0; k < 4; ++k) {
         const cv::Point3f& p = board->objPoints[it->second][k];
         detection->points.push_back({static_cast<int64_t>(ids[m]) * 4 + k, Colmap(corners[m][k]),

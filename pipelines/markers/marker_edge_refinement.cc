@@ -84,11 +84,10 @@ struct EdgeBandModel {
       if (!use[i]) continue;
       const BandPixel& p = band[i];
       const double tc = p.t - 0.5;
-      const double d = q[0] + p.t * (q[1] + p.t * q[2]);
-      const double u0 = (p.s - d) * w;
-      const ErfPixelAverage m = AverageErfOverPixel(u0, width_x, width_y);
+      double u0 = 0;
+      ErfPixelAverage m;
+      const double r = Residual(p, q, &u0, &m);
       const double k = q[5] + q[6] * tc;
-      const double r = q[3] + q[4] * tc + k * m.value - p.gray;
       const double d_d = -k * m.d_u0 * w;  // d value / d d
       Params g;
       g << d_d, d_d * p.t, quadratic ? d_d * p.t * p.t : 0.0, 1.0, tc, m.value, m.value * tc,
@@ -101,11 +100,14 @@ struct EdgeBandModel {
     return cost;
   }
 
-  double Residual(const BandPixel& p, const Params& q) const {
+  // Model minus gray at `p`; `u0` and the pixel average `m` for the
+  // derivatives.
+  double Residual(const BandPixel& p, const Params& q, double* u0, ErfPixelAverage* m) const {
     const double w = std::exp(-q[7]) / std::sqrt(2.0);
     const double tc = p.t - 0.5;
-    const double u0 = (p.s - (q[0] + p.t * (q[1] + p.t * q[2]))) * w;
-    return q[3] + q[4] * tc + (q[5] + q[6] * tc) * AverageErfOverPixel(u0, w * n.x(), w * n.y()).value - p.gray;
+    *u0 = (p.s - (q[0] + p.t * (q[1] + p.t * q[2]))) * w;
+    *m = AverageErfOverPixel(*u0, w * n.x(), w * n.y());
+    return q[3] + q[4] * tc + (q[5] + q[6] * tc) * m->value - p.gray;
   }
 };
 
@@ -172,7 +174,11 @@ std::optional<Eigen::Vector3d> FitEdgeToPixels(const cv::Mat& gray, const Eigen:
   std::vector<char> use(band.size(), 1);
   if (!MinimiseBand(model, band, use, &q)) return std::nullopt;
   std::vector<double> residuals(band.size());
-  for (size_t i = 0; i < band.size(); ++i) residuals[i] = std::abs(model.Residual(band[i], q));
+  for (size_t i = 0; i < band.size(); ++i) {
+    double u0 = 0;
+    ErfPixelAverage m;
+    residuals[i] = std::abs(model.Residual(band[i], q, &u0, &m));
+  }
   std::vector<double> sorted = residuals;
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
   const double limit = std::max(1.0, 4 * 1.4826 * sorted[sorted.size() / 2]);
