@@ -6,6 +6,7 @@
 #include <map>
 
 #include "colmap_ext/util/error.h"
+#include "pipelines/target/coarse_level.h"
 #include "pipelines/markers/aruco.h"
 #include "pipelines/markers/marker_edge_crossings.h"
 #include "pipelines/markers/marker_edge_refinement.h"
@@ -28,6 +29,9 @@ void MarkerBoardOptions::Check() const {
     throw OptionError("--Target.square_size", std::to_string(square_size_m), "> marker_size");
   }
   if (min_points < 4) throw OptionError("--Target.min_points", std::to_string(min_points), ">= 4");
+  if (coarse_max_image_size < 0) {
+    throw OptionError("--Target.coarse_max_image_size", std::to_string(coarse_max_image_size), ">= 0");
+  }
   refinement.Check();
 }
 
@@ -58,40 +62,66 @@ struct BoardMarkers {
   std::map<int, size_t> board_index;  // marker id -> index in the board
 };
 
+// The marker's corners (OpenCV pixels) refined at full resolution: false
+// where its edges could not be located. The outline's edge curves give
+// unbiased corners (OpenCV's contour corners sit ~0.6 px inside, and pixels
+// off on foreshortened markers). Precise ArUco grids fit the edges to the
+// pixels; a ChArUco board's markers give no board points, so the quicker
+// crossings (marker_edge_crossings.h) do for their detections, as for
+// quick views.
+bool RefineMarker(const cv::Mat& gray, const MarkerBoardOptions& options, int bits_per_side,
+                  std::vector<cv::Point2f>* corners) {
+  std::array<cv::Point2d, 4> quad;
+  for (int k = 0; k < 4; ++k) quad[k] = cv::Point2d((*corners)[k].x, (*corners)[k].y);
+  MarkerEdgeRefinementOptions edge_options;
+  edge_options.bits_per_side = bits_per_side;
+  const bool fitted = options.type == "aruco_grid" && options.precise_fit
+                          ? RefineMarkerCorners(gray, edge_options, &quad)
+                          : RefineMarkerCornersByCrossings(gray, edge_options, &quad);
+  if (!fitted) return false;
+  for (int k = 0; k < 4; ++k) (*corners)[k] = cv::Point2f(static_cast<float>(quad[k].x), static_cast<float>(quad[k].y));
+  return true;
+}
+
+// OpenCV's marker detection: at full resolution with its contour fit, or
+// (quick) on the coarse level without one, the corners then brought back
+// to full-resolution pixels.
+void DetectMarkersOnLevel(const cv::Mat& gray, const MarkerBoardOptions& options,
+                          const cv::Ptr<cv::aruco::Dictionary>& dictionary, const cv::Ptr<cv::aruco::Board>& board,
+                          std::vector<std::vector<cv::Point2f>>* corners, std::vector<int>* ids) {
+  const auto [scale, level] =
+      options.precise_fit ? std::pair<double, cv::Mat>(1.0, gray) : CoarseLevel(gray, options.coarse_max_image_size);
+  cv::Ptr<cv::aruco::DetectorParameters> parameters = cv::aruco::DetectorParameters::create();
+  // Line fits to the contour: sub-pixel without cornerSubPix's habit of
+  // jumping to a neighbouring marker. Quick: the crossings start from the
+  // coarse corners anyway.
+  parameters->cornerRefinementMethod =
+      options.precise_fit ? cv::aruco::CORNER_REFINE_CONTOUR : cv::aruco::CORNER_REFINE_NONE;
+  std::vector<std::vector<cv::Point2f>> rejected;
+  cv::aruco::detectMarkers(level, dictionary, *corners, *ids, parameters, rejected);
+  if (!ids->empty()) cv::aruco::refineDetectedMarkers(level, board, *corners, *ids, rejected);
+  if (scale == 1.0) return;
+  for (auto& marker : *corners) {
+    for (cv::Point2f& p : marker) {
+      p = cv::Point2f(static_cast<float>((p.x + 0.5) / scale - 0.5), static_cast<float>((p.y + 0.5) / scale - 0.5));
+    }
+  }
+}
+
 BoardMarkers DetectBoardMarkers(const cv::Mat& gray, const MarkerBoardOptions& options,
                                 const cv::Ptr<cv::aruco::Dictionary>& dictionary,
                                 const cv::Ptr<cv::aruco::Board>& board, MarkerBoardDetection* detection) {
-  cv::Ptr<cv::aruco::DetectorParameters> parameters = cv::aruco::DetectorParameters::create();
-  // Line fits to the contour: sub-pixel without cornerSubPix's habit of
-  // jumping to a neighbouring marker.
-  parameters->cornerRefinementMethod = cv::aruco::CORNER_REFINE_CONTOUR;
-  std::vector<std::vector<cv::Point2f>> corners, rejected;
+  std::vector<std::vector<cv::Point2f>> corners;
   std::vector<int> ids;
-  cv::aruco::detectMarkers(gray, dictionary, corners, ids, parameters, rejected);
-  if (!ids.empty()) cv::aruco::refineDetectedMarkers(gray, board, corners, ids, rejected);
+  DetectMarkersOnLevel(gray, options, dictionary, board, &corners, &ids);
   BoardMarkers found;
   for (size_t i = 0; i < board->ids.size(); ++i) found.board_index[board->ids[i]] = i;
   for (size_t m = 0; m < ids.size(); ++m) {
     const auto it = found.board_index.find(ids[m]);
     if (it == found.board_index.end()) continue;  // a marker of another target
+    const bool edges_fitted = RefineMarker(gray, options, dictionary->markerSize, &corners[m]);
     found.corners.push_back(corners[m]);
     found.ids.push_back(ids[m]);
-    // The outline's edge curves give unbiased corners (OpenCV's contour
-    // corners sit ~0.6 px inside, and pixels off on foreshortened markers);
-    // an ArUco grid marker whose edges cannot be fitted gives no board
-    // points. A ChArUco board's markers give none anyway: the quicker
-    // crossings (marker_edge_crossings.h) do for their detections.
-    std::array<cv::Point2d, 4> quad;
-    for (int k = 0; k < 4; ++k) quad[k] = cv::Point2d(corners[m][k].x, corners[m][k].y);
-    MarkerEdgeRefinementOptions edge_options;
-    edge_options.bits_per_side = dictionary->markerSize;
-    const bool edges_fitted = options.type == "aruco_grid" ? RefineMarkerCorners(gray, edge_options, &quad)
-                                                           : RefineMarkerCornersByCrossings(gray, edge_options, &quad);
-    if (edges_fitted) {
-      for (int k = 0; k < 4; ++k) {
-        corners[m][k] = cv::Point2f(static_cast<float>(quad[k].x), static_cast<float>(quad[k].y));
-      }
-    }
     MarkerDetection marker;
     marker.dictionary = options.dictionary;
     marker.marker_id = ids[m];
@@ -100,12 +130,12 @@ BoardMarkers DetectBoardMarkers(const cv::Mat& gray, const MarkerBoardOptions& o
     if (options.type != "aruco_grid") continue;
     if (!edges_fitted) {
       ++detection->num_markers_unfitted;  // its corners are pixels off: left out
-    } else {
-      for (int k = 0; k < 4; ++k) {
-        const cv::Point3f& p = board->objPoints[it->second][k];
-        detection->points.push_back({static_cast<int64_t>(ids[m]) * 4 + k, Colmap(corners[m][k]),
-                                     Eigen::Vector3d(p.x, p.y, p.z)});
-      }
+      continue;
+    }
+    for (int k = 0; k < 4; ++k) {
+      const cv::Point3f& p = board->objPoints[it->second][k];
+      detection->points.push_back({static_cast<int64_t>(ids[m]) * 4 + k, Colmap(corners[m][k]),
+                                   Eigen::Vector3d(p.x, p.y, p.z)});
     }
   }
   return found;
@@ -133,6 +163,10 @@ void AddCharucoCorners(const cv::Mat& gray, const MarkerBoardOptions& options, c
   std::vector<cv::Point2f> charuco_corners;
   std::vector<int> charuco_ids;
   cv::aruco::interpolateCornersCharuco(markers.corners, markers.ids, gray, charuco, charuco_corners, charuco_ids);
+  if (!options.precise_fit && !charuco_corners.empty()) {
+    cv::cornerSubPix(gray, charuco_corners, cv::Size(2, 2), cv::Size(-1, -1),
+                     cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 10, 0.01));
+  }
   const cv::Mat homography = MarkersHomography(markers, *charuco);
   const auto to_image = [&](double x, double y) {
     const cv::Mat h = homography;
@@ -143,7 +177,7 @@ void AddCharucoCorners(const cv::Mat& gray, const MarkerBoardOptions& options, c
   for (size_t i = 0; i < charuco_ids.size(); ++i) {
     const cv::Point3f& p = charuco->chessboardCorners[charuco_ids[i]];
     Eigen::Vector2d xy = Colmap(charuco_corners[i]);
-    if (!homography.empty()) {
+    if (!homography.empty() && options.precise_fit) {
       const double s = options.square_size_m;
       const Eigen::Vector2d dx = to_image(p.x + s, p.y) - to_image(p.x, p.y);
       const Eigen::Vector2d dy = to_image(p.x, p.y + s) - to_image(p.x, p.y);

@@ -28,6 +28,15 @@ struct MarkerBoardOptions {
   int squares_x = 8, squares_y = 6;
   double square_size_m = 0.03;
   int min_points = 6;  // fewer: the view is refused
+  // false, for live views: the markers are found on the image halved to at
+  // most `coarse_max_image_size` pixels on its longer side, ArUco grid
+  // corners come from the edges' half-level crossings
+  // (marker_edge_crossings.h) and ChArUco corners as OpenCV interpolates
+  // them (cornerSubPix): tenths of a pixel at video rate. true: markers at
+  // full resolution, the edges and corners fitted to the pixels
+  // (hundredths of a pixel, several times slower).
+  bool precise_fit = true;
+  int coarse_max_image_size = 1000;  // quick mode only; 0: full resolution
   CornerRefinementOptions refinement;
   void Check() const;  // throws OptionError naming --Target.*
 };

@@ -18,23 +18,22 @@ namespace fs = std::filesystem;
 
 namespace portcal {
 
+TargetDetectorOptions DetectorOptions(const TargetExtractorOptions& o) {
+  TargetDetectorOptions detector;
+  detector.type = o.target_type;
+  detector.square_size_m = o.square_size_m;
+  detector.chessboard = o.chessboard;
+  detector.markers = o.markers;
+  detector.precise_fit = true;  // stored corners are calibrated on
+  return detector;
+}
+
 void TargetExtractorOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (image_path.empty()) throw OptionError("--image_path", "''", "a directory of images");
-  if (target_type != "chessboard" && target_type != "aruco_grid" && target_type != "charuco") {
-    throw OptionError("--Target.type", target_type, "chessboard, aruco_grid or charuco");
-  }
-  if (!(square_size_m > 0)) throw OptionError("--Target.square_size", std::to_string(square_size_m), "> 0 m");
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
   reader.Check();
-  if (target_type == "chessboard") {
-    chessboard.Check();
-  } else {
-    MarkerBoardOptions board = markers;
-    board.type = target_type;
-    board.square_size_m = square_size_m;
-    board.Check();
-  }
+  DetectorOptions(*this).Check();
 }
 
 namespace {
@@ -53,33 +52,12 @@ struct ImageResult {
 };
 
 void Detect(const cv::Mat& gray, const TargetExtractorOptions& o, ImageResult* result) {
-  if (o.target_type == "chessboard") {
-    const ChessboardDetection d = DetectChessboard(gray, o.chessboard);
-    result->found = d.found;
-    result->reason = d.reason;
-    result->symmetric = d.symmetric;
-    result->note = d.note;
-    if (!d.found) return;
-    for (size_t i = 0; i < d.corners.size(); ++i) {
-      if (!d.corners[i]) continue;
-      TargetObservation observation;
-      observation.point_id = static_cast<int64_t>(i);
-      observation.xy = *d.corners[i];
-      observation.point_in_target = Eigen::Vector3d((i % o.chessboard.cols) * o.square_size_m,
-                                                    (i / o.chessboard.cols) * o.square_size_m, 0.0);
-      result->observations.push_back(observation);
-    }
-    return;
-  }
-  MarkerBoardOptions board = o.markers;
-  board.type = o.target_type;
-  board.square_size_m = o.square_size_m;
-  const MarkerBoardDetection d = DetectMarkerBoard(gray, board);
+  const TargetDetection d = DetectTarget(gray, DetectorOptions(o));
   result->found = d.found;
   result->reason = d.reason;
-  result->markers = d.markers;
+  result->symmetric = d.symmetric;
   result->note = d.note;
-  if (!d.found) return;
+  result->markers = d.markers;
   for (const BoardPoint& p : d.points) result->observations.push_back({p.point_id, p.xy, p.point_in_target});
 }
 

@@ -7,8 +7,7 @@
 
 #include "colmap_ext/util/progress.h"
 #include "pipelines/images/image_reader.h"
-#include "pipelines/markers/marker_board_detector.h"
-#include "pipelines/target/chessboard_detector.h"
+#include "pipelines/detection/target_detector.h"
 
 namespace portcal {
 
@@ -29,6 +28,9 @@ struct TargetExtractorSummary {
   int num_found = 0;
   int64_t num_points = 0;
 };
+
+// The detector the options describe (precise fits).
+TargetDetectorOptions DetectorOptions(const TargetExtractorOptions& options);
 
 // Throws InputError (bad options, no images), DatabaseError, Cancelled; the
 // database is then left as it was.

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "colmap_ext/util/error.h"
+#include "pipelines/target/coarse_level.h"
 
 namespace portcal {
 
@@ -26,19 +27,6 @@ void ChessboardDetectionOptions::Check() const {
 }
 
 namespace {
-
-// The image halved (a power of two: INTER_AREA is then a plain box average,
-// several times faster than by any other factor) until its longer side is
-// at most `max_size`, with the factor; the image itself when it fits.
-std::pair<double, cv::Mat> CoarseLevel(const cv::Mat& gray, int max_size) {
-  const int longer = std::max(gray.cols, gray.rows);
-  if (max_size <= 0 || longer <= max_size) return {1.0, gray};
-  double factor = 1.0;
-  while (longer * factor > max_size) factor /= 2;
-  cv::Mat small;
-  cv::resize(gray, small, cv::Size(), factor, factor, cv::INTER_AREA);
-  return {factor, small};
-}
 
 // The board's corners in OpenCV's pixels of the image scaled by *scale; or
 // false with the reason. First the X-junction count on the coarse level:
