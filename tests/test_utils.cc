@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "colmap_ext/util/string_utils.h"
+#include "pipelines/stages/synthesize.h"
 
 namespace fs = std::filesystem;
 
@@ -98,6 +99,15 @@ const char* const kThreeFaceTargetYaml = R"(target:
   quiet_zone_modules: 1
   dots: {seed: 11, r_min: 0.0015, r_max: 0.009, coverage: 0.5, gray_min: 20, gray_max: 110, edge_margin: 0.004}
 )";
+
+GroundTruth RenderSet(const TempDir& dir, const std::string& config_yaml) {
+  std::ofstream(dir / "set.yaml") << config_yaml;
+  SynthesizeOptions options;
+  options.config_path = (dir / "set.yaml").string();
+  options.output_path = (dir / "set").string();
+  RunSynthesize(options, NoProgress());
+  return ReadGroundTruth(dir / "set/ground_truth.yaml");
+}
 
 cv::Mat ClutteredScene(int width, int height, uint64_t seed) {
   cv::Mat scene(height, width, CV_8UC1, cv::Scalar(110));

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "colmap_ext/housing/housing.h"
+#include "colmap_ext/io/ground_truth.h"
 #include "colmap_ext/util/progress.h"
 
 namespace portcal {
@@ -57,6 +58,10 @@ std::string ReadFileToString(const std::filesystem::path& path);
 // px, as the shared textured renders look: an image with many
 // junction-like spots and no chessboard.
 cv::Mat ClutteredScene(int width, int height, uint64_t seed);
+
+// Renders the set `config_yaml` describes (synthesize's YAML) into
+// dir/set and returns its ground truth (the images under dir/set).
+GroundTruth RenderSet(const TempDir& dir, const std::string& config_yaml);
 
 // The `target:` block of a synthesize config for the shared sets' 3-D
 // target: two faces folded at 120 deg, dots, ArUco markers 0 and 1 of

@@ -38,6 +38,12 @@ int TargetExtractorCommand(int argc, char** argv) {
           "images with fewer grid junctions than this fraction of the board's are not searched (0: all are)");
   cli.Add("Target.min_refined_corners", &options.chessboard.min_refined_corners,
           "views with fewer refined corners are refused");
+  cli.Add("Target.partial_views", &options.chessboard.partial_views,
+          "chessboards cut by the image's border: keep the corners in view where their place on the board can be "
+          "told (from where the seen grid ends)");
+  cli.Add("Target.max_level_drift", &options.chessboard.refinement.max_level_drift,
+          "chessboard corners are fitted again with the board's shading taken out where its levels drift by "
+          "more than this fraction of the contrast across a corner's window (0: wherever they drift; < 0: never)");
   cli.Add("num_threads", &options.num_threads, "threads");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;

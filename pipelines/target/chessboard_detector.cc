@@ -8,6 +8,8 @@
 
 #include "colmap_ext/util/error.h"
 #include "pipelines/target/coarse_level.h"
+#include "pipelines/target/junction_lattice.h"
+#include "pipelines/target/partial_chessboard.h"
 
 namespace portcal {
 
@@ -28,52 +30,68 @@ void ChessboardDetectionOptions::Check() const {
 
 namespace {
 
-// The board's corners in OpenCV's pixels of the image scaled by *scale; or
-// false with the reason. First the X-junction count on the coarse level:
-// an image without enough of them is not searched. Then OpenCV's classic
-// detector on the coarse level without its fast check (which misses small
-// boards there and which the count replaces), at full resolution with it;
-// the classic detector finds boards on the real views that the SB detector
-// misses, an order of magnitude faster (docs/benchmarks.md). Only then the
-// SB detector (exhaustive) at each scale, so that its cost falls on the
-// images the classic one misses.
-bool FindCoarse(const cv::Mat& gray, const ChessboardDetectionOptions& options, std::vector<cv::Point2f>* corners,
-                double* scale, std::string* reason) {
-  const cv::Size pattern(options.cols, options.rows);
-  std::vector<std::pair<double, cv::Mat>> levels = {CoarseLevel(gray, options.coarse_max_image_size)};
-  if (levels.front().first < 1) levels.emplace_back(1.0, gray);
+// Where a search for the board starts: the coarse level (and the image
+// itself when that is smaller) and whether the X-junction count lets the
+// image be searched at all (else the reason).
+struct SearchLevels {
+  std::vector<std::pair<double, cv::Mat>> levels;  // (scale, image), coarse first
+  bool searched = false;
+};
+
+SearchLevels GateAndLevels(const cv::Mat& gray, const ChessboardDetectionOptions& options, std::string* reason) {
+  SearchLevels search;
+  search.levels = {CoarseLevel(gray, options.coarse_max_image_size)};
+  if (search.levels.front().first < 1) search.levels.emplace_back(1.0, gray);
   const int num_crossings = std::max(options.cols - 2, 1) * std::max(options.rows - 2, 1);
   const int needed = static_cast<int>(std::ceil(options.min_x_corner_fraction * num_crossings));
   if (needed > 0) {
-    const int count = CountXCorners(levels.front().second, {}, needed);
+    const int count = CountXCorners(search.levels.front().second, {}, needed);
     if (count < needed) {
       *reason = "no " + std::to_string(options.cols) + "x" + std::to_string(options.rows) +
                 " inner-corner chessboard in view (" + std::to_string(count) +
                 " chessboard-like grid junctions, fewer than " + std::to_string(needed) + ")";
-      return false;
+      return search;
     }
   }
-  // On the coarse level a global threshold first (a few ms where the
-  // adaptive one took up to 0.2 s on a render; docs/benchmarks.md), then
-  // the adaptive one; at full size the adaptive one with the fast check.
+  search.searched = true;
+  return search;
+}
+
+// The whole board by OpenCV's classic detector on the coarse level with a
+// global threshold: a few ms where the adaptive one took up to 0.2 s on a
+// render (docs/benchmarks.md).
+bool FindWholeQuickly(const SearchLevels& search, const ChessboardDetectionOptions& options,
+                      std::vector<cv::Point2f>* corners, double* scale) {
+  *scale = search.levels.front().first;
+  return cv::findChessboardCorners(search.levels.front().second, cv::Size(options.cols, options.rows), *corners,
+                                   cv::CALIB_CB_NORMALIZE_IMAGE);
+}
+
+// The whole board by the slower searches: the classic detector's adaptive
+// threshold on the coarse level without its fast check (which misses
+// small boards there and which the X-junction count replaces), at full
+// resolution with it; the classic detector finds boards on the real views
+// that the SB detector misses. Then the SB detector (exhaustive) at each
+// scale.
+bool FindWholeSlowly(const SearchLevels& search, const ChessboardDetectionOptions& options,
+                     std::vector<cv::Point2f>* corners, double* scale) {
+  const cv::Size pattern(options.cols, options.rows);
   const int adaptive = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE;
-  std::vector<std::pair<size_t, int>> attempts = {{0, cv::CALIB_CB_NORMALIZE_IMAGE},
-                                                  {0, adaptive | (needed > 0 ? 0 : cv::CALIB_CB_FAST_CHECK)}};
-  if (levels.size() > 1) attempts.emplace_back(1, adaptive | cv::CALIB_CB_FAST_CHECK);
+  const bool gated = options.min_x_corner_fraction > 0;
+  std::vector<std::pair<size_t, int>> attempts = {{0, adaptive | (gated ? 0 : cv::CALIB_CB_FAST_CHECK)}};
+  if (search.levels.size() > 1) attempts.emplace_back(1, adaptive | cv::CALIB_CB_FAST_CHECK);
   for (const auto& [level, flags] : attempts) {
-    if (cv::findChessboardCorners(levels[level].second, pattern, *corners, flags)) {
-      *scale = levels[level].first;
+    if (cv::findChessboardCorners(search.levels[level].second, pattern, *corners, flags)) {
+      *scale = search.levels[level].first;
       return true;
     }
   }
-  for (const auto& [factor, image] : levels) {
+  for (const auto& [factor, image] : search.levels) {
     if (cv::findChessboardCornersSB(image, pattern, *corners, cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_EXHAUSTIVE)) {
       *scale = factor;
       return true;
     }
   }
-  *reason = "no " + std::to_string(options.cols) + "x" + std::to_string(options.rows) +
-            " inner-corner chessboard found";
   return false;
 }
 
@@ -125,28 +143,27 @@ std::string LeftOutNote(const std::vector<CornerFailure>& failures) {
 }
 
 // cv::cornerSubPix at full resolution on corners in COLMAP pixels.
-void PolishQuickly(const cv::Mat& gray, std::vector<Eigen::Vector2d>* corners) {
+void PolishQuickly(const cv::Mat& gray, const std::vector<bool>& seen, std::vector<Eigen::Vector2d>* corners) {
   std::vector<cv::Point2f> points;
-  for (const Eigen::Vector2d& c : *corners) points.emplace_back(c.x() - 0.5, c.y() - 0.5);
+  std::vector<size_t> indices;
+  for (size_t i = 0; i < corners->size(); ++i) {
+    if (!seen[i]) continue;
+    points.emplace_back((*corners)[i].x() - 0.5, (*corners)[i].y() - 0.5);
+    indices.push_back(i);
+  }
   cv::cornerSubPix(gray, points, cv::Size(2, 2), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 10, 0.01));
-  for (size_t i = 0; i < points.size(); ++i) (*corners)[i] = Eigen::Vector2d(points[i].x + 0.5, points[i].y + 0.5);
+  for (size_t k = 0; k < points.size(); ++k) (*corners)[indices[k]] = Eigen::Vector2d(points[k].x + 0.5, points[k].y + 0.5);
 }
 
-}  // namespace
-
-ChessboardDetection DetectChessboard(const cv::Mat& gray, const ChessboardDetectionOptions& options) {
-  options.Check();
-  PORTCAL_CHECK(gray.type() == CV_8UC1);
-  ChessboardDetection detection;
-  std::vector<cv::Point2f> coarse;
-  double scale = 1.0;
-  if (!FindCoarse(gray, options, &coarse, &scale, &detection.reason)) return detection;
+// The whole board's corners (COLMAP pixels of the image) in canonical
+// order, from OpenCV's corners on the level scaled by `scale`.
+std::vector<Eigen::Vector2d> CanonicalOrder(const cv::Mat& gray, const std::vector<cv::Point2f>& coarse, double scale,
+                                            const ChessboardDetectionOptions& options) {
   // Back to full-resolution COLMAP pixels: OpenCV's (0, 0) is the centre of
   // the top-left pixel, also in the downscaled image.
   std::vector<Eigen::Vector2d> start;
   for (const cv::Point2f& p : coarse) start.emplace_back((p.x + 0.5) / scale, (p.y + 0.5) / scale);
-
   // Right-handed order: the rows run to the right of the columns as the
   // board is seen from the front (target x cross y away from the camera).
   // findChessboardCorners may return the mirror image, a labelling no board
@@ -160,14 +177,99 @@ ChessboardDetection DetectChessboard(const cv::Mat& gray, const ChessboardDetect
   }
   // Canonical order: corner 0's outer diagonal square is black. OpenCV may
   // start at the far corner (the same grid rotated by 180 degrees).
-  const int squares = (options.cols + 1) + (options.rows + 1);
-  detection.symmetric = squares % 2 == 0;
   if (FarEndIsBlack(gray, start, options.cols)) std::reverse(start.begin(), start.end());
+  return start;
+}
 
+// The part of the board in view, from SB's grid grown to every junction in
+// view (junction_lattice.h) and placed on the board (partial_chessboard.h):
+// every corner in full-resolution COLMAP pixels, those out of view marked
+// unseen. nullopt board with the reason.
+PartialPlacement PlacePartly(const SearchLevels& search, const SeenGrid& grid,
+                             const ChessboardDetectionOptions& options) {
+  const cv::Mat& level = search.levels.front().second;
+  const auto lattice = JunctionLattice::Grow(level, grid);
+  if (!lattice) {
+    PartialPlacement none;
+    none.reason = "a grid of junctions without dark and light squares";
+    return none;
+  }
+  PartialPlacement placement = PlaceOnChessboard(level, *lattice, options.cols, options.rows);
+  if (placement.board) {
+    for (Eigen::Vector2d& p : placement.board->corners) p = (p + Eigen::Vector2d(0.5, 0.5)) / search.levels.front().first;
+  }
+  return placement;
+}
+
+// Where the board's corners start from: the whole board, or the part of
+// it in view. The order of the searches: the classic detector's quickest;
+// SB's grid of every junction it sees (0.06-0.1 s on 800 x 600), which is
+// the whole board or, cut by the image's border, the part in view; only
+// then the slower searches for the whole board (the classic detector's
+// adaptive threshold spends 6-8 s on an 800 x 600 view of a board cut by
+// the image's border, and finds nothing; docs/benchmarks.md), and not
+// where the junctions seen rule the whole board out (more than it has, all
+// in view, or fitting it in several places). False with the reason.
+bool FindStart(const cv::Mat& gray, const ChessboardDetectionOptions& options, std::vector<Eigen::Vector2d>* start,
+               std::vector<bool>* seen, double* scale, ChessboardDetection* detection) {
+  const int squares = (options.cols + 1) + (options.rows + 1);
+  detection->symmetric = squares % 2 == 0;
+  const SearchLevels search = GateAndLevels(gray, options, &detection->reason);
+  if (!search.searched) return false;
+  std::vector<cv::Point2f> coarse;
+  bool whole = FindWholeQuickly(search, options, &coarse, scale);
+  std::optional<SeenGrid> grid;
+  if (!whole) {
+    grid = SeeChessboardGrid(search.levels.front().second);
+    const auto corners = grid ? WholeBoard(*grid, options.cols, options.rows) : std::nullopt;
+    if (corners) coarse = *corners;
+    whole = corners.has_value();
+  }
+  const std::string board = std::to_string(options.cols) + "x" + std::to_string(options.rows) + " inner-corner chessboard";
+  PartialPlacement partial;
+  if (!whole && grid && options.partial_views) {
+    partial = PlacePartly(search, *grid, options);
+    if (partial.board) {
+      *start = partial.board->corners;
+      *seen = partial.board->seen;
+      *scale = search.levels.front().first;
+      detection->symmetric = partial.board->symmetric;
+      detection->partial = true;
+      return true;
+    }
+    if (partial.too_large || partial.closed || partial.ambiguous) {
+      detection->reason = "no " + board + " found: " + partial.reason;
+      return false;
+    }
+  }
+  if (!whole) whole = FindWholeSlowly(search, options, &coarse, scale);
+  if (!whole) {
+    detection->reason = "no " + board + " found" + (partial.reason.empty() ? "" : ": " + partial.reason);
+    return false;
+  }
+  *start = CanonicalOrder(gray, coarse, *scale, options);
+  seen->assign(start->size(), true);
+  return true;
+}
+
+}  // namespace
+
+ChessboardDetection DetectChessboard(const cv::Mat& gray, const ChessboardDetectionOptions& options) {
+  options.Check();
+  PORTCAL_CHECK(gray.type() == CV_8UC1);
+  ChessboardDetection detection;
+  std::vector<Eigen::Vector2d> start;
+  std::vector<bool> seen;
+  double scale = 1.0;
+  if (!FindStart(gray, options, &start, &seen, &scale, &detection)) return detection;
+  detection.reason.clear();
   if (!options.precise_fit) {
-    PolishQuickly(gray, &start);
-    for (const Eigen::Vector2d& corner : start) detection.corners.emplace_back(corner);
-    detection.num_refined = static_cast<int>(start.size());
+    PolishQuickly(gray, seen, &start);
+    detection.corners.resize(start.size());
+    for (size_t i = 0; i < start.size(); ++i) {
+      if (seen[i]) detection.corners[i] = start[i];
+    }
+    detection.num_refined = static_cast<int>(std::count(seen.begin(), seen.end(), true));
     detection.found = true;
     return detection;
   }
@@ -176,7 +278,8 @@ ChessboardDetection DetectChessboard(const cv::Mat& gray, const ChessboardDetect
   CornerRefinementOptions refinement = options.refinement;
   refinement.max_shift_px /= scale;
   std::vector<CornerFailure> failures;
-  const auto refined = RefineChessboardCorners(gray, start, options.cols, options.rows, refinement, &failures);
+  const auto refined =
+      RefineChessboardCorners(gray, start, options.cols, options.rows, refinement, &failures, &seen);
   detection.corners.resize(refined.size());
   std::set<int> rows, cols;
   for (size_t i = 0; i < refined.size(); ++i) {

@@ -3,7 +3,8 @@
 // downscaled image (findChessboardCorners, then at full resolution, then
 // findChessboardCornersSB as a fallback), put in portcal's canonical order (right-handed, corner 0's
 // outer diagonal square black), then refined at full resolution by the
-// ideal-pattern fit (corner_refinement.h).
+// ideal-pattern fit (corner_refinement.h). A board cut by the image's
+// border: its part in view (partial_chessboard.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -35,6 +36,10 @@ struct ChessboardDetectionOptions {
   // window at full resolution): tenths of a pixel at video rate, for live
   // views; true: the ideal-pattern fit (hundredths, several times slower).
   bool precise_fit = true;
+  // A board cut by the image's border is searched for when the whole board
+  // is not found (partial_chessboard.h): the corners in view are kept where
+  // their place on the board can be told.
+  bool partial_views = true;
   CornerRefinementOptions refinement;
   void Check() const;  // throws OptionError
 };
@@ -49,6 +54,7 @@ struct ChessboardDetection {
   // The board looks the same rotated by 180 degrees (an even number of
   // squares in total): the order may be the rotated one.
   bool symmetric = false;
+  bool partial = false;  // the board was found in part (cut by the image's border)
   int num_refined = 0;
   // Found with corners left out: how many and why, e.g. "3 of 48 corners
   // left out (2 no contrast, 1 window beyond the image)".

@@ -6,6 +6,7 @@
 
 #include "colmap_ext/cost/corner_pattern_model.h"
 #include "colmap_ext/util/error.h"
+#include "pipelines/target/board_shading.h"
 
 namespace portcal {
 
@@ -23,6 +24,9 @@ void CornerRefinementOptions::Check() const {
   if (max_num_iterations < 1) {
     throw OptionError("max_num_iterations", std::to_string(max_num_iterations), ">= 1");
   }
+  if (!std::isfinite(max_level_drift)) {
+    throw OptionError("--Target.max_level_drift", std::to_string(max_level_drift), "a fraction (< 0: never)");
+  }
   if (!(corner_tolerance_px > 0)) {
     throw OptionError("corner_tolerance_px", std::to_string(corner_tolerance_px), "> 0");
   }
@@ -35,6 +39,7 @@ const char* CornerFailureText(CornerFailure failure) {
     case CornerFailure::kNoContrast: return "no contrast";
     case CornerFailure::kDiverged: return "fit diverged";
     case CornerFailure::kMovedTooFar: return "moved too far from the detection";
+    case CornerFailure::kNotSeen: return "out of view";
   }
   return "unknown";
 }
@@ -194,6 +199,80 @@ double FitOverPixelAreas(const CornerRefinementOptions& options, std::vector<Win
   return cost;
 }
 
+// The pixels (centres col + 0.5, row + 0.5) within the circular window of
+// radius `half` about `centre`, their grays brought to the levels at
+// `shading_centre` by `shading` if given; empty where the window leaves
+// the image.
+std::vector<WindowPixel> WindowAbout(const cv::Mat& gray, const Eigen::Vector2d& centre, double half,
+                                     const LocalShading* shading = nullptr,
+                                     const Eigen::Vector2d& shading_centre = Eigen::Vector2d::Zero()) {
+  const int c0 = static_cast<int>(std::floor(centre.x() - half));
+  const int r0 = static_cast<int>(std::floor(centre.y() - half));
+  const int c1 = static_cast<int>(std::ceil(centre.x() + half));
+  const int r1 = static_cast<int>(std::ceil(centre.y() + half));
+  std::vector<WindowPixel> window;
+  if (c0 < 0 || r0 < 0 || c1 >= gray.cols || r1 >= gray.rows) return window;
+  window.reserve(static_cast<size_t>((c1 - c0 + 1) * (r1 - r0 + 1)));
+  for (int r = r0; r <= r1; ++r) {
+    for (int c = c0; c <= c1; ++c) {
+      const Eigen::Vector2d p(c + 0.5, r + 0.5);
+      if ((p - centre).norm() > half) continue;
+      const double value = gray.at<uint8_t>(r, c);
+      window.push_back({p.x(), p.y(), shading != nullptr ? shading->Flatten(value, p - shading_centre) : value});
+    }
+  }
+  return window;
+}
+
+// The first stage of a corner's fit: the pattern fitted at the window's
+// pixel centres only (the blur absorbs the pixel's box), from the start's
+// levels and edge angles. kNone, or why the fit cannot go on.
+CornerFailure FitAtPixelCentres(const cv::Mat& gray, const std::vector<WindowPixel>& window,
+                                const Eigen::Vector2d& start, double half, double normal_angle1,
+                                double normal_angle2, const CornerRefinementOptions& options, Vector7d* params) {
+  if (window.size() < 12) return CornerFailure::kNearImageBorder;
+  double sum = 0;
+  for (const WindowPixel& pixel : window) sum += pixel.gray;
+  // Levels: the mean, and the contrast's sign from the quadrant between the
+  // two edge normals.
+  *params << start.x(), start.y(), normal_angle1, normal_angle2, sum / window.size(), 0, std::log(0.8);
+  const Eigen::Vector2d probe =
+      start + 0.5 * half * (Eigen::Vector2d(std::cos(normal_angle1), std::sin(normal_angle1)) +
+                            Eigen::Vector2d(std::cos(normal_angle2), std::sin(normal_angle2)))
+                               .normalized();
+  (*params)[5] = gray.at<uint8_t>(static_cast<int>(probe.y()), static_cast<int>(probe.x())) - (*params)[4];
+  if (std::abs((*params)[5]) < 5) return CornerFailure::kNoContrast;
+  // Near the minimum the steps shrink geometrically (the sharp edges'
+  // curvature, which Gauss-Newton leaves out), so this stage stops once
+  // the corner moves by less than 0.01 px; the second goes on from there.
+  if (FitCornerPattern(window, Integration{}, options.max_num_iterations, 0.01, params) < 0) {
+    return CornerFailure::kDiverged;
+  }
+  // The blur less the pixel's box (variance 1/12 px^2 across any edge).
+  (*params)[6] = 0.5 * std::log(std::max(std::exp(2 * (*params)[6]) - 1.0 / 12, 0.01));
+  return CornerFailure::kNone;
+}
+
+// The second stage: the pattern integrated over each pixel's area, from
+// the first stage's parameters; the corner, or why not.
+std::optional<RefinedCorner> FitOverAreas(std::vector<WindowPixel>* window, const Eigen::Vector2d& start,
+                                          const CornerRefinementOptions& options, Vector7d* params,
+                                          CornerFailure* failure) {
+  const double final_cost = FitOverPixelAreas(options, window, params);
+  const Eigen::Vector2d xy((*params)[0], (*params)[1]);
+  *failure = final_cost < 0 || !params->allFinite()      ? CornerFailure::kDiverged
+             : (xy - start).norm() > options.max_shift_px ? CornerFailure::kMovedTooFar
+                                                          : CornerFailure::kNone;
+  if (*failure != CornerFailure::kNone) return std::nullopt;
+  RefinedCorner corner;
+  corner.xy = xy;
+  corner.rms_gray = std::sqrt(2 * final_cost / static_cast<double>(window->size()));
+  corner.contrast = 2 * std::abs((*params)[5]);
+  corner.blur_sigma_px = std::exp((*params)[6]);
+  corner.mean_gray = (*params)[4];
+  return corner;
+}
+
 }  // namespace
 
 std::optional<RefinedCorner> RefineCorner(const cv::Mat& gray, const Eigen::Vector2d& start,
@@ -202,81 +281,81 @@ std::optional<RefinedCorner> RefineCorner(const cv::Mat& gray, const Eigen::Vect
   PORTCAL_CHECK(gray.type() == CV_8UC1);
   CornerFailure unused;
   if (failure == nullptr) failure = &unused;
-  *failure = CornerFailure::kNone;
-  const auto fail = [failure](CornerFailure why) {
-    *failure = why;
-    return std::nullopt;
-  };
-  // Pixel centres (col + 0.5, row + 0.5) within the circular window.
-  const int c0 = static_cast<int>(std::floor(start.x() - half));
-  const int r0 = static_cast<int>(std::floor(start.y() - half));
-  const int c1 = static_cast<int>(std::ceil(start.x() + half));
-  const int r1 = static_cast<int>(std::ceil(start.y() + half));
-  if (c0 < 0 || r0 < 0 || c1 >= gray.cols || r1 >= gray.rows) return fail(CornerFailure::kNearImageBorder);
+  std::vector<WindowPixel> window = WindowAbout(gray, start, half);
   Vector7d params;
-  params << start.x(), start.y(), normal_angle1, normal_angle2, 0, 0, std::log(0.8);
-  std::vector<WindowPixel> window;
-  window.reserve(static_cast<size_t>((c1 - c0 + 1) * (r1 - r0 + 1)));
-  double sum = 0;
-  for (int r = r0; r <= r1; ++r) {
-    for (int c = c0; c <= c1; ++c) {
-      const Eigen::Vector2d p(c + 0.5, r + 0.5);
-      if ((p - start).norm() > half) continue;
-      const double value = gray.at<uint8_t>(r, c);
-      sum += value;
-      window.push_back({p.x(), p.y(), value});
-    }
-  }
-  const double count = static_cast<double>(window.size());
-  if (count < 12) return fail(CornerFailure::kNearImageBorder);
-  // Levels: the mean, and the contrast's sign from the quadrant between the
-  // two edge normals.
-  params[4] = sum / count;
-  const Eigen::Vector2d probe =
-      start + 0.5 * half * (Eigen::Vector2d(std::cos(params[2]), std::sin(params[2])) +
-                            Eigen::Vector2d(std::cos(params[3]), std::sin(params[3])))
-                               .normalized();
-  params[5] = gray.at<uint8_t>(static_cast<int>(probe.y()), static_cast<int>(probe.x())) - params[4];
-  if (std::abs(params[5]) < 5) return fail(CornerFailure::kNoContrast);
-  // Most iterations with the pixel's centre only, the last ones integrating
-  // over its area, from there (the blur less the pixel's box, whose
-  // variance is 1/12 px^2 across any edge): the same minimum in a fraction
-  // of the time. Near the minimum the steps shrink geometrically (the
-  // sharp edges' curvature, which Gauss-Newton leaves out), so a fit stops
-  // once the corner moves by less than a tolerance far below the corners'
-  // accuracy.
-  if (FitCornerPattern(window, Integration{}, options.max_num_iterations, 0.01, &params) < 0) {
-    return fail(CornerFailure::kDiverged);
-  }
-  params[6] = 0.5 * std::log(std::max(std::exp(2 * params[6]) - 1.0 / 12, 0.01));
-  const double final_cost = FitOverPixelAreas(options, &window, &params);
-  const Eigen::Vector2d xy(params[0], params[1]);
-  if (final_cost < 0 || !params.allFinite()) return fail(CornerFailure::kDiverged);
-  if ((xy - start).norm() > options.max_shift_px) return fail(CornerFailure::kMovedTooFar);
-  RefinedCorner corner;
-  corner.xy = xy;
-  corner.rms_gray = std::sqrt(2 * final_cost / count);
-  corner.contrast = 2 * std::abs(params[5]);
-  corner.blur_sigma_px = std::exp(params[6]);
-  return corner;
+  *failure = FitAtPixelCentres(gray, window, start, half, normal_angle1, normal_angle2, options, &params);
+  if (*failure != CornerFailure::kNone) return std::nullopt;
+  return FitOverAreas(&window, start, options, &params, failure);
 }
+
+namespace {
+
+// One grid corner through both stages of its fit.
+struct GridCorner {
+  Eigen::Vector2d start;
+  double half = 0;
+  CornerRefinementOptions options;  // its own max_shift_px
+  Vector7d params;
+  CornerFailure failure = CornerFailure::kNone;
+};
+
+// The board's shading (board_shading.h) from the first stage's levels;
+// nullopt with too few corners.
+std::optional<BoardShading> ShadingOfFirstStage(const std::vector<GridCorner>& grid) {
+  std::vector<Eigen::Vector2d> xy;
+  std::vector<double> means, contrasts;
+  for (const GridCorner& corner : grid) {
+    if (corner.failure != CornerFailure::kNone) continue;
+    xy.emplace_back(corner.params[0], corner.params[1]);
+    means.push_back(corner.params[4]);
+    contrasts.push_back(2 * std::abs(corner.params[5]));
+  }
+  return BoardShading::Fit(xy, means, contrasts);
+}
+
+}  // namespace
 
 std::vector<std::optional<RefinedCorner>> RefineChessboardCorners(
     const cv::Mat& gray, const std::vector<Eigen::Vector2d>& corners, int cols, int rows,
-    const CornerRefinementOptions& options, std::vector<CornerFailure>* failures) {
+    const CornerRefinementOptions& options, std::vector<CornerFailure>* failures, const std::vector<bool>* seen) {
   options.Check();
+  PORTCAL_CHECK(gray.type() == CV_8UC1);
   PORTCAL_CHECK(static_cast<int>(corners.size()) == cols * rows);
-  std::vector<std::optional<RefinedCorner>> refined(corners.size());
-  if (failures != nullptr) failures->assign(corners.size(), CornerFailure::kNone);
+  PORTCAL_CHECK(seen == nullptr || seen->size() == corners.size());
+  std::vector<GridCorner> grid(corners.size());
   for (int index = 0; index < cols * rows; ++index) {
+    GridCorner& corner = grid[index];
     const double neighbour_distance = NearestNeighbourDistance(corners, cols, rows, index);
-    const double half =
-        std::clamp(options.window_fraction * neighbour_distance, options.min_window_px, options.max_window_px);
-    CornerRefinementOptions corner_options = options;
-    corner_options.max_shift_px = std::max(options.max_shift_px, options.max_shift_fraction * neighbour_distance);
-    refined[index] = RefineCorner(gray, corners[index], half, EdgeAngle(corners, cols, rows, index, true),
-                                  EdgeAngle(corners, cols, rows, index, false), corner_options,
-                                  failures != nullptr ? &(*failures)[index] : nullptr);
+    corner.start = corners[index];
+    corner.half = std::clamp(options.window_fraction * neighbour_distance, options.min_window_px, options.max_window_px);
+    corner.options = options;
+    corner.options.max_shift_px = std::max(options.max_shift_px, options.max_shift_fraction * neighbour_distance);
+    if (seen != nullptr && !(*seen)[index]) {
+      corner.failure = CornerFailure::kNotSeen;
+      continue;
+    }
+    corner.failure = FitAtPixelCentres(gray, WindowAbout(gray, corner.start, corner.half), corner.start, corner.half,
+                                       EdgeAngle(corners, cols, rows, index, true),
+                                       EdgeAngle(corners, cols, rows, index, false), corner.options, &corner.params);
+  }
+  // The second stage over windows brought to each corner's own levels
+  // where the board's levels drift across them.
+  const std::optional<BoardShading> shading =
+      options.max_level_drift >= 0 ? ShadingOfFirstStage(grid) : std::nullopt;
+  std::vector<std::optional<RefinedCorner>> refined(corners.size());
+  for (size_t index = 0; index < grid.size(); ++index) {
+    GridCorner& corner = grid[index];
+    if (corner.failure != CornerFailure::kNone) continue;
+    const Eigen::Vector2d xy(corner.params[0], corner.params[1]);
+    const std::optional<LocalShading> local = shading ? std::optional(shading->At(xy)) : std::nullopt;
+    const bool flatten = local && local->Drift(corner.half, 2 * std::abs(corner.params[5])) > options.max_level_drift;
+    std::vector<WindowPixel> window =
+        flatten ? WindowAbout(gray, corner.start, corner.half, &*local, xy) : WindowAbout(gray, corner.start, corner.half);
+    refined[index] = FitOverAreas(&window, corner.start, corner.options, &corner.params, &corner.failure);
+  }
+  if (failures != nullptr) {
+    failures->clear();
+    for (const GridCorner& corner : grid) failures->push_back(corner.failure);
   }
   return refined;
 }

@@ -40,6 +40,11 @@ struct CornerRefinementOptions {
   // The fit stops once a step moves the corner by less than this (or the
   // cost by less than 1e-6 of itself).
   double corner_tolerance_px = 2e-4;
+  // A grid's corners are fitted again with each window's pixels brought to
+  // the corner's own levels (board_shading.h) where the board's levels
+  // drift by more than this fraction of the contrast over the window (0:
+  // wherever they drift at all; < 0: never).
+  double max_level_drift = 0.002;
   void Check() const;  // throws OptionError
 };
 
@@ -47,11 +52,12 @@ struct RefinedCorner {
   Eigen::Vector2d xy;        // COLMAP pixels
   double rms_gray = 0;       // fit residual, gray levels
   double contrast = 0;       // |a| * 2, gray levels
+  double mean_gray = 0;      // m
   double blur_sigma_px = 0;
 };
 
 // Why a corner was not refined.
-enum class CornerFailure { kNone, kNearImageBorder, kNoContrast, kDiverged, kMovedTooFar };
+enum class CornerFailure { kNone, kNearImageBorder, kNoContrast, kDiverged, kMovedTooFar, kNotSeen };
 const char* CornerFailureText(CornerFailure failure);  // e.g. "no contrast"
 
 // Refines one corner from `start` (COLMAP pixels) with a circular window of
@@ -65,9 +71,14 @@ std::optional<RefinedCorner> RefineCorner(const cv::Mat& gray, const Eigen::Vect
 // Refines corners (COLMAP pixel convention) of a grid of rows x cols inner
 // corners, index r * cols + c, in an 8-bit gray image. nullopt for corners
 // whose fit failed (no contrast, diverged, moved too far), with the reasons
-// in *failures (one per corner, kNone where refined) if given.
+// in *failures (one per corner, kNone where refined) if given. The corners
+// are fitted twice where the board's levels drift across the windows
+// (`max_level_drift`). With `seen`, only the corners it marks are fitted
+// (the others, of a board in part out of view, are kNotSeen; their
+// positions still set their neighbours' windows and edge directions).
 std::vector<std::optional<RefinedCorner>> RefineChessboardCorners(
     const cv::Mat& gray, const std::vector<Eigen::Vector2d>& corners, int cols, int rows,
-    const CornerRefinementOptions& options = {}, std::vector<CornerFailure>* failures = nullptr);
+    const CornerRefinementOptions& options = {}, std::vector<CornerFailure>* failures = nullptr,
+    const std::vector<bool>* seen = nullptr);
 
 }  // namespace portcal

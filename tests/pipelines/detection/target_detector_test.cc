@@ -5,13 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
 #include "colmap_ext/io/ground_truth.h"
 #include "pipelines/detection/target_detector.h"
 #include "pipelines/detection/target_pose.h"
-#include "pipelines/stages/synthesize.h"
 #include "tests/test_utils.h"
 
 namespace portcal {
@@ -33,17 +31,13 @@ struct RenderedSet {
 // Four 800 x 600 views (blur 0.8 px, noise 2) of the target, behind
 // `housing_yaml`.
 RenderedSet Render(const testing::TempDir& dir, const std::string& target_yaml, const std::string& housing_yaml) {
-  std::ofstream(dir / "set.yaml") << "name: live\nseed: 21\nnum_images: 4\n"
-      << "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 405.0, 296.0, -0.08, 0.01]}\n"
-      << housing_yaml << target_yaml
-      << "poses: {distance: [0.4, 0.7], tilt_max_deg: 35, roll_max_deg: 30}\n"
-      << "render: {spp: 4, blur_sigma: 0.8, noise_sigma: 2.0}\n";
-  SynthesizeOptions synthesize;
-  synthesize.config_path = (dir / "set.yaml").string();
-  synthesize.output_path = (dir / "set").string();
-  RunSynthesize(synthesize, NoProgress());
   RenderedSet set;
-  set.truth = ReadGroundTruth(dir / "set/ground_truth.yaml");
+  set.truth = testing::RenderSet(
+      dir, "name: live\nseed: 21\nnum_images: 4\n"
+           "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 405.0, 296.0, -0.08, 0.01]}\n" +
+               housing_yaml + target_yaml +
+               "poses: {distance: [0.4, 0.7], tilt_max_deg: 35, roll_max_deg: 30}\n"
+               "render: {spp: 4, blur_sigma: 0.8, noise_sigma: 2.0}\n");
   for (const FrameTruth& frame : set.truth.images) {
     set.images.push_back(cv::imread((dir / "set" / frame.cam1.file).string(), cv::IMREAD_GRAYSCALE));
   }
