@@ -184,16 +184,13 @@ std::vector<Eigen::Vector2d> CanonicalOrder(const cv::Mat& gray, const std::vect
 // The part of the board in view, from SB's grid grown to every junction in
 // view (junction_lattice.h) and placed on the board (partial_chessboard.h):
 // every corner in full-resolution COLMAP pixels, those out of view marked
-// unseen. nullopt board with the reason.
-PartialPlacement PlacePartly(const SearchLevels& search, const SeenGrid& grid,
-                             const ChessboardDetectionOptions& options) {
+// unseen; no board with the reason. nullopt where SB's grid gives no
+// lattice.
+std::optional<PartialPlacement> PlacePartly(const SearchLevels& search, const SeenGrid& grid,
+                                            const ChessboardDetectionOptions& options) {
   const cv::Mat& level = search.levels.front().second;
   const auto lattice = JunctionLattice::Grow(level, grid);
-  if (!lattice) {
-    PartialPlacement none;
-    none.reason = "a grid of junctions without dark and light squares";
-    return none;
-  }
+  if (!lattice) return std::nullopt;
   PartialPlacement placement = PlaceOnChessboard(level, *lattice, options.cols, options.rows);
   if (placement.board) {
     for (Eigen::Vector2d& p : placement.board->corners) p = (p + Eigen::Vector2d(0.5, 0.5)) / search.levels.front().first;
@@ -205,11 +202,14 @@ PartialPlacement PlacePartly(const SearchLevels& search, const SeenGrid& grid,
 // it in view. The order of the searches: the classic detector's quickest;
 // SB's grid of every junction it sees (0.06-0.1 s on 800 x 600), which is
 // the whole board or, cut by the image's border, the part in view; only
-// then the slower searches for the whole board (the classic detector's
-// adaptive threshold spends 6-8 s on an 800 x 600 view of a board cut by
-// the image's border, and finds nothing; docs/benchmarks.md), and not
-// where the junctions seen rule the whole board out (more than it has, all
-// in view, or fitting it in several places). False with the reason.
+// then, only where SB's junctions give no lattice, the slower searches for
+// the whole board (the classic detector's adaptive threshold spent 6-8 s
+// on an 800 x 600 view of a board cut by the image's border, 5 s on one of
+// a board of other dimensions, and found nothing; docs/benchmarks.md). A
+// lattice holds every X-junction in view, so where it does not fit the
+// board (more junctions than it has, none of it in view, or only in part
+// and not where the image cuts it) the whole board is not in view either.
+// False with the reason.
 bool FindStart(const cv::Mat& gray, const ChessboardDetectionOptions& options, std::vector<Eigen::Vector2d>* start,
                std::vector<bool>* seen, double* scale, ChessboardDetection* detection) {
   const int squares = (options.cols + 1) + (options.rows + 1);
@@ -226,25 +226,25 @@ bool FindStart(const cv::Mat& gray, const ChessboardDetectionOptions& options, s
     whole = corners.has_value();
   }
   const std::string board = std::to_string(options.cols) + "x" + std::to_string(options.rows) + " inner-corner chessboard";
-  PartialPlacement partial;
-  if (!whole && grid && options.partial_views) {
-    partial = PlacePartly(search, *grid, options);
-    if (partial.board) {
-      *start = partial.board->corners;
-      *seen = partial.board->seen;
+  if (!whole && grid) {
+    const auto partial = PlacePartly(search, *grid, options);
+    if (partial && partial->board && options.partial_views) {
+      *start = partial->board->corners;
+      *seen = partial->board->seen;
       *scale = search.levels.front().first;
-      detection->symmetric = partial.board->symmetric;
+      detection->symmetric = partial->board->symmetric;
       detection->partial = true;
       return true;
     }
-    if (partial.too_large || partial.closed || partial.ambiguous) {
-      detection->reason = "no " + board + " found: " + partial.reason;
+    if (partial) {
+      detection->reason = "no " + board + " found" +
+                          (partial->board ? " whole (--Target.partial_views 0)" : ": " + partial->reason);
       return false;
     }
   }
   if (!whole) whole = FindWholeSlowly(search, options, &coarse, scale);
   if (!whole) {
-    detection->reason = "no " + board + " found" + (partial.reason.empty() ? "" : ": " + partial.reason);
+    detection->reason = "no " + board + " found";
     return false;
   }
   *start = CanonicalOrder(gray, coarse, *scale, options);

@@ -145,30 +145,17 @@ PartialChessboard PlaceOnBoard(const Placement& place, const JunctionLattice& la
   return result;
 }
 
-// Whether the seen junctions end inside the image on every side: each
-// unseen neighbour of a seen junction lies in view.
-bool Closed(const JunctionLattice& lattice, const cv::Size& size) {
-  for (const auto& [ij, p] : lattice.points()) {
-    for (const auto& [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
-      const int i = ij.first + di, j = ij.second + dj;
-      if (!lattice.Seen(i, j) && lattice.Hidden(i, j, size)) return false;
-    }
-  }
-  return true;
-}
-
 }  // namespace
 
 PartialPlacement PlaceOnChessboard(const cv::Mat& image, const JunctionLattice& lattice, int cols, int rows) {
   PartialPlacement placement;
   const Board board{cols, rows};
   const int num_rows = lattice.num_rows(), num_cols = lattice.num_cols();
-  placement.too_large = !((num_rows <= rows && num_cols <= cols) || (num_rows <= cols && num_cols <= rows));
-  placement.closed = Closed(lattice, image.size());
+  const bool too_large = !((num_rows <= rows && num_cols <= cols) || (num_rows <= cols && num_cols <= rows));
   const std::string seen = std::to_string(lattice.points().size()) + " junctions over " + std::to_string(num_cols) +
                            "x" + std::to_string(num_rows) + " seen";
   const std::string looked_for = std::to_string(cols) + "x" + std::to_string(rows) + " board";
-  if (placement.too_large) {
+  if (too_large) {
     placement.reason = seen + ": more than the " + looked_for + " has (another board)";
     return placement;
   }
@@ -180,7 +167,6 @@ PartialPlacement PlaceOnChessboard(const cv::Mat& image, const JunctionLattice& 
   }
   const bool symmetric = fitting.size() == 2 && TurnedByHalf(fitting[0], fitting[1], lattice, board);
   if (fitting.size() > 1 && !symmetric) {
-    placement.ambiguous = true;
     placement.reason = seen + ", which " + std::to_string(fitting.size()) + " places on the " + looked_for +
                        " fit (its part cannot be told: more of the board must be seen)";
     return placement;

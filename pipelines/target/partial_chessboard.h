@@ -35,13 +35,12 @@ struct PartialChessboard {
   bool symmetric = false;  // the order may be the board turned by 180 degrees
 };
 
-// What placing the junctions on the board gave.
+// What placing the junctions on the board gave: the board, or the reason
+// there is none (more junctions than the board has, no place on the board
+// that fits, several).
 struct PartialPlacement {
   std::optional<PartialChessboard> board;
-  std::string reason;     // when no board
-  bool closed = false;     // the junctions end inside the image on every side
-  bool too_large = false;  // more junctions than the board has, along a side
-  bool ambiguous = false;  // several places on the board fit (so not all of it is in view)
+  std::string reason;
 };
 
 PartialPlacement PlaceOnChessboard(const cv::Mat& image, const JunctionLattice& lattice, int cols, int rows);
