@@ -217,9 +217,11 @@ MarkerBoardDetection DetectMarkerBoard(const cv::Mat& gray, const MarkerBoardOpt
   detection.found = true;
   if (detection.num_markers_unfitted > 0) {
     const int found = static_cast<int>(markers.ids.size());
-    detection.note = std::to_string(4 * detection.num_markers_unfitted) + " of " + std::to_string(4 * found) +
-                     " marker corners left out (" + std::to_string(detection.num_markers_unfitted) +
-                     " markers too foreshortened, cut or blurred for their edges to be fitted)";
+    const int unfitted = detection.num_markers_unfitted;
+    detection.note = std::to_string(4 * unfitted) + " of " + std::to_string(4 * found) + " marker corners left out (" +
+                     std::to_string(unfitted) + (unfitted == 1 ? " marker" : " markers") +
+                     (unfitted == 1 ? " too foreshortened, cut or blurred for its edges to be fitted)"
+                                   : " too foreshortened, cut or blurred for their edges to be fitted)");
   } else if (detection.num_corners_unrefined > 0) {
     detection.note = std::to_string(detection.num_corners_unrefined) + " of " +
                      std::to_string(detection.num_corners_unrefined + detection.points.size()) +

@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipelines/markers/aruco_markers.h"
+#include "pipelines/markers/edge_band_model.h"
 #include "pipelines/markers/marker_edge_refinement.h"
 
 namespace portcal {
@@ -62,6 +63,46 @@ void ExpectCorners(const std::array<cv::Point2d, 4>& corners, const std::array<E
 
 const std::array<Eigen::Vector2d, 4> kMarker = {Eigen::Vector2d(40.3, 45.2), Eigen::Vector2d(118.9, 38.7),
                                                 Eigen::Vector2d(124.6, 117.5), Eigen::Vector2d(43.1, 121.8)};
+
+// The band model's derivatives written out against central differences of
+// its cost: J^T r is the cost's gradient, and J^T J's diagonal the sum of
+// the squared residual derivatives, for an edge oblique to the pixel grid,
+// quadratic along the side, with shaded levels.
+TEST(EdgeBandModel, DerivativesMatchCentralDifferences) {
+  EdgeBandModel model;
+  model.n = Eigen::Vector2d(0.6, 0.8);
+  model.quadratic = true;
+  std::vector<BandPixel> band;
+  for (int k = 0; k < 60; ++k) {
+    const double t = (k % 12 + 0.5) / 12, s = -2.5 + 0.09 * k;
+    band.push_back({t, s, 120 + 60 * std::tanh(s - 0.2) + 3 * std::sin(7.0 * k)});
+  }
+  const std::vector<char> use(band.size(), 1);
+  EdgeBandModel::Params q;
+  q << 0.15, -0.3, 0.4, 118, 6, 55, -9, std::log(0.9);
+  EdgeBandModel::Normal jtj;
+  EdgeBandModel::Params jtr;
+  model.Linearise(band, use, q, &jtj, &jtr);
+  const auto residual = [&](const EdgeBandModel::Params& at, size_t i) {
+    double u0;
+    ErfPixelAverage m;
+    return model.Residual(band[i], at, &u0, &m);
+  };
+  for (int j = 0; j < EdgeBandModel::kNumParams; ++j) {
+    const double h = 1e-6;
+    EdgeBandModel::Params up = q, down = q;
+    up[j] += h;
+    down[j] -= h;
+    double gradient = 0, squared = 0;
+    for (size_t i = 0; i < band.size(); ++i) {
+      const double derivative = (residual(up, i) - residual(down, i)) / (2 * h);
+      gradient += residual(q, i) * derivative;
+      squared += derivative * derivative;
+    }
+    EXPECT_NEAR(jtr[j], gradient, 1e-5 * (1 + std::abs(gradient))) << "parameter " << j;
+    EXPECT_NEAR(jtj(j, j), squared, 1e-5 * (1 + squared)) << "parameter " << j;
+  }
+}
 
 TEST(MarkerEdgeRefinement, FindsTheCornersOfABlurredMarker) {
   const cv::Mat gray = RenderQuad(kMarker, 1.2, 0);

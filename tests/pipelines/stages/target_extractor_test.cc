@@ -293,5 +293,51 @@ TEST_P(MarkerBoards, ObservationsAndCalibration) {
 
 INSTANTIATE_TEST_SUITE_P(Targets, MarkerBoards, ::testing::Values("aruco_grid", "charuco"));
 
+// ArUco grids seen close, steeply and cut by the image's border: markers
+// whose edges cannot be fitted give no observations, and each image's
+// status counts them (4 corners per marker detected, kept or left out).
+TEST(MarkerBoardsLeftOut, TheStatusCountsTheMarkerCornersLeftOut) {
+  testing::TempDir dir;
+  const GroundTruth truth = testing::RenderSet(
+      dir,
+      "name: close\nseed: 7\nnum_images: 8\n"
+      "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 402.0, 298.0, -0.08, 0.01]}\n"
+      "housing: null\n"
+      "target: {type: aruco_grid, markers_x: 5, markers_y: 4, marker_size: 0.03, marker_separation: 0.008}\n"
+      "poses: {distance: [0.25, 0.5], tilt_max_deg: 65, roll_max_deg: 40, visibility: any}\n"
+      "render: {spp: 4, blur_sigma: 0.8, noise_sigma: 2.0}\n");
+  TargetExtractorOptions options = Options(dir / "db.db", dir / "set/images");
+  options.target_type = "aruco_grid";
+  options.markers.markers_x = 5;
+  options.markers.markers_y = 4;
+  options.markers.marker_size_m = 0.03;
+  options.markers.marker_separation_m = 0.008;
+  RunTargetExtractor(options, NoProgress());
+  Database db(dir / "db.db", Database::OpenMode::kReadOnly);
+  int with_note = 0;
+  for (const FrameTruth& frame : truth.images) {
+    const auto image = db.ReadImageWithName(fs::path(frame.cam1.file).filename().string());
+    ASSERT_TRUE(image.has_value());
+    const auto status = db.ReadTargetDetectionStatus(image->image_id);
+    ASSERT_TRUE(status && status->found) << frame.cam1.file;
+    const int detected = static_cast<int>(db.ReadMarkerDetections(image->image_id).size());
+    const int kept = static_cast<int>(db.ReadTargetObservations(image->image_id).size());
+    EXPECT_EQ(kept % 4, 0);
+    if (kept == 4 * detected) {
+      EXPECT_EQ(status->reason, "found") << frame.cam1.file;
+      continue;
+    }
+    ++with_note;
+    const int left_out = 4 * detected - kept, markers = left_out / 4;
+    const std::string expected = "found; " + std::to_string(left_out) + " of " + std::to_string(4 * detected) +
+                                 " marker corners left out (" + std::to_string(markers) +
+                                 (markers == 1 ? " marker too" : " markers too");
+    EXPECT_EQ(status->reason.rfind(expected, 0), 0u) << status->reason << " / " << expected;
+  }
+  // 4 of these 8 views have markers too close to the border or too
+  // foreshortened for their edges to be fitted.
+  EXPECT_GE(with_note, 2);
+}
+
 }  // namespace
 }  // namespace portcal
