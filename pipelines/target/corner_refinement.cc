@@ -315,34 +315,30 @@ std::optional<BoardShading> ShadingOfFirstStage(const std::vector<GridCorner>& g
 
 }  // namespace
 
-std::vector<std::optional<RefinedCorner>> RefineChessboardCorners(
-    const cv::Mat& gray, const std::vector<Eigen::Vector2d>& corners, int cols, int rows,
-    const CornerRefinementOptions& options, std::vector<CornerFailure>* failures, const std::vector<bool>* seen) {
+std::vector<std::optional<RefinedCorner>> RefineBoardCorners(const cv::Mat& gray,
+                                                             const std::vector<CornerStart>& starts,
+                                                             const CornerRefinementOptions& options,
+                                                             std::vector<CornerFailure>* failures) {
   options.Check();
   PORTCAL_CHECK(gray.type() == CV_8UC1);
-  PORTCAL_CHECK(static_cast<int>(corners.size()) == cols * rows);
-  PORTCAL_CHECK(seen == nullptr || seen->size() == corners.size());
-  std::vector<GridCorner> grid(corners.size());
-  for (int index = 0; index < cols * rows; ++index) {
+  std::vector<GridCorner> grid(starts.size());
+  for (size_t index = 0; index < starts.size(); ++index) {
+    const CornerStart& start = starts[index];
     GridCorner& corner = grid[index];
-    const double neighbour_distance = NearestNeighbourDistance(corners, cols, rows, index);
-    corner.start = corners[index];
-    corner.half = std::clamp(options.window_fraction * neighbour_distance, options.min_window_px, options.max_window_px);
+    corner.start = start.xy;
+    corner.half = start.half_window_px;
     corner.options = options;
-    corner.options.max_shift_px = std::max(options.max_shift_px, options.max_shift_fraction * neighbour_distance);
-    if (seen != nullptr && !(*seen)[index]) {
-      corner.failure = CornerFailure::kNotSeen;
-      continue;
-    }
-    corner.failure = FitAtPixelCentres(gray, WindowAbout(gray, corner.start, corner.half), corner.start, corner.half,
-                                       EdgeAngle(corners, cols, rows, index, true),
-                                       EdgeAngle(corners, cols, rows, index, false), corner.options, &corner.params);
+    corner.options.max_shift_px = start.max_shift_px;
+    corner.failure = start.seen ? FitAtPixelCentres(gray, WindowAbout(gray, start.xy, start.half_window_px), start.xy,
+                                                    start.half_window_px, start.normal_angle1, start.normal_angle2,
+                                                    corner.options, &corner.params)
+                                : CornerFailure::kNotSeen;
   }
   // The second stage over windows brought to each corner's own levels
   // where the board's levels drift across them.
   const std::optional<BoardShading> shading =
       options.max_level_drift >= 0 ? ShadingOfFirstStage(grid) : std::nullopt;
-  std::vector<std::optional<RefinedCorner>> refined(corners.size());
+  std::vector<std::optional<RefinedCorner>> refined(starts.size());
   for (size_t index = 0; index < grid.size(); ++index) {
     GridCorner& corner = grid[index];
     if (corner.failure != CornerFailure::kNone) continue;
@@ -358,6 +354,26 @@ std::vector<std::optional<RefinedCorner>> RefineChessboardCorners(
     for (const GridCorner& corner : grid) failures->push_back(corner.failure);
   }
   return refined;
+}
+
+std::vector<std::optional<RefinedCorner>> RefineChessboardCorners(
+    const cv::Mat& gray, const std::vector<Eigen::Vector2d>& corners, int cols, int rows,
+    const CornerRefinementOptions& options, std::vector<CornerFailure>* failures, const std::vector<bool>* seen) {
+  PORTCAL_CHECK(static_cast<int>(corners.size()) == cols * rows);
+  PORTCAL_CHECK(seen == nullptr || seen->size() == corners.size());
+  std::vector<CornerStart> starts(corners.size());
+  for (int index = 0; index < cols * rows; ++index) {
+    const double neighbour_distance = NearestNeighbourDistance(corners, cols, rows, index);
+    CornerStart& start = starts[index];
+    start.xy = corners[index];
+    start.half_window_px =
+        std::clamp(options.window_fraction * neighbour_distance, options.min_window_px, options.max_window_px);
+    start.normal_angle1 = EdgeAngle(corners, cols, rows, index, true);
+    start.normal_angle2 = EdgeAngle(corners, cols, rows, index, false);
+    start.max_shift_px = std::max(options.max_shift_px, options.max_shift_fraction * neighbour_distance);
+    start.seen = seen == nullptr || (*seen)[index];
+  }
+  return RefineBoardCorners(gray, starts, options, failures);
 }
 
 }  // namespace portcal

@@ -68,6 +68,25 @@ std::optional<RefinedCorner> RefineCorner(const cv::Mat& gray, const Eigen::Vect
                                           double normal_angle2, const CornerRefinementOptions& options,
                                           CornerFailure* failure = nullptr);
 
+// Where a board's corner starts its fit from.
+struct CornerStart {
+  Eigen::Vector2d xy;  // COLMAP pixels
+  double half_window_px = 8;
+  double normal_angle1 = 0, normal_angle2 = 0;  // the two edges' normals, radians
+  double max_shift_px = 2;
+  bool seen = true;  // false: not fitted (kNotSeen)
+};
+
+// Refines the corners of one board, each from its start: fitted once, the
+// board's shading fitted over them (board_shading.h), and fitted again
+// where the levels drift across a window by more than `max_level_drift`,
+// with the window brought to the corner's own levels. nullopt for corners
+// whose fit failed, with the reasons in *failures if given.
+std::vector<std::optional<RefinedCorner>> RefineBoardCorners(const cv::Mat& gray,
+                                                             const std::vector<CornerStart>& starts,
+                                                             const CornerRefinementOptions& options = {},
+                                                             std::vector<CornerFailure>* failures = nullptr);
+
 // Refines corners (COLMAP pixel convention) of a grid of rows x cols inner
 // corners, index r * cols + c, in an 8-bit gray image. nullopt for corners
 // whose fit failed (no contrast, diverged, moved too far), with the reasons
