@@ -119,6 +119,28 @@ TEST(PartialChessboard, ABoardCutByTheImagesBorderKeepsTheCornersInView) {
   }
 }
 
+// The quick mode (live views) keeps the same corners of a cut board, to
+// tenths of a pixel.
+TEST(PartialChessboard, QuickModeKeepsTheCornersInViewToo) {
+  const int left = 30, top = 60;
+  ChessboardDetectionOptions options = AsymmetricOptions();
+  options.precise_fit = false;
+  const ChessboardDetection detection =
+      DetectChessboard(DrawnAsymmetricBoard(left + 6 * kSquare + 25, 400, left, top), options);
+  ASSERT_TRUE(detection.found) << detection.reason;
+  EXPECT_TRUE(detection.partial);
+  EXPECT_EQ(detection.num_refined, 6 * 6);
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 9; ++c) {
+      const auto& corner = detection.corners[r * 9 + c];
+      ASSERT_EQ(corner.has_value(), c < 6) << r << "," << c;
+      if (corner) {
+        EXPECT_LT((*corner - Eigen::Vector2d(left + (c + 1) * kSquare, top + (r + 1) * kSquare)).norm(), 0.3);
+      }
+    }
+  }
+}
+
 // Cut on both sides, which of the board's columns are in view cannot be
 // told: refused, saying so.
 TEST(PartialChessboard, AStripCutOnBothSidesIsRefused) {
