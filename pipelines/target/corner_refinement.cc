@@ -344,7 +344,11 @@ std::vector<std::optional<RefinedCorner>> RefineBoardCorners(const cv::Mat& gray
     if (corner.failure != CornerFailure::kNone) continue;
     const Eigen::Vector2d xy(corner.params[0], corner.params[1]);
     const std::optional<LocalShading> local = shading ? std::optional(shading->At(xy)) : std::nullopt;
-    const bool flatten = local && local->Drift(corner.half, 2 * std::abs(corner.params[5])) > options.max_level_drift;
+    // A drift of a quarter of the contrast across one window is no shading
+    // but a field fitted to wild levels (a handful of corners, one a
+    // reflection): such a window is left as it is.
+    const double drift = local ? local->Drift(corner.half, 2 * std::abs(corner.params[5])) : 0;
+    const bool flatten = local && drift > options.max_level_drift && drift < 0.25;
     std::vector<WindowPixel> window =
         flatten ? WindowAbout(gray, corner.start, corner.half, &*local, xy) : WindowAbout(gray, corner.start, corner.half);
     refined[index] = FitOverAreas(&window, corner.start, corner.options, &corner.params, &corner.failure);
