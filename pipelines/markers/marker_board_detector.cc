@@ -121,7 +121,7 @@ BoardMarkers DetectBoardMarkers(const cv::Mat& gray, const MarkerBoardOptions& o
     if (it == found.board_index.end()) continue;  // a marker of another target
     // OpenCV interpolates a ChArUco board's corners from its markers' own
     // corners: with the crossings' corners instead, the rendered boards'
-    // worst corner went from 0.096 to 0.198 px (docs/benchmarks.md).
+    // worst corner went from 0.096 to 0.198 px (docs/benchmarks_target_detection.md).
     found.corners.push_back(corners[m]);
     const bool edges_fitted = RefineMarker(gray, options, dictionary->markerSize, &corners[m]);
     found.ids.push_back(ids[m]);

@@ -9,7 +9,7 @@
 // px), but the auto-calibration's mapper is sensitive to which marker
 // corners it is given: with the pixel fit, one view of a three-face target
 // was registered with its markers 700-6000 px off and other renders
-// settled in other solutions (docs/benchmarks.md). It stays here until the
+// settled in other solutions (docs/benchmarks_target_detection.md). It stays here until the
 // mapper checks poses against the markers.
 #pragma once
 

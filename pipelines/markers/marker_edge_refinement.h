@@ -7,7 +7,7 @@
 // fitted with it; each corner is the intersection of its two sides' curves,
 // and the bands are laid again about those corners until they stay put.
 // No level is read off a profile's ends, which the next module's blur
-// reaches. Figures in docs/benchmarks.md. A marker foreshortened to modules
+// reaches. Figures in docs/benchmarks_target_detection.md. A marker foreshortened to modules
 // narrower than `min_module_px` across a side is refused: OpenCV's corners
 // of such a marker can be pixels off, and the band would hold the bits.
 #pragma once

@@ -4,7 +4,7 @@
 // at the image's rim. The corner model's levels are constant over a window,
 // so such a drift pulls the fitted corner towards or away from the brighter
 // side (median 0.0073 -> 0.012 px on renders with 50 % vignetting;
-// docs/benchmarks.md). Fitting a trend per corner costs every corner two
+// docs/benchmarks_target_detection.md). Fitting a trend per corner costs every corner two
 // more free parameters, and clean views lose accuracy with them; instead
 // the mean level and the contrast are fitted as smooth fields over the
 // whole board, from every corner's first fit, and each window's pixels are

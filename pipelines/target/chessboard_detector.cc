@@ -59,7 +59,7 @@ SearchLevels GateAndLevels(const cv::Mat& gray, const ChessboardDetectionOptions
 
 // The whole board by OpenCV's classic detector on the coarse level with a
 // global threshold: a few ms where the adaptive one took up to 0.2 s on a
-// render (docs/benchmarks.md).
+// render (docs/benchmarks_target_detection.md).
 bool FindWholeQuickly(const SearchLevels& search, const ChessboardDetectionOptions& options,
                       std::vector<cv::Point2f>* corners, double* scale) {
   *scale = search.levels.front().first;
@@ -205,7 +205,7 @@ std::optional<PartialPlacement> PlacePartly(const SearchLevels& search, const Se
 // then, only where SB's junctions give no lattice, the slower searches for
 // the whole board (the classic detector's adaptive threshold spent 6-8 s
 // on an 800 x 600 view of a board cut by the image's border, 5 s on one of
-// a board of other dimensions, and found nothing; docs/benchmarks.md). A
+// a board of other dimensions, and found nothing; docs/benchmarks_target_detection.md). A
 // lattice holds every X-junction in view, so where it does not fit the
 // board (more junctions than it has, none of it in view, or only in part
 // and not where the image cuts it) the whole board is not in view either.

@@ -27,7 +27,7 @@ struct ChessboardDetectionOptions {
   // half of it) than this fraction of the board's (cols - 2) (rows - 2)
   // are not searched (0: all are). On the shared views boards count 0.54
   // to 1.0 of theirs, textured scenes without a board at most 0.05 of a
-  // 10 x 7 board's (docs/benchmarks.md).
+  // 10 x 7 board's (docs/benchmarks_target_detection.md).
   double min_x_corner_fraction = 0.25;
   // A view keeps the corners that refined; it is refused with fewer than
   // this many, or when they lie on one row or one column (no pose then).

@@ -26,7 +26,7 @@ struct CornerRefinementOptions {
   // Window half size as a fraction of the distance to the nearest
   // neighbouring corner, clamped to [min, max] pixels. A smaller maximum
   // (10 px) was faster, but its noisy corners made the intrinsics' standard
-  // deviations optimistic (CalibrationUncertainty, docs/benchmarks.md).
+  // deviations optimistic (CalibrationUncertainty, docs/benchmarks_target_detection.md).
   double window_fraction = 0.4;
   double min_window_px = 3;
   double max_window_px = 15;

@@ -2,7 +2,7 @@
 // of N inner corners can be in it at all, decided in milliseconds before
 // OpenCV's detectors, which spend hundreds of milliseconds (half
 // resolution) to seconds (1080p) on a textured image without a board, and
-// whose own fast check lets such images through (docs/benchmarks.md).
+// whose own fast check lets such images through (docs/benchmarks_target_detection.md).
 //
 // The response at a pixel compares 16 samples on a ring around it (as in
 // ChESS, Bennett & Lasenby 2014): opposite samples alike and those a

@@ -95,7 +95,7 @@ class TargetDetector : public ::testing::TestWithParam<int> {};
 // Quick: cornerSubPix (5 x 5) or the edges' half-level crossings, ~0.1 px
 // at this blur and noise; the live goal is ~0.3 px. Precise: the fits'
 // hundredths (0.007-0.03 px here: an ArUco grid's edges blurred by 0.8 px
-// with noise 2 gave 0.024 px in docs/benchmarks.md; their own tests hold
+// with noise 2 gave 0.024 px in docs/benchmarks_target_detection.md; their own tests hold
 // the sharp renders to the figures), at most half the quick error.
 TEST_P(TargetDetector, QuickAndPreciseAgainstTheTruth) {
   testing::TempDir dir;
