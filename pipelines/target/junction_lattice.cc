@@ -75,18 +75,6 @@ std::optional<double> JunctionLattice::SquareGray(const cv::Mat& image, int i, i
   return BoxGray(image, Predict(i + 0.5, j + 0.5), 0.15 * side);
 }
 
-int JunctionLattice::num_rows() const {
-  int lo = 1 << 20, hi = -(1 << 20);
-  for (const auto& [ij, p] : points_) lo = std::min(lo, ij.first), hi = std::max(hi, ij.first);
-  return hi - lo + 1;
-}
-
-int JunctionLattice::num_cols() const {
-  int lo = 1 << 20, hi = -(1 << 20);
-  for (const auto& [ij, p] : points_) lo = std::min(lo, ij.second), hi = std::max(hi, ij.second);
-  return hi - lo + 1;
-}
-
 // An X-junction of the expected colours at (i, j): its four squares'
 // grays (a quarter of a square off along the diagonals) on the expected
 // sides of the threshold and as far apart as half the board's contrast;

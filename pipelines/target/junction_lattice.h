@@ -51,8 +51,6 @@ class JunctionLattice {
   // Mean gray of a square's centre; nullopt beyond the image.
   std::optional<double> SquareGray(const cv::Mat& image, int i, int j) const;
   double Threshold() const { return 0.5 * (dark_ + light_); }
-  int num_rows() const;  // extent of the seen points along i
-  int num_cols() const;  // and along j
 
  private:
   // A lattice of the seed alone, its squares' colours read; nullopt where

@@ -91,8 +91,8 @@ bool SeenWhereInView(const Placement& place, const JunctionLattice& lattice, con
   return true;
 }
 
-std::vector<Placement> FittingPlacements(const cv::Mat& image, const JunctionLattice& lattice, const Board& board) {
-  const LatticeBounds bounds = BoundsOf(lattice);
+std::vector<Placement> FittingPlacements(const cv::Mat& image, const JunctionLattice& lattice,
+                                         const LatticeBounds& bounds, const Board& board) {
   const std::vector<Square> squares = SampleSquares(image, lattice, bounds);
   const Eigen::Vector2d origin = lattice.Predict(bounds.i0, bounds.j0);
   const Eigen::Vector2d vi = lattice.Predict(bounds.i0 + 1, bounds.j0) - origin;
@@ -150,7 +150,8 @@ PartialChessboard PlaceOnBoard(const Placement& place, const JunctionLattice& la
 PartialPlacement PlaceOnChessboard(const cv::Mat& image, const JunctionLattice& lattice, int cols, int rows) {
   PartialPlacement placement;
   const Board board{cols, rows};
-  const int num_rows = lattice.num_rows(), num_cols = lattice.num_cols();
+  const LatticeBounds bounds = BoundsOf(lattice);
+  const int num_rows = bounds.i1 - bounds.i0 + 1, num_cols = bounds.j1 - bounds.j0 + 1;
   const bool too_large = !((num_rows <= rows && num_cols <= cols) || (num_rows <= cols && num_cols <= rows));
   const std::string seen = std::to_string(lattice.points().size()) + " junctions over " + std::to_string(num_cols) +
                            "x" + std::to_string(num_rows) + " seen";
@@ -159,7 +160,7 @@ PartialPlacement PlaceOnChessboard(const cv::Mat& image, const JunctionLattice& 
     placement.reason = seen + ": more than the " + looked_for + " has (another board)";
     return placement;
   }
-  const std::vector<Placement> fitting = FittingPlacements(image, lattice, board);
+  const std::vector<Placement> fitting = FittingPlacements(image, lattice, bounds, board);
   if (fitting.empty()) {
     placement.reason = seen + ", but they fit nowhere on the " + looked_for +
                        " with its cut sides at the image's border (another board, or one partly hidden)";

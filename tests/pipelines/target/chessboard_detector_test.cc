@@ -97,6 +97,21 @@ ChessboardDetectionOptions AsymmetricOptions() {
   return options;
 }
 
+// Of a 9 x 6 board drawn at (left, top) and cut after its 6th column:
+// exactly the corners of columns 0-5, each within `tolerance` px of where
+// it is drawn.
+void ExpectColumnsInView(const ChessboardDetection& detection, int left, int top, double tolerance) {
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 9; ++c) {
+      const auto& corner = detection.corners[r * 9 + c];
+      ASSERT_EQ(corner.has_value(), c < 6) << r << "," << c;
+      if (corner) {
+        EXPECT_LT((*corner - Eigen::Vector2d(left + (c + 1) * kSquare, top + (r + 1) * kSquare)).norm(), tolerance);
+      }
+    }
+  }
+}
+
 // Cut by the image's right border, the board's part in view is placed by
 // its left edge: the 6 columns in view, each corner where it is drawn.
 TEST(PartialChessboard, ABoardCutByTheImagesBorderKeepsTheCornersInView) {
@@ -108,15 +123,7 @@ TEST(PartialChessboard, ABoardCutByTheImagesBorderKeepsTheCornersInView) {
   EXPECT_FALSE(detection.symmetric);
   EXPECT_EQ(detection.num_refined, 6 * 6);
   EXPECT_NE(detection.note.find("18 out of view"), std::string::npos) << detection.note;
-  for (int r = 0; r < 6; ++r) {
-    for (int c = 0; c < 9; ++c) {
-      const auto& corner = detection.corners[r * 9 + c];
-      ASSERT_EQ(corner.has_value(), c < 6) << r << "," << c;
-      if (corner) {
-        EXPECT_LT((*corner - Eigen::Vector2d(left + (c + 1) * kSquare, top + (r + 1) * kSquare)).norm(), 0.02);
-      }
-    }
-  }
+  ExpectColumnsInView(detection, left, top, 0.02);
 }
 
 // The quick mode (live views) keeps the same corners of a cut board, to
@@ -130,15 +137,7 @@ TEST(PartialChessboard, QuickModeKeepsTheCornersInViewToo) {
   ASSERT_TRUE(detection.found) << detection.reason;
   EXPECT_TRUE(detection.partial);
   EXPECT_EQ(detection.num_refined, 6 * 6);
-  for (int r = 0; r < 6; ++r) {
-    for (int c = 0; c < 9; ++c) {
-      const auto& corner = detection.corners[r * 9 + c];
-      ASSERT_EQ(corner.has_value(), c < 6) << r << "," << c;
-      if (corner) {
-        EXPECT_LT((*corner - Eigen::Vector2d(left + (c + 1) * kSquare, top + (r + 1) * kSquare)).norm(), 0.3);
-      }
-    }
-  }
+  ExpectColumnsInView(detection, left, top, 0.3);
 }
 
 // Cut on both sides, which of the board's columns are in view cannot be
