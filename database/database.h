@@ -88,6 +88,9 @@ class Database {
   std::vector<image_pair_t> ReadTwoViewGeometryPairIds();
   // Deletes matches and geometries of every pair involving the image.
   void DeleteMatchesOfImage(image_t image_id);
+  // Deletes the image and every row about it (features, matches, target
+  // observations and status, markers); its camera stays.
+  void DeleteImage(image_t image_id);
 
   int64_t NumCameras();
   int64_t NumImages();

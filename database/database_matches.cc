@@ -195,6 +195,18 @@ void Database::DeleteMatchesOfImage(image_t image_id) {
   }
 }
 
+void Database::DeleteImage(image_t image_id) {
+  DeleteMatchesOfImage(image_id);
+  // Explicitly, not by ON DELETE CASCADE: COLMAP opens databases without
+  // foreign keys enforced, and so may whoever wrote this one.
+  for (const char* table : {"keypoints", "descriptors", "portcal_target_observations", "portcal_target_detections",
+                            "portcal_marker_detections", "portcal_unmasked_features", "images"}) {
+    Statement stmt(db_, path_, std::string("DELETE FROM ") + table + " WHERE image_id = ?1;");
+    stmt.Bind(1, static_cast<int64_t>(image_id));
+    stmt.Execute();
+  }
+}
+
 int64_t Database::NumCameras() { return QueryInt("SELECT count(*) FROM cameras;"); }
 int64_t Database::NumImages() { return QueryInt("SELECT count(*) FROM images;"); }
 int64_t Database::NumKeypoints() {

@@ -7,6 +7,7 @@
 
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/string_utils.h"
 
 namespace po = boost::program_options;
 
@@ -155,6 +156,27 @@ void CommandLine::AddTriState(const std::string& name, std::optional<bool>* valu
   conversions_.push_back([name, value, &raw] {
     if (raw < -1 || raw > 1) throw OptionError("--" + name, std::to_string(raw), "-1, 0 or 1");
     *value = raw == -1 ? std::nullopt : std::optional<bool>(raw == 1);
+  });
+}
+
+void CommandLine::AddRange(const std::string& name, double* low, double* high, const std::string& help) {
+  std::string& raw = strings_.emplace_back(FormatShortest(*low) + "," + FormatShortest(*high));
+  Add(name, &raw, help);
+  conversions_.push_back([name, low, high, &raw] {
+    const std::vector<std::string> parts = SplitTokens(raw, ",");
+    try {
+      size_t used0 = 0, used1 = 0;
+      if (parts.size() == 2) {
+        const double a = std::stod(parts[0], &used0), b = std::stod(parts[1], &used1);
+        if (used0 == parts[0].size() && used1 == parts[1].size() && a <= b) {
+          *low = a;
+          *high = b;
+          return;
+        }
+      }
+    } catch (const std::exception&) {
+    }
+    throw OptionError("--" + name, raw, "two numbers LOW,HIGH with LOW <= HIGH");
   });
 }
 

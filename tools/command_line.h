@@ -74,6 +74,8 @@ class CommandLine {
       throw OptionError("--" + name, raw, names);
     });
   }
+  // --name as "LOW,HIGH" (two numbers, LOW <= HIGH) into *low and *high.
+  void AddRange(const std::string& name, double* low, double* high, const std::string& help);
   // --name as -1 (nullopt: the stage decides), 0 or 1.
   void AddTriState(const std::string& name, std::optional<bool>* value, const std::string& help);
   // --Housing.model and --Housing.params, the same flags and help for every

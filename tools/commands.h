@@ -21,5 +21,7 @@ int RefractiveMapperCommand(int argc, char** argv);
 int RefractiveBundleAdjusterCommand(int argc, char** argv);
 int AutoCalibratorCommand(int argc, char** argv);
 int CrossCheckCommand(int argc, char** argv);
+int LiveCalibratorCommand(int argc, char** argv);
+int PoseSuggesterCommand(int argc, char** argv);
 
 }  // namespace portcal

@@ -58,6 +58,10 @@ const std::vector<Command>& Commands() {
        "calibrate from ArUco-marked objects without a known target: all stages"},
       {"cross_check", portcal::CrossCheckCommand,
        "cross-check an in-air calibration with mrcal, and cross-validate it"},
+      {"live_calibrator", portcal::LiveCalibratorCommand,
+       "calibrate from a camera, video file or stream: hands-free capture, next-pose guidance"},
+      {"pose_suggester", portcal::PoseSuggesterCommand,
+       "the next target poses to hold, from the views so far (planning a dive)"},
       {"synthesize", portcal::SynthesizeCommand,
        "render a calibration image set (targets, stereo, surveys, underwater "
        "effects) with exact ground truth"},

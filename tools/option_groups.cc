@@ -133,4 +133,31 @@ void Register(CommandLine* cli, BundleAdjustmentOptions* ba) {
   cli->Add("num_threads", &ba->num_threads, "threads");
 }
 
+void Register(CommandLine* cli, TargetDetectorOptions* target) {
+  cli->Add("Target.type", &target->type, "chessboard | aruco_grid | charuco");
+  cli->Add("Target.cols", &target->chessboard.cols, "inner corners per row");
+  cli->Add("Target.rows", &target->chessboard.rows, "inner corners per column");
+  cli->Add("Target.square_size", &target->square_size_m, "chessboard/ChArUco square side, metres");
+  cli->Add("Target.dictionary", &target->markers.dictionary, "ArUco dictionary (aruco_grid, charuco)");
+  cli->Add("Target.markers_x", &target->markers.markers_x, "aruco_grid: markers per row");
+  cli->Add("Target.markers_y", &target->markers.markers_y, "aruco_grid: markers per column");
+  cli->Add("Target.marker_size", &target->markers.marker_size_m, "marker side, metres");
+  cli->Add("Target.marker_separation", &target->markers.marker_separation_m, "aruco_grid: gap, metres");
+  cli->Add("Target.first_marker", &target->markers.first_marker, "aruco_grid: id of the first marker");
+  cli->Add("Target.squares_x", &target->markers.squares_x, "charuco: squares per row");
+  cli->Add("Target.squares_y", &target->markers.squares_y, "charuco: squares per column");
+  cli->Add("Target.coarse_max_image_size", &target->chessboard.coarse_max_image_size,
+          "coarse detection on images downscaled to this size (0: full size)");
+  cli->Add("Target.min_x_corner_fraction", &target->chessboard.min_x_corner_fraction,
+          "images with fewer grid junctions than this fraction of the board's are not searched (0: all are)");
+  cli->Add("Target.min_refined_corners", &target->chessboard.min_refined_corners,
+          "views with fewer refined corners are refused");
+  cli->Add("Target.partial_views", &target->chessboard.partial_views,
+          "chessboards cut by the image's border: keep the corners in view where their place on the board can be "
+          "told (from where the seen grid ends)");
+  cli->Add("Target.max_level_drift", &target->chessboard.refinement.max_level_drift,
+          "chessboard corners are fitted again with the board's shading taken out where its levels drift by "
+          "more than this fraction of the contrast across a corner's window (0: wherever they drift; < 0: never)");
+}
+
 }  // namespace portcal

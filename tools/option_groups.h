@@ -3,6 +3,7 @@
 // The fields keep their defaults as the flags' defaults.
 #pragma once
 
+#include "pipelines/stages/target_extractor.h"
 #include "pipelines/images/image_reader.h"
 #include "pipelines/stages/feature_extractor.h"
 #include "pipelines/stages/feature_matcher.h"
@@ -37,6 +38,8 @@ void Register(CommandLine* cli, MarkerScale* marker_scale);
 void Register(CommandLine* cli, IncrementalMapperOptions* mapper);
 // --Mapper.init_radial_*: the search of the first radial term.
 void Register(CommandLine* cli, RadialStartOptions* radial);
+// --Target.*: the calibration target and how it is detected.
+void Register(CommandLine* cli, TargetDetectorOptions* target);
 // --BundleAdjustment.* (with --num_threads of the adjustment).
 void Register(CommandLine* cli, BundleAdjustmentOptions* ba);
 

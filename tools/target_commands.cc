@@ -20,33 +20,15 @@ int TargetExtractorCommand(int argc, char** argv) {
   cli.AddRequired("database_path", &options.database_path, "database (created if missing)");
   cli.AddRequired("image_path", &options.image_path, "directory of images");
   Register(&cli, &options.reader);
-  cli.Add("Target.type", &options.target_type, "chessboard | aruco_grid | charuco");
-  cli.Add("Target.cols", &options.chessboard.cols, "inner corners per row");
-  cli.Add("Target.rows", &options.chessboard.rows, "inner corners per column");
-  cli.Add("Target.square_size", &options.square_size_m, "chessboard/ChArUco square side, metres");
-  cli.Add("Target.dictionary", &options.markers.dictionary, "ArUco dictionary (aruco_grid, charuco)");
-  cli.Add("Target.markers_x", &options.markers.markers_x, "aruco_grid: markers per row");
-  cli.Add("Target.markers_y", &options.markers.markers_y, "aruco_grid: markers per column");
-  cli.Add("Target.marker_size", &options.markers.marker_size_m, "marker side, metres");
-  cli.Add("Target.marker_separation", &options.markers.marker_separation_m, "aruco_grid: gap, metres");
-  cli.Add("Target.first_marker", &options.markers.first_marker, "aruco_grid: id of the first marker");
-  cli.Add("Target.squares_x", &options.markers.squares_x, "charuco: squares per row");
-  cli.Add("Target.squares_y", &options.markers.squares_y, "charuco: squares per column");
-  cli.Add("Target.coarse_max_image_size", &options.chessboard.coarse_max_image_size,
-          "coarse detection on images downscaled to this size (0: full size)");
-  cli.Add("Target.min_x_corner_fraction", &options.chessboard.min_x_corner_fraction,
-          "images with fewer grid junctions than this fraction of the board's are not searched (0: all are)");
-  cli.Add("Target.min_refined_corners", &options.chessboard.min_refined_corners,
-          "views with fewer refined corners are refused");
-  cli.Add("Target.partial_views", &options.chessboard.partial_views,
-          "chessboards cut by the image's border: keep the corners in view where their place on the board can be "
-          "told (from where the seen grid ends)");
-  cli.Add("Target.max_level_drift", &options.chessboard.refinement.max_level_drift,
-          "chessboard corners are fitted again with the board's shading taken out where its levels drift by "
-          "more than this fraction of the contrast across a corner's window (0: wherever they drift; < 0: never)");
+  TargetDetectorOptions target = DetectorOptions(options);
+  Register(&cli, &target);
   cli.Add("num_threads", &options.num_threads, "threads");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
+    options.target_type = target.type;
+    options.square_size_m = target.square_size_m;
+    options.chessboard = target.chessboard;
+    options.markers = target.markers;
     StderrProgress progress;
     RunTargetExtractor(options, progress);
   });

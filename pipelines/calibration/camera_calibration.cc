@@ -29,9 +29,7 @@ void CameraCalibrationSettings::Check() const {
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
 }
 
-namespace {
-
-std::vector<int> FixedIndices(const Camera& camera, const std::vector<std::string>& names) {
+std::vector<int> FixedParamIndices(const Camera& camera, const std::vector<std::string>& names) {
   std::set<int> fixed;
   const std::vector<std::string> param_names = SplitTokens(camera.ParamsInfo(), ", ");
   for (const std::string& name : names) {
@@ -53,6 +51,8 @@ std::vector<int> FixedIndices(const Camera& camera, const std::vector<std::strin
   }
   return {fixed.begin(), fixed.end()};
 }
+
+namespace {
 
 struct Solution {
   std::vector<double> intrinsics;
@@ -341,7 +341,7 @@ CameraCalibrationResult CalibrateCamera(const std::vector<CalibrationView>& all_
                                         const CameraCalibrationSettings& settings) {
   settings.Check();
   initial.Validate("initial camera");
-  const std::vector<int> fixed = FixedIndices(initial, settings.fixed_params);
+  const std::vector<int> fixed = FixedParamIndices(initial, settings.fixed_params);
   Eigen::Vector4d extent;
   const std::vector<const CalibrationView*> views = UsableViews(all_views, settings, &extent);
   Camera camera = initial;

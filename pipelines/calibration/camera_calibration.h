@@ -64,6 +64,10 @@ struct CameraCalibrationResult {
   std::vector<CalibratedView> views;
 };
 
+// Indices of the parameters that `names` hold (CameraCalibrationSettings::
+// fixed_params). Throws OptionError for a name the model does not have.
+std::vector<int> FixedParamIndices(const Camera& camera, const std::vector<std::string>& names);
+
 // `initial` gives the model, image size and starting (or fixed) values.
 // Throws NumericalError when too few views remain or the solve fails.
 CameraCalibrationResult CalibrateCamera(const std::vector<CalibrationView>& views,

@@ -63,4 +63,17 @@ TargetDetection DetectTarget(const cv::Mat& gray, const TargetDetectorOptions& o
   return detection;
 }
 
+std::vector<BoardPoint> TargetLayout(const TargetDetectorOptions& options) {
+  options.Check();
+  if (options.type != "chessboard") return MarkerBoardLayout(MarkerOptions(options));
+  std::vector<BoardPoint> points;
+  for (int r = 0; r < options.chessboard.rows; ++r) {
+    for (int c = 0; c < options.chessboard.cols; ++c) {
+      points.push_back({static_cast<int64_t>(r) * options.chessboard.cols + c, Eigen::Vector2d::Zero(),
+                        Eigen::Vector3d(c * options.square_size_m, r * options.square_size_m, 0.0)});
+    }
+  }
+  return points;
+}
+
 }  // namespace portcal

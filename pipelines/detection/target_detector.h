@@ -40,4 +40,8 @@ struct TargetDetection {
 
 TargetDetection DetectTarget(const cv::Mat& gray, const TargetDetectorOptions& options);
 
+// Every point of the target (ids and positions as a detection gives them,
+// xy unset): what a view of the whole target would see.
+std::vector<BoardPoint> TargetLayout(const TargetDetectorOptions& options);
+
 }  // namespace portcal

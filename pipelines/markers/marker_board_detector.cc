@@ -233,4 +233,25 @@ MarkerBoardDetection DetectMarkerBoard(const cv::Mat& gray, const MarkerBoardOpt
   return detection;
 }
 
+std::vector<BoardPoint> MarkerBoardLayout(const MarkerBoardOptions& options) {
+  options.Check();
+  cv::Ptr<cv::aruco::CharucoBoard> charuco;
+  const cv::Ptr<cv::aruco::Board> board = MakeBoard(options, ArucoDictionaryByName(options.dictionary), &charuco);
+  std::vector<BoardPoint> points;
+  if (charuco) {
+    for (size_t i = 0; i < charuco->chessboardCorners.size(); ++i) {
+      const cv::Point3f& p = charuco->chessboardCorners[i];
+      points.push_back({static_cast<int64_t>(i), Eigen::Vector2d::Zero(), Eigen::Vector3d(p.x, p.y, p.z)});
+    }
+    return points;
+  }
+  for (size_t m = 0; m < board->ids.size(); ++m) {
+    for (int k = 0; k < 4; ++k) {
+      const cv::Point3f& p = board->objPoints[m][static_cast<size_t>(k)];
+      points.push_back({static_cast<int64_t>(board->ids[m]) * 4 + k, Eigen::Vector2d::Zero(), Eigen::Vector3d(p.x, p.y, p.z)});
+    }
+  }
+  return points;
+}
+
 }  // namespace portcal

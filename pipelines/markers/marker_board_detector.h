@@ -61,4 +61,8 @@ struct MarkerBoardDetection {
 
 MarkerBoardDetection DetectMarkerBoard(const cv::Mat& gray, const MarkerBoardOptions& options);
 
+// Every point the board has, with the ids and positions a detection gives
+// (xy unset): what a view of the whole board would see.
+std::vector<BoardPoint> MarkerBoardLayout(const MarkerBoardOptions& options);
+
 }  // namespace portcal

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iomanip>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 #include <random>
 #include <sstream>
 
@@ -314,7 +315,8 @@ struct FrameRenderer {
   fs::path staging;
   std::string dir1, dir2;
 
-  FrameTruth Render(int frame, const Rigid3d& cam_from_target, std::mt19937_64* rng) const {
+  FrameTruth Render(int frame, const Rigid3d& cam_from_target, const ImageFormationOptions& render,
+                    std::mt19937_64* rng, cv::Mat* image1 = nullptr) const {
     std::vector<PlacedObject> objects;
     objects.push_back({config.survey ? static_cast<const SceneObject*>(scene.seabed.get()) : scene.target.object.get(),
                        cam_from_target});
@@ -330,7 +332,9 @@ struct FrameRenderer {
     truth.frame = frame;
     const std::string name = ImageName(frame, config.num_images);
     const uint64_t noise_seed = config.seed * 1000003ULL + 2ULL * frame;
-    WriteImage(staging / dir1 / name, RenderImage(rays1, objects, config.render, noise_seed));
+    const cv::Mat image = RenderImage(rays1, objects, render, noise_seed);
+    WriteImage(staging / dir1 / name, image);
+    if (image1) *image1 = image;
     truth.cam1 = config.survey ? ImageTruth{}
                                : TargetTruth(config.camera, camera1.HousingOrNull(), scene.target, cam_from_target,
                                              objects, occluder != nullptr);
@@ -339,7 +343,7 @@ struct FrameRenderer {
     if (config.stereo) {
       std::vector<PlacedObject> objects2 = objects;
       for (PlacedObject& placed : objects2) placed.cam_from_object = config.cam2_from_cam1 * placed.cam_from_object;
-      WriteImage(staging / dir2 / name, RenderImage(*rays2, objects2, config.render, noise_seed + 1));
+      WriteImage(staging / dir2 / name, RenderImage(*rays2, objects2, render, noise_seed + 1));
       const Rigid3d cam2_from_target = config.cam2_from_cam1 * cam_from_target;
       truth.cam2 = config.survey ? ImageTruth{}
                                  : TargetTruth(config.camera2, camera2.HousingOrNull(), scene.target,
@@ -367,12 +371,60 @@ void FinishSet(const SynthesizeOptions& options, const DatasetConfig& config, co
     WriteFileAtomically(staging / "target_dots.csv", false, [&](std::ostream& out) { out << csv; });
   }
   fs::copy_file(options.config_path, staging / "config_used.yaml", fs::copy_options::overwrite_existing);
-  for (const char* entry : {"images", "ground_truth.yaml", "target_dots.csv", "config_used.yaml", "navigation.txt"}) {
+  for (const char* entry : {"images", "ground_truth.yaml", "target_dots.csv", "config_used.yaml", "navigation.txt",
+                            "trajectory.yaml", "trajectory.avi"}) {
     if (!fs::exists(staging / entry)) continue;
     fs::remove_all(output / entry);
     fs::rename(staging / entry, output / entry);
   }
   fs::remove_all(staging);
+}
+
+// A trajectory's frames (its key poses sampled as independent views are),
+// which then set the number of images; empty without a trajectory.
+std::vector<TrajectoryFrame> PlanFrames(const Scene& scene, const HousedCamera& camera1, const HousedCamera& camera2,
+                                        std::mt19937_64* rng, DatasetConfig* config) {
+  if (!config->trajectory) return {};
+  const std::vector<Eigen::Vector3d>& check_points =
+      config->poses.visibility == "markers" ? scene.target.marker_points : scene.target.outline_points;
+  std::vector<Rigid3d> key_poses;
+  for (int k = 0; k < config->trajectory->num_pauses; ++k) {
+    key_poses.push_back(SampleRigView(*config, scene, camera1, camera2, check_points, rng));
+  }
+  std::vector<TrajectoryFrame> frames = PlanTrajectory(key_poses, *config->trajectory);
+  config->num_images = static_cast<int>(frames.size());
+  return frames;
+}
+
+// Renders a trajectory's frames (motion blur while the target moves), and
+// with `trajectory.video` the same frames as trajectory.avi (Motion JPEG, the
+// codec OpenCV writes without FFmpeg); trajectory.yaml says where the pauses
+// are.
+void RenderTrajectory(const DatasetConfig& config, const FrameRenderer& renderer,
+                      const std::vector<TrajectoryFrame>& frames, const fs::path& staging, std::mt19937_64* rng,
+                      GroundTruth* truth, ProgressSink& progress) {
+  const TrajectoryOptions& options = *config.trajectory;
+  cv::VideoWriter video;
+  if (options.video) {
+    const fs::path path = staging / "trajectory.avi";
+    video.open(path.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), options.fps,
+               cv::Size(static_cast<int>(config.camera.width), static_cast<int>(config.camera.height)), false);
+    if (!video.isOpened()) throw InputError(path.string() + ": OpenCV cannot write a Motion JPEG video here");
+  }
+  for (size_t f = 0; f < frames.size(); ++f) {
+    CancelFlag::ThrowIfRequested();
+    ImageFormationOptions render = config.render;
+    render.velocity_m_s = frames[f].velocity_m_s;
+    render.angular_velocity_rad_s = frames[f].angular_velocity_rad_s;
+    render.exposure_s = frames[f].pause < 0 ? options.exposure_s : 0.0;
+    cv::Mat image;
+    truth->images.push_back(renderer.Render(static_cast<int>(f), frames[f].cam_from_target, render, rng, &image));
+    if (video.isOpened()) video.write(image);
+    progress.Advance(1);
+  }
+  video.release();
+  const std::string yaml = TrajectoryYaml(frames, options);
+  WriteFileAtomically(staging / "trajectory.yaml", false, [&](std::ostream& out) { out << yaml; });
 }
 
 }  // namespace
@@ -384,6 +436,10 @@ SynthesizeSummary RunSynthesize(const SynthesizeOptions& options, ProgressSink& 
   if (options.seed >= 0) config.seed = static_cast<uint64_t>(options.seed);
   config.render.num_threads = options.num_threads;
   const HousedCamera camera1{config.camera, config.housing}, camera2{config.camera2, config.housing2};
+  std::mt19937_64 rng(config.seed);
+  GroundTruth truth;
+  const Scene scene = BuildScene(config, camera1, &truth);
+  const std::vector<TrajectoryFrame> trajectory = PlanFrames(scene, camera1, camera2, &rng, &config);
   LOG(INFO) << "synthesize: " << config.name << ", " << config.num_images << " frames of "
             << config.camera.width << "x" << config.camera.height << (config.stereo ? " (stereo)" : "")
             << ", " << (config.survey ? "survey" : config.target.type);
@@ -397,9 +453,9 @@ SynthesizeSummary RunSynthesize(const SynthesizeOptions& options, ProgressSink& 
   fs::create_directories(staging / dir1);
   if (config.stereo) fs::create_directories(staging / dir2);
 
-  GroundTruth truth = TruthHeader(config, dir1, dir2);
-  std::mt19937_64 rng(config.seed);
-  const Scene scene = BuildScene(config, camera1, &truth);
+  const TargetDescription target = truth.target;
+  truth = TruthHeader(config, dir1, dir2);
+  truth.target = target;
 
   const auto ray_start = Clock::now();
   const RayMap rays1(config.camera, camera1.HousingOrNull(), config.render.spp, options.num_threads);
@@ -409,16 +465,20 @@ SynthesizeSummary RunSynthesize(const SynthesizeOptions& options, ProgressSink& 
 
   progress.Begin("synthesize: frames", config.num_images);
   const auto render_start = Clock::now();
-  const std::vector<Eigen::Vector3d>& check_points =
-      config.poses.visibility == "markers" ? scene.target.marker_points : scene.target.outline_points;
   const FrameRenderer renderer{config, scene, camera1, camera2, rays1, rays2,
                                staging, dir1, dir2};
-  for (int frame = 0; frame < config.num_images; ++frame) {
-    CancelFlag::ThrowIfRequested();
-    const Rigid3d cam_from_target = config.survey ? scene.survey.cam_from_world[frame]
-                                                  : SampleRigView(config, scene, camera1, camera2, check_points, &rng);
-    truth.images.push_back(renderer.Render(frame, cam_from_target, &rng));
-    progress.Advance(1);
+  if (trajectory.empty()) {
+    const std::vector<Eigen::Vector3d>& check_points =
+        config.poses.visibility == "markers" ? scene.target.marker_points : scene.target.outline_points;
+    for (int frame = 0; frame < config.num_images; ++frame) {
+      CancelFlag::ThrowIfRequested();
+      const Rigid3d cam_from_target = config.survey ? scene.survey.cam_from_world[frame]
+                                                    : SampleRigView(config, scene, camera1, camera2, check_points, &rng);
+      truth.images.push_back(renderer.Render(frame, cam_from_target, config.render, &rng));
+      progress.Advance(1);
+    }
+  } else {
+    RenderTrajectory(config, renderer, trajectory, staging, &rng, &truth, progress);
   }
   progress.End();
   const double render_seconds = Seconds(render_start);

@@ -13,6 +13,7 @@
 #include "database/database.h"
 #include "database/new_database_file.h"
 #include "database/stage_run.h"
+#include "pipelines/detection/detection_rows.h"
 
 namespace fs = std::filesystem;
 
@@ -43,23 +44,8 @@ struct ImageResult {
   std::string name;
   int width = 0, height = 0;
   bool readable = false;
-  bool found = false;
-  bool symmetric = false;  // chessboard that looks the same turned by 180 deg
-  std::string reason;
-  std::string note;  // found, with corners left out: why
-  std::vector<TargetObservation> observations;
-  std::vector<MarkerDetection> markers;
+  TargetDetection detection;
 };
-
-void Detect(const cv::Mat& gray, const TargetExtractorOptions& o, ImageResult* result) {
-  const TargetDetection d = DetectTarget(gray, DetectorOptions(o));
-  result->found = d.found;
-  result->reason = d.reason;
-  result->symmetric = d.symmetric;
-  result->note = d.note;
-  result->markers = d.markers;
-  for (const BoardPoint& p : d.points) result->observations.push_back({p.point_id, p.xy, p.point_in_target});
-}
 
 std::string OptionsText(const TargetExtractorOptions& o) {
   std::ostringstream out;
@@ -70,15 +56,6 @@ std::string OptionsText(const TargetExtractorOptions& o) {
       << "\nTarget.cols=" << o.chessboard.cols << "\nTarget.rows=" << o.chessboard.rows
       << "\nTarget.square_size=" << o.square_size_m << "\n";
   return out.str();
-}
-
-// The status of an image where the target was found, e.g. "found; 2 of 48
-// corners left out (2 no contrast)".
-std::string FoundText(const ImageResult& result) {
-  std::string text = "found";
-  if (result.symmetric) text += " (symmetric board: order may be rotated by 180 deg)";
-  if (!result.note.empty()) text += "; " + result.note;
-  return text;
 }
 
 // Images that are to share a camera (--ImageReader.single_camera, or
@@ -123,34 +100,12 @@ std::vector<ImageResult> DetectAll(const TargetExtractorOptions& options, const 
       result.width = gray.cols;
       result.height = gray.rows;
       sizes.Check(names[i], gray.cols, gray.rows);
-      Detect(gray, options, &result);
+      result.detection = DetectTarget(gray, DetectorOptions(options));
     }
     progress.Advance(1);
   });
   progress.End();
   return results;
-}
-
-// The target as the detection status names it, e.g. "chessboard 10x7 inner
-// corners, square 0.02 m".
-std::string TargetDescription(const TargetExtractorOptions& options) {
-  const auto metres = [](double value) {
-    std::ostringstream out;
-    out << value << " m";
-    return out.str();
-  };
-  const MarkerBoardOptions& m = options.markers;
-  return options.target_type == "chessboard"
-          ? "chessboard " + std::to_string(options.chessboard.cols) + "x" +
-                std::to_string(options.chessboard.rows) + " inner corners, square " +
-                metres(options.square_size_m)
-      : options.target_type == "aruco_grid"
-          ? "aruco_grid " + std::to_string(m.markers_x) + "x" + std::to_string(m.markers_y) + " " +
-                m.dictionary + ", marker " + metres(m.marker_size_m) + ", separation " +
-                metres(m.marker_separation_m)
-          : "charuco " + std::to_string(m.squares_x) + "x" + std::to_string(m.squares_y) + " squares " +
-                m.dictionary + ", square " + metres(options.square_size_m) + ", marker " +
-                metres(m.marker_size_m);
 }
 
 }  // namespace
@@ -175,7 +130,7 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
   Transaction transaction = database.BeginTransaction();
   TargetExtractorSummary summary;
   SharedCameras shared_cameras;
-  const std::string target = TargetDescription(options);
+  const std::string target = TargetDescriptionText(DetectorOptions(options));
   for (const ImageResult& result : results) {
     if (!result.readable) {
       LOG(WARNING) << result.name << ": cannot read the image; skipped";
@@ -183,20 +138,13 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
     }
     const image_t image_id = ImportImage(&database, options.reader, result.name, result.width,
                                          result.height, &shared_cameras);
-    const std::vector<TargetObservation>& observations = result.observations;
-    if (!result.found) LOG(WARNING) << result.name << ": " << result.reason;
-    database.WriteTargetObservations(image_id, observations);
-    database.WriteMarkerDetections(image_id, result.markers);
-    TargetDetectionStatus status;
-    status.target = target;
-    status.found = result.found;
-    status.num_points = static_cast<int>(observations.size());
-    status.reason = result.found ? FoundText(result) : result.reason;
-    if (result.found && !result.note.empty()) LOG(INFO) << result.name << ": " << result.note;
-    database.WriteTargetDetectionStatus(image_id, status);
+    const TargetDetection& detection = result.detection;
+    if (!detection.found) LOG(WARNING) << result.name << ": " << detection.reason;
+    if (detection.found && !detection.note.empty()) LOG(INFO) << result.name << ": " << detection.note;
+    WriteTargetDetection(&database, image_id, detection, target);
     ++summary.num_images;
-    summary.num_found += result.found;
-    summary.num_points += static_cast<int64_t>(observations.size());
+    summary.num_found += detection.found;
+    summary.num_points += static_cast<int64_t>(detection.points.size());
   }
   run.Finish(&database, {{"images", summary.num_images},
                          {"found", summary.num_found},

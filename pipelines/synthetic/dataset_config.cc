@@ -22,6 +22,10 @@ void DatasetConfig::Check() const {
     poses.Check();
   }
   render.Check();
+  if (trajectory) {
+    trajectory->Check();
+    if (stereo) throw OptionError("trajectory", "with stereo", "one camera (a stereo trajectory is not rendered)");
+  }
   if (!(clutter_distance_m > 0)) {
     throw OptionError("clutter.distance", std::to_string(clutter_distance_m), "> 0 m");
   }
@@ -242,6 +246,16 @@ DatasetConfig ReadDatasetConfig(const std::filesystem::path& path) {
     reader.Optional(p, "poses.", "max_view_angle_deg", &config.poses.max_view_angle_deg);
     reader.Optional(p, "poses.", "visibility", &config.poses.visibility);
     if (config.target.type == "target3d" && !(p && p["visibility"])) config.poses.visibility = "markers";
+    if (root["trajectory"] && !root["trajectory"].IsNull()) {
+      const YAML::Node t = root["trajectory"];
+      TrajectoryOptions& trajectory = config.trajectory.emplace();
+      reader.Optional(t, "trajectory.", "fps", &trajectory.fps);
+      reader.Optional(t, "trajectory.", "pauses", &trajectory.num_pauses);
+      reader.Optional(t, "trajectory.", "pause_seconds", &trajectory.pause_seconds);
+      reader.Optional(t, "trajectory.", "move_seconds", &trajectory.move_seconds);
+      reader.Optional(t, "trajectory.", "exposure", &trajectory.exposure_s);
+      reader.Optional(t, "trajectory.", "video", &trajectory.video);
+    }
   }
   const YAML::Node c = root["clutter"];
   reader.Optional(c, "clutter.", "enabled", &config.clutter);

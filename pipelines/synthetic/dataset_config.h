@@ -12,6 +12,7 @@
 #include "colmap_ext/housing/housing.h"
 #include "pipelines/synthetic/renderer.h"
 #include "pipelines/synthetic/target_builder.h"
+#include "pipelines/synthetic/trajectory.h"
 #include "pipelines/synthetic/view_sampler.h"
 
 namespace portcal {
@@ -33,6 +34,10 @@ struct DatasetConfig {
   SurveyOptions survey_options;
   TargetOptions target;
   ViewSamplingOptions poses;
+  // A hand-held trajectory (pauses at trajectory.num_pauses poses sampled
+  // as `poses` says, smooth moves between) instead of independent views;
+  // its frames replace num_images.
+  std::optional<TrajectoryOptions> trajectory;
   // Static textured background plane (camera frame, z = distance).
   bool clutter = false;
   double clutter_distance_m = 3.0;

@@ -1,0 +1,194 @@
+#include "pipelines/guidance/next_pose.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+#include "colmap_ext/util/error.h"
+#include "pipelines/guidance/calibration_unknowns.h"
+#include "pipelines/synthetic/view_sampler.h"
+
+namespace portcal {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+bool InView(const CalibrationUnknowns& unknowns, const TargetShape& target, const Rigid3d& cam_from_target,
+            double margin) {
+  const Camera& camera = unknowns.camera.camera;
+  for (const Eigen::Vector3d& corner : target.outline) {
+    const auto pixel = unknowns.camera.Project(cam_from_target * corner);
+    if (!pixel || pixel->x() < margin || pixel->y() < margin || pixel->x() > camera.width - margin ||
+        pixel->y() > camera.height - margin) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// The target centred on the optical axis at distance d, turned by
+// `rotation` about its centre.
+Rigid3d Centred(const TargetShape& target, const Eigen::Quaterniond& rotation, double d) {
+  return Rigid3d(rotation, Eigen::Vector3d(0, 0, d) - rotation * target.center);
+}
+
+ViewSamplingOptions SamplingOptions(const NextPoseOptions& options) {
+  ViewSamplingOptions sampling;
+  sampling.distance_min_m = options.distance_min_m;
+  sampling.distance_max_m = options.distance_max_m;
+  sampling.tilt_max_deg = options.tilt_max_deg;
+  sampling.roll_max_deg = options.roll_max_deg;
+  sampling.border_margin_px = options.border_margin_px;
+  sampling.max_view_angle_deg = 85;
+  sampling.visibility = "full";
+  sampling.max_tries = 2000;
+  return sampling;
+}
+
+}  // namespace
+
+void NextPoseOptions::Check() const {
+  if (!(distance_min_m > 0)) throw OptionError("--Live.distance_range", std::to_string(distance_min_m), "> 0 m");
+  if (!(distance_max_m >= distance_min_m)) {
+    throw OptionError("--Live.distance_range", std::to_string(distance_max_m), ">= the minimum distance");
+  }
+  if (!(tilt_max_deg >= 0 && tilt_max_deg <= 80)) {
+    throw OptionError("--Live.max_tilt_deg", std::to_string(tilt_max_deg), "[0, 80]");
+  }
+  if (!(roll_max_deg >= 0 && roll_max_deg <= 180)) {
+    throw OptionError("--Live.max_roll_deg", std::to_string(roll_max_deg), "[0, 180]");
+  }
+  if (!(border_margin_px >= 0)) throw OptionError("--Live.margin_px", std::to_string(border_margin_px), ">= 0");
+  if (num_candidates < 1) throw OptionError("--Live.num_candidates", std::to_string(num_candidates), ">= 1");
+  Uncertainty().Check();
+}
+
+ProjectionUncertaintyOptions NextPoseOptions::Uncertainty() const {
+  ProjectionUncertaintyOptions result = uncertainty;
+  if (result.working_distance_m <= 0) result.working_distance_m = 0.5 * (distance_min_m + distance_max_m);
+  return result;
+}
+
+TargetShape TargetShape::FromPoints(const std::vector<Eigen::Vector3d>& points) {
+  TargetShape shape;
+  shape.points = points;
+  if (points.empty()) return shape;
+  Eigen::Vector3d low = points[0], high = points[0];
+  for (const Eigen::Vector3d& p : points) {
+    low = low.cwiseMin(p);
+    high = high.cwiseMax(p);
+  }
+  shape.center = 0.5 * (low + high);
+  shape.outline = {Eigen::Vector3d(low.x(), low.y(), 0), Eigen::Vector3d(high.x(), low.y(), 0),
+                   Eigen::Vector3d(high.x(), high.y(), 0), Eigen::Vector3d(low.x(), high.y(), 0)};
+  return shape;
+}
+
+std::vector<PoseSuggestion> OpeningPoses(const CalibrationUnknowns& unknowns, const TargetShape& target,
+                                         const NextPoseOptions& options) {
+  const double tilt = std::min(options.tilt_max_deg, 40.0) * kDeg;
+  const std::vector<std::pair<Eigen::Quaterniond, std::string>> turns = {
+      {Eigen::Quaterniond::Identity(), "opening 1/3: facing the camera, filling the image"},
+      {Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX())),
+       "opening 2/3: tilted about the horizontal axis"},
+      {Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitY())),
+       "opening 3/3: tilted about the vertical axis"}};
+  std::vector<PoseSuggestion> poses;
+  for (const auto& [rotation, why] : turns) {
+    const int steps = 60;
+    for (int k = 0; k <= steps; ++k) {
+      const double d = options.distance_min_m + (options.distance_max_m - options.distance_min_m) * k / steps;
+      const Rigid3d pose = Centred(target, rotation, d);
+      if (!InView(unknowns, target, pose, options.border_margin_px)) continue;
+      PoseSuggestion suggestion;
+      suggestion.cam_from_target = pose;
+      suggestion.why = why;
+      suggestion.opening = true;
+      poses.push_back(suggestion);
+      break;
+    }
+  }
+  if (poses.size() < turns.size()) {
+    throw NumericalError("next-pose guidance: the target does not fit in the image within --Live.distance_range [" +
+                         std::to_string(options.distance_min_m) + ", " + std::to_string(options.distance_max_m) +
+                         "] m; allow a larger distance");
+  }
+  return poses;
+}
+
+std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, const TargetShape& target,
+                                         const Eigen::MatrixXd& information, int num_kept, int count,
+                                         const NextPoseOptions& options) {
+  options.Check();
+  unknowns.Check();
+  const ProjectionUncertaintyModel model(unknowns, options.Uncertainty());
+  const std::vector<PoseSuggestion> opening = OpeningPoses(unknowns, target, options);
+  const ViewSamplingOptions sampling = SamplingOptions(options);
+  Eigen::MatrixXd current = information;
+  std::vector<PoseSuggestion> suggestions;
+  for (int step = 0; step < count; ++step) {
+    const int index = num_kept + step;
+    PoseSuggestion best;
+    best.before = model.Evaluate(current);
+    if (index < static_cast<int>(opening.size())) {
+      best = opening[static_cast<size_t>(index)];
+      best.before = model.Evaluate(current);
+      current += ViewInformation(unknowns, target.points, best.cam_from_target);
+      best.after = model.Evaluate(current);
+      suggestions.push_back(best);
+      continue;
+    }
+    std::mt19937_64 rng(options.seed * 1000003ULL + static_cast<uint64_t>(index));
+    double best_score = std::numeric_limits<double>::infinity();
+    Eigen::MatrixXd best_information;
+    for (int c = 0; c < options.num_candidates; ++c) {
+      Rigid3d pose;
+      try {
+        pose = SampleTargetView(unknowns.camera.camera, unknowns.camera.HousingOrNull(), target.outline,
+                                target.center, -Eigen::Vector3d::UnitZ(), sampling, &rng);
+      } catch (const NumericalError&) {
+        break;  // no pose fits: handled below
+      }
+      const Eigen::MatrixXd added = ViewInformation(unknowns, target.points, pose);
+      const ProjectionUncertainty after = model.Evaluate(current + added);
+      // Undetermined counts as infinitely uncertain; ties (all undetermined)
+      // go to the view adding the most information.
+      const double score = after.determined ? after.mean_px : 1e12 / (1.0 + added.trace());
+      if (score < best_score) {
+        best_score = score;
+        best.cam_from_target = pose;
+        best.after = after;
+        best_information = added;
+      }
+    }
+    if (best_information.size() == 0) {
+      throw NumericalError("next-pose guidance: no pose keeps the whole target in view within --Live.distance_range [" +
+                           std::to_string(options.distance_min_m) + ", " + std::to_string(options.distance_max_m) +
+                           "] m and --Live.max_tilt_deg " + std::to_string(options.tilt_max_deg));
+    }
+    best.why = "most lowers the expected projection uncertainty";
+    current += best_information;
+    suggestions.push_back(best);
+  }
+  return suggestions;
+}
+
+PoseDistance DistanceToSuggestion(const CalibrationUnknowns& unknowns, const TargetShape& target,
+                                  const Rigid3d& cam_from_target, const Rigid3d& suggested) {
+  PoseDistance distance;
+  int count = 0;
+  for (const Eigen::Vector3d& corner : target.outline) {
+    const auto a = unknowns.camera.Project(cam_from_target * corner);
+    const auto b = unknowns.camera.Project(suggested * corner);
+    if (!a || !b) continue;
+    distance.outline_px += (*a - *b).norm();
+    ++count;
+  }
+  distance.outline_px = count > 0 ? distance.outline_px / count : std::numeric_limits<double>::infinity();
+  distance.rotation_deg =
+      cam_from_target.rotation.angularDistance(suggested.rotation) / kDeg;
+  distance.translation_m = (cam_from_target.Inverse().translation - suggested.Inverse().translation).norm();
+  return distance;
+}
+
+}  // namespace portcal

@@ -1,0 +1,79 @@
+// The estimate a live calibration shows after each kept view: the camera
+// (or the housing, in-air intrinsics given) from the views kept so far, its
+// standard deviations, the expected projection uncertainty, and where the
+// target should be held next.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "colmap_ext/camera/housed_camera.h"
+#include "pipelines/calibration/camera_calibration.h"
+#include "pipelines/guidance/next_pose.h"
+
+namespace portcal {
+
+struct LiveEstimatorOptions {
+  // Camera calibration: the model, image size and starting parameters.
+  // Housing calibration: the in-air intrinsics, held.
+  Camera camera;
+  // Housing calibration when set: the model, its constants and a start.
+  std::optional<Housing> housing;
+  std::vector<std::string> fixed_params;  // camera calibration
+  NextPoseOptions guidance;
+  // The corners' noise before a solve has measured it, px.
+  double prior_pixel_sigma_px = 0.1;
+  int num_threads = 1;
+  void Check() const;  // throws OptionError / InputError
+  bool HousingCalibration() const { return housing.has_value(); }
+  // Views a first solve needs: 3 for intrinsics (Zhang), 2 for a housing.
+  int MinViews() const { return HousingCalibration() ? 2 : 3; }
+};
+
+struct LiveEstimate {
+  int num_views = 0;
+  bool solved = false;   // a calibration of the kept views
+  std::string status;    // why not solved, or a warning about the solve
+  HousedCamera camera;   // the estimate (the start before a solve)
+  std::vector<std::string> names;    // the estimated parameters
+  std::vector<double> values;
+  std::vector<double> std_devs;      // -1 undetermined
+  double rms_px = 0;
+  double pixel_sigma_px = 0;         // the residuals' (or the prior)
+  std::vector<Rigid3d> view_poses;   // cam_from_target of each kept view
+  Eigen::MatrixXd information;       // the kept views', unit pixel variance
+  ProjectionUncertainty uncertainty;
+  std::optional<PoseSuggestion> next;
+  std::string suggestion_error;      // why there is no suggestion
+
+  // "4 views: fx 505.2 ± 0.8, ...; uncertainty 0.41 px (max 1.2 px)"
+  std::string Summary() const;
+};
+
+class LiveEstimator {
+ public:
+  LiveEstimator(const LiveEstimatorOptions& options, const TargetShape& target);
+
+  // Solves the kept views (from the previous estimate's camera), then the
+  // information, the uncertainty and the next pose. Never throws for a
+  // failed solve: the estimate says why.
+  LiveEstimate Estimate(const std::vector<CalibrationView>& views, const LiveEstimate* previous) const;
+
+  // How much a view would lower the expected uncertainty (relative, 0..1;
+  // 1 while the unknowns are undetermined and the view adds information).
+  double Gain(const LiveEstimate& estimate, const CalibrationView& view) const;
+
+  CalibrationUnknowns Unknowns(const HousedCamera& camera) const;
+  const TargetShape& target() const { return target_; }
+
+ private:
+  void Solve(const std::vector<CalibrationView>& views, LiveEstimate* estimate) const;
+
+  LiveEstimatorOptions options_;
+  TargetShape target_;
+  std::vector<int> fixed_indices_;
+};
+
+}  // namespace portcal

@@ -1,0 +1,170 @@
+// live_calibrator: a rendered hand-held trajectory played in real time as a
+// video keeps one frame per pause and none while the target moves, and the
+// result equals the batch stages on the same frames; bad sources, frames of
+// another size and Ctrl-C lose nothing.
+#include "pipelines/stages/live_calibrator.h"
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <thread>
+
+#include "colmap_ext/util/error.h"
+#include "database/database.h"
+#include "pipelines/stages/camera_calibrator.h"
+#include "pipelines/images/image_reader.h"
+#include "pipelines/stages/target_extractor.h"
+#include "tests/test_utils.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+namespace {
+
+// Five pauses of 1.2 s with 1 s moves at 10 fps: 8.6 s of video, 640 x 480.
+constexpr const char* kTrajectoryYaml = R"(
+name: live_trajectory
+seed: 3
+camera: {model: OPENCV, width: 640, height: 480, params: [505, 498, 326.5, 236.0, -0.21, 0.06, 0.0012, -0.0007]}
+housing: null
+target: {type: chessboard, cols: 9, rows: 6, square_size: 0.03, margin: 0.015}
+poses: {distance: [0.35, 0.8], tilt_max_deg: 45, roll_max_deg: 20, border_margin_px: 15}
+trajectory: {fps: 10, pauses: 5, pause_seconds: 1.2, move_seconds: 1.0, exposure: 0.03}
+render: {spp: 2, blur_sigma: 0.6, noise_sigma: 2.0}
+)";
+
+LiveCalibratorOptions Options(const testing::TempDir& dir, const std::string& source) {
+  LiveCalibratorOptions options;
+  options.live.source.source = source;
+  options.database_path = (dir / "live.db").string();
+  options.image_path = (dir / "kept").string();
+  options.output_path = (dir / "out").string();
+  options.reader.camera_model = "OPENCV";
+  options.live.detector.chessboard.cols = 9;
+  options.live.detector.chessboard.rows = 6;
+  options.live.detector.square_size_m = 0.03;
+  options.live.estimator.guidance.distance_min_m = 0.35;
+  options.live.estimator.guidance.distance_max_m = 0.8;
+  options.live.estimator.guidance.num_candidates = 100;
+  options.live.status_interval_s = 0;
+  return options;
+}
+
+std::vector<std::pair<int, int>> Pauses(const fs::path& trajectory_yaml) {
+  std::vector<std::pair<int, int>> pauses;
+  for (const YAML::Node& pause : YAML::LoadFile(trajectory_yaml.string())["pauses"]) {
+    pauses.emplace_back(pause["first_frame"].as<int>(), pause["last_frame"].as<int>());
+  }
+  return pauses;
+}
+
+CameraCalibrationResult Calibrate(const std::string& database, const fs::path& output) {
+  CameraCalibratorOptions options;
+  options.database_path = database;
+  options.output_path = output.string();
+  return RunCameraCalibrator(options, NoProgress());
+}
+
+TEST(LiveCalibrator, HandsFreeKeepsOneFramePerPauseAndMatchesTheBatchStages) {
+  const testing::TempDir dir;
+  testing::RenderSet(dir, kTrajectoryYaml);
+  const std::vector<std::pair<int, int>> pauses = Pauses(dir / "set/trajectory.yaml");
+  ASSERT_EQ(pauses.size(), 5u);
+  // In real time, as a camera would deliver it: frames the session is late
+  // for are dropped.
+  const LiveCalibratorSummary summary =
+      RunLiveCalibrator(Options(dir, (dir / "set/trajectory.avi").string()), NoProgress());
+  EXPECT_EQ(summary.session.end_reason, "the source ended");
+  EXPECT_TRUE(summary.calibrated);
+  std::vector<int> kept_per_pause(pauses.size(), 0);
+  for (const KeptView& kept : summary.session.kept_views) {
+    const int frame = static_cast<int>(std::lround(kept.time_s * 10));
+    int pause = -1;
+    for (size_t p = 0; p < pauses.size(); ++p) {
+      if (frame >= pauses[p].first && frame <= pauses[p].second) pause = static_cast<int>(p);
+    }
+    EXPECT_GE(pause, 0) << kept.name << " is frame " << frame << ", taken while the target moved";
+    if (pause >= 0) ++kept_per_pause[static_cast<size_t>(pause)];
+  }
+  for (size_t p = 0; p < pauses.size(); ++p) EXPECT_EQ(kept_per_pause[p], 1) << "pause " << p;
+
+  // The batch stages on the kept frames: the same corners, the same camera.
+  TargetExtractorOptions extract;
+  extract.database_path = (dir / "batch.db").string();
+  extract.image_path = (dir / "kept").string();
+  extract.reader.camera_model = "OPENCV";
+  extract.reader.single_camera = true;
+  extract.chessboard.cols = 9;
+  extract.chessboard.rows = 6;
+  extract.square_size_m = 0.03;
+  RunTargetExtractor(extract, NoProgress());
+  const CameraCalibrationResult live = Calibrate((dir / "live.db").string(), dir / "out_live");
+  const CameraCalibrationResult batch = Calibrate(extract.database_path, dir / "out_batch");
+  ASSERT_EQ(live.camera.params.size(), batch.camera.params.size());
+  for (size_t k = 0; k < live.camera.params.size(); ++k) {
+    EXPECT_NEAR(live.camera.params[k], batch.camera.params[k], 1e-9 * (1 + std::abs(batch.camera.params[k])));
+  }
+  EXPECT_EQ(live.num_points, batch.num_points);
+  EXPECT_TRUE(fs::exists(dir / "out/calibration.yaml"));
+}
+
+TEST(LiveCalibrator, AMissingDeviceOrFileIsAClearError) {
+  const testing::TempDir dir;
+  for (const std::string& source : std::vector<std::string>{"/dev/video97", (dir / "no_such.avi").string()}) {
+    try {
+      RunLiveCalibrator(Options(dir, source), NoProgress());
+      ADD_FAILURE() << source << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(source), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_FALSE(fs::exists(dir / "live.db")) << "a database made for nothing";
+}
+
+// A folder: the frames of a short trajectory, one of another size among
+// them. Not in real time: every frame is processed.
+int FolderWithAnOddFrame(const testing::TempDir& dir) {
+  testing::RenderSet(dir, kTrajectoryYaml);
+  const std::vector<std::string> names = ListImages(dir / "set/images");
+
+  cv::Mat odd;
+  cv::resize(cv::imread((dir / "set/images" / names[30]).string()), odd, cv::Size(320, 240));
+  cv::imwrite((dir / "set/images" / names[30]).string(), odd);
+  return static_cast<int>(names.size());
+}
+
+TEST(LiveCalibrator, FramesOfAnotherSizeAreSkippedAndCtrlCKeepsTheViews) {
+  const testing::TempDir dir;
+  const int num_frames = FolderWithAnOddFrame(dir);
+  LiveCalibratorOptions options = Options(dir, (dir / "set/images").string());
+  options.live.source.realtime = false;
+  // Ctrl-C once three views are kept.
+  std::thread watcher;
+  const auto on_start = [&](LiveSession& session) {
+    watcher = std::thread([&session] {
+      while (session.Snapshot().kept.size() < 3) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      CancelFlag::Request();
+    });
+  };
+  EXPECT_THROW(RunLiveCalibrator(options, NoProgress(), on_start), Cancelled);
+  watcher.join();
+  CancelFlag::Reset();
+  Database database(options.database_path, Database::OpenMode::kReadOnly);
+  EXPECT_EQ(database.NumImages(), 3);
+  for (const DatabaseImage& image : database.ReadAllImages()) {
+    EXPECT_TRUE(fs::exists(dir / "kept" / image.name)) << image.name;
+    EXPECT_EQ(database.ReadTargetObservations(image.image_id).size(), 54u) << image.name;
+  }
+
+  // The whole folder: the odd frame is skipped with a warning, the rest go on.
+  options.database_path = (dir / "all.db").string();
+  options.image_path = (dir / "kept_all").string();
+  const LiveCalibratorSummary summary = RunLiveCalibrator(options, NoProgress());
+  EXPECT_EQ(summary.session.frames, num_frames - 1);
+  EXPECT_EQ(summary.session.kept, 5);
+}
+
+}  // namespace
+}  // namespace portcal

@@ -1,0 +1,107 @@
+#include "colmap_ext/util/progress.h"
+#include "colmap_ext/util/string_utils.h"
+#include "pipelines/stages/live_calibrator.h"
+#include "pipelines/stages/pose_suggester.h"
+#include "tools/command_line.h"
+#include "tools/commands.h"
+#include "tools/option_groups.h"
+
+namespace portcal {
+namespace {
+
+// --Live.* of next-pose guidance: the poses a person can hold.
+void RegisterGuidance(CommandLine* cli, NextPoseOptions* guidance) {
+  cli->AddRange("Live.distance_range", &guidance->distance_min_m, &guidance->distance_max_m,
+                "suggested target distances, metres, camera to target centre (what the person can reach)");
+  cli->Add("Live.max_tilt_deg", &guidance->tilt_max_deg, "suggested tilts up to this (target normal vs line of sight)");
+  cli->Add("Live.max_roll_deg", &guidance->roll_max_deg, "suggested rolls about the line of sight up to this");
+  cli->Add("Live.margin_px", &guidance->border_margin_px, "suggested poses keep the whole target this far inside");
+  cli->Add("Live.num_candidates", &guidance->num_candidates, "poses scored per suggestion");
+  cli->Add("Live.working_distance", &guidance->uncertainty.working_distance_m,
+           "depth at which projection uncertainty is measured, metres (0: the middle of the distance range)");
+}
+
+// --Live.*: the source's pacing, hands-free capture, next-pose guidance.
+void RegisterLive(CommandLine* cli, LiveSessionOptions* live) {
+  cli->Add("Live.fps", &live->source.folder_fps, "frame rate of a folder of images played as a source");
+  cli->Add("Live.realtime", &live->source.realtime,
+           "files and folders play at their frame rate, late frames dropped (1), or every frame as fast as it "
+           "is processed (0)");
+  cli->Add("Live.stall_seconds", &live->source.stall_seconds,
+           "a live source without a frame this long is stalled (a warning; three in a row end the session)");
+  HandsFreeOptions& hands_free = live->hands_free;
+  cli->Add("Live.hands_free", &hands_free.enabled, "keep frames when the target is held still (0 | 1)");
+  cli->Add("Live.still_px", &hands_free.still_px, "held still: every corner within this many pixels ...");
+  cli->Add("Live.still_seconds", &hands_free.still_seconds, "... for this long");
+  cli->Add("Live.min_sharpness", &hands_free.min_sharpness,
+           "a still frame is kept if its corners are at least this sharp, relative to the sharpest of the spell");
+  cli->Add("Live.novelty", &hands_free.novelty_fraction,
+           "a new view's corners must lie this far (fraction of the image diagonal, mean) from every kept view's");
+  cli->Add("Live.min_gain", &hands_free.min_gain,
+           "once estimated, a new view must lower the expected projection uncertainty by this fraction");
+  RegisterGuidance(cli, &live->estimator.guidance);
+  cli->Add("Live.max_views", &live->max_views, "finish after this many kept views (0: when the source ends)");
+  cli->Add("Live.status_interval", &live->status_interval_s, "seconds between status lines on stderr (0: none)");
+}
+
+}  // namespace
+
+int LiveCalibratorCommand(int argc, char** argv) {
+  LiveCalibratorOptions options;
+  options.live.estimator.guidance.uncertainty.working_distance_m = 0;
+  std::string fixed;
+  CommandLine cli("live_calibrator",
+                  "Calibrates from a camera, a video file or a network stream: frames where the target is held "
+                  "still are kept (hands-free), written to --image_path and imported into the database as "
+                  "target_extractor would; after each kept view the estimate, its uncertainty and the next "
+                  "suggested pose are printed; at the end camera_calibrator (or, with --input_calibration and "
+                  "--Housing.*, housing_calibrator) writes the reports. Ctrl-C stops with every view kept.");
+  cli.AddRequired("source", &options.live.source.source,
+                  "/dev/videoN or an index (V4L2), a video file, a folder of images, an rtsp:// URL, or a "
+                  "GStreamer pipeline ending in appsink");
+  cli.AddRequired("database_path", &options.database_path, "database (created if missing; a rerun adds views)");
+  cli.AddRequired("image_path", &options.image_path, "folder for the kept frames (created if missing)");
+  cli.AddRequired("output_path", &options.output_path, "folder for the final reports");
+  Register(&cli, &options.reader);
+  TargetDetectorOptions& target = options.live.detector;
+  Register(&cli, &target);
+  cli.Add("input_calibration", &options.input_calibration, "in-air calibration.yaml: calibrate the housing");
+  cli.AddHousing(&options.housing, "the port to calibrate (with --input_calibration)");
+  cli.Add("Calibration.fixed_params", &fixed, "camera calibration: parameters to hold, comma separated");
+  RegisterLive(&cli, &options.live);
+  cli.Add("calibrate_at_end", &options.calibrate_at_end, "write the final reports when the session ends (0 | 1)");
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    options.fixed_params = SplitTokens(fixed, ", ");
+    StderrProgress progress;
+    RunLiveCalibrator(options, progress);
+  });
+}
+
+int PoseSuggesterCommand(int argc, char** argv) {
+  PoseSuggesterOptions options;
+  options.guidance.uncertainty.working_distance_m = 0;
+  std::string fixed;
+  CommandLine cli("pose_suggester",
+                  "The next target poses to hold, from the views a database holds so far (none: the opening "
+                  "sequence): each the pose that most lowers the expected projection uncertainty over the image. "
+                  "Writes suggested_poses.txt (cam_from_target per pose) and suggested_pose_NN.png (where the "
+                  "target must appear).");
+  cli.AddRequired("database_path", &options.database_path, "database with the views so far");
+  cli.AddRequired("output_path", &options.output_path, "folder for the suggestions");
+  cli.Add("num_poses", &options.num_poses, "how many poses");
+  cli.Add("camera_id", &options.camera_id, "camera (-1: the only one)");
+  Register(&cli, &options.target);
+  cli.Add("input_calibration", &options.input_calibration, "in-air calibration.yaml: guide a housing calibration");
+  cli.AddHousing(&options.housing, "the port being calibrated (with --input_calibration)");
+  cli.Add("Calibration.fixed_params", &fixed, "camera calibration: parameters held, comma separated");
+  RegisterGuidance(&cli, &options.guidance);
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    options.fixed_params = SplitTokens(fixed, ", ");
+    StderrProgress progress;
+    RunPoseSuggester(options, progress);
+  });
+}
+
+}  // namespace portcal
