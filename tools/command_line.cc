@@ -209,8 +209,8 @@ int ReportErrors(const std::function<void()>& body) {
   } catch (const UsageError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitUsage;
-  } catch (const Cancelled&) {
-    std::cerr << "error: cancelled; the database was left as it was\n";
+  } catch (const Cancelled& e) {
+    std::cerr << "error: " << e.what() << "\n";
     return kExitCancelled;
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";

@@ -69,6 +69,10 @@ int LiveCalibratorCommand(int argc, char** argv) {
   cli.AddHousing(&options.housing, "the port to calibrate (with --input_calibration)");
   cli.Add("Calibration.fixed_params", &fixed, "camera calibration: parameters to hold, comma separated");
   RegisterLive(&cli, &options.live);
+  cli.Add("Live.address", &options.page.address,
+          "where the live page is served, HOST:PORT (0.0.0.0:PORT: seen from other machines; port 0: a free one)");
+  cli.Add("Live.headless", &options.page.headless, "no page: state and suggestions on stderr only (0 | 1)");
+  cli.Add("Live.max_width", &options.page.max_width, "frames on the page scaled down to this width, pixels");
   cli.Add("calibrate_at_end", &options.calibrate_at_end, "write the final reports when the session ends (0 | 1)");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;

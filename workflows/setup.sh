@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs portcal's dependencies from Debian's packages (idempotent: only
 # missing packages are installed, so a second run takes seconds) and builds
-# portcal into build/ (Release). Used by test.sh and demo.sh.
+# portcal into build/ (Release). Used by test.sh and demo.sh; arguments are
+# more packages to install (test.sh: the browser of the page test).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -14,7 +15,9 @@ packages=(
   libmrcal-dev mrcal python3-mrcal
   libgtest-dev libbenchmark-dev
   libopengv-dev libyaml-cpp-dev libzip-dev
+  libcpp-httplib-dev nlohmann-json3-dev
   colmap
+  "$@"
 )
 
 missing=()

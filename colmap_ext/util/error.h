@@ -37,9 +37,12 @@ class NumericalError : public std::runtime_error {
 };
 
 // The user (or a signal) asked the running stage to stop.
+// By default the stage rolled back ("the database was left as it was");
+// a stage that commits as it goes says what it kept.
 class Cancelled : public std::runtime_error {
  public:
-  Cancelled() : std::runtime_error("cancelled") {}
+  Cancelled() : std::runtime_error("cancelled; the database was left as it was") {}
+  explicit Cancelled(const std::string& kept) : std::runtime_error("cancelled; " + kept) {}
 };
 
 [[noreturn]] void ThrowCheckFailure(const char* file, int line,

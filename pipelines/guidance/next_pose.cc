@@ -175,20 +175,29 @@ std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, co
 
 PoseDistance DistanceToSuggestion(const CalibrationUnknowns& unknowns, const TargetShape& target,
                                   const Rigid3d& cam_from_target, const Rigid3d& suggested) {
-  PoseDistance distance;
-  int count = 0;
-  for (const Eigen::Vector3d& corner : target.outline) {
-    const auto a = unknowns.camera.Project(cam_from_target * corner);
-    const auto b = unknowns.camera.Project(suggested * corner);
-    if (!a || !b) continue;
-    distance.outline_px += (*a - *b).norm();
-    ++count;
+  // A rectangular target held turned by 180 deg about its normal looks the
+  // same to the person (and a detector may number it so): the nearer of
+  // the two counts.
+  const Eigen::Quaterniond half_turn(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
+  const Rigid3d turned_from_target(half_turn, target.center - half_turn * target.center);
+  PoseDistance best;
+  best.outline_px = std::numeric_limits<double>::infinity();
+  for (const Rigid3d& aim : {suggested, suggested * turned_from_target}) {
+    PoseDistance distance;
+    int count = 0;
+    for (const Eigen::Vector3d& corner : target.outline) {
+      const auto a = unknowns.camera.Project(cam_from_target * corner);
+      const auto b = unknowns.camera.Project(aim * corner);
+      if (!a || !b) continue;
+      distance.outline_px += (*a - *b).norm();
+      ++count;
+    }
+    distance.outline_px = count > 0 ? distance.outline_px / count : std::numeric_limits<double>::infinity();
+    distance.rotation_deg = cam_from_target.rotation.angularDistance(aim.rotation) / kDeg;
+    distance.translation_m = (cam_from_target * target.center - aim * target.center).norm();
+    if (distance.outline_px < best.outline_px) best = distance;
   }
-  distance.outline_px = count > 0 ? distance.outline_px / count : std::numeric_limits<double>::infinity();
-  distance.rotation_deg =
-      cam_from_target.rotation.angularDistance(suggested.rotation) / kDeg;
-  distance.translation_m = (cam_from_target.Inverse().translation - suggested.Inverse().translation).norm();
-  return distance;
+  return best;
 }
 
 }  // namespace portcal

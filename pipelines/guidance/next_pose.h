@@ -67,8 +67,9 @@ std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, co
                                          const NextPoseOptions& options);
 
 // How far the target is from a suggested pose: the mean distance (px) of
-// its outline's corners in the image, and the pose's rotation (deg) and
-// centre (m) differences.
+// its outline's corners in the image, the rotation (deg) between the poses
+// and the distance (m) between the target's centres; the target turned by
+// 180 deg about its normal counts as the same.
 struct PoseDistance {
   double outline_px = 0;
   double rotation_deg = 0;

@@ -35,6 +35,14 @@ CalibrationView ViewOf(const TargetDetection& detection, const std::string& name
   return view;
 }
 
+cv::Mat Thumbnail(const cv::Mat& image) {
+  cv::Mat small;
+  cv::resize(image, small, cv::Size(160, std::max(1, 160 * image.rows / std::max(1, image.cols))), 0, 0,
+             cv::INTER_AREA);
+  if (small.channels() == 1) cv::cvtColor(small, small, cv::COLOR_GRAY2BGR);
+  return small;
+}
+
 cv::Mat Gray(const cv::Mat& image) {
   if (image.channels() == 1) return image;
   cv::Mat gray;
@@ -64,7 +72,8 @@ struct LiveSession::Pending {
 };
 
 LiveSession::LiveSession(const LiveSessionOptions& options, KeptFrameStore* store, std::vector<KeptView> existing)
-    : options_(options), store_(store), tracker_(options.hands_free), kept_(std::move(existing)) {
+    : options_(options), store_(store), tracker_(options.hands_free), target_(ShapeOf(options.detector)),
+      kept_(std::move(existing)) {
   options.Check();
   snapshot_.kept = kept_;
 }
@@ -76,6 +85,17 @@ LiveSession::~LiveSession() {
 void LiveSession::Capture() { capture_requested_ = true; }
 void LiveSession::Undo() { undo_requested_ = true; }
 void LiveSession::Finish() { finish_requested_ = true; }
+void LiveSession::CalibrateNow() { calibrate_requested_ = true; }
+
+bool LiveSession::WaitForFrame(int64_t frames_processed, double timeout_s, LiveSnapshot* snapshot) const {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const bool processed = frame_processed_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
+    return snapshot_.frames_processed > frames_processed || ended_;
+  });
+  if (!processed || snapshot_.frames_processed <= frames_processed) return false;
+  *snapshot = snapshot_;
+  return true;
+}
 void LiveSession::Remove(const std::string& name) {
   const std::lock_guard<std::mutex> lock(mutex_);
   remove_requested_.push_back(name);
@@ -132,6 +152,12 @@ void LiveSession::CollectEstimate(bool wait) {
   }
 }
 
+void LiveSession::RememberRefused(const CornerMap& corners) {
+  KeptView refused;  // seen: the same still spell is not fitted again
+  refused.corners = corners;
+  rejected_.push_back(refused);
+}
+
 bool LiveSession::TryKeep(const Frame& frame, const cv::Mat& gray, const CornerMap& corners, bool requested) {
   const cv::Mat& image = frame.image;
   const double novelty_px =
@@ -148,6 +174,7 @@ bool LiveSession::TryKeep(const Frame& frame, const cv::Mat& gray, const CornerM
   const TargetDetection detection = DetectTarget(gray, precise);
   if (!detection.found) {
     Note("frame " + std::to_string(frame.index) + " not kept: the precise fit failed (" + detection.reason + ")", true);
+    RememberRefused(corners);
     return false;
   }
   const CalibrationView view = ViewOf(detection, "");
@@ -158,9 +185,7 @@ bool LiveSession::TryKeep(const Frame& frame, const cv::Mat& gray, const CornerM
       text << "held still, but this view would lower the uncertainty by only " << std::setprecision(2)
            << 100 * gain << " %: move the target (see the suggestion)";
       Note(text.str(), false);
-      KeptView rejected;  // remembered as seen, so the same spell is not fitted again
-      rejected.corners = corners;
-      rejected_.push_back(rejected);
+      RememberRefused(corners);
       return false;
     }
   }
@@ -170,8 +195,11 @@ bool LiveSession::TryKeep(const Frame& frame, const cv::Mat& gray, const CornerM
   } catch (const InputError& e) {
     Note(std::string("frame not stored: ") + e.what(), true);
     return false;
+  } catch (const DatabaseError& e) {
+    Note(std::string("frame not stored (it can be captured again): ") + e.what(), true);
+    return false;
   }
-  KeptView kept{name, frame.time_s, view, Corners(detection)};
+  KeptView kept{name, frame.time_s, view, Corners(detection), Thumbnail(image)};
   kept.view.image_name = name;
   kept_.push_back(kept);
   rejected_.clear();
@@ -186,7 +214,7 @@ bool LiveSession::TryKeep(const Frame& frame, const cv::Mat& gray, const CornerM
   return true;
 }
 
-void LiveSession::Process(const Frame& frame, const cv::Mat& gray) {
+void LiveSession::Process(const Frame& frame, const cv::Mat& gray, double arrival_wall_s) {
   TargetDetectorOptions quick = options_.detector;
   quick.precise_fit = false;
   const TargetDetection detection = DetectTarget(gray, quick);
@@ -206,13 +234,22 @@ void LiveSession::Process(const Frame& frame, const cv::Mat& gray) {
     if (TryKeep(frame, gray, corners, requested)) tracker_.Reset();
   }
   const std::lock_guard<std::mutex> lock(mutex_);
+  // Frames processed per second, over about the last second.
+  if (snapshot_.arrival_wall_s > 0 && arrival_wall_s > snapshot_.arrival_wall_s) {
+    const double rate = 1 / (arrival_wall_s - snapshot_.arrival_wall_s);
+    const double weight = std::min(1.0, (arrival_wall_s - snapshot_.arrival_wall_s) / 1.0);
+    snapshot_.fps = snapshot_.fps > 0 ? (1 - weight) * snapshot_.fps + weight * rate : rate;
+  }
   snapshot_.frame = gray;
+  snapshot_.arrival_wall_s = arrival_wall_s;
+  ++snapshot_.frames_processed;
   snapshot_.time_s = frame.time_s;
   snapshot_.frame_index = frame.index;
   snapshot_.target_seen = detection.found;
   snapshot_.corners = corners;
   snapshot_.hold = hold;
   snapshot_.to_suggestion = to_suggestion;
+  frame_processed_.notify_all();
 }
 
 void LiveSession::ApplyRequests() {
@@ -248,10 +285,9 @@ void LiveSession::ApplyRequests() {
 void LiveSession::PrintStatus(double time_s) {
   const double now = WallSeconds();
   if (options_.status_interval_s <= 0 || now - last_status_s_ < options_.status_interval_s) return;
-  const double fps = last_status_s_ > 0 ? (summary_.frames - status_frames_) / (now - last_status_s_) : 0;
   last_status_s_ = now;
-  status_frames_ = summary_.frames;
   const LiveSnapshot s = Snapshot();
+  const double fps = s.fps;
   std::ostringstream line;
   line << std::fixed << std::setprecision(1) << "live: t " << time_s << " s, " << fps << " fps; ";
   if (s.target_seen) {
@@ -265,8 +301,6 @@ void LiveSession::PrintStatus(double time_s) {
     if (s.to_suggestion) line << ", " << std::setprecision(0) << s.to_suggestion->outline_px << " px away";
   }
   LOG(INFO) << line.str();
-  const std::lock_guard<std::mutex> lock(mutex_);
-  snapshot_.fps = fps;
 }
 
 bool LiveSession::CheckSize(const cv::Mat& gray, int64_t index) {
@@ -282,7 +316,7 @@ bool LiveSession::CheckSize(const cv::Mat& gray, int64_t index) {
                        std::to_string(gray.rows) + ", the camera (--input_calibration) is " +
                        std::to_string(estimator.camera.width) + "x" + std::to_string(estimator.camera.height));
     }
-    estimator_ = std::make_unique<LiveEstimator>(estimator, ShapeOf(options_.detector));
+    estimator_ = std::make_unique<LiveEstimator>(estimator, target_);
     StartEstimate();  // the opening suggestion (or the continued session's estimate)
     return true;
   }
@@ -339,14 +373,21 @@ LiveSummary LiveSession::Run() {
     }
     stalls = 0;
     if (frame.image.empty()) continue;
+    const double arrival = WallSeconds();
     const cv::Mat gray = Gray(frame.image);
     if (!CheckSize(gray, frame.index)) continue;
-    Process(frame, gray);
+    Process(frame, gray, arrival);
+    if (calibrate_requested_.exchange(false)) StartEstimate();
     ApplyRequests();
     CollectEstimate(false);
     PrintStatus(frame.time_s);
   }
   CollectEstimate(true);
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    ended_ = true;
+    frame_processed_.notify_all();
+  }
   summary_.kept = static_cast<int>(kept_.size());
   summary_.kept_views = kept_;
   summary_.seconds = WallSeconds() - start;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <atomic>
+#include <condition_variable>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -45,6 +46,7 @@ struct KeptView {
   double time_s = 0;
   CalibrationView view;  // the precise corners
   CornerMap corners;
+  cv::Mat thumbnail;     // BGR, 160 px wide (empty for a continued session's views)
 };
 
 // What a viewer shows (a copy, taken under the session's lock).
@@ -52,6 +54,8 @@ struct LiveSnapshot {
   cv::Mat frame;             // the newest frame, gray
   double time_s = 0;
   int64_t frame_index = 0;
+  int64_t frames_processed = 0;  // counts every processed frame (WaitForFrame)
+  double arrival_wall_s = 0;     // when the frame was read (steady clock, s)
   double fps = 0;            // frames processed per second, recently
   bool target_seen = false;
   CornerMap corners;         // quick corners of the newest frame
@@ -89,14 +93,24 @@ class LiveSession {
   void Undo();
   void Remove(const std::string& name);
   void Finish();
+  // Solve the kept views now (the estimate is also updated after each keep).
+  void CalibrateNow();
   LiveSnapshot Snapshot() const;
+  // Waits until a frame after `frames_processed` is processed (or
+  // `timeout_s` passes); false on time-out or once the session has ended.
+  bool WaitForFrame(int64_t frames_processed, double timeout_s, LiveSnapshot* snapshot) const;
+  // The target as guidance sees it (its points and outline).
+  const TargetShape& target() const { return target_; }
 
  private:
-  void Process(const Frame& frame, const cv::Mat& gray);
+  void Process(const Frame& frame, const cv::Mat& gray, double arrival_wall_s);
   // The first frame fixes the image size (and the camera's, if unknown);
   // false for a frame of another size.
   bool CheckSize(const cv::Mat& gray, int64_t index);
   bool TryKeep(const Frame& frame, const cv::Mat& gray, const CornerMap& corners, bool requested);
+  // A still view refused (no precise fit, too little gain): not tried
+  // again until a view is kept.
+  void RememberRefused(const CornerMap& corners);
   void ApplyRequests();
   void StartEstimate();
   void CollectEstimate(bool wait);
@@ -108,6 +122,10 @@ class LiveSession {
   std::unique_ptr<LiveEstimator> estimator_;
   StillnessTracker tracker_;
   mutable std::mutex mutex_;
+  mutable std::condition_variable frame_processed_;
+  bool ended_ = false;
+  TargetShape target_;
+  std::atomic<bool> calibrate_requested_{false};
   LiveSnapshot snapshot_;
   std::vector<KeptView> kept_;
   std::vector<KeptView> rejected_;  // held still but refused since the last keep
@@ -120,7 +138,6 @@ class LiveSession {
   std::unique_ptr<Pending> pending_;  // the estimate being computed
   bool estimate_stale_ = false;       // views changed while it ran
   double last_status_s_ = -1e9;
-  int64_t status_frames_ = 0;
   cv::Size size_;
   double other_size_since_s_ = -1;  // wall time frames of another size began
   LiveSummary summary_;

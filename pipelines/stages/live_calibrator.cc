@@ -29,6 +29,7 @@ void LiveCalibratorOptions::Check() const {
   }
   reader.Check();
   live.Check();
+  page.Check();
 }
 
 namespace {
@@ -173,14 +174,16 @@ struct SessionOutcome {
 
 // The session, with the database open only while it runs.
 SessionOutcome RunSession(const LiveCalibratorOptions& options, const LiveSessionOptions& live,
-                          const std::function<void(LiveSession&)>& on_start) {
+                          const std::function<void(LiveSession&, const std::string&)>& on_start) {
   fs::create_directories(options.image_path);
   NewDatabaseFile new_file(options.database_path);
   Database database(options.database_path, Database::OpenMode::kCreate);
   { Transaction probe = database.BeginTransaction(); }  // fails now, not at the first keep, when locked
   DatabaseFrameStore store(options, &database);
   LiveSession session(live, &store, ExistingViews(&database));
-  if (on_start) on_start(session);
+  std::optional<LiveServer> page;
+  if (!options.page.headless) page.emplace(&session, options.page);
+  if (on_start) on_start(session, page ? page->url() : std::string());
   SessionOutcome outcome;
   outcome.summary = session.Run();
   outcome.num_views = static_cast<int>(database.NumImages());
@@ -192,26 +195,27 @@ SessionOutcome RunSession(const LiveCalibratorOptions& options, const LiveSessio
 }  // namespace
 
 LiveCalibratorSummary RunLiveCalibrator(const LiveCalibratorOptions& options, ProgressSink& progress,
-                                        const std::function<void(LiveSession&)>& on_start) {
+                                        const std::function<void(LiveSession&, const std::string&)>& on_start) {
   options.Check();
   LiveCalibratorOptions adjusted = options;
+  adjusted.page.output_path = options.output_path;
   const LiveSessionOptions live = SessionOptions(options, &adjusted.reader);
   const SessionOutcome outcome = RunSession(adjusted, live, on_start);
   LiveCalibratorSummary summary;
   summary.session = outcome.summary;
   const int views = outcome.num_views;
   if (summary.session.end_reason == "interrupted") {
-    LOG(WARNING) << "live_calibrator: interrupted; " << views << " views are in " << options.database_path
-                 << " (calibrate them with camera_calibrator / housing_calibrator, or rerun to add more)";
-    throw Cancelled();
+    throw Cancelled(std::to_string(views) + " views kept in " + options.database_path + " and " +
+                    options.image_path +
+                    " (calibrate them with camera_calibrator / housing_calibrator, or rerun to add more)");
   }
+  if (!options.calibrate_at_end) return summary;
   const int needed = options.housing ? 2 : 3;
   if (views < needed) {
     throw NumericalError("live_calibrator: " + std::to_string(views) + " views kept (" + summary.session.end_reason +
                          "); a calibration needs " + std::to_string(needed) + ". They stay in " +
                          options.database_path + "; rerun to add more");
   }
-  if (!options.calibrate_at_end) return summary;
   CalibrateAtEnd(options, outcome.camera_id, progress);
   summary.calibrated = true;
   return summary;

@@ -14,6 +14,7 @@
 #include "colmap_ext/housing/housing.h"
 #include "colmap_ext/util/progress.h"
 #include "pipelines/images/image_reader.h"
+#include "pipelines/live/live_server.h"
 #include "pipelines/live/live_session.h"
 
 namespace portcal {
@@ -29,6 +30,7 @@ struct LiveCalibratorOptions {
   std::optional<Housing> housing;
   std::vector<std::string> fixed_params;  // camera calibration
   LiveSessionOptions live;                // source, target, hands-free, guidance
+  LivePageOptions page;                   // the live view in a browser (or headless)
   bool calibrate_at_end = true;
   void Check() const;  // throws OptionError naming the option
 };
@@ -38,12 +40,12 @@ struct LiveCalibratorSummary {
   bool calibrated = false;  // the final reports were written
 };
 
-// `on_start` is called with the running session (a viewer attaches to it)
-// before the first frame. Throws InputError (options, the source, the
+// `on_start` is called with the session (and the page's address, "" when
+// headless) before the first frame. Throws InputError (options, the source, the
 // input calibration), NumericalError (too few views for the final
 // calibration: they stay in the database), Cancelled after Ctrl-C (every
 // view kept so far stays).
 LiveCalibratorSummary RunLiveCalibrator(const LiveCalibratorOptions& options, ProgressSink& progress,
-                                        const std::function<void(LiveSession&)>& on_start = {});
+                                        const std::function<void(LiveSession&, const std::string&)>& on_start = {});
 
 }  // namespace portcal

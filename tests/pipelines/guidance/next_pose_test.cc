@@ -14,36 +14,16 @@
 #include "pipelines/calibration/camera_calibration.h"
 #include "pipelines/live/live_estimator.h"
 #include "pipelines/synthetic/view_sampler.h"
+#include "tests/pipelines/guidance/simulated_person.h"
 
 namespace portcal {
 namespace {
 
+using simulated::Board;
+using simulated::Options;
+using simulated::TrueCamera;
+
 constexpr double kDeg = M_PI / 180.0;
-
-Camera TrueCamera() {
-  Camera camera = Camera::FromModelName("OPENCV", 500, 640, 480);
-  camera.params = {505, 498, 326.5, 236.0, -0.21, 0.06, 0.0012, -0.0007};
-  return camera;
-}
-
-// A 9 x 6 inner-corner chessboard, 3 cm squares.
-TargetShape Board() {
-  std::vector<Eigen::Vector3d> points;
-  for (int r = 0; r < 6; ++r) {
-    for (int c = 0; c < 9; ++c) points.emplace_back(0.03 * c, 0.03 * r, 0);
-  }
-  return TargetShape::FromPoints(points);
-}
-
-NextPoseOptions Options() {
-  NextPoseOptions options;
-  options.distance_min_m = 0.3;
-  options.distance_max_m = 0.9;
-  options.tilt_max_deg = 50;
-  options.num_candidates = 120;
-  options.uncertainty.pixel_sigma_px = 0.2;
-  return options;
-}
 
 // The corners seen at a pose with Gaussian noise; empty when one leaves the
 // image (the detector refuses a cut board).
@@ -125,24 +105,6 @@ TEST(ProjectionUncertainty, PredictionMatchesTheSpreadOfRepeatedCalibrations) {
   EXPECT_LT(empirical / predicted.mean_px, 1.4) << empirical << " vs " << predicted.mean_px;
 }
 
-// A person holding the target near a pose: within 5 cm and 5 degrees.
-Rigid3d WithHumanError(const Rigid3d& pose, std::mt19937_64* rng) {
-  std::uniform_real_distribution<double> unit(-1, 1);
-  Eigen::Vector3d axis(unit(*rng), unit(*rng), unit(*rng));
-  const Eigen::Quaterniond turn(Eigen::AngleAxisd(5 * kDeg * std::abs(unit(*rng)), axis.normalized()));
-  const Eigen::Vector3d shift = 0.05 * std::abs(unit(*rng)) * Eigen::Vector3d(unit(*rng), unit(*rng), unit(*rng)).normalized();
-  // The target turned about its own centre and moved.
-  return Rigid3d(pose.rotation * turn, pose.translation + shift);
-}
-
-// A flat port 12 mm in front of the lens, its normal 1 deg off the axis;
-// the start the person gives: on the axis, 5 mm.
-Housing TruePort() {
-  const Eigen::Vector3d normal = Eigen::Vector3d(0.0175, -0.0052, 1.0).normalized();
-  return Housing::FromName("FLATPORT", {normal.x(), normal.y(), normal.z(), 0.012, 0.008, 1.0, 1.49, 1.334}, "test");
-}
-Housing StartPort() { return Housing::FromName("FLATPORT", {0, 0, 1, 0.005, 0.008, 1.0, 1.49, 1.334}, "test"); }
-
 // The corners seen through lens and port, with noise; empty when one
 // leaves the image.
 std::optional<CalibrationView> ObserveHoused(const HousedCamera& camera, const TargetShape& target,
@@ -162,59 +124,17 @@ std::optional<CalibrationView> ObserveHoused(const HousedCamera& camera, const T
   return view;
 }
 
-// Views a simulated person needs until the true projection uncertainty
-// drops below `goal_px`, capped at `max_views`: guided (the live
-// estimator's suggestion, held with a person's error) or random poses from
-// the same ranges. A camera calibration, or with `housing` a flat port's.
-int ViewsToReach(bool housing, bool guided, double goal_px, int max_views, uint64_t seed) {
-  const HousedCamera truth{TrueCamera(), housing ? std::optional<Housing>(TruePort()) : std::nullopt};
-  const TargetShape board = Board();
-  LiveEstimatorOptions estimator_options;
-  estimator_options.guidance = Options();
-  estimator_options.guidance.seed = seed;
-  estimator_options.prior_pixel_sigma_px = 0.2;
-  // Nothing known yet: COLMAP's default focal length, no distortion; or
-  // the in-air camera and a port on the axis.
-  estimator_options.camera = housing ? TrueCamera() : Camera::FromModelName("OPENCV", 1.2 * 640, 640, 480);
-  if (housing) estimator_options.housing = StartPort();
-  const LiveEstimator estimator(estimator_options, board);
-  CalibrationUnknowns true_unknowns = estimator.Unknowns(truth);
-  const ProjectionUncertaintyModel true_model(true_unknowns, estimator_options.guidance.Uncertainty());
-  std::mt19937_64 rng(seed);
-  ViewSamplingOptions sampling;
-  sampling.distance_min_m = estimator_options.guidance.distance_min_m;
-  sampling.distance_max_m = estimator_options.guidance.distance_max_m;
-  sampling.tilt_max_deg = estimator_options.guidance.tilt_max_deg;
-  sampling.border_margin_px = estimator_options.guidance.border_margin_px;
-  std::shared_ptr<LiveEstimate> estimate;
-  std::vector<CalibrationView> views;
-  Eigen::MatrixXd true_information = Eigen::MatrixXd::Zero(true_unknowns.NumUnknowns(), true_unknowns.NumUnknowns());
-  for (int n = 1; n <= max_views; ++n) {
-    if (guided) estimate = std::make_shared<LiveEstimate>(estimator.Estimate(views, estimate.get()));
-    std::optional<CalibrationView> view;
-    Rigid3d held;
-    for (int attempt = 0; attempt < 20 && !view; ++attempt) {
-      held = guided && estimate->next ? WithHumanError(estimate->next->cam_from_target, &rng)
-                                      : SampleTargetView(truth.camera, truth.HousingOrNull(), board.outline,
-                                                         board.center, -Eigen::Vector3d::UnitZ(), sampling, &rng);
-      view = ObserveHoused(truth, board, held, 0.2, &rng);
-    }
-    if (!view) continue;
-    views.push_back(*view);
-    true_information += ViewInformation(true_unknowns, board.points, held);
-    const ProjectionUncertainty reached = true_model.Evaluate(true_information);
-    if (reached.determined && reached.mean_px < goal_px) return n;
-  }
-  return max_views + 1;
-}
-
 // Mean views to the goal over a few seeds, guided and random.
 std::pair<double, double> MeanViewsToReach(bool housing, double goal_px, int max_views) {
   double guided = 0, random = 0;
   const int seeds = 3;
   for (uint64_t seed = 1; seed <= seeds; ++seed) {
-    const int with = ViewsToReach(housing, true, goal_px, max_views, seed);
-    const int without = ViewsToReach(housing, false, goal_px, max_views, seed);
+    const HousedCamera truth{TrueCamera(), housing ? std::optional<Housing>(simulated::TruePort()) : std::nullopt};
+    const simulated::Observer observe = [&](const Rigid3d& pose, std::mt19937_64* rng) {
+      return ObserveHoused(truth, Board(), pose, 0.2, rng);
+    };
+    const int with = simulated::ViewsToReach(housing, true, goal_px, max_views, seed, observe);
+    const int without = simulated::ViewsToReach(housing, false, goal_px, max_views, seed, observe);
     LOG(INFO) << (housing ? "housing" : "camera") << " seed " << seed << ": suggested " << with << " views, random "
               << without;
     guided += with;

@@ -16,40 +16,18 @@
 #include "pipelines/stages/camera_calibrator.h"
 #include "pipelines/images/image_reader.h"
 #include "pipelines/stages/target_extractor.h"
-#include "tests/test_utils.h"
+#include "tests/pipelines/stages/live_test_setup.h"
 
 namespace fs = std::filesystem;
 
 namespace portcal {
 namespace {
 
-// Five pauses of 1.2 s with 1 s moves at 10 fps: 8.6 s of video, 640 x 480.
-constexpr const char* kTrajectoryYaml = R"(
-name: live_trajectory
-seed: 3
-camera: {model: OPENCV, width: 640, height: 480, params: [505, 498, 326.5, 236.0, -0.21, 0.06, 0.0012, -0.0007]}
-housing: null
-target: {type: chessboard, cols: 9, rows: 6, square_size: 0.03, margin: 0.015}
-poses: {distance: [0.35, 0.8], tilt_max_deg: 45, roll_max_deg: 20, border_margin_px: 15}
-trajectory: {fps: 10, pauses: 5, pause_seconds: 1.2, move_seconds: 1.0, exposure: 0.03}
-render: {spp: 2, blur_sigma: 0.6, noise_sigma: 2.0}
-)";
+// Five pauses: 8.6 s of video.
+const std::string kTrajectoryYaml = testing::LiveTrajectoryYaml(3, 5, true);
 
 LiveCalibratorOptions Options(const testing::TempDir& dir, const std::string& source) {
-  LiveCalibratorOptions options;
-  options.live.source.source = source;
-  options.database_path = (dir / "live.db").string();
-  options.image_path = (dir / "kept").string();
-  options.output_path = (dir / "out").string();
-  options.reader.camera_model = "OPENCV";
-  options.live.detector.chessboard.cols = 9;
-  options.live.detector.chessboard.rows = 6;
-  options.live.detector.square_size_m = 0.03;
-  options.live.estimator.guidance.distance_min_m = 0.35;
-  options.live.estimator.guidance.distance_max_m = 0.8;
-  options.live.estimator.guidance.num_candidates = 100;
-  options.live.status_interval_s = 0;
-  return options;
+  return testing::LiveOptions(dir, source);
 }
 
 std::vector<std::pair<int, int>> Pauses(const fs::path& trajectory_yaml) {
@@ -142,7 +120,7 @@ TEST(LiveCalibrator, FramesOfAnotherSizeAreSkippedAndCtrlCKeepsTheViews) {
   options.live.source.realtime = false;
   // Ctrl-C once three views are kept.
   std::thread watcher;
-  const auto on_start = [&](LiveSession& session) {
+  const auto on_start = [&](LiveSession& session, const std::string&) {
     watcher = std::thread([&session] {
       while (session.Snapshot().kept.size() < 3) std::this_thread::sleep_for(std::chrono::milliseconds(5));
       CancelFlag::Request();

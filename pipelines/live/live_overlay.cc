@@ -1,0 +1,135 @@
+#include "pipelines/live/live_overlay.h"
+
+#include <iomanip>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "pipelines/live/pose_preview.h"
+
+namespace portcal {
+namespace {
+
+double ScaleFor(const cv::Size& size, int max_width) {
+  return size.width > max_width && max_width > 0 ? static_cast<double>(max_width) / size.width : 1.0;
+}
+
+cv::Mat ScaledBgr(const cv::Mat& gray, double scale) {
+  cv::Mat bgr;
+  if (gray.empty()) return cv::Mat(360, 640, CV_8UC3, cv::Scalar(40, 40, 40));
+  cv::cvtColor(gray, bgr, cv::COLOR_GRAY2BGR);
+  if (scale != 1.0) cv::resize(bgr, bgr, cv::Size(), scale, scale, cv::INTER_AREA);
+  return bgr;
+}
+
+void Caption(const std::string& text, int line, cv::Mat* bgr) {
+  const double size = std::max(0.4, bgr->cols / 1100.0);
+  const cv::Point at(10, static_cast<int>((line + 1) * 26 * size / 0.6));
+  cv::putText(*bgr, text, at, cv::FONT_HERSHEY_SIMPLEX, size, cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
+  cv::putText(*bgr, text, at, cv::FONT_HERSHEY_SIMPLEX, size, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+}
+
+}  // namespace
+
+cv::Mat DrawLiveOverlay(const LiveSnapshot& snapshot, const TargetShape& target, int max_width) {
+  const double scale = ScaleFor(snapshot.frame.size(), max_width);
+  cv::Mat bgr = ScaledBgr(snapshot.frame, scale);
+  const cv::Scalar color = snapshot.hold.still   ? cv::Scalar(0, 220, 0)
+                           : snapshot.hold.held_s > 0 ? cv::Scalar(0, 220, 255)
+                                                      : cv::Scalar(0, 0, 255);
+  for (const auto& [id, pixel] : snapshot.corners) {
+    cv::circle(bgr, cv::Point(cvRound((pixel.x() - 0.5) * scale * 16), cvRound((pixel.y() - 0.5) * scale * 16)),
+               4 * 16, color, 1, cv::LINE_AA, 4);
+  }
+  const LiveEstimate* estimate = snapshot.estimate.get();
+  if (estimate && estimate->next) {
+    const std::vector<cv::Point2f> outline =
+        TargetOutlinePixels(estimate->camera, target, estimate->next->cam_from_target);
+    std::vector<cv::Point> polygon;
+    for (const cv::Point2f& p : outline) polygon.emplace_back(cvRound(p.x * scale * 16), cvRound(p.y * scale * 16));
+    if (!polygon.empty()) cv::polylines(bgr, polygon, true, cv::Scalar(0, 140, 255), 2, cv::LINE_AA, 4);
+  }
+  std::ostringstream line;
+  line << std::fixed << std::setprecision(1) << snapshot.fps << " fps  ";
+  if (!snapshot.target_seen) {
+    line << "no target";
+  } else {
+    line << snapshot.corners.size() << " corners, held " << snapshot.hold.held_s << " s";
+  }
+  line << "  " << snapshot.kept.size() << " kept";
+  Caption(line.str(), 0, &bgr);
+  if (snapshot.to_suggestion && estimate && estimate->next) {
+    std::ostringstream away;
+    away << std::fixed << std::setprecision(0) << "to the suggested pose: " << snapshot.to_suggestion->outline_px
+         << " px, " << snapshot.to_suggestion->rotation_deg << " deg, " << 100 * snapshot.to_suggestion->translation_m
+         << " cm";
+    Caption(away.str(), 1, &bgr);
+  }
+  return bgr;
+}
+
+cv::Mat DrawCoverage(const LiveSnapshot& snapshot, int max_width, double* covered) {
+  const double scale = ScaleFor(snapshot.frame.size(), max_width);
+  cv::Mat bgr = ScaledBgr(snapshot.frame, scale) * 0.4;
+  cv::Mat counts = cv::Mat::zeros(bgr.size(), CV_32F);
+  const cv::Size cells(16, 9);
+  cv::Mat occupied = cv::Mat::zeros(cells, CV_8U);
+  for (const KeptView& kept : snapshot.kept) {
+    for (const Eigen::Vector2d& pixel : kept.view.pixels) {
+      const int x = static_cast<int>(pixel.x() * scale), y = static_cast<int>(pixel.y() * scale);
+      if (x < 0 || y < 0 || x >= counts.cols || y >= counts.rows) continue;
+      counts.at<float>(y, x) += 1;
+      occupied.at<uint8_t>(y * cells.height / counts.rows, x * cells.width / counts.cols) = 1;
+    }
+  }
+  if (covered) *covered = cv::countNonZero(occupied) / static_cast<double>(cells.area());
+  const double sigma = std::max(4.0, bgr.cols / 40.0);
+  cv::GaussianBlur(counts, counts, cv::Size(), sigma);
+  double peak = 0;
+  cv::minMaxLoc(counts, nullptr, &peak);
+  if (peak <= 0) return bgr;
+  cv::Mat level;
+  counts.convertTo(level, CV_8U, 255.0 / peak);
+  cv::Mat heat;
+  cv::applyColorMap(level, heat, cv::COLORMAP_TURBO);
+  cv::Mat mask = level > 8;
+  cv::addWeighted(bgr, 0.35, heat, 0.65, 0, heat);
+  heat.copyTo(bgr, mask);
+  return bgr;
+}
+
+cv::Mat DrawUncertainty(const LiveSnapshot& snapshot, int max_width) {
+  const double scale = ScaleFor(snapshot.frame.size(), max_width);
+  const cv::Size size = snapshot.frame.empty() ? cv::Size(640, 360)
+                                               : cv::Size(cvRound(snapshot.frame.cols * scale),
+                                                          cvRound(snapshot.frame.rows * scale));
+  cv::Mat bgr(size, CV_8UC3, cv::Scalar(50, 50, 50));
+  const LiveEstimate* estimate = snapshot.estimate.get();
+  if (!estimate || !estimate->uncertainty.determined) {
+    Caption(estimate ? "not yet determined: " + estimate->status : "no estimate yet", 0, &bgr);
+    return bgr;
+  }
+  const Eigen::MatrixXd& map = estimate->uncertainty.map_px;
+  const double top = std::max(1e-9, estimate->uncertainty.max_px);
+  for (int r = 0; r < map.rows(); ++r) {
+    for (int c = 0; c < map.cols(); ++c) {
+      const cv::Rect cell(c * size.width / static_cast<int>(map.cols()), r * size.height / static_cast<int>(map.rows()),
+                          size.width / static_cast<int>(map.cols()) + 1, size.height / static_cast<int>(map.rows()) + 1);
+      if (map(r, c) < 0) continue;
+      cv::Mat level(1, 1, CV_8U, cv::Scalar(cv::saturate_cast<uint8_t>(255 * map(r, c) / top)));
+      cv::Mat color;
+      cv::applyColorMap(level, color, cv::COLORMAP_TURBO);
+      bgr(cell & cv::Rect(cv::Point(0, 0), size)).setTo(color.at<cv::Vec3b>(0, 0));
+      std::ostringstream value;
+      value << std::setprecision(2) << map(r, c);
+      cv::putText(bgr, value.str(), cell.tl() + cv::Point(3, cell.height / 2), cv::FONT_HERSHEY_SIMPLEX,
+                  std::max(0.3, cell.width / 110.0), cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    }
+  }
+  std::ostringstream line;
+  line << std::setprecision(3) << "expected projection uncertainty: mean " << estimate->uncertainty.mean_px
+       << " px, max " << estimate->uncertainty.max_px << " px";
+  Caption(line.str(), 0, &bgr);
+  return bgr;
+}
+
+}  // namespace portcal

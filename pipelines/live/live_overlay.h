@@ -1,0 +1,27 @@
+// What the live page draws: the frame with the corners found and the
+// suggested pose, the coverage heat-map of the kept corners, and the map of
+// the expected projection uncertainty. Pure drawing, no state.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include "pipelines/live/live_session.h"
+
+namespace portcal {
+
+// The frame (BGR, scaled to at most `max_width`): corners (green once held
+// still long enough, yellow while held, red while moving), the suggested
+// pose's outline (orange), and a line saying how far the target is from it.
+cv::Mat DrawLiveOverlay(const LiveSnapshot& snapshot, const TargetShape& target, int max_width);
+
+// The kept views' corners over the image as a heat-map (smoothed counts,
+// coloured) on the dimmed newest frame; `covered` is the fraction of a
+// 16 x 9 grid's cells with a corner in them.
+cv::Mat DrawCoverage(const LiveSnapshot& snapshot, int max_width, double* covered = nullptr);
+
+// The expected projection uncertainty over the image (px, one sigma),
+// coloured, with the grid's values written in; a gray image saying why when
+// there is none yet.
+cv::Mat DrawUncertainty(const LiveSnapshot& snapshot, int max_width);
+
+}  // namespace portcal

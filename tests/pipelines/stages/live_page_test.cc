@@ -1,0 +1,153 @@
+// The live page in a real browser (Debian's headless chromium): it loads
+// from a running live_calibrator, its stream moves on, its capture and undo
+// buttons work; a screenshot is kept as an artefact. Also the page's HTTP
+// endpoints, a port already in use, and Ctrl-C on the real process.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <fstream>
+#include <future>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <thread>
+
+#include "colmap_ext/util/error.h"
+#include "database/database.h"
+#include "pipelines/stages/live_calibrator.h"
+#include "tests/pipelines/stages/live_test_setup.h"
+
+// Last: <resolv.h>, which it includes, defines _res, a name inside Eigen.
+#include <httplib.h>
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+namespace {
+
+// Three pauses: 34 frames.
+const std::string kTrajectoryYaml = testing::LiveTrajectoryYaml(4, 3, false);
+
+LiveCalibratorOptions Options(const testing::TempDir& dir) {
+  LiveCalibratorOptions options = testing::LiveOptions(dir, (dir / "set/images").string());
+  options.live.source.folder_fps = 3;  // 11 s, time enough for the browser
+  options.live.estimator.guidance.num_candidates = 60;
+  options.page.headless = false;
+  options.page.address = "127.0.0.1:0";
+  options.calibrate_at_end = false;
+  return options;
+}
+
+// Headless chromium as the machine's probe runs it, with a fresh profile.
+std::string Chromium(const testing::TempDir& dir, const std::string& what, const std::string& url) {
+  return "timeout 90 chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
+         "--disable-background-networking --disable-component-update --disable-sync --user-data-dir=" +
+         (dir / ("profile_" + std::to_string(std::hash<std::string>()(what)))).string() +
+         " --window-size=1400,1000 --virtual-time-budget=15000 " + what + " '" + url + "' 2>/dev/null";
+}
+
+TEST(LivePage, ABrowserSeesTheStreamAndItsButtonsWork) {
+  if (testing::RunCommand("command -v chromium").exit_code != 0) {
+    GTEST_SKIP() << "chromium is not installed (bash workflows/test.sh installs it)";
+  }
+  const testing::TempDir dir;
+  testing::RenderSet(dir, kTrajectoryYaml);
+  std::promise<std::string> url_promise;
+  LiveSession* session = nullptr;
+  auto run = std::async(std::launch::async, [&] {
+    return RunLiveCalibrator(Options(dir), NoProgress(), [&](LiveSession& s, const std::string& url) {
+      session = &s;
+      url_promise.set_value(url);
+    });
+  });
+  const std::string url = url_promise.get_future().get();
+  ASSERT_FALSE(url.empty());
+  const std::smatch port = [&] {
+    std::smatch match;
+    std::regex_search(url, match, std::regex(":([0-9]+)/"));
+    return match;
+  }();
+  httplib::Client client("127.0.0.1", std::stoi(port[1]));
+
+  // The page presses its own buttons (?selftest=1) and writes what happened.
+  const testing::CommandResult dom = testing::RunCommand(Chromium(dir, "--dump-dom", url + "?selftest=1"));
+  EXPECT_NE(dom.output.find("selftest: passed"), std::string::npos) << dom.output.substr(0, 4000);
+  EXPECT_NE(dom.output.find("capture: "), std::string::npos);
+
+  // A screenshot, kept beside the test binary for a person to look at.
+  const fs::path artefact = fs::current_path() / "artifacts/live_page.png";
+  fs::create_directories(artefact.parent_path());
+  testing::RunCommand(Chromium(dir, "--screenshot=" + artefact.string(), url));
+  EXPECT_GT(fs::exists(artefact) ? fs::file_size(artefact) : 0, 20000u) << artefact;
+
+  // The endpoints themselves.
+  const auto state = client.Get("/state.json");
+  ASSERT_TRUE(state && state->status == 200);
+  const nlohmann::json json = nlohmann::json::parse(state->body);
+  EXPECT_EQ(json["width"], 640);
+  std::string stream;
+  client.Get("/stream.mjpg", [&](const char* data, size_t length) {
+    stream.append(data, length);
+    return stream.size() < 20000;  // enough for a part
+  });
+  EXPECT_NE(stream.find("--frame\r\nContent-Type: image/jpeg"), std::string::npos);
+  EXPECT_NE(stream.find("\xff\xd8"), std::string::npos) << "no JPEG in the stream";
+  for (const char* image : {"/coverage.jpg", "/uncertainty.jpg"}) {
+    const auto reply = client.Get(image);
+    ASSERT_TRUE(reply && reply->status == 200) << image;
+    EXPECT_EQ(reply->get_header_value("Content-Type"), "image/jpeg");
+  }
+
+  // Another session on the same port: a clear error naming the option.
+  try {
+    LivePageOptions taken;
+    taken.address = "127.0.0.1:" + std::string(port[1]);
+    LiveServer second(session, taken);
+    ADD_FAILURE() << "a second server on a port in use";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--Live.address"), std::string::npos) << e.what();
+  }
+
+  ASSERT_TRUE(client.Post("/finish"));
+  const LiveCalibratorSummary summary = run.get();
+  EXPECT_EQ(summary.session.end_reason, "finish requested");
+  Database database(dir / "live.db", Database::OpenMode::kReadOnly);
+  EXPECT_EQ(database.NumImages(), summary.session.kept);
+}
+
+TEST(LivePage, CtrlCOnTheProcessKeepsEveryViewItReported) {
+  const testing::TempDir dir;
+  testing::RenderSet(dir, kTrajectoryYaml);
+  const std::string log = (dir / "log.txt").string();
+  const std::string command = testing::PortcalBinary() + " live_calibrator --source " + (dir / "set/images").string() +
+                              " --Live.fps 4 --Live.headless 1 --database_path " + (dir / "live.db").string() +
+                              " --image_path " + (dir / "kept").string() + " --output_path " +
+                              (dir / "out").string() +
+                              " --Target.cols 9 --Target.rows 6 --Target.square_size 0.03 "
+                              "--ImageReader.camera_model OPENCV --Live.distance_range 0.35,0.8";
+  // In the background (its own output away from RunCommand's pipe, which
+  // would wait for it); SIGINT once the second view is kept.
+  testing::RunCommand("(" + command + " > " + log + " 2>&1; echo exit=$? >> " + log + ") > /dev/null 2>&1 &");
+  int kept = 0;
+  for (int wait = 0; wait < 300 && kept < 2; ++wait) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const std::string text = testing::ReadFileToString(log);
+    kept = 0;
+    for (size_t at = text.find("live: kept "); at != std::string::npos; at = text.find("live: kept ", at + 1)) ++kept;
+  }
+  ASSERT_GE(kept, 2) << testing::ReadFileToString(log);
+  testing::RunCommand("pkill -INT -f 'live_calibrator --source " + (dir / "set/images").string() + "'");
+  std::string text;
+  for (int wait = 0; wait < 200 && text.find("exit=") == std::string::npos; ++wait) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    text = testing::ReadFileToString(log);
+  }
+  EXPECT_NE(text.find("exit=130"), std::string::npos) << text;
+  size_t reported = 0;
+  for (size_t at = text.find("live: kept "); at != std::string::npos; at = text.find("live: kept ", at + 1)) ++reported;
+  Database database(dir / "live.db", Database::OpenMode::kReadOnly);
+  EXPECT_EQ(static_cast<size_t>(database.NumImages()), reported);
+  for (const DatabaseImage& image : database.ReadAllImages()) EXPECT_TRUE(fs::exists(dir / "kept" / image.name));
+}
+
+}  // namespace
+}  // namespace portcal

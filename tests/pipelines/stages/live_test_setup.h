@@ -1,0 +1,44 @@
+// What the live calibrator's tests share: a rendered hand-held trajectory
+// of a 9 x 6 chessboard before a 640 x 480 OPENCV camera, and the options
+// that calibrate it.
+#pragma once
+
+#include <string>
+
+#include "pipelines/stages/live_calibrator.h"
+#include "tests/test_utils.h"
+
+namespace portcal::testing {
+
+// `pauses` pauses of 1.2 s, moves of 1 s, at 10 fps.
+inline std::string LiveTrajectoryYaml(int seed, int pauses, bool video) {
+  return "name: live_trajectory\nseed: " + std::to_string(seed) + R"(
+camera: {model: OPENCV, width: 640, height: 480, params: [505, 498, 326.5, 236.0, -0.21, 0.06, 0.0012, -0.0007]}
+housing: null
+target: {type: chessboard, cols: 9, rows: 6, square_size: 0.03, margin: 0.015}
+poses: {distance: [0.35, 0.8], tilt_max_deg: 45, roll_max_deg: 20, border_margin_px: 15}
+render: {spp: 2, blur_sigma: 0.6, noise_sigma: 2.0}
+trajectory: {fps: 10, pause_seconds: 1.2, move_seconds: 1.0, exposure: 0.03, pauses: )" +
+         std::to_string(pauses) + ", video: " + (video ? "true" : "false") + "}\n";
+}
+
+// Headless, the board and camera above, guidance over the rendered range.
+inline LiveCalibratorOptions LiveOptions(const TempDir& dir, const std::string& source) {
+  LiveCalibratorOptions options;
+  options.live.source.source = source;
+  options.database_path = (dir / "live.db").string();
+  options.image_path = (dir / "kept").string();
+  options.output_path = (dir / "out").string();
+  options.reader.camera_model = "OPENCV";
+  options.live.detector.chessboard.cols = 9;
+  options.live.detector.chessboard.rows = 6;
+  options.live.detector.square_size_m = 0.03;
+  options.live.estimator.guidance.distance_min_m = 0.35;
+  options.live.estimator.guidance.distance_max_m = 0.8;
+  options.live.estimator.guidance.num_candidates = 100;
+  options.live.status_interval_s = 0;
+  options.page.headless = true;
+  return options;
+}
+
+}  // namespace portcal::testing
