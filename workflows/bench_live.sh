@@ -27,7 +27,7 @@ trajectory: {fps: 25, pauses: 3, pause_seconds: 1.6, move_seconds: 1.5, exposure
 render: {spp: 1, blur_sigma: 0.8, noise_sigma: 2.0}
 YAML
 echo "bench_live: rendering the 1080p trajectory (about a minute)" >&2
-build/portcal synthesize --config "$work/trajectory.yaml" --output_path "$work/set" --log_level warning
+build/portcal synthesize --config "$work/trajectory.yaml" --output_path "$work/set" --log_level warn
 frames=$(ls "$work/set/images" | wc -l)
 
 build/portcal live_calibrator --source "$work/set/trajectory.avi" --database_path "$work/live.db" \
