@@ -109,7 +109,11 @@ void LiveServer::Impl::EncodeLoop() {
   int64_t seen = 0;
   LiveSnapshot snapshot;
   while (!stopping) {
-    if (!session->WaitForFrame(seen, 0.25, &snapshot)) continue;
+    if (!session->WaitForFrame(seen, 0.25, &snapshot)) {
+      // The session has ended (WaitForFrame no longer waits) or no frame came.
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      continue;
+    }
     seen = snapshot.frames_processed;
     if (WallSeconds() - last_viewer_s.load() > 2) continue;
     auto bytes = std::make_shared<const std::vector<uint8_t>>(EncodeOverlayJpeg(snapshot, session->target(), options));

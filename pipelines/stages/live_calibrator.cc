@@ -49,6 +49,7 @@ class DatabaseFrameStore : public KeptFrameStore {
     const std::string name = NextName();
     const fs::path path = fs::path(options_.image_path) / name;
     const fs::path partial = fs::path(options_.image_path) / ("." + name + ".partial.png");
+    fs::create_directories(options_.image_path);  // at the first keep: a session that keeps nothing leaves nothing
     if (!cv::imwrite(partial.string(), image)) throw InputError(partial.string() + ": cannot write the frame");
     fs::rename(partial, path);
     try {
@@ -175,7 +176,6 @@ struct SessionOutcome {
 // The session, with the database open only while it runs.
 SessionOutcome RunSession(const LiveCalibratorOptions& options, const LiveSessionOptions& live,
                           const std::function<void(LiveSession&, const std::string&)>& on_start) {
-  fs::create_directories(options.image_path);
   NewDatabaseFile new_file(options.database_path);
   Database database(options.database_path, Database::OpenMode::kCreate);
   { Transaction probe = database.BeginTransaction(); }  // fails now, not at the first keep, when locked
@@ -185,7 +185,13 @@ SessionOutcome RunSession(const LiveCalibratorOptions& options, const LiveSessio
   if (!options.page.headless) page.emplace(&session, options.page);
   if (on_start) on_start(session, page ? page->url() : std::string());
   SessionOutcome outcome;
-  outcome.summary = session.Run();
+  try {
+    outcome.summary = session.Run();
+  } catch (...) {
+    // A source that fails mid-session: what was kept stays.
+    if (database.NumImages() > 0) new_file.Keep();
+    throw;
+  }
   outcome.num_views = static_cast<int>(database.NumImages());
   if (outcome.num_views > 0) new_file.Keep();
   outcome.camera_id = store.camera_id();

@@ -142,6 +142,27 @@ TEST(LiveCalibrator, FramesOfAnotherSizeAreSkippedAndCtrlCKeepsTheViews) {
   const LiveCalibratorSummary summary = RunLiveCalibrator(options, NoProgress());
   EXPECT_EQ(summary.session.frames, num_frames - 1);
   EXPECT_EQ(summary.session.kept, 5);
+
+  // A stream whose size changes for good (the last pause's frames): an
+  // error naming the sizes, and the views kept before it stay.
+  const std::vector<std::string> names = ListImages(dir / "set/images");
+  for (size_t k = names.size() - 12; k < names.size(); ++k) {
+    cv::Mat odd;
+    cv::resize(cv::imread((dir / "set/images" / names[k]).string()), odd, cv::Size(320, 240));
+    cv::imwrite((dir / "set/images" / names[k]).string(), odd);
+  }
+  options.database_path = (dir / "changed.db").string();
+  options.image_path = (dir / "kept_changed").string();
+  options.live.source.stall_seconds = 1e-3;
+  try {
+    RunLiveCalibrator(options, NoProgress());
+    ADD_FAILURE() << "frames of another size for good were accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("changed size to 320x240 instead of 640x480"), std::string::npos)
+        << e.what();
+  }
+  Database changed(options.database_path, Database::OpenMode::kReadOnly);
+  EXPECT_EQ(changed.NumImages(), 4);  // the four pauses before
 }
 
 }  // namespace
