@@ -148,7 +148,8 @@ LiveSessionOptions SessionOptions(const LiveCalibratorOptions& options, ImageRea
 }
 
 // The final reports, by the batch calibrators on the database.
-void CalibrateAtEnd(const LiveCalibratorOptions& options, int camera_id, ProgressSink& progress) {
+void CalibrateAtEnd(const LiveCalibratorOptions& options, int camera_id, ProgressSink& progress,
+                    LiveCalibratorSummary* summary) {
   if (options.housing) {
     HousingCalibratorOptions housing;
     housing.database_path = options.database_path;
@@ -156,7 +157,7 @@ void CalibrateAtEnd(const LiveCalibratorOptions& options, int camera_id, Progres
     housing.output_path = options.output_path;
     housing.housing = options.housing;
     housing.camera_id = camera_id;
-    RunHousingCalibrator(housing, progress);
+    summary->housing = RunHousingCalibrator(housing, progress);
     return;
   }
   CameraCalibratorOptions camera;
@@ -164,7 +165,7 @@ void CalibrateAtEnd(const LiveCalibratorOptions& options, int camera_id, Progres
   camera.output_path = options.output_path;
   camera.camera_id = camera_id;
   camera.calibration.fixed_params = options.fixed_params;
-  RunCameraCalibrator(camera, progress);
+  summary->camera = RunCameraCalibrator(camera, progress);
 }
 
 struct SessionOutcome {
@@ -222,7 +223,7 @@ LiveCalibratorSummary RunLiveCalibrator(const LiveCalibratorOptions& options, Pr
                          "); a calibration needs " + std::to_string(needed) + ". They stay in " +
                          options.database_path + "; rerun to add more");
   }
-  CalibrateAtEnd(options, outcome.camera_id, progress);
+  CalibrateAtEnd(options, outcome.camera_id, progress, &summary);
   summary.calibrated = true;
   return summary;
 }

@@ -13,6 +13,7 @@
 
 #include "colmap_ext/housing/housing.h"
 #include "colmap_ext/util/progress.h"
+#include "pipelines/calibration/housing_calibration.h"
 #include "pipelines/images/image_reader.h"
 #include "pipelines/live/live_server.h"
 #include "pipelines/live/live_session.h"
@@ -38,6 +39,9 @@ struct LiveCalibratorOptions {
 struct LiveCalibratorSummary {
   LiveSummary session;
   bool calibrated = false;  // the final reports were written
+  // The final calibration (the one the reports give).
+  std::optional<CameraCalibrationResult> camera;
+  std::optional<HousingCalibrationResult> housing;
 };
 
 // `on_start` is called with the session (and the page's address, "" when

@@ -13,6 +13,7 @@
 
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
+#include "pipelines/calibration/calibration_report.h"
 #include "pipelines/stages/camera_calibrator.h"
 #include "pipelines/images/image_reader.h"
 #include "pipelines/stages/target_extractor.h"
@@ -86,6 +87,38 @@ TEST(LiveCalibrator, HandsFreeKeepsOneFramePerPauseAndMatchesTheBatchStages) {
   }
   EXPECT_EQ(live.num_points, batch.num_points);
   EXPECT_TRUE(fs::exists(dir / "out/calibration.yaml"));
+}
+
+// Behind a flat port: the in-air intrinsics given, the port calibrated by
+// housing_calibrator at the end, within a few standard deviations of the
+// truth (and far from the start, 7 mm and 1 deg off).
+TEST(LiveCalibrator, AHousingIsCalibratedFromTheKeptViews) {
+  const testing::TempDir dir;
+  std::string yaml = testing::LiveTrajectoryYaml(6, 5, false);
+  const std::string in_air = "housing: null";
+  yaml.replace(yaml.find(in_air), in_air.size(),
+               "housing: {model: FLATPORT, params: [0.0174524, 0, 0.9998477, 0.012, 0.008, 1.0, 1.49, 1.334]}");
+  testing::RenderSet(dir, yaml);
+  CalibrationReport air;
+  air.camera = Camera::FromModelName("OPENCV", 505, 640, 480);
+  air.camera.params = {505, 498, 326.5, 236.0, -0.21, 0.06, 0.0012, -0.0007};
+  WriteCalibrationReport(air, dir / "air");
+  LiveCalibratorOptions options = Options(dir, (dir / "set/images").string());
+  options.live.source.realtime = false;
+  options.input_calibration = (dir / "air/calibration.yaml").string();
+  options.housing = Housing::FromName("FLATPORT", {0, 0, 1, 0.005, 0.008, 1.0, 1.49, 1.334}, "test");
+  const LiveCalibratorSummary summary = RunLiveCalibrator(options, NoProgress());
+  EXPECT_EQ(summary.session.kept, 5);
+  ASSERT_TRUE(summary.calibrated && summary.housing);
+  EXPECT_TRUE(fs::exists(dir / "out/calibration.yaml"));
+  const std::vector<double>& p = summary.housing->housing.params;
+  const std::vector<double>& sigma = summary.housing->housing_std_dev;
+  ASSERT_EQ(sigma.size(), p.size());
+  const std::vector<double> truth = {0.0174524, 0, 0.9998477, 0.012};
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_GT(sigma[k], 0) << k;
+    EXPECT_LT(std::abs(p[k] - truth[k]), 5 * sigma[k] + 1e-6) << "parameter " << k << ": " << p[k] << " ± " << sigma[k];
+  }
 }
 
 TEST(LiveCalibrator, AMissingDeviceOrFileIsAClearError) {
