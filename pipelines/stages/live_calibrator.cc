@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <iomanip>
+#include <set>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
@@ -10,7 +11,6 @@
 #include "database/database.h"
 #include "database/new_database_file.h"
 #include "pipelines/calibration/calibration_report.h"
-#include "pipelines/calibration/target_views.h"
 #include "pipelines/detection/detection_rows.h"
 #include "pipelines/stages/camera_calibrator.h"
 #include "pipelines/stages/housing_calibrator.h"
@@ -43,15 +43,25 @@ class DatabaseFrameStore : public KeptFrameStore {
     reader_ = options.reader;
     reader_.single_camera = true;
     reader_.single_camera_per_folder = false;
+    // A continued session: the new frames join the camera of the kept ones
+    // (a frame of another size is then refused, naming both).
+    std::set<camera_t> cameras;
+    for (const DatabaseImage& image : database->ReadAllImages()) cameras.insert(image.camera_id);
+    if (cameras.size() == 1) shared_.by_folder[""] = *cameras.begin();
   }
 
   std::string Store(const cv::Mat& image, const TargetDetection& detection) override {
     const std::string name = NextName();
     const fs::path path = fs::path(options_.image_path) / name;
     const fs::path partial = fs::path(options_.image_path) / ("." + name + ".partial.png");
-    fs::create_directories(options_.image_path);  // at the first keep: a session that keeps nothing leaves nothing
-    if (!cv::imwrite(partial.string(), image)) throw InputError(partial.string() + ": cannot write the frame");
-    fs::rename(partial, path);
+    std::error_code error;
+    // At the first keep: a session that keeps nothing leaves nothing.
+    fs::create_directories(options_.image_path, error);
+    if (error || !cv::imwrite(partial.string(), image)) {
+      throw InputError(partial.string() + ": cannot write the frame" + (error ? " (" + error.message() + ")" : ""));
+    }
+    fs::rename(partial, path, error);
+    if (error) throw InputError(path.string() + ": cannot move the frame into place (" + error.message() + ")");
     try {
       Transaction transaction = database_->BeginTransaction();
       const image_t id = ImportImage(database_, reader_, name, image.cols, image.rows, &shared_);
@@ -106,23 +116,21 @@ class DatabaseFrameStore : public KeptFrameStore {
   }
 };
 
-// Views a previous session kept in this database (a continued session).
+// Views a previous session kept in this database (a continued session),
+// with their corners' ids, so that hands-free capture does not keep them
+// again.
 std::vector<KeptView> ExistingViews(Database* database) {
   std::vector<KeptView> kept;
-  if (database->NumImages() == 0) return kept;
-  TargetViews views;
-  try {
-    views = ReadTargetViews(database);
-  } catch (const InputError&) {
-    return kept;  // images without observations: nothing to continue from
-  }
-  for (const auto& [camera_id, camera_views] : views.by_camera) {
-    for (const CalibrationView& view : camera_views) {
-      KeptView k;  // no point ids are read back: novelty does not compare with it
-      k.name = view.image_name;
-      k.view = view;
-      kept.push_back(k);
+  for (const DatabaseImage& image : database->ReadAllImages()) {
+    KeptView view;
+    view.name = image.name;
+    view.view.image_name = image.name;
+    for (const TargetObservation& o : database->ReadTargetObservations(image.image_id)) {
+      view.view.points_in_target.push_back(o.point_in_target);
+      view.view.pixels.push_back(o.xy);
+      view.corners[static_cast<int>(o.point_id)] = o.xy;
     }
+    if (!view.view.pixels.empty()) kept.push_back(view);
   }
   return kept;
 }

@@ -121,6 +121,27 @@ TEST(LiveCalibrator, AHousingIsCalibratedFromTheKeptViews) {
   }
 }
 
+// A second session on the same database goes on from the first: the views
+// already kept are not kept again, the new ones join the same camera.
+TEST(LiveCalibrator, ASecondSessionGoesOnFromTheFirst) {
+  const testing::TempDir dir;
+  testing::RenderSet(dir, kTrajectoryYaml);
+  LiveCalibratorOptions options = Options(dir, (dir / "set/images").string());
+  options.live.source.realtime = false;
+  options.live.max_views = 2;
+  options.calibrate_at_end = false;
+  EXPECT_EQ(RunLiveCalibrator(options, NoProgress()).session.kept, 2);
+  options.live.max_views = 0;
+  options.calibrate_at_end = true;
+  const LiveCalibratorSummary second = RunLiveCalibrator(options, NoProgress());
+  EXPECT_EQ(second.session.kept, 5);  // the two, then the three later pauses
+  ASSERT_TRUE(second.camera.has_value());
+  EXPECT_EQ(second.camera->views.size(), 5u);
+  Database database(options.database_path, Database::OpenMode::kReadOnly);
+  EXPECT_EQ(database.NumImages(), 5);
+  EXPECT_EQ(database.NumCameras(), 1);
+}
+
 TEST(LiveCalibrator, AMissingDeviceOrFileIsAClearError) {
   const testing::TempDir dir;
   for (const std::string& source : std::vector<std::string>{"/dev/video97", (dir / "no_such.avi").string()}) {
