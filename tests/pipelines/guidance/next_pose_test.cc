@@ -98,6 +98,8 @@ TEST(ProjectionUncertainty, PredictionMatchesTheSpreadOfRepeatedCalibrations) {
     empirical += std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(s).eigenvalues().maxCoeff());
   }
   empirical /= static_cast<double>(scatter.size());
+  std::printf("projection uncertainty: predicted %.4f px, spread of %d calibrations %.4f px (ratio %.2f)\n",
+              predicted.mean_px, trials, empirical, empirical / predicted.mean_px);
   // 40 trials give a standard deviation known to about 1/sqrt(2 * 40) =
   // 11 %; the calibrations also refine the poses of noisy views, which the
   // linear prediction only approximates.
