@@ -81,10 +81,14 @@ std::string FormatFixed(double value, int digits) {
 
 std::string FormatShortest(double value) {
   // 17 significant digits always read back exactly; the first precision
-  // that does is the shortest.
+  // that does is the shortest. Exponents only for the very small or large:
+  // 10 reads back from "1e+01" already, but a person expects "10".
+  const double magnitude = std::abs(value);
+  const bool plain = magnitude >= 1e-4 && magnitude < 1e15;
   for (int digits = 1; digits < 17; ++digits) {
     std::ostringstream out;
     out << std::setprecision(digits) << value;
+    if (plain && out.str().find('e') != std::string::npos) continue;
     if (std::strtod(out.str().c_str(), nullptr) == value) return out.str();
   }
   std::ostringstream out;

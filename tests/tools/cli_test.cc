@@ -52,6 +52,9 @@ TEST(Cli, CommandHelpShowsOptionsWithDefaults) {
   EXPECT_EQ(FormatShortest(0.04), "0.04");
   EXPECT_EQ(FormatShortest(1.0 / 3.0), "0.3333333333333333");  // 16 digits read it back
   EXPECT_EQ(FormatShortest(1e-5), "1e-05");
+  EXPECT_EQ(FormatShortest(10), "10");  // not "1e+01"
+  EXPECT_EQ(FormatShortest(1500), "1500");
+  EXPECT_EQ(FormatShortest(-50), "-50");
   EXPECT_EQ(std::stod(FormatShortest(0.1 + 0.2)), 0.1 + 0.2);
 }
 
