@@ -122,17 +122,19 @@ std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, co
   options.Check();
   unknowns.Check();
   const ProjectionUncertaintyModel model(unknowns, options.Uncertainty());
-  const std::vector<PoseSuggestion> opening = OpeningPoses(unknowns, target, options);
+  // The opening only while it is not yet taken: past it, a range where
+  // only tilted views fit is no error.
+  const std::vector<PoseSuggestion> opening =
+      num_kept < 3 ? OpeningPoses(unknowns, target, options) : std::vector<PoseSuggestion>();
   const ViewSamplingOptions sampling = SamplingOptions(options);
   Eigen::MatrixXd current = information;
   std::vector<PoseSuggestion> suggestions;
   for (int step = 0; step < count; ++step) {
     const int index = num_kept + step;
     PoseSuggestion best;
+    if (index < static_cast<int>(opening.size())) best = opening[static_cast<size_t>(index)];
     best.before = model.Evaluate(current);
-    if (index < static_cast<int>(opening.size())) {
-      best = opening[static_cast<size_t>(index)];
-      best.before = model.Evaluate(current);
+    if (best.opening) {
       current += ViewInformation(unknowns, target.points, best.cam_from_target);
       best.after = model.Evaluate(current);
       suggestions.push_back(best);

@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <random>
 
+#include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "pipelines/calibration/camera_calibration.h"
 #include "pipelines/live/live_estimator.h"
@@ -145,6 +146,20 @@ std::pair<double, double> MeanViewsToReach(bool housing, double goal_px, int max
   std::printf("%s: views to reach %.3f px: suggested %.1f, random %.1f (mean of %d seeds)\n",
               housing ? "flat port" : "camera", goal_px, guided / seeds, random / seeds, seeds);
   return {guided / seeds, random / seeds};
+}
+
+TEST(NextPose, ARangeWhereTheTargetCannotFitIsAnErrorNamingIt) {
+  NextPoseOptions options = Options();
+  options.distance_min_m = 0.05;  // the board fills more than the image
+  options.distance_max_m = 0.08;
+  CalibrationUnknowns unknowns;
+  unknowns.camera.camera = TrueCamera();
+  try {
+    SuggestPoses(unknowns, Board(), Eigen::MatrixXd::Zero(8, 8), 0, 1, options);
+    ADD_FAILURE() << "a suggestion where the target cannot fit";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("--Live.distance_range"), std::string::npos) << e.what();
+  }
 }
 
 TEST(NextPose, SuggestionsReachTheGoalInFewerViewsThanRandomPoses) {
