@@ -61,6 +61,23 @@ CalibrationUnknowns LiveEstimator::Unknowns(const HousedCamera& camera) const {
   return unknowns;
 }
 
+namespace {
+
+// What a camera or housing calibration says that the estimate shows: the
+// estimated parameters by name with their deviations, the fit, the poses.
+template <typename Result>
+void TakeSolve(const Result& result, const std::string& names, const std::vector<double>& values,
+               const std::vector<double>& std_devs, LiveEstimate* estimate) {
+  estimate->names = SplitTokens(names, ", ");
+  estimate->values = values;
+  estimate->std_devs = std_devs;
+  estimate->rms_px = result.overall_rms_px;
+  estimate->pixel_sigma_px = result.residual_sigma_px;
+  for (const CalibratedView& view : result.views) estimate->view_poses.push_back(view.cam_from_target);
+}
+
+}  // namespace
+
 void LiveEstimator::Solve(const std::vector<CalibrationView>& views, LiveEstimate* estimate) const {
   const int needed = options_.MinViews() - static_cast<int>(views.size());
   if (needed > 0) {
@@ -74,12 +91,7 @@ void LiveEstimator::Solve(const std::vector<CalibrationView>& views, LiveEstimat
       const HousingCalibrationResult result =
           CalibrateHousing(views, estimate->camera.camera, *estimate->camera.housing, settings);
       estimate->camera.housing = result.housing;
-      estimate->names = SplitTokens(result.housing.ParamsInfo(), ", ");
-      estimate->values = result.housing.params;
-      estimate->std_devs = result.housing_std_dev;
-      estimate->rms_px = result.overall_rms_px;
-      estimate->pixel_sigma_px = result.residual_sigma_px;
-      for (const CalibratedView& view : result.views) estimate->view_poses.push_back(view.cam_from_target);
+      TakeSolve(result, result.housing.ParamsInfo(), result.housing.params, result.housing_std_dev, estimate);
       if (const auto why = result.housing.Implausibility()) estimate->status = "implausible housing: " + *why;
     } else {
       CameraCalibrationSettings settings;
@@ -87,12 +99,7 @@ void LiveEstimator::Solve(const std::vector<CalibrationView>& views, LiveEstimat
       settings.num_threads = options_.num_threads;
       const CameraCalibrationResult result = CalibrateCamera(views, estimate->camera.camera, settings);
       estimate->camera.camera = result.camera;
-      estimate->names = SplitTokens(result.camera.ParamsInfo(), ", ");
-      estimate->values = result.camera.params;
-      estimate->std_devs = result.params_std_dev;
-      estimate->rms_px = result.overall_rms_px;
-      estimate->pixel_sigma_px = result.residual_sigma_px;
-      for (const CalibratedView& view : result.views) estimate->view_poses.push_back(view.cam_from_target);
+      TakeSolve(result, result.camera.ParamsInfo(), result.camera.params, result.params_std_dev, estimate);
     }
     estimate->solved = true;
   } catch (const NumericalError& e) {

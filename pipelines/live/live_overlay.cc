@@ -67,21 +67,30 @@ cv::Mat DrawLiveOverlay(const LiveSnapshot& snapshot, const TargetShape& target,
   return bgr;
 }
 
-cv::Mat DrawCoverage(const LiveSnapshot& snapshot, int max_width, double* covered) {
-  const double scale = ScaleFor(snapshot.frame.size(), max_width);
-  cv::Mat bgr = ScaledBgr(snapshot.frame, scale) * 0.4;
-  cv::Mat counts = cv::Mat::zeros(bgr.size(), CV_32F);
+double CoverageFraction(const LiveSnapshot& snapshot) {
+  if (snapshot.frame.empty()) return 0;
   const cv::Size cells(16, 9);
   cv::Mat occupied = cv::Mat::zeros(cells, CV_8U);
   for (const KeptView& kept : snapshot.kept) {
     for (const Eigen::Vector2d& pixel : kept.view.pixels) {
-      const int x = static_cast<int>(pixel.x() * scale), y = static_cast<int>(pixel.y() * scale);
-      if (x < 0 || y < 0 || x >= counts.cols || y >= counts.rows) continue;
-      counts.at<float>(y, x) += 1;
-      occupied.at<uint8_t>(y * cells.height / counts.rows, x * cells.width / counts.cols) = 1;
+      const int x = static_cast<int>(pixel.x() * cells.width / snapshot.frame.cols);
+      const int y = static_cast<int>(pixel.y() * cells.height / snapshot.frame.rows);
+      if (x >= 0 && y >= 0 && x < cells.width && y < cells.height) occupied.at<uint8_t>(y, x) = 1;
     }
   }
-  if (covered) *covered = cv::countNonZero(occupied) / static_cast<double>(cells.area());
+  return cv::countNonZero(occupied) / static_cast<double>(cells.area());
+}
+
+cv::Mat DrawCoverage(const LiveSnapshot& snapshot, int max_width) {
+  const double scale = ScaleFor(snapshot.frame.size(), max_width);
+  cv::Mat bgr = ScaledBgr(snapshot.frame, scale) * 0.4;
+  cv::Mat counts = cv::Mat::zeros(bgr.size(), CV_32F);
+  for (const KeptView& kept : snapshot.kept) {
+    for (const Eigen::Vector2d& pixel : kept.view.pixels) {
+      const int x = static_cast<int>(pixel.x() * scale), y = static_cast<int>(pixel.y() * scale);
+      if (x >= 0 && y >= 0 && x < counts.cols && y < counts.rows) counts.at<float>(y, x) += 1;
+    }
+  }
   const double sigma = std::max(4.0, bgr.cols / 40.0);
   cv::GaussianBlur(counts, counts, cv::Size(), sigma);
   double peak = 0;

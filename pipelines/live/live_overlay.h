@@ -14,10 +14,13 @@ namespace portcal {
 // pose's outline (orange), and a line saying how far the target is from it.
 cv::Mat DrawLiveOverlay(const LiveSnapshot& snapshot, const TargetShape& target, int max_width);
 
+// The fraction of a 16 x 9 grid over the image whose cells hold a kept
+// view's corner.
+double CoverageFraction(const LiveSnapshot& snapshot);
+
 // The kept views' corners over the image as a heat-map (smoothed counts,
-// coloured) on the dimmed newest frame; `covered` is the fraction of a
-// 16 x 9 grid's cells with a corner in them.
-cv::Mat DrawCoverage(const LiveSnapshot& snapshot, int max_width, double* covered = nullptr);
+// coloured) on the dimmed newest frame.
+cv::Mat DrawCoverage(const LiveSnapshot& snapshot, int max_width);
 
 // The expected projection uncertainty over the image (px, one sigma),
 // coloured, with the grid's values written in; a gray image saying why when

@@ -165,9 +165,7 @@ nlohmann::json LiveServer::Impl::State() const {
   nlohmann::json kept = nlohmann::json::array();
   for (const KeptView& view : snapshot.kept) kept.push_back({{"name", view.name}, {"points", view.view.pixels.size()}});
   state["kept"] = kept;
-  double covered = 0;
-  DrawCoverage(snapshot, 64, &covered);
-  state["coverage"] = covered;
+  state["coverage"] = CoverageFraction(snapshot);
   state["estimate"] = snapshot.estimate ? EstimateJson(*snapshot.estimate) : nlohmann::json(nullptr);
   if (snapshot.to_suggestion) {
     state["to_suggestion"] = {{"outline_px", snapshot.to_suggestion->outline_px},

@@ -50,14 +50,13 @@ cv::Mat Gray(const cv::Mat& image) {
   return gray;
 }
 
-// The target as guidance sees it: all of its points.
-TargetShape ShapeOf(const TargetDetectorOptions& detector) {
+}  // namespace
+
+TargetShape ShapeOfTarget(const TargetDetectorOptions& detector) {
   std::vector<Eigen::Vector3d> points;
   for (const BoardPoint& p : TargetLayout(detector)) points.push_back(p.point_in_target);
   return TargetShape::FromPoints(points);
 }
-
-}  // namespace
 
 void LiveSessionOptions::Check() const {
   source.Check();
@@ -72,7 +71,7 @@ struct LiveSession::Pending {
 };
 
 LiveSession::LiveSession(const LiveSessionOptions& options, KeptFrameStore* store, std::vector<KeptView> existing)
-    : options_(options), store_(store), tracker_(options.hands_free), target_(ShapeOf(options.detector)),
+    : options_(options), store_(store), tracker_(options.hands_free), target_(ShapeOfTarget(options.detector)),
       kept_(std::move(existing)) {
   options.Check();
   snapshot_.kept = kept_;

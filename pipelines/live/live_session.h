@@ -40,6 +40,10 @@ struct LiveSessionOptions {
   void Check() const;             // throws OptionError naming the option
 };
 
+// The target as guidance sees it: every point the detector options'
+// target has.
+TargetShape ShapeOfTarget(const TargetDetectorOptions& detector);
+
 // One kept view as the session holds it.
 struct KeptView {
   std::string name;

@@ -11,6 +11,7 @@
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
+#include "pipelines/live/live_session.h"
 #include "pipelines/live/pose_preview.h"
 
 namespace fs = std::filesystem;
@@ -105,9 +106,7 @@ PoseSuggesterSummary RunPoseSuggester(const PoseSuggesterOptions& options, Progr
     estimator_options.camera = ReadCalibrationReport(options.input_calibration).camera;
     estimator_options.housing = options.housing;
   }
-  std::vector<Eigen::Vector3d> points;
-  for (const BoardPoint& p : TargetLayout(options.target)) points.push_back(p.point_in_target);
-  const LiveEstimator estimator(estimator_options, TargetShape::FromPoints(points));
+  const LiveEstimator estimator(estimator_options, ShapeOfTarget(options.target));
   progress.Begin("pose_suggester: poses", static_cast<size_t>(options.num_poses));
   PoseSuggesterSummary summary;
   summary.estimate = estimator.Estimate(data.views, nullptr);

@@ -21,6 +21,7 @@
 #include "pipelines/live/live_estimator.h"
 #include "pipelines/live/live_overlay.h"
 #include "pipelines/live/live_server.h"
+#include "pipelines/live/live_session.h"
 #include "pipelines/synthetic/view_sampler.h"
 #include "tests/test_utils.h"
 
@@ -59,11 +60,7 @@ render: {spp: 4, blur_sigma: 0.8, noise_sigma: 2.0}
   return frame;
 }
 
-TargetShape Shape() {
-  std::vector<Eigen::Vector3d> points;
-  for (const BoardPoint& p : TargetLayout(Target())) points.push_back(p.point_in_target);
-  return TargetShape::FromPoints(points);
-}
+TargetShape Shape() { return ShapeOfTarget(Target()); }
 
 void BM_LiveDetect(benchmark::State& state) {
   const cv::Mat& gray = Frame();
