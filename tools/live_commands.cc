@@ -59,6 +59,12 @@ int LiveCalibratorCommand(int argc, char** argv) {
   cli.AddRequired("source", &options.live.source.source,
                   "/dev/videoN or an index (V4L2), a video file, a folder of images, an rtsp:// URL, or a "
                   "GStreamer pipeline ending in appsink");
+  cli.Add("source2", &options.live.source2,
+          "a stereo rig's camera 2 (a source of the same kind): frames paired by time, kept in cam1/ and cam2/, "
+          "each camera calibrated (OUT/cam1, OUT/cam2), then stereo_calibrator (OUT)");
+  cli.Add("Live.pair_tolerance", &options.live.pair_tolerance_s,
+          "stereo: frames of the two sources pair when their times differ by at most this, seconds "
+          "(0: half a frame interval)");
   cli.AddRequired("database_path", &options.database_path, "database (created if missing; a rerun adds views)");
   cli.AddRequired("image_path", &options.image_path, "folder for the kept frames (created if missing)");
   cli.AddRequired("output_path", &options.output_path, "folder for the final reports");
@@ -66,6 +72,8 @@ int LiveCalibratorCommand(int argc, char** argv) {
   TargetDetectorOptions& target = options.live.detector;
   Register(&cli, &target);
   cli.Add("input_calibration", &options.input_calibration, "in-air calibration.yaml: calibrate the housing");
+  cli.Add("input_calibration2", &options.input_calibration2,
+          "stereo behind housings: camera 2's in-air calibration.yaml (its port starts from --Housing.params too)");
   cli.AddHousing(&options.housing, "the port to calibrate (with --input_calibration)");
   cli.Add("Calibration.fixed_params", &fixed, "camera calibration: parameters to hold, comma separated");
   RegisterLive(&cli, &options.live);

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <optional>
 #include <random>
 
 #include "colmap_ext/util/error.h"
@@ -173,6 +174,102 @@ std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, co
     suggestions.push_back(best);
   }
   return suggestions;
+}
+
+namespace {
+
+bool InBothViews(const RigUnknowns& rig, const TargetShape& target, const Rigid3d& cam1_from_target, double margin) {
+  return InView(rig.camera1, target, cam1_from_target, margin) &&
+         InView(rig.camera2, target, rig.cam2_from_cam1 * cam1_from_target, margin);
+}
+
+// The rig's opening pose `index`: camera 1's opening rotation, the target
+// centred between the two cameras' axes, as near as both see all of it.
+std::optional<Rigid3d> RigOpeningPose(const RigUnknowns& rig, const TargetShape& target, int index,
+                                      const NextPoseOptions& options) {
+  const double tilt = std::min(options.tilt_max_deg, 40.0) * kDeg;
+  const Eigen::Quaterniond rotations[] = {Eigen::Quaterniond::Identity(),
+                                          Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX())),
+                                          Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitY()))};
+  const Eigen::Vector3d centre2_in_cam1 = rig.cam2_from_cam1.Inverse().translation;
+  const Eigen::Vector3d shift(0.5 * centre2_in_cam1.x(), 0.5 * centre2_in_cam1.y(), 0);
+  const int steps = 60;
+  for (int k = 0; k <= steps; ++k) {
+    const double d = options.distance_min_m + (options.distance_max_m - options.distance_min_m) * k / steps;
+    Rigid3d pose = Centred(target, rotations[index], d);
+    pose.translation += shift;
+    if (InBothViews(rig, target, pose, options.border_margin_px)) return pose;
+  }
+  return std::nullopt;
+}
+
+// The worse camera's expected uncertainty with these informations;
+// undetermined counts as infinitely uncertain, ties going to the most
+// information added.
+double RigScore(const ProjectionUncertainty& after1, const ProjectionUncertainty& after2, double added_trace) {
+  if (!after1.determined || !after2.determined) return 1e12 / (1.0 + added_trace);
+  return std::max(after1.mean_px, after2.mean_px);
+}
+
+}  // namespace
+
+PoseSuggestion SuggestRigPose(const RigUnknowns& rig, const TargetShape& target, const Eigen::MatrixXd& information1,
+                              const Eigen::MatrixXd& information2, int num_kept, const NextPoseOptions& options) {
+  options.Check();
+  rig.camera1.Check();
+  rig.camera2.Check();
+  const ProjectionUncertaintyModel model1(rig.camera1, options.Uncertainty());
+  const ProjectionUncertaintyModel model2(rig.camera2, options.Uncertainty());
+  const auto worse = [](const ProjectionUncertainty& a, const ProjectionUncertainty& b) {
+    return !a.determined || (b.determined && a.mean_px >= b.mean_px) ? a : b;
+  };
+  PoseSuggestion best;
+  best.before = worse(model1.Evaluate(information1), model2.Evaluate(information2));
+  const char* openings[] = {"opening 1/3: facing the rig, between the cameras",
+                            "opening 2/3: tilted about the horizontal axis", "opening 3/3: tilted about the vertical axis"};
+  if (num_kept < 3) {
+    if (const auto pose = RigOpeningPose(rig, target, num_kept, options)) {
+      best.cam_from_target = *pose;
+      best.why = openings[num_kept];
+      best.opening = true;
+    }
+  }
+  const ViewSamplingOptions sampling = SamplingOptions(options);
+  std::mt19937_64 rng(options.seed * 1000003ULL + static_cast<uint64_t>(num_kept));
+  double best_score = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < (best.opening ? 0 : options.num_candidates); ++c) {
+    Rigid3d pose;
+    try {
+      pose = SampleTargetView(rig.camera1.camera.camera, rig.camera1.camera.HousingOrNull(), target.outline,
+                              target.center, -Eigen::Vector3d::UnitZ(), sampling, &rng);
+    } catch (const NumericalError&) {
+      break;
+    }
+    if (!InBothViews(rig, target, pose, options.border_margin_px)) continue;
+    const Eigen::MatrixXd added1 = ViewInformation(rig.camera1, target.points, pose);
+    const Eigen::MatrixXd added2 = ViewInformation(rig.camera2, target.points, rig.cam2_from_cam1 * pose);
+    const ProjectionUncertainty after1 = model1.Evaluate(information1 + added1);
+    const ProjectionUncertainty after2 = model2.Evaluate(information2 + added2);
+    const double score = RigScore(after1, after2, added1.trace() + added2.trace());
+    if (score < best_score) {
+      best_score = score;
+      best.cam_from_target = pose;
+      best.after = worse(after1, after2);
+      best.why = "most lowers the rig's expected projection uncertainty";
+    }
+  }
+  if (best.why.empty()) {
+    throw NumericalError("next-pose guidance: no pose keeps the whole target in both cameras' views within "
+                         "--Live.distance_range [" + std::to_string(options.distance_min_m) + ", " +
+                         std::to_string(options.distance_max_m) + "] m and --Live.max_tilt_deg " +
+                         std::to_string(options.tilt_max_deg));
+  }
+  if (best.opening) {
+    best.after = worse(model1.Evaluate(information1 + ViewInformation(rig.camera1, target.points, best.cam_from_target)),
+                       model2.Evaluate(information2 + ViewInformation(rig.camera2, target.points,
+                                                                      rig.cam2_from_cam1 * best.cam_from_target)));
+  }
+  return best;
 }
 
 PoseDistance DistanceToSuggestion(const CalibrationUnknowns& unknowns, const TargetShape& target,

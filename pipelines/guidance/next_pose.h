@@ -66,6 +66,24 @@ std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, co
                                          const Eigen::MatrixXd& information, int num_kept, int count,
                                          const NextPoseOptions& options);
 
+// A stereo rig's guidance: both cameras' unknowns and the rig's relative
+// pose (its own uncertainty is not scored: the views that fix the two
+// cameras' intrinsics also fix it well).
+struct RigUnknowns {
+  CalibrationUnknowns camera1, camera2;
+  Rigid3d cam2_from_cam1;
+};
+
+// The next pose of the target for a rig, as camera 1 sees it: while fewer
+// than 3 pairs are kept, the opening poses turned about the point between
+// the cameras' axes (nearest distance where both see the whole target),
+// then the candidate seen whole by both cameras that most lowers the
+// larger of the two cameras' expected uncertainty. `before` and `after` are
+// the worse camera's. Throws NumericalError when no pose keeps the target
+// in both views within the options.
+PoseSuggestion SuggestRigPose(const RigUnknowns& rig, const TargetShape& target, const Eigen::MatrixXd& information1,
+                              const Eigen::MatrixXd& information2, int num_kept, const NextPoseOptions& options);
+
 // How far the target is from a suggested pose: the mean distance (px) of
 // its outline's corners in the image, the rotation (deg) between the poses
 // and the distance (m) between the target's centres; the target turned by

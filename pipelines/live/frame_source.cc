@@ -53,7 +53,7 @@ struct FrameSource::Shared {
   bool ended = false;
   bool stop = false;
   double start_wall_s = 0;
-  double newest_time_s = 0;
+  double newest_wall_s = 0;  // when the newest frame arrived
 };
 
 FrameSource::FrameSource(const FrameSourceOptions& options) : options_(options) {
@@ -121,7 +121,7 @@ FrameSource::FrameSource(const FrameSourceOptions& options) : options_(options) 
         break;
       }
       shared->newest = image.clone();
-      shared->newest_time_s = WallSeconds() - shared->start_wall_s;
+      shared->newest_wall_s = WallSeconds();
       ++shared->count;
       shared->changed.notify_all();
     }
@@ -169,6 +169,7 @@ FrameStatus FrameSource::NextRecorded(Frame* frame) {
   }
   frame->index = next_index_;
   frame->time_s = next_index_ / fps_;
+  frame->arrival_wall_s = WallSeconds();
   if (kind_ == SourceKind::kFolder) {
     if (next_index_ >= static_cast<int64_t>(folder_images_.size())) return FrameStatus::kEnd;
     const fs::path path = fs::path(options_.source) / folder_images_[static_cast<size_t>(next_index_)];
@@ -189,7 +190,8 @@ FrameStatus FrameSource::NextLive(Frame* frame) {
   });
   if (shared_->count > seen) {
     frame->image = shared_->newest;
-    frame->time_s = shared_->newest_time_s;
+    frame->time_s = shared_->newest_wall_s - shared_->start_wall_s;
+    frame->arrival_wall_s = shared_->newest_wall_s;
     frame->index = shared_->count - 1;
     next_index_ = shared_->count;
     return FrameStatus::kFrame;

@@ -34,6 +34,7 @@ struct Frame {
   cv::Mat image;       // as decoded (gray or BGR)
   double time_s = 0;   // media time (files, folders) or since the start (live)
   int64_t index = 0;   // frame number in the source
+  double arrival_wall_s = 0;  // when it was read (steady clock, s): pairs live sources
 };
 
 enum class FrameStatus { kFrame, kEnd, kStalled };

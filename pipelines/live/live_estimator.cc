@@ -6,6 +6,7 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/string_utils.h"
 #include "pipelines/calibration/housing_calibration.h"
+#include "pipelines/calibration/stereo_calibration.h"
 #include "pipelines/calibration/view_pose.h"
 
 namespace portcal {
@@ -21,6 +22,21 @@ void LiveEstimatorOptions::Check() const {
 }
 
 std::string LiveEstimate::Summary() const {
+  if (!camera2) return CameraSummary();
+  std::ostringstream out;
+  out << "camera 1, " << CameraSummary() << "\ncamera 2, " << camera2->CameraSummary() << "\nrig: ";
+  if (rig && rig->solved) {
+    const double sigma = rig->translation_std_dev.norm();
+    out << std::setprecision(4) << "baseline " << 1000 * rig->cam2_from_cam1.translation.norm() << " mm ± "
+        << std::setprecision(2) << 1000 * sigma << " mm, rotation σ " << rig->rotation_std_dev_deg.maxCoeff()
+        << " deg, RMS " << std::setprecision(3) << rig->rms_px << " px";
+  } else {
+    out << (rig ? rig->status : std::string("not estimated"));
+  }
+  return out.str();
+}
+
+std::string LiveEstimate::CameraSummary() const {
   std::ostringstream out;
   out << num_views << (num_views == 1 ? " view" : " views");
   if (!solved) {
@@ -109,7 +125,8 @@ void LiveEstimator::Solve(const std::vector<CalibrationView>& views, LiveEstimat
   }
 }
 
-LiveEstimate LiveEstimator::Estimate(const std::vector<CalibrationView>& views, const LiveEstimate* previous) const {
+LiveEstimate LiveEstimator::EstimateCamera(const std::vector<CalibrationView>& views,
+                                           const LiveEstimate* previous) const {
   LiveEstimate estimate;
   estimate.num_views = static_cast<int>(views.size());
   estimate.camera = previous && previous->solved ? previous->camera : HousedCamera{options_.camera, options_.housing};
@@ -126,12 +143,86 @@ LiveEstimate LiveEstimator::Estimate(const std::vector<CalibrationView>& views, 
   NextPoseOptions guidance = options_.guidance;
   guidance.uncertainty.pixel_sigma_px = std::max(0.02, estimate.pixel_sigma_px);
   estimate.uncertainty = ProjectionUncertaintyModel(unknowns, guidance.Uncertainty()).Evaluate(estimate.information);
+  return estimate;
+}
+
+LiveEstimate LiveEstimator::Estimate(const std::vector<CalibrationView>& views, const LiveEstimate* previous) const {
+  LiveEstimate estimate = EstimateCamera(views, previous);
+  NextPoseOptions guidance = options_.guidance;
+  guidance.uncertainty.pixel_sigma_px = std::max(0.02, estimate.pixel_sigma_px);
   try {
-    estimate.next = SuggestPoses(unknowns, target_, estimate.information, estimate.num_views, 1, guidance)[0];
+    estimate.next =
+        SuggestPoses(Unknowns(estimate.camera), target_, estimate.information, estimate.num_views, 1, guidance)[0];
   } catch (const NumericalError& e) {
     estimate.suggestion_error = e.what();
   }
   return estimate;
+}
+
+namespace {
+
+LiveRig SolveRig(const std::vector<CalibrationView>& views1, const std::vector<CalibrationView>& views2,
+                 const LiveEstimate& camera1, const LiveEstimate& camera2, int num_threads) {
+  LiveRig rig;
+  if (!camera1.solved || !camera2.solved) {
+    rig.status = "the relative pose once both cameras are estimated";
+    return rig;
+  }
+  std::vector<StereoFrame> frames;
+  for (size_t i = 0; i < views1.size(); ++i) frames.push_back({views1[i], views2[i]});
+  StereoCalibrationSettings settings;
+  settings.num_threads = num_threads;
+  try {
+    const StereoCalibrationResult result = CalibrateStereo(frames, camera1.camera, camera2.camera, settings);
+    rig.solved = true;
+    rig.cam2_from_cam1 = result.cam2_from_cam1;
+    rig.rotation_std_dev_deg = result.rotation_std_dev_deg;
+    rig.translation_std_dev = result.translation_std_dev;
+    rig.rms_px = result.overall_rms_px;
+  } catch (const NumericalError& e) {
+    rig.status = std::string("no relative pose: ") + e.what();
+  } catch (const InputError& e) {
+    rig.status = std::string("no relative pose: ") + e.what();
+  }
+  return rig;
+}
+
+}  // namespace
+
+LiveEstimate EstimateRig(const LiveEstimator& camera1, const LiveEstimator& camera2,
+                         const std::vector<CalibrationView>& views1, const std::vector<CalibrationView>& views2,
+                         const LiveEstimate* previous) {
+  if (views1.size() != views2.size()) throw std::logic_error("EstimateRig: views1 and views2 differ in number");
+  LiveEstimate estimate = camera1.EstimateCamera(views1, previous);
+  LiveEstimate estimate2 = camera2.EstimateCamera(views2, previous ? previous->camera2.get() : nullptr);
+  estimate.rig = SolveRig(views1, views2, estimate, estimate2, camera1.num_threads());
+  NextPoseOptions guidance = camera1.guidance();
+  guidance.uncertainty.pixel_sigma_px = std::max({0.02, estimate.pixel_sigma_px, estimate2.pixel_sigma_px});
+  try {
+    if (estimate.rig->solved) {
+      const RigUnknowns rig{camera1.Unknowns(estimate.camera), camera2.Unknowns(estimate2.camera),
+                            estimate.rig->cam2_from_cam1};
+      estimate.next = SuggestRigPose(rig, camera1.target(), estimate.information, estimate2.information,
+                                     estimate.num_views, guidance);
+    } else {
+      estimate.next = SuggestPoses(camera1.Unknowns(estimate.camera), camera1.target(), estimate.information,
+                                   estimate.num_views, 1, guidance)[0];
+    }
+  } catch (const NumericalError& e) {
+    estimate.suggestion_error = e.what();
+  }
+  if (estimate.next && estimate.rig->solved) {
+    estimate2.next = *estimate.next;
+    estimate2.next->cam_from_target = estimate.rig->cam2_from_cam1 * estimate.next->cam_from_target;
+  }
+  estimate.camera2 = std::make_shared<const LiveEstimate>(std::move(estimate2));
+  return estimate;
+}
+
+double RigGain(const LiveEstimator& camera1, const LiveEstimator& camera2, const LiveEstimate& estimate,
+               const CalibrationView& view1, const CalibrationView& view2) {
+  const double gain1 = camera1.Gain(estimate, view1);
+  return estimate.camera2 ? std::max(gain1, camera2.Gain(*estimate.camera2, view2)) : gain1;
 }
 
 double LiveEstimator::Gain(const LiveEstimate& estimate, const CalibrationView& view) const {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,6 +33,17 @@ struct LiveEstimatorOptions {
   int MinViews() const { return HousingCalibration() ? 2 : 3; }
 };
 
+// A stereo rig's relative pose from the kept pairs (CalibrateStereo, each
+// camera as estimated).
+struct LiveRig {
+  bool solved = false;
+  std::string status;  // why not solved
+  Rigid3d cam2_from_cam1;
+  Eigen::Vector3d rotation_std_dev_deg = Eigen::Vector3d::Zero();
+  Eigen::Vector3d translation_std_dev = Eigen::Vector3d::Zero();  // m
+  double rms_px = 0;
+};
+
 struct LiveEstimate {
   int num_views = 0;
   bool solved = false;   // a calibration of the kept views
@@ -47,9 +59,15 @@ struct LiveEstimate {
   ProjectionUncertainty uncertainty;
   std::optional<PoseSuggestion> next;
   std::string suggestion_error;      // why there is no suggestion
+  // A stereo rig (this is camera 1's estimate): camera 2's, whose `next` is
+  // the same suggestion as camera 2 sees it, and the relative pose.
+  std::shared_ptr<const LiveEstimate> camera2;
+  std::optional<LiveRig> rig;
 
-  // "4 views: fx 505.2 ± 0.8, ...; uncertainty 0.41 px (max 1.2 px)"
+  // "4 views: fx 505.2 ± 0.8, ...; uncertainty 0.41 px (max 1.2 px)"; a
+  // rig's: a line per camera and one for the relative pose.
   std::string Summary() const;
+  std::string CameraSummary() const;
 };
 
 class LiveEstimator {
@@ -60,6 +78,8 @@ class LiveEstimator {
   // information, the uncertainty and the next pose. Never throws for a
   // failed solve: the estimate says why.
   LiveEstimate Estimate(const std::vector<CalibrationView>& views, const LiveEstimate* previous) const;
+  // The same without the suggestion.
+  LiveEstimate EstimateCamera(const std::vector<CalibrationView>& views, const LiveEstimate* previous) const;
 
   // How much a view would lower the expected uncertainty (relative, 0..1;
   // 1 while the unknowns are undetermined and the view adds information).
@@ -67,6 +87,8 @@ class LiveEstimator {
 
   CalibrationUnknowns Unknowns(const HousedCamera& camera) const;
   const TargetShape& target() const { return target_; }
+  const NextPoseOptions& guidance() const { return options_.guidance; }
+  int num_threads() const { return options_.num_threads; }
 
  private:
   void Solve(const std::vector<CalibrationView>& views, LiveEstimate* estimate) const;
@@ -75,5 +97,18 @@ class LiveEstimator {
   TargetShape target_;
   std::vector<int> fixed_indices_;
 };
+
+// A stereo rig's estimate from the kept pairs (views1[i] and views2[i] are
+// one frame): each camera's, then the relative pose once both are solved,
+// then the rig's next pose (SuggestRigPose; camera 1's opening before the
+// relative pose is known).
+LiveEstimate EstimateRig(const LiveEstimator& camera1, const LiveEstimator& camera2,
+                         const std::vector<CalibrationView>& views1, const std::vector<CalibrationView>& views2,
+                         const LiveEstimate* previous);
+
+// How much a kept pair would lower the worse camera's uncertainty: the
+// larger of the two cameras' gains.
+double RigGain(const LiveEstimator& camera1, const LiveEstimator& camera2, const LiveEstimate& estimate,
+               const CalibrationView& view1, const CalibrationView& view2);
 
 }  // namespace portcal

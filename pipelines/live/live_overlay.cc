@@ -1,5 +1,6 @@
 #include "pipelines/live/live_overlay.h"
 
+#include <functional>
 #include <iomanip>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -28,9 +29,8 @@ void Caption(const std::string& text, int line, cv::Mat* bgr) {
   cv::putText(*bgr, text, at, cv::FONT_HERSHEY_SIMPLEX, size, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
 }
 
-}  // namespace
 
-cv::Mat DrawLiveOverlay(const LiveSnapshot& snapshot, const TargetShape& target, int max_width) {
+cv::Mat DrawOneOverlay(const LiveSnapshot& snapshot, const TargetShape& target, int max_width) {
   const double scale = ScaleFor(snapshot.frame.size(), max_width);
   cv::Mat bgr = ScaledBgr(snapshot.frame, scale);
   const cv::Scalar color = snapshot.hold.still   ? cv::Scalar(0, 220, 0)
@@ -67,6 +67,8 @@ cv::Mat DrawLiveOverlay(const LiveSnapshot& snapshot, const TargetShape& target,
   return bgr;
 }
 
+}  // namespace
+
 double CoverageFraction(const LiveSnapshot& snapshot) {
   if (snapshot.frame.empty()) return 0;
   const cv::Size cells(16, 9);
@@ -81,7 +83,9 @@ double CoverageFraction(const LiveSnapshot& snapshot) {
   return cv::countNonZero(occupied) / static_cast<double>(cells.area());
 }
 
-cv::Mat DrawCoverage(const LiveSnapshot& snapshot, int max_width) {
+namespace {
+
+cv::Mat DrawOneCoverage(const LiveSnapshot& snapshot, int max_width) {
   const double scale = ScaleFor(snapshot.frame.size(), max_width);
   cv::Mat bgr = ScaledBgr(snapshot.frame, scale) * 0.4;
   cv::Mat counts = cv::Mat::zeros(bgr.size(), CV_32F);
@@ -106,7 +110,7 @@ cv::Mat DrawCoverage(const LiveSnapshot& snapshot, int max_width) {
   return bgr;
 }
 
-cv::Mat DrawUncertainty(const LiveSnapshot& snapshot, int max_width) {
+cv::Mat DrawOneUncertainty(const LiveSnapshot& snapshot, int max_width) {
   const double scale = ScaleFor(snapshot.frame.size(), max_width);
   const cv::Size size = snapshot.frame.empty() ? cv::Size(640, 360)
                                                : cv::Size(cvRound(snapshot.frame.cols * scale),
@@ -139,6 +143,49 @@ cv::Mat DrawUncertainty(const LiveSnapshot& snapshot, int max_width) {
        << " px, max " << estimate->uncertainty.max_px << " px";
   Caption(line.str(), 0, &bgr);
   return bgr;
+}
+
+// Camera 2 of a rig as camera 1's fields (no distance to the suggestion:
+// that line is camera 1's).
+LiveSnapshot SecondCamera(const LiveSnapshot& snapshot) {
+  LiveSnapshot second = snapshot;
+  second.frame = snapshot.frame2;
+  second.corners = snapshot.corners2;
+  second.to_suggestion.reset();
+  for (KeptView& kept : second.kept) {
+    kept.view = kept.view2;
+    kept.corners = kept.corners2;
+  }
+  second.estimate = snapshot.estimate ? snapshot.estimate->camera2 : nullptr;
+  return second;
+}
+
+// One camera's picture, or a rig's two side by side (each half as wide).
+cv::Mat PerCamera(const LiveSnapshot& snapshot, int max_width,
+                  const std::function<cv::Mat(const LiveSnapshot&, int)>& draw) {
+  if (snapshot.frame2.empty()) return draw(snapshot, max_width);
+  cv::Mat first = draw(snapshot, max_width / 2), second = draw(SecondCamera(snapshot), max_width / 2);
+  if (second.rows != first.rows) {
+    cv::resize(second, second, cv::Size(second.cols * first.rows / std::max(1, second.rows), first.rows));
+  }
+  cv::Mat joined;
+  cv::hconcat(first, second, joined);
+  return joined;
+}
+
+}  // namespace
+
+cv::Mat DrawLiveOverlay(const LiveSnapshot& snapshot, const TargetShape& target, int max_width) {
+  return PerCamera(snapshot, max_width,
+                   [&target](const LiveSnapshot& s, int width) { return DrawOneOverlay(s, target, width); });
+}
+
+cv::Mat DrawCoverage(const LiveSnapshot& snapshot, int max_width) {
+  return PerCamera(snapshot, max_width, DrawOneCoverage);
+}
+
+cv::Mat DrawUncertainty(const LiveSnapshot& snapshot, int max_width) {
+  return PerCamera(snapshot, max_width, DrawOneUncertainty);
 }
 
 }  // namespace portcal

@@ -1,6 +1,7 @@
 // What the live page draws: the frame with the corners found and the
 // suggested pose, the coverage heat-map of the kept corners, and the map of
-// the expected projection uncertainty. Pure drawing, no state.
+// the expected projection uncertainty; a rig's two cameras side by side.
+// Pure drawing, no state.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -14,8 +15,8 @@ namespace portcal {
 // pose's outline (orange), and a line saying how far the target is from it.
 cv::Mat DrawLiveOverlay(const LiveSnapshot& snapshot, const TargetShape& target, int max_width);
 
-// The fraction of a 16 x 9 grid over the image whose cells hold a kept
-// view's corner.
+// The fraction of a 16 x 9 grid over (camera 1's) image whose cells hold a
+// kept view's corner.
 double CoverageFraction(const LiveSnapshot& snapshot);
 
 // The kept views' corners over the image as a heat-map (smoothed counts,

@@ -57,6 +57,18 @@ nlohmann::json EstimateJson(const LiveEstimate& estimate) {
     json["next"] = nullptr;
     json["suggestion_error"] = estimate.suggestion_error;
   }
+  if (estimate.camera2) json["camera2"] = EstimateJson(*estimate.camera2);
+  if (estimate.rig) {
+    const LiveRig& rig = *estimate.rig;
+    const Eigen::Vector3d& t = rig.cam2_from_cam1.translation;
+    json["rig"] = {{"solved", rig.solved},
+                   {"status", rig.status},
+                   {"translation", {t.x(), t.y(), t.z()}},
+                   {"baseline_m", t.norm()},
+                   {"translation_std_dev_m", rig.translation_std_dev.norm()},
+                   {"rotation_std_dev_deg", rig.rotation_std_dev_deg.maxCoeff()},
+                   {"rms_px", rig.rms_px}};
+  }
   return json;
 }
 

@@ -1,5 +1,6 @@
 #include "pipelines/live/live_session.h"
 
+#include <algorithm>
 #include <chrono>
 #include <future>
 #include <iomanip>
@@ -10,6 +11,7 @@
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/progress.h"
 #include "pipelines/detection/target_pose.h"
+#include "pipelines/live/frame_pair_source.h"
 
 namespace portcal {
 namespace {
@@ -35,12 +37,20 @@ CalibrationView ViewOf(const TargetDetection& detection, const std::string& name
   return view;
 }
 
-cv::Mat Thumbnail(const cv::Mat& image) {
-  cv::Mat small;
-  cv::resize(image, small, cv::Size(160, std::max(1, 160 * image.rows / std::max(1, image.cols))), 0, 0,
-             cv::INTER_AREA);
-  if (small.channels() == 1) cv::cvtColor(small, small, cv::COLOR_GRAY2BGR);
-  return small;
+// 160 px wide per camera, a rig's side by side.
+cv::Mat Thumbnail(const std::vector<cv::Mat>& images) {
+  std::vector<cv::Mat> parts;
+  for (const cv::Mat& image : images) {
+    cv::Mat small;
+    cv::resize(image, small, cv::Size(160, std::max(1, 160 * image.rows / std::max(1, image.cols))), 0, 0,
+               cv::INTER_AREA);
+    if (small.channels() == 1) cv::cvtColor(small, small, cv::COLOR_GRAY2BGR);
+    if (!parts.empty() && small.rows != parts[0].rows) cv::resize(small, small, cv::Size(160, parts[0].rows));
+    parts.push_back(small);
+  }
+  cv::Mat joined;
+  cv::hconcat(parts, joined);
+  return joined;
 }
 
 cv::Mat Gray(const cv::Mat& image) {
@@ -64,6 +74,7 @@ void LiveSessionOptions::Check() const {
   hands_free.Check();
   estimator.guidance.Check();
   if (max_views < 0) throw OptionError("--Live.max_views", std::to_string(max_views), ">= 0");
+  if (Stereo() && source2 == source.source) throw OptionError("--source2", source2, "a source other than --source");
 }
 
 struct LiveSession::Pending {
@@ -71,9 +82,15 @@ struct LiveSession::Pending {
 };
 
 LiveSession::LiveSession(const LiveSessionOptions& options, KeptFrameStore* store, std::vector<KeptView> existing)
-    : options_(options), store_(store), tracker_(options.hands_free), target_(ShapeOfTarget(options.detector)),
-      kept_(std::move(existing)) {
+    : options_(options), store_(store), target_(ShapeOfTarget(options.detector)), kept_(std::move(existing)) {
   options.Check();
+  channels_.push_back({options.source.source, options.estimator, nullptr, StillnessTracker(options.hands_free)});
+  if (options.Stereo()) {
+    LiveEstimatorOptions estimator2 = options.estimator;
+    estimator2.camera = options.camera2;
+    estimator2.housing = options.housing2;
+    channels_.push_back({options.source2, estimator2, nullptr, StillnessTracker(options.hands_free)});
+  }
   snapshot_.kept = kept_;
 }
 
@@ -120,11 +137,17 @@ void LiveSession::StartEstimate() {
     estimate_stale_ = true;
     return;
   }
-  std::vector<CalibrationView> views;
-  for (const KeptView& kept : kept_) views.push_back(kept.view);
+  std::vector<CalibrationView> views, views2;
+  for (const KeptView& kept : kept_) {
+    views.push_back(kept.view);
+    views2.push_back(kept.view2);
+  }
   pending_ = std::make_unique<Pending>();
-  pending_->result = std::async(std::launch::async, [estimator = estimator_.get(), views, previous = estimate_] {
-    return estimator->Estimate(views, previous.get());
+  const LiveEstimator* camera1 = channels_[0].estimator.get();
+  const LiveEstimator* camera2 = options_.Stereo() ? channels_[1].estimator.get() : nullptr;
+  pending_->result = std::async(std::launch::async, [camera1, camera2, views, views2, previous = estimate_] {
+    return camera2 ? EstimateRig(*camera1, *camera2, views, views2, previous.get())
+                   : camera1->Estimate(views, previous.get());
   });
 }
 
@@ -133,7 +156,8 @@ void LiveSession::CollectEstimate(bool wait) {
   if (!wait && pending_->result.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
   estimate_ = std::make_shared<const LiveEstimate>(pending_->result.get());
   pending_.reset();
-  LOG(INFO) << "live: estimate from " << estimate_->Summary();
+  std::istringstream lines(estimate_->Summary());  // a rig's: a line per camera and one for the rig
+  for (std::string line; std::getline(lines, line);) LOG(INFO) << "live: estimate from " << line;
   if (estimate_->next) {
     LOG(INFO) << "live: next pose (" << estimate_->next->why << "): target centre at "
               << estimate_->next->cam_from_target.translation.transpose() << " m";
@@ -151,46 +175,68 @@ void LiveSession::CollectEstimate(bool wait) {
   }
 }
 
-void LiveSession::RememberRefused(const CornerMap& corners) {
+void LiveSession::RememberRefused(const std::vector<Sight>& sights) {
   KeptView refused;  // seen: the same still spell is not fitted again
-  refused.corners = corners;
+  refused.corners = sights[0].corners;
+  if (sights.size() > 1) refused.corners2 = sights[1].corners;
   rejected_.push_back(refused);
 }
 
-bool LiveSession::TryKeep(const Frame& frame, const cv::Mat& gray, const CornerMap& corners, bool requested) {
-  const cv::Mat& image = frame.image;
+// A view is new when some camera sees the target elsewhere than in every
+// kept (or refused) view.
+bool LiveSession::Novel(const std::vector<Sight>& sights) const {
+  const cv::Mat& image = sights[0].frame->image;
   const double novelty_px =
       options_.hands_free.novelty_fraction * std::hypot(static_cast<double>(image.cols), static_cast<double>(image.rows));
-  if (!requested) {
-    for (const std::vector<KeptView>* seen : {&kept_, &rejected_}) {
-      for (const KeptView& kept : *seen) {
-        if (MeanCornerShift(corners, kept.corners) < novelty_px) return false;  // the same view again
-      }
+  for (const std::vector<KeptView>* seen : {&kept_, &rejected_}) {
+    for (const KeptView& kept : *seen) {
+      bool same = MeanCornerShift(sights[0].corners, kept.corners) < novelty_px;
+      if (sights.size() > 1) same = same && MeanCornerShift(sights[1].corners, kept.corners2) < novelty_px;
+      if (same) return false;
     }
   }
+  return true;
+}
+
+double LiveSession::Gain(const std::vector<CalibrationView>& views) const {
+  if (views.size() == 1) return channels_[0].estimator->Gain(*estimate_, views[0]);
+  return RigGain(*channels_[0].estimator, *channels_[1].estimator, *estimate_, views[0], views[1]);
+}
+
+bool LiveSession::TryKeep(const std::vector<Sight>& sights, bool requested) {
+  if (!requested && !Novel(sights)) return false;  // the same view again
   TargetDetectorOptions precise = options_.detector;
   precise.precise_fit = true;
-  const TargetDetection detection = DetectTarget(gray, precise);
-  if (!detection.found) {
-    Note("frame " + std::to_string(frame.index) + " not kept: the precise fit failed (" + detection.reason + ")", true);
-    RememberRefused(corners);
-    return false;
+  std::vector<TargetDetection> detections;
+  std::vector<CalibrationView> views;
+  std::vector<cv::Mat> images;
+  for (size_t c = 0; c < sights.size(); ++c) {
+    detections.push_back(DetectTarget(sights[c].gray, precise));
+    if (!detections.back().found) {
+      const std::string camera = sights.size() > 1 ? " of camera " + std::to_string(c + 1) : "";
+      Note("frame " + std::to_string(sights[c].frame->index) + camera + " not kept: the precise fit failed (" +
+               detections.back().reason + ")",
+           true);
+      RememberRefused(sights);
+      return false;
+    }
+    views.push_back(ViewOf(detections.back(), ""));
+    images.push_back(sights[c].frame->image);
   }
-  const CalibrationView view = ViewOf(detection, "");
   if (!requested && estimate_) {
-    const double gain = estimator_->Gain(*estimate_, view);
+    const double gain = Gain(views);
     if (gain < options_.hands_free.min_gain) {
       std::ostringstream text;
       text << "held still, but this view would lower the uncertainty by only " << std::setprecision(2)
            << 100 * gain << " %: move the target (see the suggestion)";
       Note(text.str(), false);
-      RememberRefused(corners);
+      RememberRefused(sights);
       return false;
     }
   }
   std::string name;
   try {
-    name = store_->Store(image, detection);
+    name = store_->Store(images, detections);
   } catch (const InputError& e) {
     Note(std::string("frame not stored: ") + e.what(), true);
     return false;
@@ -198,39 +244,67 @@ bool LiveSession::TryKeep(const Frame& frame, const cv::Mat& gray, const CornerM
     Note(std::string("frame not stored (it can be captured again): ") + e.what(), true);
     return false;
   }
-  KeptView kept{name, frame.time_s, view, Corners(detection), Thumbnail(image)};
+  KeptView kept{name, sights[0].frame->time_s, views[0], Corners(detections[0]), Thumbnail(images)};
   kept.view.image_name = name;
+  if (sights.size() > 1) {
+    kept.view2 = views[1];
+    kept.view2.image_name = name;
+    kept.corners2 = Corners(detections[1]);
+  }
   kept_.push_back(kept);
   rejected_.clear();
   {
     const std::lock_guard<std::mutex> lock(mutex_);
     snapshot_.kept = kept_;
   }
-  Note("kept " + name + " (frame " + std::to_string(frame.index) + ", " + std::to_string(detection.points.size()) +
-           " corners)" + (requested ? ", on request" : ""),
+  Note("kept " + name + " (frame " + std::to_string(sights[0].frame->index) + ", " +
+           std::to_string(detections[0].points.size()) + " corners)" + (requested ? ", on request" : ""),
        false);
   StartEstimate();
   return true;
 }
 
-void LiveSession::Process(const Frame& frame, const cv::Mat& gray, double arrival_wall_s) {
+void LiveSession::Process(std::vector<Sight>& sights, double arrival_wall_s) {
   TargetDetectorOptions quick = options_.detector;
   quick.precise_fit = false;
-  const TargetDetection detection = DetectTarget(gray, quick);
-  const CornerMap corners = Corners(detection);
-  const StillnessTracker::State hold = tracker_.Update(frame.time_s, corners, CornerSharpness(gray, corners));
+  // A rig's second image on the other core.
+  std::future<TargetDetection> second;
+  if (sights.size() > 1) {
+    second = std::async(std::launch::async, [&quick, gray = sights[1].gray] { return DetectTarget(gray, quick); });
+  }
+  const TargetDetection detection = DetectTarget(sights[0].gray, quick);
+  bool seen = detection.found;
+  sights[0].corners = Corners(detection);
+  if (second.valid()) {
+    const TargetDetection detection2 = second.get();
+    seen = seen && detection2.found;
+    sights[1].corners = Corners(detection2);
+  }
+  const double time_s = sights[0].frame->time_s;
+  StillnessTracker::State hold;
+  for (size_t c = 0; c < sights.size(); ++c) {
+    const StillnessTracker::State state = channels_[c].tracker.Update(
+        time_s, sights[c].corners, CornerSharpness(sights[c].gray, sights[c].corners));
+    hold = c == 0 ? state
+                  : StillnessTracker::State{hold.still && state.still, hold.sharp && state.sharp,
+                                            std::min(hold.held_s, state.held_s),
+                                            std::max(hold.motion_px, state.motion_px)};
+  }
   std::optional<PoseDistance> to_suggestion;
   if (detection.found && estimate_ && estimate_->next) {
     if (const auto pose = EstimateTargetPose(detection, estimate_->camera)) {
-      to_suggestion = DistanceToSuggestion(estimator_->Unknowns(estimate_->camera), estimator_->target(),
+      const LiveEstimator& estimator = *channels_[0].estimator;
+      to_suggestion = DistanceToSuggestion(estimator.Unknowns(estimate_->camera), estimator.target(),
                                            pose->cam_from_target, estimate_->next->cam_from_target);
     }
   }
   ++summary_.frames;
-  summary_.frames_with_target += detection.found;
-  const bool requested = detection.found && capture_requested_.exchange(false);
-  if (requested || (options_.hands_free.enabled && hold.still && hold.sharp)) {
-    if (TryKeep(frame, gray, corners, requested)) tracker_.Reset();
+  summary_.frames_with_target += seen;
+  const bool requested = seen && capture_requested_.exchange(false);
+  if (requested || (options_.hands_free.enabled && seen && hold.still && hold.sharp)) {
+    if (TryKeep(sights, requested)) {
+      for (Channel& channel : channels_) channel.tracker.Reset();
+    }
   }
   const std::lock_guard<std::mutex> lock(mutex_);
   // Frames processed per second, over about the last second.
@@ -239,13 +313,17 @@ void LiveSession::Process(const Frame& frame, const cv::Mat& gray, double arriva
     const double weight = std::min(1.0, (arrival_wall_s - snapshot_.arrival_wall_s) / 1.0);
     snapshot_.fps = snapshot_.fps > 0 ? (1 - weight) * snapshot_.fps + weight * rate : rate;
   }
-  snapshot_.frame = gray;
+  snapshot_.frame = sights[0].gray;
   snapshot_.arrival_wall_s = arrival_wall_s;
   ++snapshot_.frames_processed;
-  snapshot_.time_s = frame.time_s;
-  snapshot_.frame_index = frame.index;
-  snapshot_.target_seen = detection.found;
-  snapshot_.corners = corners;
+  snapshot_.time_s = time_s;
+  snapshot_.frame_index = sights[0].frame->index;
+  snapshot_.target_seen = seen;
+  snapshot_.corners = sights[0].corners;
+  if (sights.size() > 1) {
+    snapshot_.frame2 = sights[1].gray;
+    snapshot_.corners2 = sights[1].corners;
+  }
   snapshot_.hold = hold;
   snapshot_.to_suggestion = to_suggestion;
   frame_processed_.notify_all();
@@ -302,60 +380,84 @@ void LiveSession::PrintStatus(double time_s) {
   LOG(INFO) << line.str();
 }
 
-bool LiveSession::CheckSize(const cv::Mat& gray, int64_t index) {
-  if (size_.area() == 0) {
-    size_ = gray.size();
-    LiveEstimatorOptions& estimator = options_.estimator;
+bool LiveSession::CheckSize(Channel* channel, const cv::Mat& gray, int64_t index) {
+  if (channel->size.area() == 0) {
+    channel->size = gray.size();
+    LiveEstimatorOptions& estimator = channel->estimator_options;
     if (estimator.camera.width == 0) {
       estimator.camera = Camera::FromModelName(estimator.camera.ModelName(), 1.2 * std::max(gray.cols, gray.rows),
                                                gray.cols, gray.rows);
     } else if (static_cast<int>(estimator.camera.width) != gray.cols ||
                static_cast<int>(estimator.camera.height) != gray.rows) {
-      throw InputError(options_.source.source + ": frames are " + std::to_string(gray.cols) + "x" +
+      throw InputError(channel->source + ": frames are " + std::to_string(gray.cols) + "x" +
                        std::to_string(gray.rows) + ", the camera (--input_calibration) is " +
                        std::to_string(estimator.camera.width) + "x" + std::to_string(estimator.camera.height));
     }
-    estimator_ = std::make_unique<LiveEstimator>(estimator, target_);
-    StartEstimate();  // the opening suggestion (or the continued session's estimate)
+    channel->estimator = std::make_unique<LiveEstimator>(estimator, target_);
+    // The opening suggestion (or the continued session's estimate), once
+    // every camera is sized.
+    if (std::all_of(channels_.begin(), channels_.end(), [](const Channel& c) { return c.estimator != nullptr; })) {
+      StartEstimate();
+    }
     return true;
   }
-  if (gray.size() == size_) {
-    other_size_since_s_ = -1;
+  if (gray.size() == channel->size) {
+    channel->other_size_since_s = -1;
     return true;
   }
   const std::string sizes = std::to_string(gray.cols) + "x" + std::to_string(gray.rows) + " instead of " +
-                            std::to_string(size_.width) + "x" + std::to_string(size_.height);
-  if (other_size_since_s_ < 0) {
-    other_size_since_s_ = WallSeconds();
-    Note(options_.source.source + ": frame " + std::to_string(index) + " is " + sizes + "; skipped", true);
-  } else if (WallSeconds() - other_size_since_s_ > options_.source.stall_seconds) {
-    throw InputError(options_.source.source + ": the frames changed size to " + sizes + " for " +
+                            std::to_string(channel->size.width) + "x" + std::to_string(channel->size.height);
+  if (channel->other_size_since_s < 0) {
+    channel->other_size_since_s = WallSeconds();
+    Note(channel->source + ": frame " + std::to_string(index) + " is " + sizes + "; skipped", true);
+  } else if (WallSeconds() - channel->other_size_since_s > options_.source.stall_seconds) {
+    throw InputError(channel->source + ": the frames changed size to " + sizes + " for " +
                      std::to_string(static_cast<int>(options_.source.stall_seconds)) +
                      " s (a stream's resolution changed?)");
   }
   return false;
 }
 
+// One camera's frames, or a rig's paired by time.
+class LiveSession::Frames {
+ public:
+  explicit Frames(const LiveSessionOptions& options) {
+    if (!options.Stereo()) {
+      single_ = std::make_unique<FrameSource>(options.source);
+      return;
+    }
+    FrameSourceOptions second = options.source;
+    second.source = options.source2;
+    pairs_ = std::make_unique<FramePairSource>(options.source, second, options.pair_tolerance_s);
+  }
+  FrameStatus Next(FramePair* pair) { return pairs_ ? pairs_->Next(pair) : single_->Next(&pair->first); }
+  std::string Describe() const { return pairs_ ? pairs_->Describe() : single_->Describe(); }
+
+ private:
+  std::unique_ptr<FrameSource> single_;
+  std::unique_ptr<FramePairSource> pairs_;
+};
+
+// The loop's reasons to stop before the next frame ("" to go on).
+std::string LiveSession::StopReason() const {
+  if (CancelFlag::Requested()) return "interrupted";
+  if (finish_requested_) return "finish requested";
+  if (options_.max_views > 0 && static_cast<int>(kept_.size()) >= options_.max_views) {
+    return std::to_string(options_.max_views) + " views kept (--Live.max_views)";
+  }
+  return "";
+}
+
 LiveSummary LiveSession::Run() {
-  FrameSource source(options_.source);
+  Frames source(options_);
   LOG(INFO) << "live: reading " << source.Describe();
   const double start = WallSeconds();
   int stalls = 0;
-  Frame frame;
+  FramePair frames;
   while (true) {
-    if (CancelFlag::Requested()) {
-      summary_.end_reason = "interrupted";
-      break;
-    }
-    if (finish_requested_) {
-      summary_.end_reason = "finish requested";
-      break;
-    }
-    if (options_.max_views > 0 && static_cast<int>(kept_.size()) >= options_.max_views) {
-      summary_.end_reason = std::to_string(options_.max_views) + " views kept (--Live.max_views)";
-      break;
-    }
-    const FrameStatus status = source.Next(&frame);
+    summary_.end_reason = StopReason();
+    if (!summary_.end_reason.empty()) break;
+    const FrameStatus status = source.Next(&frames);
     if (status == FrameStatus::kEnd) {
       summary_.end_reason = "the source ended";
       break;
@@ -371,15 +473,21 @@ LiveSummary LiveSession::Run() {
       continue;
     }
     stalls = 0;
-    if (frame.image.empty()) continue;
     const double arrival = WallSeconds();
-    const cv::Mat gray = Gray(frame.image);
-    if (!CheckSize(gray, frame.index)) continue;
-    Process(frame, gray, arrival);
+    // Every camera's frame, each of its camera's size (else none is processed).
+    std::vector<Sight> sights;
+    for (const Frame* frame : {&frames.first, &frames.second}) {
+      if (sights.size() == channels_.size() || frame->image.empty()) break;
+      const cv::Mat gray = Gray(frame->image);
+      if (!CheckSize(&channels_[sights.size()], gray, frame->index)) break;
+      sights.push_back({frame, gray, {}});
+    }
+    if (sights.size() != channels_.size()) continue;
+    Process(sights, arrival);
     if (calibrate_requested_.exchange(false)) StartEstimate();
     ApplyRequests();
     CollectEstimate(false);
-    PrintStatus(frame.time_s);
+    PrintStatus(frames.first.time_s);
   }
   CollectEstimate(true);
   {

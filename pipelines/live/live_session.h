@@ -25,8 +25,9 @@ namespace portcal {
 class KeptFrameStore {
  public:
   virtual ~KeptFrameStore() = default;
-  // Returns the image's name.
-  virtual std::string Store(const cv::Mat& image, const TargetDetection& detection) = 0;
+  // One image per camera (a rig's pair, in camera order) with its target;
+  // returns the view's name (a pair's: the name its two images share).
+  virtual std::string Store(const std::vector<cv::Mat>& images, const std::vector<TargetDetection>& detections) = 0;
   virtual void Remove(const std::string& name) = 0;
 };
 
@@ -37,6 +38,15 @@ struct LiveSessionOptions {
   LiveEstimatorOptions estimator;
   int max_views = 0;              // finish after this many kept views (0: when the source ends)
   double status_interval_s = 2;   // a status line on stderr this often (<= 0: never)
+  // A stereo rig: camera 2's source (empty: one camera; the other source
+  // options are shared), frames paired by time within pair_tolerance_s
+  // (<= 0: half a frame interval), and camera 2's start (its model, or its
+  // in-air intrinsics and housing; the rest as `estimator`).
+  std::string source2;
+  double pair_tolerance_s = 0;
+  Camera camera2;
+  std::optional<Housing> housing2;
+  bool Stereo() const { return !source2.empty(); }
   void Check() const;             // throws OptionError naming the option
 };
 
@@ -51,6 +61,9 @@ struct KeptView {
   CalibrationView view;  // the precise corners
   CornerMap corners;
   cv::Mat thumbnail;     // BGR, 160 px wide (empty for a continued session's views)
+  // A rig's camera 2 (empty for one camera).
+  CalibrationView view2;
+  CornerMap corners2;
 };
 
 // What a viewer shows (a copy, taken under the session's lock).
@@ -61,8 +74,10 @@ struct LiveSnapshot {
   int64_t frames_processed = 0;  // counts every processed frame (WaitForFrame)
   double arrival_wall_s = 0;     // when the frame was read (steady clock, s)
   double fps = 0;            // frames processed per second, recently
-  bool target_seen = false;
+  bool target_seen = false;  // by every camera
   CornerMap corners;         // quick corners of the newest frame
+  cv::Mat frame2;            // a rig's camera 2 (empty for one camera)
+  CornerMap corners2;
   StillnessTracker::State hold;
   std::vector<KeptView> kept;
   std::shared_ptr<const LiveEstimate> estimate;
@@ -107,14 +122,34 @@ class LiveSession {
   const TargetShape& target() const { return target_; }
 
  private:
-  void Process(const Frame& frame, const cv::Mat& gray, double arrival_wall_s);
+  // What each camera saw at one moment (one or two).
+  struct Sight {
+    const Frame* frame;
+    cv::Mat gray;
+    CornerMap corners;
+  };
+  // Per camera: its estimator, its stillness, its image size.
+  struct Channel {
+    std::string source;
+    LiveEstimatorOptions estimator_options;
+    std::unique_ptr<LiveEstimator> estimator;
+    StillnessTracker tracker;
+    cv::Size size;
+    double other_size_since_s = -1;  // wall time frames of another size began
+  };
+
+  void Process(std::vector<Sight>& sights, double arrival_wall_s);
   // The first frame fixes the image size (and the camera's, if unknown);
   // false for a frame of another size.
-  bool CheckSize(const cv::Mat& gray, int64_t index);
-  bool TryKeep(const Frame& frame, const cv::Mat& gray, const CornerMap& corners, bool requested);
+  bool CheckSize(Channel* channel, const cv::Mat& gray, int64_t index);
+  bool Novel(const std::vector<Sight>& sights) const;
+  bool TryKeep(const std::vector<Sight>& sights, bool requested);
+  double Gain(const std::vector<CalibrationView>& views) const;
   // A still view refused (no precise fit, too little gain): not tried
   // again until a view is kept.
-  void RememberRefused(const CornerMap& corners);
+  void RememberRefused(const std::vector<Sight>& sights);
+  std::string StopReason() const;
+  class Frames;
   void ApplyRequests();
   void StartEstimate();
   void CollectEstimate(bool wait);
@@ -123,8 +158,7 @@ class LiveSession {
 
   LiveSessionOptions options_;
   KeptFrameStore* store_;
-  std::unique_ptr<LiveEstimator> estimator_;
-  StillnessTracker tracker_;
+  std::vector<Channel> channels_;  // camera 1 (and a rig's camera 2)
   mutable std::mutex mutex_;
   mutable std::condition_variable frame_processed_;
   bool ended_ = false;
@@ -142,8 +176,6 @@ class LiveSession {
   std::unique_ptr<Pending> pending_;  // the estimate being computed
   bool estimate_stale_ = false;       // views changed while it ran
   double last_status_s_ = -1e9;
-  cv::Size size_;
-  double other_size_since_s_ = -1;  // wall time frames of another size began
   LiveSummary summary_;
 };
 

@@ -1,7 +1,9 @@
 #include "pipelines/stages/live_calibrator.h"
 
 #include <filesystem>
+#include <algorithm>
 #include <iomanip>
+#include <map>
 #include <set>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
@@ -14,6 +16,7 @@
 #include "pipelines/detection/detection_rows.h"
 #include "pipelines/stages/camera_calibrator.h"
 #include "pipelines/stages/housing_calibrator.h"
+#include "pipelines/stages/stereo_calibrator.h"
 
 namespace fs = std::filesystem;
 
@@ -27,6 +30,12 @@ void LiveCalibratorOptions::Check() const {
     throw OptionError(housing ? "--input_calibration" : "--Housing.model", "''",
                       "both --input_calibration and --Housing.model for a housing calibration, neither for a camera's");
   }
+  if (!input_calibration2.empty() && !live.Stereo()) {
+    throw OptionError("--input_calibration2", input_calibration2, "only with --source2 (a stereo rig)");
+  }
+  if (live.Stereo() && housing && input_calibration2.empty()) {
+    throw OptionError("--input_calibration2", "''", "camera 2's in-air calibration.yaml (a rig behind housings)");
+  }
   reader.Check();
   live.Check();
   page.Check();
@@ -34,162 +43,253 @@ void LiveCalibratorOptions::Check() const {
 
 namespace {
 
-// Kept frames as files and rows: the file is moved into place first, then
-// the rows are committed (a failed commit removes the file again).
+// The folder of each camera's kept frames below --image_path: none for one
+// camera, cam1/ and cam2/ for a rig (a camera per folder, as
+// target_extractor imports a rig and stereo_calibrator pairs it by name).
+std::vector<std::string> CameraFolders(const LiveCalibratorOptions& options) {
+  return options.live.Stereo() ? std::vector<std::string>{"cam1", "cam2"} : std::vector<std::string>{""};
+}
+
+// Kept frames as files and rows: the files are moved into place first, then
+// the rows are committed (a failed commit removes the files again).
 class DatabaseFrameStore : public KeptFrameStore {
  public:
-  DatabaseFrameStore(const LiveCalibratorOptions& options, Database* database)
-      : options_(options), database_(database), target_(TargetDescriptionText(options.live.detector)) {
-    reader_ = options.reader;
-    reader_.single_camera = true;
-    reader_.single_camera_per_folder = false;
+  DatabaseFrameStore(const LiveCalibratorOptions& options, const std::vector<ImageReaderOptions>& readers,
+                     Database* database)
+      : options_(options), database_(database), target_(TargetDescriptionText(options.live.detector)),
+        readers_(readers), folders_(CameraFolders(options)) {
+    const bool stereo = folders_.size() > 1;
+    for (ImageReaderOptions& reader : readers_) {
+      reader.single_camera = !stereo;
+      reader.single_camera_per_folder = stereo;
+    }
     // A continued session: the new frames join the camera of the kept ones
     // (a frame of another size is then refused, naming both).
     std::set<camera_t> cameras;
     for (const DatabaseImage& image : database->ReadAllImages()) cameras.insert(image.camera_id);
-    if (cameras.size() == 1) shared_.by_folder[""] = *cameras.begin();
+    if (!stereo && cameras.size() == 1) shared_.by_folder[""] = *cameras.begin();
   }
 
-  std::string Store(const cv::Mat& image, const TargetDetection& detection) override {
+  std::string Store(const std::vector<cv::Mat>& images, const std::vector<TargetDetection>& detections) override {
     const std::string name = NextName();
-    const fs::path path = fs::path(options_.image_path) / name;
-    const fs::path partial = fs::path(options_.image_path) / ("." + name + ".partial.png");
-    std::error_code error;
-    // At the first keep: a session that keeps nothing leaves nothing.
-    fs::create_directories(options_.image_path, error);
-    if (error || !cv::imwrite(partial.string(), image)) {
-      throw InputError(partial.string() + ": cannot write the frame" + (error ? " (" + error.message() + ")" : ""));
-    }
-    fs::rename(partial, path, error);
-    if (error) throw InputError(path.string() + ": cannot move the frame into place (" + error.message() + ")");
+    std::vector<fs::path> written;
     try {
+      for (size_t c = 0; c < images.size(); ++c) written.push_back(WriteFrame(images[c], ImageName(c, name)));
       Transaction transaction = database_->BeginTransaction();
-      const image_t id = ImportImage(database_, reader_, name, image.cols, image.rows, &shared_);
-      WriteTargetDetection(database_, id, detection, target_);
+      for (size_t c = 0; c < images.size(); ++c) {
+        const image_t id = ImportImage(database_, readers_[c], ImageName(c, name), images[c].cols, images[c].rows,
+                                       &shared_);
+        WriteTargetDetection(database_, id, detections[c], target_);
+      }
       transaction.Commit();
     } catch (...) {
       std::error_code ignored;
-      fs::remove(path, ignored);
+      for (const fs::path& path : written) fs::remove(path, ignored);
       throw;
     }
     return name;
   }
 
-  // The rows go; the file is renamed NAME.removed (no image extension, so
-  // no later import sees it), not deleted.
+  // The rows go; the files are renamed NAME.removed (no image extension, so
+  // no later import sees them), not deleted.
   void Remove(const std::string& name) override {
     Transaction transaction = database_->BeginTransaction();
-    const std::optional<DatabaseImage> image = database_->ReadImageWithName(name);
-    if (!image) throw InputError(name + ": not in " + options_.database_path);
-    database_->DeleteImage(image->image_id);
+    for (size_t c = 0; c < folders_.size(); ++c) {
+      const std::optional<DatabaseImage> image = database_->ReadImageWithName(ImageName(c, name));
+      if (!image) throw InputError(ImageName(c, name) + ": not in " + options_.database_path);
+      database_->DeleteImage(image->image_id);
+    }
     transaction.Commit();
-    const fs::path path = fs::path(options_.image_path) / name;
-    std::error_code ignored;
-    fs::rename(path, fs::path(path.string() + ".removed"), ignored);
+    for (size_t c = 0; c < folders_.size(); ++c) {
+      const fs::path path = fs::path(options_.image_path) / ImageName(c, name);
+      std::error_code ignored;
+      fs::rename(path, fs::path(path.string() + ".removed"), ignored);
+    }
+  }
+
+  // The camera of each folder's kept frames (-1 before the first).
+  std::vector<int> camera_ids() const {
+    std::vector<int> ids;
+    for (const std::string& folder : folders_) {
+      const auto it = shared_.by_folder.find(folder);
+      ids.push_back(it == shared_.by_folder.end() ? -1 : static_cast<int>(it->second));
+    }
+    return ids;
   }
 
  private:
-  // live_NNNN.png after the highest such name in the folder or database.
+  std::string ImageName(size_t camera, const std::string& name) const {
+    return folders_[camera].empty() ? name : folders_[camera] + "/" + name;
+  }
+
+  fs::path WriteFrame(const cv::Mat& image, const std::string& name) const {
+    const fs::path path = fs::path(options_.image_path) / name;
+    const fs::path partial = path.parent_path() / ("." + path.filename().string() + ".partial.png");
+    std::error_code error;
+    // At the first keep: a session that keeps nothing leaves nothing.
+    fs::create_directories(path.parent_path(), error);
+    if (error || !cv::imwrite(partial.string(), image)) {
+      throw InputError(partial.string() + ": cannot write the frame" + (error ? " (" + error.message() + ")" : ""));
+    }
+    fs::rename(partial, path, error);
+    if (error) throw InputError(path.string() + ": cannot move the frame into place (" + error.message() + ")");
+    return path;
+  }
+
+  // live_NNNN.png after the highest such name in the folders or database.
   std::string NextName() {
     while (true) {
       std::ostringstream name;
       name << "live_" << std::setw(4) << std::setfill('0') << ++counter_ << ".png";
-      const fs::path path = fs::path(options_.image_path) / name.str();
-      if (!fs::exists(path) && !fs::exists(path.string() + ".removed") && !database_->ReadImageWithName(name.str())) {
-        return name.str();
+      bool taken = false;
+      for (size_t c = 0; c < folders_.size(); ++c) {
+        const fs::path path = fs::path(options_.image_path) / ImageName(c, name.str());
+        taken = taken || fs::exists(path) || fs::exists(path.string() + ".removed") ||
+                database_->ReadImageWithName(ImageName(c, name.str()));
       }
+      if (!taken) return name.str();
     }
   }
 
   const LiveCalibratorOptions& options_;
   Database* database_;
   std::string target_;
-  ImageReaderOptions reader_;
+  std::vector<ImageReaderOptions> readers_;
+  std::vector<std::string> folders_;
   SharedCameras shared_;
   int counter_ = 0;
-
- public:
-  // The camera the kept frames share (-1 before the first).
-  int camera_id() const {
-    const auto it = shared_.by_folder.find("");
-    return it == shared_.by_folder.end() ? -1 : static_cast<int>(it->second);
-  }
 };
 
 // Views a previous session kept in this database (a continued session),
 // with their corners' ids, so that hands-free capture does not keep them
-// again.
-std::vector<KeptView> ExistingViews(Database* database) {
-  std::vector<KeptView> kept;
+// again; a rig's by the name its two images share.
+std::vector<KeptView> ExistingViews(Database* database, const std::vector<std::string>& folders) {
+  std::map<std::string, KeptView> by_name;
   for (const DatabaseImage& image : database->ReadAllImages()) {
-    KeptView view;
-    view.name = image.name;
-    view.view.image_name = image.name;
+    const fs::path path(image.name);
+    const bool stereo = folders.size() > 1;
+    const auto folder = std::find(folders.begin(), folders.end(), path.parent_path().generic_string());
+    if (stereo && folder == folders.end()) continue;
+    const bool second = stereo && folder != folders.begin();
+    const std::string name = stereo ? path.filename().string() : image.name;
+    KeptView& view = by_name[name];
+    view.name = name;
+    CalibrationView& calibration_view = second ? view.view2 : view.view;
+    calibration_view.image_name = view.name;
     for (const TargetObservation& o : database->ReadTargetObservations(image.image_id)) {
-      view.view.points_in_target.push_back(o.point_in_target);
-      view.view.pixels.push_back(o.xy);
-      view.corners[static_cast<int>(o.point_id)] = o.xy;
+      calibration_view.points_in_target.push_back(o.point_in_target);
+      calibration_view.pixels.push_back(o.xy);
+      (second ? view.corners2 : view.corners)[static_cast<int>(o.point_id)] = o.xy;
     }
-    if (!view.view.pixels.empty()) kept.push_back(view);
+  }
+  std::vector<KeptView> kept;
+  for (auto& [name, view] : by_name) {
+    const bool complete = !view.view.pixels.empty() && (folders.size() == 1 || !view.view2.pixels.empty());
+    if (complete) kept.push_back(std::move(view));
   }
   return kept;
 }
 
-// The estimator's start: the in-air calibration (housing) or the model
-// alone, sized by the first frame (camera).
-LiveSessionOptions SessionOptions(const LiveCalibratorOptions& options, ImageReaderOptions* reader) {
+// A camera's import options: the model alone (camera calibration) or its
+// in-air calibration, which the estimator also starts from.
+ImageReaderOptions ReaderFor(const ImageReaderOptions& reader, const std::string& input_calibration,
+                             Camera* start) {
+  ImageReaderOptions result = reader;
+  if (input_calibration.empty()) {
+    *start = Camera::FromModelName(reader.camera_model, 1.0, 0, 0);  // sized by the first frame
+    return result;
+  }
+  *start = ReadCalibrationReport(input_calibration).camera;
+  std::ostringstream params;
+  params.precision(17);
+  for (size_t k = 0; k < start->params.size(); ++k) params << (k ? "," : "") << start->params[k];
+  result.camera_model = start->ModelName();
+  result.camera_params = params.str();
+  return result;
+}
+
+// The estimators' starts (a rig's camera 2 behind a housing of the same
+// kind, from the same start) and each camera's import options.
+LiveSessionOptions SessionOptions(const LiveCalibratorOptions& options, std::vector<ImageReaderOptions>* readers) {
   LiveSessionOptions live = options.live;
   live.estimator.fixed_params = options.fixed_params;
-  if (options.housing) {
-    const CalibrationReport in_air = ReadCalibrationReport(options.input_calibration);
-    live.estimator.camera = in_air.camera;
-    live.estimator.housing = options.housing;
-    std::ostringstream params;
-    params.precision(17);
-    for (size_t k = 0; k < in_air.camera.params.size(); ++k) params << (k ? "," : "") << in_air.camera.params[k];
-    reader->camera_model = in_air.camera.ModelName();
-    reader->camera_params = params.str();
-  } else {
-    live.estimator.camera = Camera::FromModelName(options.reader.camera_model, 1.0, 0, 0);
+  live.estimator.housing = options.housing;
+  readers->push_back(ReaderFor(options.reader, options.input_calibration, &live.estimator.camera));
+  if (live.Stereo()) {
+    live.housing2 = options.housing;
+    readers->push_back(ReaderFor(options.reader, options.input_calibration2, &live.camera2));
   }
   return live;
 }
 
-// The final reports, by the batch calibrators on the database.
-void CalibrateAtEnd(const LiveCalibratorOptions& options, int camera_id, ProgressSink& progress,
-                    LiveCalibratorSummary* summary) {
+// One camera's final report, by the batch calibrators on the database.
+void CalibrateCameraAtEnd(const LiveCalibratorOptions& options, int camera_id, const std::string& input_calibration,
+                          const std::string& output_path, ProgressSink& progress,
+                          std::optional<CameraCalibrationResult>* camera_result,
+                          std::optional<HousingCalibrationResult>* housing_result) {
   if (options.housing) {
     HousingCalibratorOptions housing;
     housing.database_path = options.database_path;
-    housing.input_calibration = options.input_calibration;
-    housing.output_path = options.output_path;
+    housing.input_calibration = input_calibration;
+    housing.output_path = output_path;
     housing.housing = options.housing;
     housing.camera_id = camera_id;
-    summary->housing = RunHousingCalibrator(housing, progress);
+    *housing_result = RunHousingCalibrator(housing, progress);
     return;
   }
   CameraCalibratorOptions camera;
   camera.database_path = options.database_path;
-  camera.output_path = options.output_path;
+  camera.output_path = output_path;
   camera.camera_id = camera_id;
   camera.calibration.fixed_params = options.fixed_params;
-  summary->camera = RunCameraCalibrator(camera, progress);
+  *camera_result = RunCameraCalibrator(camera, progress);
+}
+
+// The final reports: one camera's in --output_path; a rig's cameras in
+// OUT/cam1 and OUT/cam2, then stereo_calibrator from those into OUT
+// (with --Stereo.refine_intrinsics 1 for a camera calibration).
+void CalibrateAtEnd(const LiveCalibratorOptions& options, const std::vector<int>& camera_ids, ProgressSink& progress,
+                    LiveCalibratorSummary* summary) {
+  if (camera_ids.size() == 1) {
+    CalibrateCameraAtEnd(options, camera_ids[0], options.input_calibration, options.output_path, progress,
+                         &summary->camera, &summary->housing);
+    return;
+  }
+  const fs::path out(options.output_path);
+  CalibrateCameraAtEnd(options, camera_ids[0], options.input_calibration, (out / "cam1").string(), progress,
+                       &summary->camera, &summary->housing);
+  CalibrateCameraAtEnd(options, camera_ids[1], options.input_calibration2, (out / "cam2").string(), progress,
+                       &summary->camera2, &summary->housing2);
+  StereoCalibratorOptions stereo;
+  stereo.database_path = options.database_path;
+  stereo.output_path = options.output_path;
+  stereo.camera1_id = camera_ids[0];
+  stereo.camera2_id = camera_ids[1];
+  stereo.input_calibration1 = (out / "cam1" / "calibration.yaml").string();
+  stereo.input_calibration2 = (out / "cam2" / "calibration.yaml").string();
+  // The intrinsics come from these very frames: refined with the rig, so
+  // that the rig's standard deviations carry their uncertainty (held, a
+  // few pairs' intrinsics errors would hide in a confident baseline). A
+  // housing calibration holds the in-air intrinsics it was given.
+  stereo.stereo.refine_intrinsics = !options.housing.has_value();
+  summary->stereo = RunStereoCalibrator(stereo, progress);
 }
 
 struct SessionOutcome {
   LiveSummary summary;
-  int camera_id = -1;  // of the kept frames
-  int num_views = 0;   // in the database
+  std::vector<int> camera_ids;  // of the kept frames, per camera
+  int num_views = 0;            // kept views in the database (a rig's pairs)
 };
 
 // The session, with the database open only while it runs.
 SessionOutcome RunSession(const LiveCalibratorOptions& options, const LiveSessionOptions& live,
+                          const std::vector<ImageReaderOptions>& readers,
                           const std::function<void(LiveSession&, const std::string&)>& on_start) {
   NewDatabaseFile new_file(options.database_path);
   Database database(options.database_path, Database::OpenMode::kCreate);
   { Transaction probe = database.BeginTransaction(); }  // fails now, not at the first keep, when locked
-  DatabaseFrameStore store(options, &database);
-  LiveSession session(live, &store, ExistingViews(&database));
+  DatabaseFrameStore store(options, readers, &database);
+  LiveSession session(live, &store, ExistingViews(&database, CameraFolders(options)));
   std::optional<LiveServer> page;
   if (!options.page.headless) page.emplace(&session, options.page);
   if (on_start) on_start(session, page ? page->url() : std::string());
@@ -201,9 +301,9 @@ SessionOutcome RunSession(const LiveCalibratorOptions& options, const LiveSessio
     if (database.NumImages() > 0) new_file.Keep();
     throw;
   }
-  outcome.num_views = static_cast<int>(database.NumImages());
-  if (outcome.num_views > 0) new_file.Keep();
-  outcome.camera_id = store.camera_id();
+  if (database.NumImages() > 0) new_file.Keep();
+  outcome.num_views = static_cast<int>(ExistingViews(&database, CameraFolders(options)).size());
+  outcome.camera_ids = store.camera_ids();
   return outcome;
 }
 
@@ -214,24 +314,26 @@ LiveCalibratorSummary RunLiveCalibrator(const LiveCalibratorOptions& options, Pr
   options.Check();
   LiveCalibratorOptions adjusted = options;
   adjusted.page.output_path = options.output_path;
-  const LiveSessionOptions live = SessionOptions(options, &adjusted.reader);
-  const SessionOutcome outcome = RunSession(adjusted, live, on_start);
+  std::vector<ImageReaderOptions> readers;
+  const LiveSessionOptions live = SessionOptions(options, &readers);
+  const SessionOutcome outcome = RunSession(adjusted, live, readers, on_start);
   LiveCalibratorSummary summary;
   summary.session = outcome.summary;
   const int views = outcome.num_views;
+  const std::string what = options.live.Stereo() ? " pairs" : " views";
   if (summary.session.end_reason == "interrupted") {
-    throw Cancelled(std::to_string(views) + " views kept in " + options.database_path + " and " +
-                    options.image_path +
-                    " (calibrate them with camera_calibrator / housing_calibrator, or rerun to add more)");
+    throw Cancelled(std::to_string(views) + what + " kept in " + options.database_path + " and " +
+                    options.image_path + " (calibrate them with camera_calibrator / housing_calibrator" +
+                    (options.live.Stereo() ? " and stereo_calibrator" : "") + ", or rerun to add more)");
   }
   if (!options.calibrate_at_end) return summary;
   const int needed = options.housing ? 2 : 3;
   if (views < needed) {
-    throw NumericalError("live_calibrator: " + std::to_string(views) + " views kept (" + summary.session.end_reason +
-                         "); a calibration needs " + std::to_string(needed) + ". They stay in " +
-                         options.database_path + "; rerun to add more");
+    throw NumericalError("live_calibrator: " + std::to_string(views) + what + " kept (" +
+                         summary.session.end_reason + "); a calibration needs " + std::to_string(needed) +
+                         ". They stay in " + options.database_path + "; rerun to add more");
   }
-  CalibrateAtEnd(options, outcome.camera_id, progress, &summary);
+  CalibrateAtEnd(options, outcome.camera_ids, progress, &summary);
   summary.calibrated = true;
   return summary;
 }

@@ -4,7 +4,9 @@
 // target_extractor would (same tables, same precise corners), one
 // transaction per frame, so an interrupted session keeps every view; at the
 // end the views are calibrated by camera_calibrator or housing_calibrator
-// (the same reports as those commands give on this database).
+// (the same reports as those commands give on this database). With two
+// sources, a stereo rig: pairs of frames in cam1/ and cam2/, each camera
+// calibrated, then stereo_calibrator.
 #pragma once
 
 #include <functional>
@@ -14,6 +16,7 @@
 #include "colmap_ext/housing/housing.h"
 #include "colmap_ext/util/progress.h"
 #include "pipelines/calibration/housing_calibration.h"
+#include "pipelines/calibration/stereo_calibration.h"
 #include "pipelines/images/image_reader.h"
 #include "pipelines/live/live_server.h"
 #include "pipelines/live/live_session.h"
@@ -29,6 +32,9 @@ struct LiveCalibratorOptions {
   // constants and a start); camera calibration without them.
   std::string input_calibration;
   std::optional<Housing> housing;
+  // A rig (--source2 in `live`): camera 2's in-air calibration for a
+  // housing calibration (its housing starts from `housing` too).
+  std::string input_calibration2;
   std::vector<std::string> fixed_params;  // camera calibration
   LiveSessionOptions live;                // source, target, hands-free, guidance
   LivePageOptions page;                   // the live view in a browser (or headless)
@@ -42,6 +48,10 @@ struct LiveCalibratorSummary {
   // The final calibration (the one the reports give).
   std::optional<CameraCalibrationResult> camera;
   std::optional<HousingCalibrationResult> housing;
+  // A rig: camera 2's (in OUT/cam2; camera 1's in OUT/cam1) and the rig's.
+  std::optional<CameraCalibrationResult> camera2;
+  std::optional<HousingCalibrationResult> housing2;
+  std::optional<StereoCalibrationResult> stereo;
 };
 
 // `on_start` is called with the session (and the page's address, "" when

@@ -303,6 +303,17 @@ Rigid3d SampleRigView(const DatasetConfig& config, const Scene& scene, const Hou
   }
 }
 
+// The rig's motion as camera 2 sees it: for a small motion M of camera 1,
+// camera 2 moves by T M T^-1 (T = cam2_from_cam1), whose rates are
+// w2 = R w1 and v2 = R v1 - w2 x t.
+ImageFormationOptions MotionInCamera2(ImageFormationOptions render, const Rigid3d& cam2_from_cam1) {
+  const Eigen::Matrix3d rotation = cam2_from_cam1.rotation.toRotationMatrix();
+  render.angular_velocity_rad_s = rotation * render.angular_velocity_rad_s;
+  render.velocity_m_s =
+      rotation * render.velocity_m_s - render.angular_velocity_rad_s.cross(cam2_from_cam1.translation);
+  return render;
+}
+
 // Renders one frame (both cameras of a rig) into the staging folder and
 // returns its truth.
 struct FrameRenderer {
@@ -316,7 +327,7 @@ struct FrameRenderer {
   std::string dir1, dir2;
 
   FrameTruth Render(int frame, const Rigid3d& cam_from_target, const ImageFormationOptions& render,
-                    std::mt19937_64* rng, cv::Mat* image1 = nullptr) const {
+                    std::mt19937_64* rng, cv::Mat* image1 = nullptr, cv::Mat* image2_out = nullptr) const {
     std::vector<PlacedObject> objects;
     objects.push_back({config.survey ? static_cast<const SceneObject*>(scene.seabed.get()) : scene.target.object.get(),
                        cam_from_target});
@@ -343,7 +354,9 @@ struct FrameRenderer {
     if (config.stereo) {
       std::vector<PlacedObject> objects2 = objects;
       for (PlacedObject& placed : objects2) placed.cam_from_object = config.cam2_from_cam1 * placed.cam_from_object;
-      WriteImage(staging / dir2 / name, RenderImage(*rays2, objects2, render, noise_seed + 1));
+      const cv::Mat image2 = RenderImage(*rays2, objects2, MotionInCamera2(render, config.cam2_from_cam1), noise_seed + 1);
+      WriteImage(staging / dir2 / name, image2);
+      if (image2_out) *image2_out = image2;
       const Rigid3d cam2_from_target = config.cam2_from_cam1 * cam_from_target;
       truth.cam2 = config.survey ? ImageTruth{}
                                  : TargetTruth(config.camera2, camera2.HousingOrNull(), scene.target,
@@ -372,7 +385,7 @@ void FinishSet(const SynthesizeOptions& options, const DatasetConfig& config, co
   }
   fs::copy_file(options.config_path, staging / "config_used.yaml", fs::copy_options::overwrite_existing);
   for (const char* entry : {"images", "ground_truth.yaml", "target_dots.csv", "config_used.yaml", "navigation.txt",
-                            "trajectory.yaml", "trajectory.avi"}) {
+                            "trajectory.yaml", "trajectory.avi", "trajectory_cam2.avi"}) {
     if (!fs::exists(staging / entry)) continue;
     fs::remove_all(output / entry);
     fs::rename(staging / entry, output / entry);
@@ -396,6 +409,12 @@ std::vector<TrajectoryFrame> PlanFrames(const Scene& scene, const HousedCamera& 
   return frames;
 }
 
+void OpenVideo(const fs::path& path, const Camera& camera, double fps, cv::VideoWriter* video) {
+  video->open(path.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
+              cv::Size(static_cast<int>(camera.width), static_cast<int>(camera.height)), false);
+  if (!video->isOpened()) throw InputError(path.string() + ": OpenCV cannot write a Motion JPEG video here");
+}
+
 // Renders a trajectory's frames (motion blur while the target moves), and
 // with `trajectory.video` the same frames as trajectory.avi (Motion JPEG, the
 // codec OpenCV writes without FFmpeg); trajectory.yaml says where the pauses
@@ -404,12 +423,10 @@ void RenderTrajectory(const DatasetConfig& config, const FrameRenderer& renderer
                       const std::vector<TrajectoryFrame>& frames, const fs::path& staging, std::mt19937_64* rng,
                       GroundTruth* truth, ProgressSink& progress) {
   const TrajectoryOptions& options = *config.trajectory;
-  cv::VideoWriter video;
+  cv::VideoWriter video, video2;
   if (options.video) {
-    const fs::path path = staging / "trajectory.avi";
-    video.open(path.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), options.fps,
-               cv::Size(static_cast<int>(config.camera.width), static_cast<int>(config.camera.height)), false);
-    if (!video.isOpened()) throw InputError(path.string() + ": OpenCV cannot write a Motion JPEG video here");
+    OpenVideo(staging / "trajectory.avi", config.camera, options.fps, &video);
+    if (config.stereo) OpenVideo(staging / "trajectory_cam2.avi", config.camera2, options.fps, &video2);
   }
   for (size_t f = 0; f < frames.size(); ++f) {
     CancelFlag::ThrowIfRequested();
@@ -417,12 +434,15 @@ void RenderTrajectory(const DatasetConfig& config, const FrameRenderer& renderer
     render.velocity_m_s = frames[f].velocity_m_s;
     render.angular_velocity_rad_s = frames[f].angular_velocity_rad_s;
     render.exposure_s = frames[f].pause < 0 ? options.exposure_s : 0.0;
-    cv::Mat image;
-    truth->images.push_back(renderer.Render(static_cast<int>(f), frames[f].cam_from_target, render, rng, &image));
+    cv::Mat image, image2;
+    truth->images.push_back(
+        renderer.Render(static_cast<int>(f), frames[f].cam_from_target, render, rng, &image, &image2));
     if (video.isOpened()) video.write(image);
+    if (video2.isOpened()) video2.write(image2);
     progress.Advance(1);
   }
   video.release();
+  video2.release();
   const std::string yaml = TrajectoryYaml(frames, options);
   WriteFileAtomically(staging / "trajectory.yaml", false, [&](std::ostream& out) { out << yaml; });
 }

@@ -24,7 +24,6 @@ void DatasetConfig::Check() const {
   render.Check();
   if (trajectory) {
     trajectory->Check();
-    if (stereo) throw OptionError("trajectory", "with stereo", "one camera (a stereo trajectory is not rendered)");
   }
   if (!(clutter_distance_m > 0)) {
     throw OptionError("clutter.distance", std::to_string(clutter_distance_m), "> 0 m");

@@ -5,7 +5,6 @@
 #include "pipelines/stages/live_calibrator.h"
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -31,14 +30,6 @@ LiveCalibratorOptions Options(const testing::TempDir& dir, const std::string& so
   return testing::LiveOptions(dir, source);
 }
 
-std::vector<std::pair<int, int>> Pauses(const fs::path& trajectory_yaml) {
-  std::vector<std::pair<int, int>> pauses;
-  for (const YAML::Node& pause : YAML::LoadFile(trajectory_yaml.string())["pauses"]) {
-    pauses.emplace_back(pause["first_frame"].as<int>(), pause["last_frame"].as<int>());
-  }
-  return pauses;
-}
-
 CameraCalibrationResult Calibrate(const std::string& database, const fs::path& output) {
   CameraCalibratorOptions options;
   options.database_path = database;
@@ -49,7 +40,7 @@ CameraCalibrationResult Calibrate(const std::string& database, const fs::path& o
 TEST(LiveCalibrator, HandsFreeKeepsOneFramePerPauseAndMatchesTheBatchStages) {
   const testing::TempDir dir;
   testing::RenderSet(dir, kTrajectoryYaml);
-  const std::vector<std::pair<int, int>> pauses = Pauses(dir / "set/trajectory.yaml");
+  const std::vector<std::pair<int, int>> pauses = testing::TrajectoryPauses(dir / "set/trajectory.yaml");
   ASSERT_EQ(pauses.size(), 5u);
   // In real time, as a camera would deliver it: frames the session is late
   // for are dropped.

@@ -6,6 +6,7 @@
 
 #include <csignal>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
 #include <future>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -114,6 +115,59 @@ TEST(LivePage, ABrowserSeesTheStreamAndItsButtonsWork) {
   EXPECT_EQ(summary.session.end_reason, "finish requested");
   Database database(dir / "live.db", Database::OpenMode::kReadOnly);
   EXPECT_EQ(database.NumImages(), summary.session.kept);
+}
+
+// A rig: the page shows both cameras side by side, each camera's estimate
+// and the relative pose once three pairs are kept.
+TEST(LivePage, ARigShowsBothCamerasAndTheRelativePose) {
+  const testing::TempDir dir;
+  testing::RenderSet(dir, testing::LiveStereoTrajectoryYaml(11, 4, false));
+  LiveCalibratorOptions options = Options(dir);
+  options.live.source.source = (dir / "set/images/cam1").string();
+  options.live.source2 = (dir / "set/images/cam2").string();
+  options.live.source.folder_fps = 5;
+  std::promise<std::string> url_promise;
+  auto run = std::async(std::launch::async, [&] {
+    return RunLiveCalibrator(options, NoProgress(),
+                             [&](LiveSession&, const std::string& url) { url_promise.set_value(url); });
+  });
+  const std::string url = url_promise.get_future().get();
+  std::smatch port;
+  ASSERT_TRUE(std::regex_search(url, port, std::regex(":([0-9]+)/")));
+  httplib::Client client("127.0.0.1", std::stoi(port[1]));
+  nlohmann::json estimate;
+  for (int wait = 0; wait < 400; ++wait) {
+    const auto state = client.Get("/state.json");
+    ASSERT_TRUE(state && state->status == 200);
+    estimate = nlohmann::json::parse(state->body)["estimate"];
+    if (estimate.is_object() && estimate.contains("rig") && estimate["rig"]["solved"] == true) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_TRUE(estimate.is_object() && estimate.contains("rig")) << estimate.dump();
+  EXPECT_EQ(estimate["rig"]["solved"], true) << estimate.dump();
+  EXPECT_NEAR(estimate["rig"]["baseline_m"].get<double>(), 0.1, 0.002);
+  EXPECT_EQ(estimate["camera2"]["solved"], true);
+  EXPECT_FALSE(estimate["next"].is_null()) << estimate.dump();
+  std::string stream;
+  client.Get("/stream.mjpg", [&](const char* data, size_t length) {
+    stream.append(data, length);
+    return stream.size() < 60000;
+  });
+  const size_t start = stream.find("\xff\xd8");
+  ASSERT_NE(start, std::string::npos);
+  const cv::Mat frame = cv::imdecode(std::vector<uint8_t>(stream.begin() + start, stream.end()), cv::IMREAD_COLOR);
+  ASSERT_FALSE(frame.empty());
+  EXPECT_NEAR(frame.cols, 2 * frame.rows * 640 / 480, 2) << "not two 640 x 480 frames side by side";
+  if (testing::RunCommand("command -v chromium").exit_code == 0) {
+    const fs::path artefact = fs::current_path() / "artifacts/live_page_stereo.png";
+    fs::create_directories(artefact.parent_path());
+    testing::RunCommand(Chromium(dir, "--screenshot=" + artefact.string(), url));
+    EXPECT_GT(fs::exists(artefact) ? fs::file_size(artefact) : 0, 20000u) << artefact;
+  }
+  ASSERT_TRUE(client.Post("/finish"));
+  const LiveCalibratorSummary summary = run.get();
+  Database database(dir / "live.db", Database::OpenMode::kReadOnly);
+  EXPECT_EQ(database.NumImages(), 2 * summary.session.kept);
 }
 
 TEST(LivePage, CtrlCOnTheProcessKeepsEveryViewItReported) {

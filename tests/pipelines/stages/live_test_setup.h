@@ -3,7 +3,12 @@
 // that calibrate it.
 #pragma once
 
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "pipelines/stages/live_calibrator.h"
 #include "tests/test_utils.h"
@@ -20,6 +25,25 @@ poses: {distance: [0.35, 0.8], tilt_max_deg: 45, roll_max_deg: 20, border_margin
 render: {spp: 2, blur_sigma: 0.6, noise_sigma: 2.0}
 trajectory: {fps: 10, pause_seconds: 1.2, move_seconds: 1.0, exposure: 0.03, pauses: )" +
          std::to_string(pauses) + ", video: " + (video ? "true" : "false") + "}\n";
+}
+
+// The same on a rig: camera 2 10 cm to the right, turned 4 deg towards
+// camera 1's field, with a lens of its own.
+inline std::string LiveStereoTrajectoryYaml(int seed, int pauses, bool video) {
+  return LiveTrajectoryYaml(seed, pauses, video) +
+         "stereo:\n"
+         "  cam2_from_cam1: {rotation_axis_angle_deg: [0, 1, 0, 4], translation: [-0.1, 0.002, 0.004]}\n"
+         "  camera2: {model: OPENCV, width: 640, height: 480, params: [511, 506, 317.5, 243.0, -0.19, 0.05, "
+         "-0.0009, 0.0011]}\n";
+}
+
+// Each pause's first and last frame, from the set's trajectory.yaml.
+inline std::vector<std::pair<int, int>> TrajectoryPauses(const std::filesystem::path& trajectory_yaml) {
+  std::vector<std::pair<int, int>> pauses;
+  for (const YAML::Node& pause : YAML::LoadFile(trajectory_yaml.string())["pauses"]) {
+    pauses.emplace_back(pause["first_frame"].as<int>(), pause["last_frame"].as<int>());
+  }
+  return pauses;
 }
 
 // Headless, the board and camera above, guidance over the rendered range.
