@@ -169,6 +169,7 @@ nlohmann::json LiveServer::Impl::State() const {
   state["held_s"] = snapshot.hold.held_s;
   state["still"] = snapshot.hold.still;
   state["message"] = snapshot.message;
+  state["final"] = snapshot.final_status;
   state["output_path"] = options.output_path;
   {
     const std::lock_guard<std::mutex> lock(mutex);

@@ -103,6 +103,11 @@ void LiveSession::Undo() { undo_requested_ = true; }
 void LiveSession::Finish() { finish_requested_ = true; }
 void LiveSession::CalibrateNow() { calibrate_requested_ = true; }
 
+void LiveSession::SetFinalStatus(const std::string& text) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  snapshot_.final_status = text;
+}
+
 bool LiveSession::WaitForFrame(int64_t frames_processed, double timeout_s, LiveSnapshot* snapshot) const {
   std::unique_lock<std::mutex> lock(mutex_);
   const bool processed = frame_processed_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {

@@ -83,6 +83,7 @@ struct LiveSnapshot {
   std::shared_ptr<const LiveEstimate> estimate;
   std::optional<PoseDistance> to_suggestion;  // the current pose vs the suggestion
   std::string message;       // the last warning or event, for the page
+  std::string final_status;  // after the session: the final calibration's progress, then its outcome
 };
 
 struct LiveSummary {
@@ -114,6 +115,8 @@ class LiveSession {
   void Finish();
   // Solve the kept views now (the estimate is also updated after each keep).
   void CalibrateNow();
+  // After Run: what the final calibration is doing or gave, for viewers.
+  void SetFinalStatus(const std::string& text);
   LiveSnapshot Snapshot() const;
   // Waits until a frame after `frames_processed` is processed (or
   // `timeout_s` passes); false on time-out or once the session has ended.

@@ -7,6 +7,7 @@
 #include <set>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
+#include <thread>
 
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
@@ -281,10 +282,37 @@ struct SessionOutcome {
   int num_views = 0;            // kept views in the database (a rig's pairs)
 };
 
-// The session, with the database open only while it runs.
+// What follows the session (the final calibration), run while the page
+// still serves; returns the line the page shows.
+using Conclusion = std::function<std::string(const SessionOutcome&)>;
+
+// The final calibration with the page told what happens: a page polls
+// every 0.4 s, so it gets the outcome before the server goes (it keeps
+// showing it after portcal exits). Not after Ctrl-C: the person is at the
+// terminal.
+void Conclude(const SessionOutcome& outcome, const Conclusion& conclude, LiveSession* session, bool page) {
+  const auto linger = [page] {
+    if (page) std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  };
+  session->SetFinalStatus("calibrating the kept views ...");
+  try {
+    session->SetFinalStatus(conclude(outcome));
+  } catch (const Cancelled&) {
+    throw;
+  } catch (const std::exception& e) {
+    session->SetFinalStatus(std::string("no calibration: ") + e.what());
+    linger();
+    throw;
+  }
+  linger();
+}
+
+// The session, then `conclude`, with the database open (idle) and the page
+// serving until both are done.
 SessionOutcome RunSession(const LiveCalibratorOptions& options, const LiveSessionOptions& live,
                           const std::vector<ImageReaderOptions>& readers,
-                          const std::function<void(LiveSession&, const std::string&)>& on_start) {
+                          const std::function<void(LiveSession&, const std::string&)>& on_start,
+                          const Conclusion& conclude) {
   NewDatabaseFile new_file(options.database_path);
   Database database(options.database_path, Database::OpenMode::kCreate);
   { Transaction probe = database.BeginTransaction(); }  // fails now, not at the first keep, when locked
@@ -304,7 +332,45 @@ SessionOutcome RunSession(const LiveCalibratorOptions& options, const LiveSessio
   if (database.NumImages() > 0) new_file.Keep();
   outcome.num_views = static_cast<int>(ExistingViews(&database, CameraFolders(options)).size());
   outcome.camera_ids = store.camera_ids();
+  Conclude(outcome, conclude, &session, page.has_value());
   return outcome;
+}
+
+// After the session: Cancelled after Ctrl-C, else the final calibration
+// (NumericalError with too few views), and the line that says how it went.
+std::string FinalCalibration(const LiveCalibratorOptions& options, const SessionOutcome& outcome,
+                             ProgressSink& progress, LiveCalibratorSummary* summary) {
+  const int views = outcome.num_views;
+  const std::string what = options.live.Stereo() ? " pairs" : " views";
+  if (outcome.summary.end_reason == "interrupted") {
+    throw Cancelled(std::to_string(views) + what + " kept in " + options.database_path + " and " +
+                    options.image_path + " (calibrate them with camera_calibrator / housing_calibrator" +
+                    (options.live.Stereo() ? " and stereo_calibrator" : "") + ", or rerun to add more)");
+  }
+  if (!options.calibrate_at_end) return std::to_string(views) + what + " kept; not calibrated (--calibrate_at_end 0)";
+  const int needed = options.housing ? 2 : 3;
+  if (views < needed) {
+    throw NumericalError("live_calibrator: " + std::to_string(views) + what + " kept (" +
+                         outcome.summary.end_reason + "); a calibration needs " + std::to_string(needed) +
+                         ". They stay in " + options.database_path + "; rerun to add more");
+  }
+  CalibrateAtEnd(options, outcome.camera_ids, progress, summary);
+  summary->calibrated = true;
+  std::ostringstream line;
+  line << std::setprecision(3) << "reports in " << options.output_path << " (" << views << what;
+  const auto rms = [&line](const char* which, const auto& result) {
+    if (result) line << "; " << which << "RMS " << result->overall_rms_px << " px";
+  };
+  rms(options.live.Stereo() ? "camera 1 " : "", summary->camera);
+  rms(options.live.Stereo() ? "camera 1 " : "", summary->housing);
+  rms("camera 2 ", summary->camera2);
+  rms("camera 2 ", summary->housing2);
+  if (summary->stereo) {
+    line << "; baseline " << std::setprecision(5) << 1000 * summary->stereo->cam2_from_cam1.translation.norm()
+         << " mm ± " << std::setprecision(2) << 1000 * summary->stereo->translation_std_dev.norm() << " mm";
+  }
+  line << ")";
+  return line.str();
 }
 
 }  // namespace
@@ -316,25 +382,11 @@ LiveCalibratorSummary RunLiveCalibrator(const LiveCalibratorOptions& options, Pr
   adjusted.page.output_path = options.output_path;
   std::vector<ImageReaderOptions> readers;
   const LiveSessionOptions live = SessionOptions(options, &readers);
-  const SessionOutcome outcome = RunSession(adjusted, live, readers, on_start);
   LiveCalibratorSummary summary;
+  const SessionOutcome outcome = RunSession(adjusted, live, readers, on_start, [&](const SessionOutcome& o) {
+    return FinalCalibration(options, o, progress, &summary);
+  });
   summary.session = outcome.summary;
-  const int views = outcome.num_views;
-  const std::string what = options.live.Stereo() ? " pairs" : " views";
-  if (summary.session.end_reason == "interrupted") {
-    throw Cancelled(std::to_string(views) + what + " kept in " + options.database_path + " and " +
-                    options.image_path + " (calibrate them with camera_calibrator / housing_calibrator" +
-                    (options.live.Stereo() ? " and stereo_calibrator" : "") + ", or rerun to add more)");
-  }
-  if (!options.calibrate_at_end) return summary;
-  const int needed = options.housing ? 2 : 3;
-  if (views < needed) {
-    throw NumericalError("live_calibrator: " + std::to_string(views) + what + " kept (" +
-                         summary.session.end_reason + "); a calibration needs " + std::to_string(needed) +
-                         ". They stay in " + options.database_path + "; rerun to add more");
-  }
-  CalibrateAtEnd(options, outcome.camera_ids, progress, &summary);
-  summary.calibrated = true;
   return summary;
 }
 

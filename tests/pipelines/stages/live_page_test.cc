@@ -118,7 +118,8 @@ TEST(LivePage, ABrowserSeesTheStreamAndItsButtonsWork) {
 }
 
 // A rig: the page shows both cameras side by side, each camera's estimate
-// and the relative pose once three pairs are kept.
+// and the relative pose once three pairs are kept, and at the end the final
+// calibration's outcome.
 TEST(LivePage, ARigShowsBothCamerasAndTheRelativePose) {
   const testing::TempDir dir;
   testing::RenderSet(dir, testing::LiveStereoTrajectoryYaml(11, 4, false));
@@ -126,6 +127,7 @@ TEST(LivePage, ARigShowsBothCamerasAndTheRelativePose) {
   options.live.source.source = (dir / "set/images/cam1").string();
   options.live.source2 = (dir / "set/images/cam2").string();
   options.live.source.folder_fps = 5;
+  options.calibrate_at_end = true;
   std::promise<std::string> url_promise;
   auto run = std::async(std::launch::async, [&] {
     return RunLiveCalibrator(options, NoProgress(),
@@ -164,8 +166,19 @@ TEST(LivePage, ARigShowsBothCamerasAndTheRelativePose) {
     testing::RunCommand(Chromium(dir, "--screenshot=" + artefact.string(), url));
     EXPECT_GT(fs::exists(artefact) ? fs::file_size(artefact) : 0, 20000u) << artefact;
   }
+  // Finish: the page is told of the final calibration before it goes.
   ASSERT_TRUE(client.Post("/finish"));
+  std::string final_status;
+  for (int wait = 0; wait < 200 && final_status.find("reports in") == std::string::npos; ++wait) {
+    const auto state = client.Get("/state.json");
+    if (!state) break;
+    final_status = nlohmann::json::parse(state->body)["final"].get<std::string>();
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_NE(final_status.find("reports in " + (dir / "out").string()), std::string::npos) << final_status;
+  EXPECT_NE(final_status.find("baseline"), std::string::npos) << final_status;
   const LiveCalibratorSummary summary = run.get();
+  EXPECT_TRUE(summary.calibrated && summary.stereo);
   Database database(dir / "live.db", Database::OpenMode::kReadOnly);
   EXPECT_EQ(database.NumImages(), 2 * summary.session.kept);
 }
