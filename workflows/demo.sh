@@ -7,11 +7,15 @@
 #   3. target_extractor + housing_calibrator on the underwater set: the dome's
 #      decentering, the intrinsics fixed.
 #   4. The estimates next to the truth.
+# Everything it makes stays in demo_output/ (replaced on the next run), the
+# reports among it; a run that fails leaves the previous demo_output/ as it
+# was.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash workflows/setup.sh >/dev/null
 
-work="$(mktemp -d)"
+output="$PWD/demo_output"
+work="$(mktemp -d "$PWD/.demo_output.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 portcal=build/portcal
 
@@ -56,5 +60,13 @@ echo "== 3. Under water: target_extractor, housing_calibrator (DOMEPORT; radius,
   --Housing.model DOMEPORT --Housing.params 0,0,0,0.05,0.006,1.0,1.473,1.334
 sed -n '/^Housing/,/^RMS/p' "$work/dome_calibration/calibration.txt"
 echo "-- truth: Cx 0.004, Cy -0.002, Cz 0.006 m"
+
+rm -rf "$output"
+mv "$work" "$output"
+trap - EXIT
 echo
-echo "Reports: calibration.yaml (calibmar's keys + standard deviations) and calibration.txt."
+echo "Everything is in $output:"
+echo "  images and truth: air/, dome/ (ground_truth.yaml); databases: air.db, dome.db"
+echo "  reports (calibration.txt to read, calibration.yaml with calibmar's keys and standard deviations):"
+echo "    $output/air_calibration/calibration.txt"
+echo "    $output/dome_calibration/calibration.txt"
