@@ -12,6 +12,7 @@ int TargetExtractorCommand(int argc, char** argv);
 int CameraCalibratorCommand(int argc, char** argv);
 int HousingCalibratorCommand(int argc, char** argv);
 int StereoCalibratorCommand(int argc, char** argv);
+int CalibrationEvaluatorCommand(int argc, char** argv);
 int FeatureExtractorCommand(int argc, char** argv);
 int FeatureMaskerCommand(int argc, char** argv);
 int ExhaustiveMatcherCommand(int argc, char** argv);

@@ -40,6 +40,8 @@ const std::vector<Command>& Commands() {
        "calibrate a flat or dome port, the in-air intrinsics given"},
       {"stereo_calibrator", portcal::StereoCalibratorCommand,
        "calibrate a stereo rig's relative pose, in air or behind housings"},
+      {"calibration_evaluator", portcal::CalibrationEvaluatorCommand,
+       "judge a calibration on held-out views (pose alone per view), K-fold cross-validation"},
       {"feature_extractor", portcal::FeatureExtractorCommand,
        "import images and store SIFT features as COLMAP does"},
       {"feature_masker", portcal::FeatureMaskerCommand,

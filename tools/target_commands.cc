@@ -1,5 +1,6 @@
 #include "colmap_ext/util/progress.h"
 #include "colmap_ext/util/string_utils.h"
+#include "pipelines/stages/calibration_evaluator.h"
 #include "pipelines/stages/camera_calibrator.h"
 #include "pipelines/stages/housing_calibrator.h"
 #include "pipelines/stages/stereo_calibrator.h"
@@ -62,6 +63,29 @@ int CameraCalibratorCommand(int argc, char** argv) {
     StderrProgress progress;
     options.calibration.fixed_params = SplitTokens(fixed, ", ");
     RunCameraCalibrator(options, progress);
+  });
+}
+
+int CalibrationEvaluatorCommand(int argc, char** argv) {
+  CalibrationEvaluatorOptions options;
+  CommandLine cli("calibration_evaluator",
+                  "Judges a calibration (lens, or lens and housing) on the target views of a database, "
+                  "typically views it was not fitted to: each view's pose estimated alone with the "
+                  "calibration fixed, per-view and overall RMS, and the residuals' pattern over the image "
+                  "(the mean residual per cell of a 16 x 9 grid against what noise alone gives). With "
+                  "--Evaluation.folds K: K-fold cross-validation of the same kind of calibration on these "
+                  "views. Writes evaluation.yaml and evaluation.txt.");
+  cli.AddRequired("database_path", &options.database_path, "database with target observations (target_extractor)");
+  cli.AddRequired("input_calibration", &options.input_calibration,
+                  "calibration.yaml to judge (portcal's or calibmar's; with its housing, if any)");
+  cli.AddRequired("output_path", &options.output_path, "folder for evaluation.yaml and evaluation.txt");
+  cli.Add("camera_id", &options.camera_id, "camera whose views are used (-1: the only one)");
+  cli.Add("Evaluation.folds", &options.folds, "K-fold cross-validation (0: none, else >= 2)");
+  cli.Add("num_threads", &options.num_threads, "threads");
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    StderrProgress progress;
+    RunCalibrationEvaluator(options, progress);
   });
 }
 
