@@ -3,7 +3,9 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cstdio>
+#include <fstream>
 #include <iomanip>
+#include <regex>
 #include <sstream>
 
 #include "colmap_ext/camera/camera_models.h"
@@ -378,6 +380,35 @@ CalibrationReport ReportOfCamera(const Camera& camera) {
   return report;
 }
 
+// calibmar writes the standard deviations, the RMS and the target as
+// comments ("# non_svp_est_std_dev: a, b, ...", "# overall_rms: x",
+// "# target: ..."), not as keys: taken where the keys are absent.
+void ReadCalibmarComments(const fs::path& path, CalibrationReport* report) {
+  std::ifstream in(path);
+  const std::regex comment(R"(^#\s*(non_svp_est_std_dev|overall_rms|target)\s*:\s*(.*\S)\s*$)");
+  std::smatch match;
+  for (std::string line; std::getline(in, line);) {
+    if (!std::regex_match(line, match, comment)) continue;
+    const std::string key = match[1], value = match[2];
+    try {
+      if (key == "target" && report->target_description.empty()) {
+        report->target_description = value;
+      } else if (key == "overall_rms" && report->overall_rms_px == 0) {
+        report->overall_rms_px = std::stod(value);
+      } else if (key == "non_svp_est_std_dev" && report->housing && report->housing_std_dev.empty()) {
+        for (const std::string& token : SplitTokens(value, ", ")) report->housing_std_dev.push_back(std::stod(token));
+        if (report->housing_std_dev.size() != report->housing->params.size()) {
+          throw InputError(path.string() + ": the comment non_svp_est_std_dev has " +
+                           std::to_string(report->housing_std_dev.size()) + " values, non_svp_parameters " +
+                           std::to_string(report->housing->params.size()));
+        }
+      }
+    } catch (const std::logic_error&) {  // std::stod: not a number
+      throw InputError(path.string() + ": the comment '" + line + "' does not hold numbers");
+    }
+  }
+}
+
 }  // namespace
 
 CalibrationReport ReadCalibrationReport(const fs::path& path) {
@@ -439,6 +470,7 @@ CalibrationReport ReadCalibrationReport(const fs::path& path) {
   } catch (const YAML::Exception& e) {
     throw InputError(path.string() + ": " + e.what());
   }
+  ReadCalibmarComments(path, &report);
   report.camera.Validate(path.string());
   return report;
 }

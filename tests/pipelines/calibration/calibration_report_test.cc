@@ -90,6 +90,63 @@ TEST(ReadCalibrationReport, ReadsTheRealSetsRosCameraInfo) {
   EXPECT_EQ(read.camera.height, 1080u);
 }
 
+// A report as calibmar writes it: the shared set's calibration_condria.yaml
+// (from EmilioOlivastri/calibmar, config/calibration_condria.yaml, a BSD
+// calibmar fork), as is. calibmar keeps the standard deviations, RMS and
+// target in comments.
+const char* const kCalibmarReport = R"(model: OPENCV_FISHEYE
+# fx, fy, cx, cy, k1, k2, k3, k4
+parameters: [2641.404135, 2644.628977, 1990.530781, 1055.024804, 0.05608049163, 0.07435086083, -0.001746305011, 0.01681019584]
+non_svp_model: FLATPORT
+# Nx, Ny, Nz, int_dist, int_thick, na, ng, nw (Note that [Nx, Ny, Nz] must be unit vector)
+non_svp_parameters: [-0.004348434312, -0.00752015894, 0.9999622685, 0.03480104832, 0.008, 1, 1.48899, 1.334]
+# non_svp_est_std_dev: 0.0002753845735, 0.0002450684841, 2.170503842e-06, 0.0004740286295, 0, 0, 0, 0
+width: 3840
+height: 2160
+# overall_rms: 2.61747377
+# target: aruco grid board, APRILTAG_36h11, 6, 6, 0.088000, 0.300000, 2, bl, hor
+)";
+
+void ExpectTheCalibmarReport(const CalibrationReport& read) {
+  EXPECT_EQ(read.camera.ModelName(), "OPENCV_FISHEYE");
+  EXPECT_EQ(read.camera.width, 3840u);
+  EXPECT_EQ(read.camera.height, 2160u);
+  ASSERT_EQ(read.camera.params.size(), 8u);
+  EXPECT_DOUBLE_EQ(read.camera.params[0], 2641.404135);
+  EXPECT_DOUBLE_EQ(read.camera.params[3], 1055.024804);  // calibmar's pixels are COLMAP's: no shift
+  EXPECT_DOUBLE_EQ(read.camera.params[7], 0.01681019584);
+  ASSERT_TRUE(read.housing.has_value());
+  EXPECT_EQ(read.housing->ModelName(), "FLATPORT");
+  EXPECT_DOUBLE_EQ(read.housing->params[3], 0.03480104832);
+  EXPECT_DOUBLE_EQ(read.housing->params[6], 1.48899);
+  ASSERT_EQ(read.housing_std_dev.size(), 8u);
+  EXPECT_DOUBLE_EQ(read.housing_std_dev[0], 0.0002753845735);
+  EXPECT_DOUBLE_EQ(read.housing_std_dev[3], 0.0004740286295);
+  EXPECT_DOUBLE_EQ(read.overall_rms_px, 2.61747377);
+  EXPECT_EQ(read.target_description, "aruco grid board, APRILTAG_36h11, 6, 6, 0.088000, 0.300000, 2, bl, hor");
+}
+
+TEST(ReadCalibrationReport, ReadsCalibmarsOwnReportWithItsCommentedDeviations) {
+  const testing::TempDir dir;
+  std::ofstream(dir / "calibration.yaml") << kCalibmarReport;
+  ExpectTheCalibmarReport(ReadCalibrationReport(dir / "calibration.yaml"));
+  // A comment that should hold numbers and does not: an error naming the file.
+  std::string broken = kCalibmarReport;
+  broken.replace(broken.find("2.61747377"), 10, "n/a");
+  std::ofstream(dir / "broken.yaml") << broken;
+  try {
+    ReadCalibrationReport(dir / "broken.yaml");
+    ADD_FAILURE() << "a comment without numbers accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("broken.yaml"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ReadCalibrationReport, ReadsTheSharedCalibmarReport) {
+  PORTCAL_REQUIRE_SHARED(shared);
+  ExpectTheCalibmarReport(ReadCalibrationReport(shared / "datasets/calibmar-reports/calibration_condria.yaml"));
+}
+
 TEST(ReadCalibrationReport, AFileOfNoKnownFormatNamesTheFormatsAndTheKey) {
   testing::TempDir dir;
   const fs::path file = dir / "calib.yaml";
