@@ -108,7 +108,9 @@ std::vector<FoldEvaluation> CrossValidate(const std::vector<CalibrationView>& vi
     evaluation.num_train = static_cast<int>(train.size());
     evaluation.num_test = static_cast<int>(test.size());
     const HousedCamera fitted = calibrate(train, &evaluation.train_rms_px);
-    evaluation.test_rms_px = EvaluateHeldOut(test, fitted, num_threads).rms_px;
+    const HeldOutEvaluation held_out = EvaluateHeldOut(test, fitted, num_threads);
+    evaluation.test_rms_px = held_out.rms_px;
+    evaluation.num_test_points = held_out.num_points;
     result.push_back(evaluation);
   }
   return result;

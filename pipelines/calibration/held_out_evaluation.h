@@ -55,6 +55,7 @@ struct FoldEvaluation {
   int num_train = 0, num_test = 0;
   double train_rms_px = 0;  // the fit's own RMS
   double test_rms_px = 0;   // held out
+  int num_test_points = 0;  // of the held-out views evaluated
 };
 
 // Fits a calibration to views (a camera or a housing calibration) and

@@ -46,6 +46,14 @@ ViewSamplingOptions SamplingOptions(const NextPoseOptions& options) {
   return sampling;
 }
 
+// The opening sequence's turns of the target: facing the camera, then
+// tilted about the horizontal and the vertical axis by min(tilt_max, 40 deg).
+std::vector<Eigen::Quaterniond> OpeningRotations(const NextPoseOptions& options) {
+  const double tilt = std::min(options.tilt_max_deg, 40.0) * kDeg;
+  return {Eigen::Quaterniond::Identity(), Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX())),
+          Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitY()))};
+}
+
 }  // namespace
 
 void NextPoseOptions::Check() const {
@@ -87,15 +95,14 @@ TargetShape TargetShape::FromPoints(const std::vector<Eigen::Vector3d>& points) 
 
 std::vector<PoseSuggestion> OpeningPoses(const CalibrationUnknowns& unknowns, const TargetShape& target,
                                          const NextPoseOptions& options) {
-  const double tilt = std::min(options.tilt_max_deg, 40.0) * kDeg;
-  const std::vector<std::pair<Eigen::Quaterniond, std::string>> turns = {
-      {Eigen::Quaterniond::Identity(), "opening 1/3: facing the camera, filling the image"},
-      {Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX())),
-       "opening 2/3: tilted about the horizontal axis"},
-      {Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitY())),
-       "opening 3/3: tilted about the vertical axis"}};
+  const std::vector<Eigen::Quaterniond> rotations = OpeningRotations(options);
+  const char* const whys[] = {"opening 1/3: facing the camera, filling the image",
+                              "opening 2/3: tilted about the horizontal axis",
+                              "opening 3/3: tilted about the vertical axis"};
   std::vector<PoseSuggestion> poses;
-  for (const auto& [rotation, why] : turns) {
+  for (size_t turn = 0; turn < rotations.size(); ++turn) {
+    const Eigen::Quaterniond& rotation = rotations[turn];
+    const std::string why = whys[turn];
     const int steps = 60;
     for (int k = 0; k <= steps; ++k) {
       const double d = options.distance_min_m + (options.distance_max_m - options.distance_min_m) * k / steps;
@@ -109,7 +116,7 @@ std::vector<PoseSuggestion> OpeningPoses(const CalibrationUnknowns& unknowns, co
       break;
     }
   }
-  if (poses.size() < turns.size()) {
+  if (poses.size() < rotations.size()) {
     throw NumericalError("next-pose guidance: the target does not fit in the image within --Live.distance_range [" +
                          std::to_string(options.distance_min_m) + ", " + std::to_string(options.distance_max_m) +
                          "] m; allow a larger distance");
@@ -187,16 +194,13 @@ bool InBothViews(const RigUnknowns& rig, const TargetShape& target, const Rigid3
 // centred between the two cameras' axes, as near as both see all of it.
 std::optional<Rigid3d> RigOpeningPose(const RigUnknowns& rig, const TargetShape& target, int index,
                                       const NextPoseOptions& options) {
-  const double tilt = std::min(options.tilt_max_deg, 40.0) * kDeg;
-  const Eigen::Quaterniond rotations[] = {Eigen::Quaterniond::Identity(),
-                                          Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX())),
-                                          Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitY()))};
+  const Eigen::Quaterniond rotation = OpeningRotations(options)[static_cast<size_t>(index)];
   const Eigen::Vector3d centre2_in_cam1 = rig.cam2_from_cam1.Inverse().translation;
   const Eigen::Vector3d shift(0.5 * centre2_in_cam1.x(), 0.5 * centre2_in_cam1.y(), 0);
   const int steps = 60;
   for (int k = 0; k <= steps; ++k) {
     const double d = options.distance_min_m + (options.distance_max_m - options.distance_min_m) * k / steps;
-    Rigid3d pose = Centred(target, rotations[index], d);
+    Rigid3d pose = Centred(target, rotation, d);
     pose.translation += shift;
     if (InBothViews(rig, target, pose, options.border_margin_px)) return pose;
   }

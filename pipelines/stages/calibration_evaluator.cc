@@ -129,12 +129,8 @@ CalibrationEvaluatorSummary RunCalibrationEvaluator(const CalibrationEvaluatorOp
     double sum_squares = 0;
     int points = 0;
     for (const FoldEvaluation& fold : summary.folds) {
-      int fold_points = 0;
-      for (size_t v = static_cast<size_t>(fold.fold); v < views.size(); v += summary.folds.size()) {
-        fold_points += static_cast<int>(views[v].pixels.size());
-      }
-      sum_squares += fold.test_rms_px * fold.test_rms_px * fold_points;
-      points += fold_points;
+      sum_squares += fold.test_rms_px * fold.test_rms_px * fold.num_test_points;
+      points += fold.num_test_points;
     }
     summary.cross_validation_rms_px = std::sqrt(sum_squares / std::max(1, points));
     progress.Advance(static_cast<size_t>(options.folds));

@@ -10,8 +10,7 @@
 #include "colmap_ext/io/ground_truth.h"
 #include "colmap_ext/util/error.h"
 #include "pipelines/calibration/calibration_report.h"
-#include "pipelines/stages/target_extractor.h"
-#include "tests/test_utils.h"
+#include "tests/pipelines/stages/live_test_setup.h"
 
 namespace fs = std::filesystem;
 
@@ -35,16 +34,8 @@ struct Fixture {
 
   Fixture() {
     truth = testing::RenderSet(dir, kSetYaml);
-    TargetExtractorOptions extract;
-    extract.database_path = (dir / "set.db").string();
-    extract.image_path = (dir / "set/images").string();
-    extract.reader.camera_model = "OPENCV";
-    extract.reader.single_camera = true;
-    extract.chessboard.cols = 9;
-    extract.chessboard.rows = 6;
-    extract.square_size_m = 0.03;
-    RunTargetExtractor(extract, NoProgress());
-    options.database_path = extract.database_path;
+    testing::ExtractBoard(dir / "set/images", dir / "set.db", false);
+    options.database_path = (dir / "set.db").string();
     options.output_path = (dir / "evaluation").string();
   }
 

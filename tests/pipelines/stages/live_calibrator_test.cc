@@ -15,7 +15,6 @@
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/stages/camera_calibrator.h"
 #include "pipelines/images/image_reader.h"
-#include "pipelines/stages/target_extractor.h"
 #include "tests/pipelines/stages/live_test_setup.h"
 
 namespace fs = std::filesystem;
@@ -61,17 +60,9 @@ TEST(LiveCalibrator, HandsFreeKeepsOneFramePerPauseAndMatchesTheBatchStages) {
   for (size_t p = 0; p < pauses.size(); ++p) EXPECT_EQ(kept_per_pause[p], 1) << "pause " << p;
 
   // The batch stages on the kept frames: the same corners, the same camera.
-  TargetExtractorOptions extract;
-  extract.database_path = (dir / "batch.db").string();
-  extract.image_path = (dir / "kept").string();
-  extract.reader.camera_model = "OPENCV";
-  extract.reader.single_camera = true;
-  extract.chessboard.cols = 9;
-  extract.chessboard.rows = 6;
-  extract.square_size_m = 0.03;
-  RunTargetExtractor(extract, NoProgress());
+  testing::ExtractBoard(dir / "kept", dir / "batch.db", false);
   const CameraCalibrationResult live = Calibrate((dir / "live.db").string(), dir / "out_live");
-  const CameraCalibrationResult batch = Calibrate(extract.database_path, dir / "out_batch");
+  const CameraCalibrationResult batch = Calibrate((dir / "batch.db").string(), dir / "out_batch");
   ASSERT_EQ(live.camera.params.size(), batch.camera.params.size());
   for (size_t k = 0; k < live.camera.params.size(); ++k) {
     EXPECT_NEAR(live.camera.params[k], batch.camera.params[k], 1e-9 * (1 + std::abs(batch.camera.params[k])));

@@ -15,7 +15,6 @@
 #include "pipelines/stages/camera_calibrator.h"
 #include "pipelines/stages/live_calibrator.h"
 #include "pipelines/stages/stereo_calibrator.h"
-#include "pipelines/stages/target_extractor.h"
 #include "tests/pipelines/stages/live_test_setup.h"
 
 namespace fs = std::filesystem;
@@ -26,20 +25,13 @@ namespace {
 // The batch stages on the kept frames: target_extractor (a camera per
 // folder), camera_calibrator per camera, stereo_calibrator refining both.
 StereoCalibrationResult BatchStereo(const testing::TempDir& dir) {
-  TargetExtractorOptions extract;
-  extract.database_path = (dir / "batch.db").string();
-  extract.image_path = (dir / "kept").string();
-  extract.reader.camera_model = "OPENCV";
-  extract.reader.single_camera_per_folder = true;
-  extract.chessboard.cols = 9;
-  extract.chessboard.rows = 6;
-  extract.square_size_m = 0.03;
-  RunTargetExtractor(extract, NoProgress());
-  Database database(extract.database_path, Database::OpenMode::kReadOnly);
+  const std::string batch_database = (dir / "batch.db").string();
+  testing::ExtractBoard(dir / "kept", batch_database, true);
+  Database database(batch_database, Database::OpenMode::kReadOnly);
   StereoCalibratorOptions stereo;
   for (const int camera : {1, 2}) {
     CameraCalibratorOptions calibrate;
-    calibrate.database_path = extract.database_path;
+    calibrate.database_path = batch_database;
     calibrate.camera_id = database.ReadImageWithName("cam" + std::to_string(camera) + "/live_0001.png")->camera_id;
     calibrate.output_path = (dir / ("batch_cam" + std::to_string(camera))).string();
     RunCameraCalibrator(calibrate, NoProgress());
@@ -47,7 +39,7 @@ StereoCalibrationResult BatchStereo(const testing::TempDir& dir) {
     (camera == 1 ? stereo.input_calibration1 : stereo.input_calibration2) =
         (fs::path(calibrate.output_path) / "calibration.yaml").string();
   }
-  stereo.database_path = extract.database_path;
+  stereo.database_path = batch_database;
   stereo.output_path = (dir / "batch_rig").string();
   stereo.stereo.refine_intrinsics = true;
   return RunStereoCalibrator(stereo, NoProgress());

@@ -1,6 +1,7 @@
-// What the live calibrator's tests share: a rendered hand-held trajectory
-// of a 9 x 6 chessboard before a 640 x 480 OPENCV camera, and the options
-// that calibrate it.
+// What the live calibrator's tests (and others on the same board) share: a
+// rendered hand-held trajectory of a 9 x 6 chessboard before a 640 x 480
+// OPENCV camera, the options that calibrate it, and target_extractor for
+// that board.
 #pragma once
 
 #include <yaml-cpp/yaml.h>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "pipelines/stages/live_calibrator.h"
+#include "pipelines/stages/target_extractor.h"
 #include "tests/test_utils.h"
 
 namespace portcal::testing {
@@ -44,6 +46,22 @@ inline std::vector<std::pair<int, int>> TrajectoryPauses(const std::filesystem::
     pauses.emplace_back(pause["first_frame"].as<int>(), pause["last_frame"].as<int>());
   }
   return pauses;
+}
+
+// target_extractor with the board above (OPENCV cameras): one camera for
+// all images, or one per folder (a rig's cam1/ and cam2/).
+inline void ExtractBoard(const std::filesystem::path& images, const std::filesystem::path& database,
+                         bool camera_per_folder) {
+  TargetExtractorOptions extract;
+  extract.database_path = database.string();
+  extract.image_path = images.string();
+  extract.reader.camera_model = "OPENCV";
+  extract.reader.single_camera = !camera_per_folder;
+  extract.reader.single_camera_per_folder = camera_per_folder;
+  extract.chessboard.cols = 9;
+  extract.chessboard.rows = 6;
+  extract.square_size_m = 0.03;
+  RunTargetExtractor(extract, NoProgress());
 }
 
 // Headless, the board and camera above, guidance over the rendered range.
