@@ -93,12 +93,18 @@ int HousingCalibratorCommand(int argc, char** argv) {
   HousingCalibratorOptions options;
   CommandLine cli("housing_calibrator",
                   "Calibrates a flat or dome port from the target observations of underwater "
-                  "views, the camera's in-air intrinsics given (--input_calibration, portcal's "
-                  "or calibmar's calibration.yaml) and fixed unless refined. The port's axis "
-                  "and magnitude are initialised from the data; thickness, radius and indices "
-                  "are the constants of --Housing.params. Writes calibration.yaml/.txt.");
+                  "views. With the same camera's in-air views (--in_air_database_path) the "
+                  "intrinsics are refined jointly, so the housing's standard deviations include "
+                  "their uncertainty; else the in-air intrinsics are given (--input_calibration, "
+                  "portcal's or calibmar's calibration.yaml) and fixed unless refined. The port's "
+                  "axis and magnitude are initialised from the data; thickness, radius and "
+                  "indices are the constants of --Housing.params. Writes calibration.yaml/.txt.");
   cli.AddRequired("database_path", &options.database_path, "database with target observations");
-  cli.AddRequired("input_calibration", &options.input_calibration, "in-air calibration.yaml");
+  cli.Add("input_calibration", &options.input_calibration,
+          "in-air calibration.yaml (with --in_air_database_path: the start, optional)");
+  cli.Add("in_air_database_path", &options.in_air_database_path,
+          "database with the camera's in-air target observations: joint solve");
+  cli.Add("in_air_camera_id", &options.in_air_camera_id, "camera of the in-air database (-1: the only one)");
   cli.AddRequired("output_path", &options.output_path, "directory for the reports");
   cli.AddHousing(&options.housing, "the port to calibrate (required; the parameters: its constants and a "
                                    "guess for what is estimated)");
@@ -107,6 +113,8 @@ int HousingCalibratorCommand(int argc, char** argv) {
           "refine the intrinsics jointly (0 | 1)");
   cli.Add("Calibration.initialize_from_data", &options.calibration.initialize_from_data,
           "initialise the port from the views (0: from --Housing.params)");
+  cli.Add("Calibration.estimate_board_warp", &options.calibration.estimate_board_warp,
+          "fit the board's sag, shared with the in-air views of the same board (0 | 1)");
   cli.Add("update_database", &options.update_database,
           "write the housing and the intrinsics into the database, for the next stage (0 | 1)");
   cli.Add("num_threads", &options.calibration.num_threads, "threads");

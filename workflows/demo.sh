@@ -4,8 +4,10 @@
 #   1. portcal synthesize: an in-air chessboard set and an underwater set of
 #      the same camera behind a decentred dome port (8 views each, 960 x 540).
 #   2. target_extractor + camera_calibrator on the in-air set: intrinsics.
-#   3. target_extractor + housing_calibrator on the underwater set: the dome's
-#      decentering, the intrinsics fixed.
+#   3. target_extractor + housing_calibrator on the underwater set, solved
+#      jointly with the in-air views: the dome's decentering, the intrinsics
+#      refined by both sets, so that the dome's standard deviations include
+#      the intrinsics' uncertainty.
 #   4. The estimates next to the truth.
 # Everything it makes stays in demo_output/ (replaced on the next run), the
 # reports among it; a run that fails leaves the previous demo_output/ as it
@@ -51,12 +53,14 @@ sed -n '/^  parameter /,/^RMS/p' "$work/air_calibration/calibration.txt"
 echo "-- truth: f 648.68, cx 480, cy 270, k1 -0.08, k2 0.01"
 
 echo
-echo "== 3. Under water: target_extractor, housing_calibrator (DOMEPORT; radius, thickness, indices given)"
+echo "== 3. Under water: target_extractor, housing_calibrator (DOMEPORT; radius, thickness, indices given),"
+echo "      jointly with the in-air views"
 "$portcal" target_extractor --log_level warn --database_path "$work/dome.db" \
   --image_path "$work/dome/images" --ImageReader.camera_model RADIAL \
   --ImageReader.single_camera 1 --Target.cols 10 --Target.rows 7 --Target.square_size 0.02
 "$portcal" housing_calibrator --log_level warn --database_path "$work/dome.db" \
-  --input_calibration "$work/air_calibration/calibration.yaml" --output_path "$work/dome_calibration" \
+  --input_calibration "$work/air_calibration/calibration.yaml" --in_air_database_path "$work/air.db" \
+  --output_path "$work/dome_calibration" \
   --Housing.model DOMEPORT --Housing.params 0,0,0,0.05,0.006,1.0,1.473,1.334
 sed -n '/^Housing/,/^RMS/p' "$work/dome_calibration/calibration.txt"
 echo "-- truth: Cx 0.004, Cy -0.002, Cz 0.006 m"

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include "colmap_ext/cost/autodiff_functor.h"
+#include "colmap_ext/cost/board_warp.h"
 
 namespace portcal {
 
@@ -23,8 +24,7 @@ struct BoardReprojectionError
     const Eigen::Map<const Eigen::Quaternion<T>> rotation(cam_from_target);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> translation(cam_from_target + 4);
     Eigen::Matrix<T, 3, 1> point = point_.cast<T>();
-    point.z() += warp[0] * (1.0 - warp_uv_.x() * warp_uv_.x()) +
-                 warp[1] * (1.0 - warp_uv_.y() * warp_uv_.y());
+    point.z() += BoardSag(warp, warp_uv_);
     const Eigen::Matrix<T, 3, 1> in_cam = rotation * point + translation;
     T x, y;
     if (!CameraModel::ImgFromCam(intrinsics, in_cam.x(), in_cam.y(), in_cam.z(), &x, &y)) {

@@ -335,6 +335,30 @@ std::string BoardWarpNote(const CameraCalibrationResult& warped, const CameraCal
   return note.str();
 }
 
+namespace {
+
+// Which uncertainty the housing's standard deviations give.
+std::string HousingUncertaintyNote(const HousingCalibrationResult& result) {
+  std::ostringstream note;
+  if (!result.in_air_views.empty()) {
+    note << "joint solve with " << result.in_air_views.size() << " in-air views (RMS "
+         << FormatFixed(result.in_air_rms_px, 3) << " px, residual sigma " << FormatFixed(result.in_air_residual_sigma_px, 3)
+         << " px; each set weighted by its own): the intrinsics are refined by both sets, and the housing's "
+            "standard deviations include their uncertainty";
+  } else if (std::any_of(result.camera_std_dev.begin(), result.camera_std_dev.end(),
+                         [](double s) { return s != 0; })) {
+    note << "intrinsics refined from the underwater views alone; the standard deviations include their "
+            "uncertainty";
+  } else {
+    note << "the in-air intrinsics are taken as exact: the housing's standard deviations leave out their "
+            "uncertainty and understate its error (give the in-air views, --in_air_database_path, for a joint "
+            "solve)";
+  }
+  return note.str();
+}
+
+}  // namespace
+
 CalibrationReport ReportOf(const HousingCalibrationResult& result, const std::string& target) {
   CalibrationReport report;
   report.camera = result.camera;
@@ -346,6 +370,11 @@ CalibrationReport ReportOf(const HousingCalibrationResult& result, const std::st
   report.num_points = result.num_points;
   report.views = result.views;
   report.target_description = target;
+  if (result.board_warp_estimated) {
+    report.board_warp = result.board_warp;
+    report.board_warp_std_dev = result.board_warp_std_dev;
+  }
+  report.notes.push_back(HousingUncertaintyNote(result));
   std::vector<std::string> undetermined = UndeterminedNames(result.camera_std_dev, result.camera.ParamsInfo());
   for (const std::string& name : UndeterminedNames(result.housing_std_dev, result.housing.ParamsInfo())) {
     undetermined.push_back(name);

@@ -8,6 +8,7 @@
 
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/cost/board_reprojection_error.h"
+#include "colmap_ext/cost/board_warp.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/string_utils.h"
@@ -67,14 +68,6 @@ struct Solution {
   int num_free = 0;
 };
 
-// A board point's coordinates scaled to [-1, 1] over the board's extent
-// (x min, x max, y min, y max): where the board warp's sag is evaluated.
-Eigen::Vector2d WarpUv(const Eigen::Vector3d& p, const Eigen::Vector4d& board_extent) {
-  return Eigen::Vector2d(
-      2 * (p.x() - board_extent[0]) / std::max(1e-12, board_extent[1] - board_extent[0]) - 1,
-      2 * (p.y() - board_extent[2]) / std::max(1e-12, board_extent[3] - board_extent[2]) - 1);
-}
-
 void AddBoardResiduals(const std::vector<const CalibrationView*>& views, int model_id,
                        const Eigen::Vector4d& board_extent, Solution* s, ceres::Problem* problem) {
   VisitCameraModel(model_id, [&](auto model) {
@@ -83,7 +76,7 @@ void AddBoardResiduals(const std::vector<const CalibrationView*>& views, int mod
       for (size_t i = 0; i < views[v]->pixels.size(); ++i) {
         const Eigen::Vector3d& p = views[v]->points_in_target[i];
         problem->AddResidualBlock(
-            BoardReprojectionError<Model>::Create(p, WarpUv(p, board_extent), views[v]->pixels[i]), nullptr,
+            BoardReprojectionError<Model>::Create(p, BoardWarpUv(p, board_extent), views[v]->pixels[i]), nullptr,
             s->poses[v].data(), s->intrinsics.data(), s->warp.data());
       }
     }
@@ -102,8 +95,7 @@ void ComputeViewRms(const std::vector<const CalibrationView*>& views, int model_
       for (size_t i = 0; i < views[v]->pixels.size(); ++i) {
         const Eigen::Quaterniond q(s->poses[v][3], s->poses[v][0], s->poses[v][1], s->poses[v][2]);
         Eigen::Vector3d p = views[v]->points_in_target[i];
-        const Eigen::Vector2d uv = WarpUv(p, board_extent);
-        p.z() += s->warp.x() * (1 - uv.x() * uv.x()) + s->warp.y() * (1 - uv.y() * uv.y());
+        p.z() += BoardSag(s->warp.data(), BoardWarpUv(p, board_extent));
         const Eigen::Vector3d in_cam = q * p + Eigen::Vector3d(s->poses[v][4], s->poses[v][5], s->poses[v][6]);
         double x = 0, y = 0;
         if (!Model::ImgFromCam(s->intrinsics.data(), in_cam.x(), in_cam.y(), in_cam.z(), &x, &y)) {

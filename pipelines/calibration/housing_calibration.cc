@@ -3,10 +3,14 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Dense>
+#include <array>
 #include <cmath>
+#include <memory>
 
 #include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/cost/board_reprojection_error.h"
 #include "colmap_ext/cost/board_through_port_error.h"
+#include "colmap_ext/cost/board_warp.h"
 #include "colmap_ext/housing/housing_manifold.h"
 #include "colmap_ext/housing/housing_models.h"
 #include "colmap_ext/housing/port_projection.h"
@@ -82,55 +86,152 @@ Eigen::Vector3d EstimateAxis(const std::vector<CalibrationView>& views, const Ca
 struct State {
   std::vector<double> intrinsics;
   Housing housing;  // its params are the port block
-  std::vector<Pose> poses;
+  std::vector<Pose> poses;         // the underwater views'
+  std::vector<Pose> in_air_poses;  // the in-air views'
+  std::array<double, 2> warp = {0, 0};         // the underwater board's
+  std::array<double, 2> in_air_warp = {0, 0};  // a different in-air board's
+  // 1 / residual variance of each set (px^-2): the joint solve's weights.
+  double water_weight = 1, air_weight = 1;
 };
 
+// The views and what the solve does with them.
+struct Inputs {
+  const std::vector<CalibrationView>& views;
+  const InAirViews* in_air;  // null: none
+  int camera_model;
+  Eigen::Vector4d board_extent;
+  const HousingCalibrationSettings& settings;
+  bool RefinesIntrinsics() const { return settings.refine_intrinsics || in_air != nullptr; }
+};
+
+// A Ceres problem with its residual blocks per view (to weigh each set
+// and measure each view) and the weights' losses, which outlive it.
+struct JointProblem {
+  std::unique_ptr<ceres::LossFunction> water_loss, air_loss;
+  ceres::Problem problem{LossesNotOwned()};
+  std::vector<std::vector<ceres::ResidualBlockId>> water_ids, air_ids;
+
+  static ceres::Problem::Options LossesNotOwned() {
+    ceres::Problem::Options options;
+    options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    return options;
+  }
+};
+
+Eigen::Vector4d BoardExtent(const std::vector<CalibrationView>& views, const InAirViews* in_air) {
+  Eigen::Vector4d extent(1e300, -1e300, 1e300, -1e300);
+  const auto add = [&](const std::vector<CalibrationView>& set) {
+    for (const CalibrationView& view : set) {
+      for (const Eigen::Vector3d& p : view.points_in_target) {
+        extent = Eigen::Vector4d(std::min(extent[0], p.x()), std::max(extent[1], p.x()),
+                                 std::min(extent[2], p.y()), std::max(extent[3], p.y()));
+      }
+    }
+  };
+  add(views);
+  if (in_air != nullptr && in_air->same_board) add(in_air->views);
+  return extent;
+}
+
+// A weight as a loss: rho(s) = w s, so the covariance sees the weighted
+// Jacobian too.
+ceres::LossFunction* WeightLoss(double weight, std::unique_ptr<ceres::LossFunction>* holder) {
+  if (weight == 1) return nullptr;
+  holder->reset(new ceres::ScaledLoss(nullptr, weight, ceres::DO_NOT_TAKE_OWNERSHIP));
+  return holder->get();
+}
+
 template <PortErrorKind kError>
-void AddResiduals(const std::vector<CalibrationView>& views, int camera_model, State* state,
-                  ceres::Problem* problem) {
-  VisitCameraModel(camera_model, [&](auto camera_tag) {
+void AddWaterResiduals(const Inputs& in, State* state, JointProblem* jp) {
+  ceres::LossFunction* loss = WeightLoss(state->water_weight, &jp->water_loss);
+  VisitCameraModel(in.camera_model, [&](auto camera_tag) {
     using CameraModel = decltype(camera_tag);
     VisitHousingModel(state->housing.model_id, [&](auto port_tag) {
-      using Port = decltype(port_tag);
-      using Functor = BoardThroughPortError<CameraModel, Port, kError>;
-      for (size_t v = 0; v < views.size(); ++v) {
-        for (size_t i = 0; i < views[v].pixels.size(); ++i) {
-          problem->AddResidualBlock(
-              Functor::Create(views[v].points_in_target[i], views[v].pixels[i]), nullptr,
-              state->poses[v].data(), state->intrinsics.data(), state->housing.params.data());
+      using Functor = WarpedBoardThroughPortError<CameraModel, decltype(port_tag), kError>;
+      for (size_t v = 0; v < in.views.size(); ++v) {
+        const CalibrationView& view = in.views[v];
+        jp->water_ids.emplace_back();
+        for (size_t i = 0; i < view.pixels.size(); ++i) {
+          const Eigen::Vector3d& p = view.points_in_target[i];
+          jp->water_ids.back().push_back(jp->problem.AddResidualBlock(
+              Functor::Create(p, BoardWarpUv(p, in.board_extent), view.pixels[i]), loss,
+              state->poses[v].data(), state->intrinsics.data(), state->housing.params.data(),
+              state->warp.data()));
         }
       }
     });
   });
 }
 
+void AddAirResiduals(const Inputs& in, State* state, JointProblem* jp) {
+  ceres::LossFunction* loss = WeightLoss(state->air_weight, &jp->air_loss);
+  double* warp = in.in_air->same_board ? state->warp.data() : state->in_air_warp.data();
+  VisitCameraModel(in.camera_model, [&](auto camera_tag) {
+    using Functor = BoardReprojectionError<decltype(camera_tag)>;
+    for (size_t v = 0; v < in.in_air->views.size(); ++v) {
+      const CalibrationView& view = in.in_air->views[v];
+      jp->air_ids.emplace_back();
+      for (size_t i = 0; i < view.pixels.size(); ++i) {
+        const Eigen::Vector3d& p = view.points_in_target[i];
+        jp->air_ids.back().push_back(jp->problem.AddResidualBlock(
+            Functor::Create(p, BoardWarpUv(p, in.board_extent), view.pixels[i]), loss,
+            state->in_air_poses[v].data(), state->intrinsics.data(), warp));
+      }
+    }
+  });
+}
+
+// What each block does in a solve: poses free; the housing refined unless
+// `poses_only`; the intrinsics and the warp as `in` says, in the exact
+// solve only (the virtual-camera error back-projects through the
+// intrinsics, which is ill-conditioned far from the solution).
+void SetBlocks(const Inputs& in, bool exact, bool poses_only, State* state, ceres::Problem* problem) {
+  for (Pose& pose : state->poses) problem->SetManifold(pose.data(), PoseManifold());
+  for (Pose& pose : state->in_air_poses) {
+    if (problem->HasParameterBlock(pose.data())) problem->SetManifold(pose.data(), PoseManifold());
+  }
+  const bool intrinsics_free = exact && !poses_only && in.RefinesIntrinsics();
+  const std::vector<int> fixed = in.in_air != nullptr ? in.in_air->fixed_params : std::vector<int>{};
+  if (!intrinsics_free || fixed.size() == state->intrinsics.size()) {
+    problem->SetParameterBlockConstant(state->intrinsics.data());
+  } else if (!fixed.empty()) {
+    problem->SetManifold(state->intrinsics.data(),
+                         new ceres::SubsetManifold(static_cast<int>(state->intrinsics.size()), fixed));
+  }
+  if (poses_only) {
+    problem->SetParameterBlockConstant(state->housing.params.data());
+  } else {
+    SetHousingRefinement(state->housing, true, state->housing.params.data(), problem);
+  }
+  const bool warp_free = exact && !poses_only && in.settings.estimate_board_warp;
+  for (double* warp : {state->warp.data(), state->in_air_warp.data()}) {
+    if (problem->HasParameterBlock(warp) && !warp_free) problem->SetParameterBlockConstant(warp);
+  }
+}
+
 // Solves poses only (housing and intrinsics fixed); returns the final cost.
-double PoseOnlyCost(const std::vector<CalibrationView>& views, int camera_model, State* state,
-                    int num_threads) {
-  ceres::Problem problem;
-  AddResiduals<PortErrorKind::kReprojection>(views, camera_model, state, &problem);
-  for (Pose& pose : state->poses) problem.SetManifold(pose.data(), PoseManifold());
-  problem.SetParameterBlockConstant(state->intrinsics.data());
-  problem.SetParameterBlockConstant(state->housing.params.data());
+double PoseOnlyCost(const Inputs& in, State* state) {
+  JointProblem jp;
+  AddWaterResiduals<PortErrorKind::kReprojection>(in, state, &jp);
+  SetBlocks(in, true, true, state, &jp.problem);
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_SCHUR;
   options.max_num_iterations = 30;
-  options.num_threads = num_threads;
+  options.num_threads = in.settings.num_threads;
   ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
+  ceres::Solve(options, &jp.problem, &summary);
   return summary.IsSolutionUsable() ? summary.final_cost : 1e300;
 }
 
 // The start with the smallest pose-only residual among the model's
 // candidates for the refraction axis the views show.
-State BestStart(const std::vector<CalibrationView>& views, const Camera& camera, const State& state,
-                const Eigen::Vector3d& axis, int num_threads) {
+State BestStart(const Inputs& in, const State& state, const Eigen::Vector3d& axis) {
   double best_cost = 1e300;
   State best = state;
   for (const Housing& candidate : state.housing.StartCandidates(axis)) {
     State trial = state;
     trial.housing = candidate;
-    const double cost = PoseOnlyCost(views, camera.model_id, &trial, num_threads);
+    const double cost = PoseOnlyCost(in, &trial);
     if (cost < best_cost) {
       best_cost = cost;
       best = trial;
@@ -139,43 +240,103 @@ State BestStart(const std::vector<CalibrationView>& views, const Camera& camera,
   return best;
 }
 
-// Joint solves: virtual-camera error first, then the exact reprojection.
-// Returns the final sum of squares; `final_problem` keeps the exact one for
-// the covariance.
-double SolveJointly(const std::vector<CalibrationView>& views, int camera_model,
-                    const HousingCalibrationSettings& settings, State* state, ceres::Problem* final_problem) {
-  double sum_squares = 0;
-  for (const PortErrorKind error : {PortErrorKind::kVirtualCamera, PortErrorKind::kReprojection}) {
-    ceres::Problem local;
-    ceres::Problem& problem = error == PortErrorKind::kReprojection ? *final_problem : local;
-    if (error == PortErrorKind::kVirtualCamera) {
-      AddResiduals<PortErrorKind::kVirtualCamera>(views, camera_model, state, &problem);
-    } else {
-      AddResiduals<PortErrorKind::kReprojection>(views, camera_model, state, &problem);
-    }
-    for (Pose& pose : state->poses) problem.SetManifold(pose.data(), PoseManifold());
-    // The intrinsics join only the final, exact solve: the virtual-camera
-    // error back-projects through them, which is ill-conditioned far from
-    // the solution.
-    if (!settings.refine_intrinsics || error == PortErrorKind::kVirtualCamera) {
-      problem.SetParameterBlockConstant(state->intrinsics.data());
-    }
-    SetHousingRefinement(state->housing, true, state->housing.params.data(), &problem);
-    sum_squares = 2 * SolveCalibration(&problem, settings.max_num_iterations, settings.num_threads,
-                                       "housing calibration")
-                          .final_cost;
+// Sum of squared residuals (unweighted) over `ids`; per view when asked.
+double SumSquares(ceres::Problem* problem, const std::vector<std::vector<ceres::ResidualBlockId>>& ids,
+                  std::vector<double>* per_view_rms = nullptr) {
+  double total = 0;
+  for (const auto& view_ids : ids) {
+    ceres::Problem::EvaluateOptions options;
+    options.residual_blocks = view_ids;
+    options.apply_loss_function = false;
+    double cost = 0;
+    problem->Evaluate(options, &cost, nullptr, nullptr, nullptr);
+    total += 2 * cost;
+    if (per_view_rms != nullptr) per_view_rms->push_back(std::sqrt(2 * cost / std::max<size_t>(1, view_ids.size())));
   }
-  return sum_squares;
+  return total;
 }
 
-// Standard deviations from the covariance scaled by the residual variance;
-// -1 where the covariance is rank deficient (undetermined).
-void FillStdDevs(const HousingCalibrationSettings& settings, double variance, State* state,
-                 ceres::Problem* problem, HousingCalibrationResult* result) {
-  ceres::Covariance covariance(CalibrationCovarianceOptions(settings.num_threads));
+int NumPoints(const std::vector<CalibrationView>& views) {
+  int n = 0;
+  for (const CalibrationView& view : views) n += static_cast<int>(view.pixels.size());
+  return n;
+}
+
+// Each set's residual variance (px^2), its own poses (and the housing, for
+// the underwater set) taken from its degrees of freedom.
+void WeighBySetVariance(const Inputs& in, JointProblem* jp, State* state) {
+  const double water = SumSquares(&jp->problem, jp->water_ids) /
+                       std::max(1.0, 2.0 * NumPoints(in.views) - 6.0 * in.views.size() -
+                                         static_cast<double>(state->housing.Refinement().Refined().size()));
+  const double air = SumSquares(&jp->problem, jp->air_ids) /
+                     std::max(1.0, 2.0 * NumPoints(in.in_air->views) - 6.0 * in.in_air->views.size());
+  if (!(water > 0) || !(air > 0)) throw NumericalError("housing calibration: a residual variance of zero");
+  state->water_weight = 1 / water;
+  state->air_weight = 1 / air;
+  LOG(INFO) << "housing calibration: residual sigma " << std::sqrt(water) << " px under water, "
+            << std::sqrt(air) << " px in air; each set weighted by it";
+}
+
+std::unique_ptr<JointProblem> SolveExactly(const Inputs& in, State* state) {
+  auto jp = std::make_unique<JointProblem>();
+  AddWaterResiduals<PortErrorKind::kReprojection>(in, state, jp.get());
+  if (in.in_air != nullptr) AddAirResiduals(in, state, jp.get());
+  SetBlocks(in, true, false, state, &jp->problem);
+  SolveCalibration(&jp->problem, in.settings.max_num_iterations, in.settings.num_threads, "housing calibration");
+  return jp;
+}
+
+// Joint solves: virtual-camera error first (under water, intrinsics held),
+// then the exact reprojection (with the in-air views: once, then again
+// with each set weighted by its residual variance). Returns the final
+// problem, for the covariance and the residuals.
+std::unique_ptr<JointProblem> SolveJointly(const Inputs& in, State* state) {
+  {
+    JointProblem jp;
+    AddWaterResiduals<PortErrorKind::kVirtualCamera>(in, state, &jp);
+    SetBlocks(in, false, false, state, &jp.problem);
+    SolveCalibration(&jp.problem, in.settings.max_num_iterations, in.settings.num_threads, "housing calibration");
+  }
+  std::unique_ptr<JointProblem> jp = SolveExactly(in, state);
+  if (in.in_air == nullptr) return jp;
+  WeighBySetVariance(in, jp.get(), state);
+  jp.reset();
+  return SolveExactly(in, state);
+}
+
+// The free parameters of the final solve: the poses, the housing's refined
+// ones (a unit vector has two), the intrinsics when refined, the warps.
+int NumFreeParameters(const Inputs& in, const State& state) {
+  const HousingRefinement refinement = state.housing.Refinement();
+  int num_free = 6 * static_cast<int>(state.poses.size() + state.in_air_poses.size()) +
+                 (refinement.orientation.empty() ? 0 : 2) + static_cast<int>(refinement.position.size());
+  if (in.RefinesIntrinsics()) {
+    num_free += static_cast<int>(state.intrinsics.size()) -
+                static_cast<int>(in.in_air != nullptr ? in.in_air->fixed_params.size() : 0);
+  }
+  if (in.settings.estimate_board_warp) num_free += (in.in_air != nullptr && !in.in_air->same_board) ? 4 : 2;
+  return num_free;
+}
+
+std::vector<double> StdDevsOf(ceres::Covariance* covariance, const double* block, int size, double variance) {
+  std::vector<double> c(static_cast<size_t>(size * size));
+  covariance->GetCovarianceBlock(block, block, c.data());
+  std::vector<double> std_dev(static_cast<size_t>(size));
+  for (int i = 0; i < size; ++i) {
+    std_dev[static_cast<size_t>(i)] = std::sqrt(std::max(0.0, c[static_cast<size_t>(i * size + i)] * variance));
+  }
+  return std_dev;
+}
+
+// Standard deviations from the covariance scaled by the (weighted)
+// residual variance; -1 where the covariance is rank deficient.
+void FillStdDevs(const Inputs& in, double variance, State* state, ceres::Problem* problem,
+                 HousingCalibrationResult* result) {
+  ceres::Covariance covariance(CalibrationCovarianceOptions(in.settings.num_threads));
   double* port = state->housing.params.data();
   std::vector<std::pair<const double*, const double*>> blocks = {{port, port}};
-  if (settings.refine_intrinsics) blocks.emplace_back(state->intrinsics.data(), state->intrinsics.data());
+  if (in.RefinesIntrinsics()) blocks.emplace_back(state->intrinsics.data(), state->intrinsics.data());
+  if (in.settings.estimate_board_warp) blocks.emplace_back(state->warp.data(), state->warp.data());
   const int m = static_cast<int>(state->housing.params.size());
   const int n = static_cast<int>(state->intrinsics.size());
   result->housing_std_dev.assign(static_cast<size_t>(m), 0.0);
@@ -187,78 +348,91 @@ void FillStdDevs(const HousingCalibrationSettings& settings, double variance, St
     LOG(WARNING) << "housing calibration: the covariance is rank deficient (parameters not "
                     "separable from these views); standard deviations undetermined";
     for (int k : refined) result->housing_std_dev[static_cast<size_t>(k)] = -1;
-    if (settings.refine_intrinsics) std::fill(result->camera_std_dev.begin(), result->camera_std_dev.end(), -1.0);
+    if (in.RefinesIntrinsics()) std::fill(result->camera_std_dev.begin(), result->camera_std_dev.end(), -1.0);
     return;
   }
-  std::vector<double> c(static_cast<size_t>(m * m));
-  covariance.GetCovarianceBlock(port, port, c.data());
-  for (int k : refined) {
-    result->housing_std_dev[static_cast<size_t>(k)] = std::sqrt(std::max(0.0, c[static_cast<size_t>(k * m + k)] * variance));
+  const std::vector<double> housing = StdDevsOf(&covariance, port, m, variance);
+  for (int k : refined) result->housing_std_dev[static_cast<size_t>(k)] = housing[static_cast<size_t>(k)];
+  if (in.RefinesIntrinsics()) result->camera_std_dev = StdDevsOf(&covariance, state->intrinsics.data(), n, variance);
+  if (in.settings.estimate_board_warp) {
+    const std::vector<double> warp = StdDevsOf(&covariance, state->warp.data(), 2, variance);
+    result->board_warp_std_dev = Eigen::Vector2d(warp[0], warp[1]);
   }
-  if (settings.refine_intrinsics) {
-    std::vector<double> k(static_cast<size_t>(n * n));
-    covariance.GetCovarianceBlock(state->intrinsics.data(), state->intrinsics.data(), k.data());
-    for (int i = 0; i < n; ++i) {
-      result->camera_std_dev[static_cast<size_t>(i)] = std::sqrt(std::max(0.0, k[static_cast<size_t>(i * n + i)] * variance));
-    }
+}
+
+std::vector<CalibratedView> ViewsOf(const std::vector<CalibrationView>& views, const std::vector<Pose>& poses,
+                                    const std::vector<double>& rms) {
+  std::vector<CalibratedView> out;
+  for (size_t v = 0; v < views.size(); ++v) {
+    CalibratedView view;
+    view.image_name = views[v].image_name;
+    view.num_points = static_cast<int>(views[v].pixels.size());
+    view.cam_from_target = FromPose(poses[v]);
+    view.rms_px = rms[v];
+    out.push_back(view);
   }
+  return out;
+}
+
+// The result at the solution: RMS and residual sigma of each set, the
+// standard deviations, the per-view tables.
+HousingCalibrationResult ResultOf(const Inputs& in, const Camera& camera, State* state, JointProblem* jp) {
+  HousingCalibrationResult result;
+  std::vector<double> water_rms, air_rms;
+  const double water = SumSquares(&jp->problem, jp->water_ids, &water_rms);
+  const double air = SumSquares(&jp->problem, jp->air_ids, &air_rms);
+  const int num_points = NumPoints(in.views);
+  const int num_air_points = in.in_air != nullptr ? NumPoints(in.in_air->views) : 0;
+  const double dof = 2.0 * (num_points + num_air_points) - NumFreeParameters(in, *state);
+  // Weighted: ~1 when each set's weight is its residual variance.
+  const double variance = dof > 0 ? (state->water_weight * water + state->air_weight * air) / dof : 0;
+  FillStdDevs(in, variance, state, &jp->problem, &result);
+  result.housing = state->housing;
+  result.camera = camera;
+  result.camera.params = state->intrinsics;
+  result.num_points = num_points;
+  result.overall_rms_px = std::sqrt(water / std::max(1, num_points));
+  result.residual_sigma_px = std::sqrt(variance / state->water_weight);
+  result.views = ViewsOf(in.views, state->poses, water_rms);
+  result.board_warp_estimated = in.settings.estimate_board_warp;
+  result.board_warp = Eigen::Vector2d(state->warp[0], state->warp[1]);
+  if (in.in_air != nullptr) {
+    result.in_air_views = ViewsOf(in.in_air->views, state->in_air_poses, air_rms);
+    result.in_air_rms_px = std::sqrt(air / std::max(1, num_air_points));
+    result.in_air_residual_sigma_px = std::sqrt(variance / state->air_weight);
+  }
+  return result;
 }
 
 }  // namespace
 
 HousingCalibrationResult CalibrateHousing(const std::vector<CalibrationView>& views,
                                           const Camera& camera, const Housing& housing,
-                                          const HousingCalibrationSettings& settings) {
+                                          const HousingCalibrationSettings& settings, const InAirViews* in_air) {
   settings.Check();
   camera.Validate("camera");
   housing.Validate("housing");
   if (views.size() < 2) throw NumericalError("housing calibration needs at least 2 views");
+  if (in_air != nullptr && in_air->views.empty()) throw NumericalError("housing calibration: no in-air views");
+  const Inputs in{views, in_air, camera.model_id, BoardExtent(views, in_air), settings};
   State state;
   state.intrinsics = camera.params;
   state.housing = housing;
   state.poses = InitialPoses(views, camera);
+  if (in_air != nullptr) state.in_air_poses = InitialPoses(in_air->views, camera);
 
-  HousingCalibrationResult result;
-  result.initial_axis = EstimateAxis(views, camera);
+  const Eigen::Vector3d axis = EstimateAxis(views, camera);
   if (settings.initialize_from_data) {
-    state = BestStart(views, camera, state, result.initial_axis, settings.num_threads);
-    LOG(INFO) << "housing_calibrator: axis from the views " << result.initial_axis.transpose() << ", start "
+    state = BestStart(in, state, axis);
+    LOG(INFO) << "housing_calibrator: axis from the views " << axis.transpose() << ", start "
               << Eigen::Map<const Eigen::VectorXd>(state.housing.params.data(),
                                                    static_cast<Eigen::Index>(state.housing.params.size()))
                      .transpose();
   }
-  ceres::Problem final_problem;
-  const double sum_squares = SolveJointly(views, camera.model_id, settings, &state, &final_problem);
-  const Housing& calibrated = state.housing;
-  calibrated.Validate("calibrated housing");
-
-  // Free parameters: the poses, the housing's refined ones (a unit vector
-  // has two), the intrinsics when refined.
-  const HousingRefinement refinement = calibrated.Refinement();
-  const int num_free = 6 * static_cast<int>(views.size()) + (refinement.orientation.empty() ? 0 : 2) +
-                       static_cast<int>(refinement.position.size()) +
-                       (settings.refine_intrinsics ? static_cast<int>(camera.params.size()) : 0);
-  int num_points = 0;
-  for (const auto& view : views) num_points += static_cast<int>(view.pixels.size());
-  const double dof = 2.0 * num_points - num_free;
-  const double variance = dof > 0 ? sum_squares / dof : 0;
-  FillStdDevs(settings, variance, &state, &final_problem, &result);
-
-  result.housing = calibrated;
-  result.camera = camera;
-  result.camera.params = state.intrinsics;
-  result.num_points = num_points;
-  result.overall_rms_px = std::sqrt(sum_squares / std::max(1, num_points));
-  result.residual_sigma_px = dof > 0 ? std::sqrt(sum_squares / dof) : 0;
-  const HousedCamera housed{result.camera, calibrated};
-  for (size_t v = 0; v < views.size(); ++v) {
-    CalibratedView out;
-    out.image_name = views[v].image_name;
-    out.num_points = static_cast<int>(views[v].pixels.size());
-    out.cam_from_target = FromPose(state.poses[v]);
-    out.rms_px = ViewRms(views[v], housed, out.cam_from_target);
-    result.views.push_back(out);
-  }
+  const std::unique_ptr<JointProblem> jp = SolveJointly(in, &state);
+  state.housing.Validate("calibrated housing");
+  HousingCalibrationResult result = ResultOf(in, camera, &state, jp.get());
+  result.initial_axis = axis;
   return result;
 }
 

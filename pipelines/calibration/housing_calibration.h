@@ -14,6 +14,14 @@
 // virtual-camera error, then with the exact reprojection error, which gives
 // the reported RMS and, through the covariance scaled by the residual
 // variance, the standard deviations.
+//
+// With the camera's in-air views (InAirViews), the exact solve is joint:
+// the intrinsics are shared by both sets and refined by both, each set
+// weighted by its own residual variance, so the housing's standard
+// deviations include what the in-air calibration does not know. Without
+// them the intrinsics are taken as exact (or refined from the underwater
+// views alone), and the housing's standard deviations are smaller than its
+// errors whenever the intrinsics are not.
 #pragma once
 
 #include <vector>
@@ -27,9 +35,19 @@ namespace portcal {
 struct HousingCalibrationSettings {
   bool refine_intrinsics = false;  // jointly with the housing
   bool initialize_from_data = true;  // else start from the given parameters
+  // mrcal's board sag (board_warp.h), shared with the in-air views when
+  // they show the same board.
+  bool estimate_board_warp = false;
   int max_num_iterations = 200;
   int num_threads = 2;
   void Check() const;  // throws OptionError
+};
+
+// The camera's views in air (same lens, focus and zoom), solved jointly.
+struct InAirViews {
+  std::vector<CalibrationView> views;
+  bool same_board = true;         // the board warp is shared; else each has its own
+  std::vector<int> fixed_params;  // intrinsics held, as in the in-air calibration
 };
 
 struct HousingCalibrationResult {
@@ -44,12 +62,21 @@ struct HousingCalibrationResult {
   double residual_sigma_px = 0;
   int num_points = 0;
   std::vector<CalibratedView> views;
+  Eigen::Vector2d board_warp = Eigen::Vector2d::Zero();  // metres, when estimated
+  Eigen::Vector2d board_warp_std_dev = Eigen::Vector2d::Zero();
+  bool board_warp_estimated = false;
+  // The joint solve's in-air half (empty without InAirViews).
+  std::vector<CalibratedView> in_air_views;
+  double in_air_rms_px = 0;
+  double in_air_residual_sigma_px = 0;
 };
 
 // `housing` gives the model, the constants (thickness, radius, indices) and
-// the starting guess. Throws NumericalError when the solve fails.
+// the starting guess; `camera` the intrinsics (the start when refined).
+// Throws NumericalError when the solve fails.
 HousingCalibrationResult CalibrateHousing(const std::vector<CalibrationView>& views,
                                           const Camera& camera, const Housing& housing,
-                                          const HousingCalibrationSettings& settings);
+                                          const HousingCalibrationSettings& settings,
+                                          const InAirViews* in_air = nullptr);
 
 }  // namespace portcal

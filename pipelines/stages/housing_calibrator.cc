@@ -1,5 +1,7 @@
 #include "pipelines/stages/housing_calibrator.h"
 
+#include <optional>
+
 #include "colmap_ext/housing/housing_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
@@ -13,8 +15,9 @@ namespace portcal {
 
 void HousingCalibratorOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
-  if (input_calibration.empty()) {
-    throw OptionError("--input_calibration", "''", "the in-air calibration.yaml");
+  if (input_calibration.empty() && in_air_database_path.empty()) {
+    throw OptionError("--input_calibration", "''",
+                      "the in-air calibration.yaml, or the in-air views (--in_air_database_path)");
   }
   if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
   if (!housing) throw OptionError("--Housing.model", "''", "FLATPORT or DOMEPORT");
@@ -22,24 +25,72 @@ void HousingCalibratorOptions::Check() const {
   calibration.Check();
 }
 
+namespace {
+
+void CheckImageSize(const Camera& camera, const Camera& database_camera, const std::string& source,
+                    const std::string& database_path) {
+  if (database_camera.width != camera.width || database_camera.height != camera.height) {
+    throw InputError(source + ": calibrated for " + std::to_string(camera.width) + "x" +
+                     std::to_string(camera.height) + " images, " + database_path + "'s are " +
+                     std::to_string(database_camera.width) + "x" + std::to_string(database_camera.height));
+  }
+}
+
+// The in-air views of the joint solve and the intrinsics it starts from:
+// the given calibration's (its held parameters held), else a camera
+// calibration of the in-air views.
+InAirViews ReadInAirViews(const HousingCalibratorOptions& options, const std::string& underwater_target,
+                          const Camera& underwater_camera, std::optional<CalibrationReport>* start) {
+  Database database(options.in_air_database_path, Database::OpenMode::kReadOnly);
+  const TargetViews target_views = ReadTargetViews(&database);
+  const camera_t camera_id = ChooseCamera(target_views, options.in_air_camera_id, options.in_air_database_path);
+  InAirViews in_air;
+  in_air.views = target_views.by_camera.at(camera_id);
+  in_air.same_board = target_views.target == underwater_target;
+  const Camera database_camera = *database.ReadCamera(camera_id);
+  CheckImageSize(underwater_camera, database_camera, options.in_air_database_path, options.database_path);
+  if (start->has_value()) {
+    for (size_t i = 0; i < (*start)->parameters_std_dev.size(); ++i) {
+      if ((*start)->parameters_std_dev[i] == 0) in_air.fixed_params.push_back(static_cast<int>(i));
+    }
+  } else {
+    Camera initial = database_camera;
+    if (underwater_camera.model_id != database_camera.model_id) initial = underwater_camera;
+    CameraCalibrationSettings settings;
+    settings.estimate_board_warp = options.calibration.estimate_board_warp;
+    settings.num_threads = options.calibration.num_threads;
+    CalibrationReport report;
+    report.camera = CalibrateCamera(in_air.views, initial, settings).camera;
+    *start = report;
+  }
+  LOG(INFO) << "housing_calibrator: " << in_air.views.size() << " in-air views of "
+            << options.in_air_database_path << (in_air.same_board ? " (the same board)" : " (another board)")
+            << ", intrinsics refined jointly";
+  return in_air;
+}
+
+}  // namespace
+
 HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& options, ProgressSink& progress) {
   options.Check();
   const Housing& housing = *options.housing;
-  const CalibrationReport in_air = ReadCalibrationReport(options.input_calibration);
+  std::optional<CalibrationReport> start;
+  if (!options.input_calibration.empty()) start = ReadCalibrationReport(options.input_calibration);
   Database database(options.database_path,
                     options.update_database ? Database::OpenMode::kReadWrite : Database::OpenMode::kReadOnly);
   const TargetViews target_views = ReadTargetViews(&database);
   const camera_t camera_id = ChooseCamera(target_views, options.camera_id, options.database_path);
   const std::vector<CalibrationView>& views = target_views.by_camera.at(camera_id);
-  const std::optional<Camera> database_camera = database.ReadCamera(camera_id);
-  if (database_camera->width != in_air.camera.width || database_camera->height != in_air.camera.height) {
-    throw InputError(options.input_calibration + ": calibrated for " + std::to_string(in_air.camera.width) +
-                     "x" + std::to_string(in_air.camera.height) + " images, the database's are " +
-                     std::to_string(database_camera->width) + "x" + std::to_string(database_camera->height));
+  const Camera database_camera = *database.ReadCamera(camera_id);
+  if (start) CheckImageSize(start->camera, database_camera, options.input_calibration, options.database_path);
+  std::optional<InAirViews> in_air;
+  if (!options.in_air_database_path.empty()) {
+    in_air = ReadInAirViews(options, target_views.target, start ? start->camera : database_camera, &start);
   }
-  LOG(INFO) << "housing_calibrator: " << housing.ModelName() << ", camera " << in_air.camera.ModelName()
-            << " from " << options.input_calibration << ", " << views.size() << " views";
-  const HousingCalibrationResult result = CalibrateHousing(views, in_air.camera, housing, options.calibration);
+  LOG(INFO) << "housing_calibrator: " << housing.ModelName() << ", camera " << start->camera.ModelName() << ", "
+            << views.size() << " views";
+  const HousingCalibrationResult result =
+      CalibrateHousing(views, start->camera, housing, options.calibration, in_air ? &*in_air : nullptr);
 
   const CalibrationReport report = ReportOf(result, target_views.target);
   WriteCalibrationOutput(report, options.output_path, options.update_database ? &database : nullptr, camera_id);

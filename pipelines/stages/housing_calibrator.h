@@ -1,6 +1,8 @@
-// `portcal housing_calibrator`: the flat or dome port of a camera whose
-// in-air intrinsics are known (--input_calibration), from the target
-// observations of its underwater views; writes the reports.
+// `portcal housing_calibrator`: the flat or dome port of a camera from the
+// target observations of its underwater views, the in-air intrinsics given
+// (--input_calibration) or, better, solved jointly with the camera's in-air
+// views (--in_air_database_path), so that the housing's standard
+// deviations include the intrinsics' uncertainty; writes the reports.
 #pragma once
 
 #include <optional>
@@ -12,13 +14,28 @@
 
 namespace portcal {
 
+inline HousingCalibrationSettings HousingWithBoardWarp() {
+  HousingCalibrationSettings settings;
+  settings.estimate_board_warp = true;
+  return settings;
+}
+
 struct HousingCalibratorOptions {
   std::string database_path;
-  std::string input_calibration;  // calibration.yaml (portcal or calibmar)
+  // calibration.yaml (portcal or calibmar): the intrinsics, fixed unless
+  // refined; with in_air_database_path the start of the joint solve, its
+  // held parameters held ("" there: calibrated from the in-air views first).
+  std::string input_calibration;
+  // The same camera's in-air target observations (may be database_path,
+  // another camera of it): the intrinsics are refined jointly.
+  std::string in_air_database_path;
+  int in_air_camera_id = -1;
   std::string output_path;
   std::optional<Housing> housing;  // required: the constants and a guess
   int camera_id = -1;
-  HousingCalibrationSettings calibration;
+  // The board's sag fitted, as camera_calibrator does (one board, in air
+  // and under water).
+  HousingCalibrationSettings calibration = HousingWithBoardWarp();
   // Writes the housing (portcal_housings) and the intrinsics into the
   // database camera, so that the next stage starts from them.
   bool update_database = false;

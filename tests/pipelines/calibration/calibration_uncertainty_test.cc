@@ -1,7 +1,9 @@
 // Standard deviations that mean something: over 20 renders (40 for the
 // camera) with different seeds, (estimate - truth) / reported std dev must have an RMS between 0.7
 // and 1.4 for every estimated parameter — camera intrinsics, dome
-// decentering, flat-port normal and distance, stereo relative pose.
+// decentering, flat-port normal and distance (solved jointly with the
+// camera's in-air views, so that the intrinsics' uncertainty is in them),
+// stereo relative pose.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -100,64 +102,116 @@ render: {spp: 4, blur_sigma: 0.5, noise_sigma: 2.0}
   ExpectHonest({"f", "cx", "cy", "k1", "k2"}, z);
 }
 
-// The dome's decentering, the intrinsics given exactly.
-TEST(CalibrationUncertainty, DomeStdDevsAreHonestAcrossSeeds) {
+// A housing's set: the camera's in-air views and its underwater views
+// (rendered with seeds `seed` and `seed` + 500), extracted.
+struct HousingSets {
+  Rendered in_air, underwater;
+};
+
+HousingSets RenderHousingSets(const fs::path& dir, const std::string& underwater_config, int64_t seed,
+                              double square) {
+  std::string in_air_config = underwater_config;
+  const size_t housing = in_air_config.find("housing:");
+  in_air_config.replace(housing, in_air_config.find('\n', housing) - housing, "housing: null");
+  std::ofstream(dir / "air.yaml") << in_air_config;
+  std::ofstream(dir / "water.yaml") << underwater_config;
+  const std::string tag = std::to_string(seed);
+  return {RenderAndExtract(dir / "air.yaml", dir / ("air" + tag), seed, "SIMPLE_RADIAL", 8, 6, square),
+          RenderAndExtract(dir / "water.yaml", dir / ("water" + tag), seed + 500, "SIMPLE_RADIAL", 8, 6, square)};
+}
+
+// The housing solved jointly with the in-air views (intrinsics calibrated,
+// not given), the board's warp fitted, as housing_calibrator does with
+// --in_air_database_path. Also prints the z-scores of the same housing with
+// the in-air intrinsics held, which leave their uncertainty out.
+HousingCalibrationResult CalibrateJointly(const HousingSets& sets, const Housing& guess,
+                                          std::vector<double>* held_z = nullptr, const std::vector<int>& params = {}) {
+  const auto& in_air_views = sets.in_air.views.by_camera.begin()->second;
+  const auto& views = sets.underwater.views.by_camera.begin()->second;
+  const CameraCalibrationResult in_air = CalibrateCamera(
+      in_air_views, Camera::FromModelName("SIMPLE_RADIAL", 500, sets.in_air.truth.camera.width,
+                                          sets.in_air.truth.camera.height), {});
+  HousingCalibrationSettings settings;
+  settings.estimate_board_warp = true;
+  if (held_z != nullptr) {
+    const HousingCalibrationResult held = CalibrateHousing(views, in_air.camera, guess, settings);
+    for (int i : params) {
+      held_z->push_back((held.housing.params[i] - sets.underwater.truth.housing->params[i]) /
+                        held.housing_std_dev[i]);
+    }
+  }
+  const InAirViews joint{in_air_views, true, {}};
+  return CalibrateHousing(views, in_air.camera, guess, settings, &joint);
+}
+
+// The dome's decentering with its standard deviations from the joint solve.
+TEST(CalibrationUncertainty, DomeStdDevsIncludeTheInAirCalibration) {
   testing::TempDir dir;
-  std::ofstream(dir / "set.yaml") << R"(name: z_scores_dome
+  const std::string config = R"(name: z_scores_dome
 num_images: 10
-camera: {model: SIMPLE_RADIAL, width: 640, height: 480, params: [560.0, 320.0, 240.0, -0.05]}
+camera: {model: SIMPLE_RADIAL, width: 640, height: 480, params: [560.0, 323.0, 236.5, -0.05]}
 housing: {model: DOMEPORT, params: [0.006, -0.004, 0.008, 0.05, 0.006, 1.0, 1.473, 1.334]}
 target: {type: chessboard, cols: 8, rows: 6, square_size: 0.025, margin: 0.015}
 poses: {distance: [0.35, 0.8], tilt_max_deg: 45, roll_max_deg: 30}
-render: {spp: 4, noise_sigma: 2.0}
+render: {spp: 4, blur_sigma: 0.5, noise_sigma: 2.0}
 )";
-  std::vector<std::vector<double>> z(3);
+  std::vector<std::vector<double>> z(4);
+  std::vector<double> held_z;
   for (int seed = 0; seed < kNumSeeds; ++seed) {
-    const Rendered r = RenderAndExtract(dir / "set.yaml", dir / ("set" + std::to_string(seed)), 2000 + seed,
-                                        "SIMPLE_RADIAL", 8, 6, 0.025);
-    Housing guess = *r.truth.housing;
+    const HousingSets sets = RenderHousingSets(dir.path(), config, 2000 + seed, 0.025);
+    Housing guess = *sets.underwater.truth.housing;
     guess.params[0] = guess.params[1] = guess.params[2] = 0;
-    const HousingCalibrationResult result =
-        CalibrateHousing(r.views.by_camera.begin()->second, r.truth.camera, guess, {});
+    const HousingCalibrationResult result = CalibrateJointly(sets, guess, &held_z, {0, 1, 2});
     for (int i = 0; i < 3; ++i) {
       ASSERT_GT(result.housing_std_dev[i], 0);
-      z[i].push_back((result.housing.params[i] - r.truth.housing->params[i]) / result.housing_std_dev[i]);
+      z[i].push_back((result.housing.params[i] - sets.underwater.truth.housing->params[i]) /
+                     result.housing_std_dev[i]);
     }
+    z[3].push_back((result.camera.params[0] - sets.in_air.truth.camera.params[0]) / result.camera_std_dev[0]);
   }
-  ExpectHonest({"Cx", "Cy", "Cz"}, z);
+  ExpectHonest({"Cx", "Cy", "Cz", "f"}, z);
+  double sum = 0;
+  for (double v : held_z) sum += v * v;
+  std::cout << "z-score RMS of Cx, Cy, Cz with the in-air intrinsics held: " << std::sqrt(sum / held_z.size())
+            << "\n";
 }
 
 // The flat port's normal (Nx, Ny: to first order its tangent angles) and
-// distance.
-TEST(CalibrationUncertainty, FlatPortStdDevsAreHonestAcrossSeeds) {
+// distance, from the joint solve.
+TEST(CalibrationUncertainty, FlatPortStdDevsIncludeTheInAirCalibration) {
   testing::TempDir dir;
-  std::ofstream(dir / "set.yaml") << R"(name: z_scores_flat
+  const std::string config = R"(name: z_scores_flat
 num_images: 10
-camera: {model: SIMPLE_RADIAL, width: 640, height: 480, params: [500.0, 320.0, 240.0, -0.05]}
+camera: {model: SIMPLE_RADIAL, width: 640, height: 480, params: [500.0, 316.0, 243.0, -0.05]}
 housing: {model: FLATPORT, params: [0.0523360, -0.0348782, 0.9980203, 0.03, 0.012, 1.0, 1.49, 1.334]}
 target: {type: chessboard, cols: 8, rows: 6, square_size: 0.03, margin: 0.015}
 poses: {distance: [0.4, 1.0], tilt_max_deg: 45, roll_max_deg: 30}
-render: {spp: 4, noise_sigma: 2.0}
+render: {spp: 4, blur_sigma: 0.5, noise_sigma: 2.0}
 )";
-  std::vector<std::vector<double>> z(3);
+  std::vector<std::vector<double>> z(4);
+  std::vector<double> held_z;
   for (int seed = 0; seed < kNumSeeds; ++seed) {
-    const Rendered r = RenderAndExtract(dir / "set.yaml", dir / ("set" + std::to_string(seed)), 3000 + seed,
-                                        "SIMPLE_RADIAL", 8, 6, 0.03);
-    Housing guess = *r.truth.housing;
+    const HousingSets sets = RenderHousingSets(dir.path(), config, 3000 + seed, 0.03);
+    Housing guess = *sets.underwater.truth.housing;
     guess.params[0] = 0;
     guess.params[1] = 0;
     guess.params[2] = 1;
     guess.params[3] = 0.05;
-    const HousingCalibrationResult result =
-        CalibrateHousing(r.views.by_camera.begin()->second, r.truth.camera, guess, {});
+    const HousingCalibrationResult result = CalibrateJointly(sets, guess, &held_z, {0, 1, 3});
     const int params[] = {0, 1, 3};
     for (int k = 0; k < 3; ++k) {
       const int i = params[k];
       ASSERT_GT(result.housing_std_dev[i], 0);
-      z[k].push_back((result.housing.params[i] - r.truth.housing->params[i]) / result.housing_std_dev[i]);
+      z[k].push_back((result.housing.params[i] - sets.underwater.truth.housing->params[i]) /
+                     result.housing_std_dev[i]);
     }
+    z[3].push_back((result.camera.params[0] - sets.in_air.truth.camera.params[0]) / result.camera_std_dev[0]);
   }
-  ExpectHonest({"Nx", "Ny", "int_dist"}, z);
+  ExpectHonest({"Nx", "Ny", "int_dist", "f"}, z);
+  double sum = 0;
+  for (double v : held_z) sum += v * v;
+  std::cout << "z-score RMS of Nx, Ny, int_dist with the in-air intrinsics held: "
+            << std::sqrt(sum / held_z.size()) << "\n";
 }
 
 // A stereo rig's relative pose, the intrinsics given.
