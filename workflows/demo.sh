@@ -74,3 +74,6 @@ echo "  images and truth: air/, dome/ (ground_truth.yaml); databases: air.db, do
 echo "  reports (calibration.txt to read, calibration.yaml with calibmar's keys and standard deviations):"
 echo "    $output/air_calibration/calibration.txt"
 echo "    $output/dome_calibration/calibration.txt"
+echo "  pages with pictures (coverage, per-view RMS, residuals, uncertainty, the dome to scale), open in a browser:"
+echo "    $output/air_calibration/report.html"
+echo "    $output/dome_calibration/report.html"

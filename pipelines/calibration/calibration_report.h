@@ -56,6 +56,9 @@ CalibrationReport ReportOf(const HousingCalibrationResult& result, const std::st
 // calibrated with the board held flat), in pixels and standard deviations.
 std::string BoardWarpNote(const CameraCalibrationResult& warped, const CameraCalibrationResult& flat);
 
+// calibration.txt's text.
+std::string CalibrationReportText(const CalibrationReport& report);
+
 // Writes calibration.yaml and calibration.txt into `dir` (created),
 // atomically.
 void WriteCalibrationReport(const CalibrationReport& report, const std::filesystem::path& dir);

@@ -13,6 +13,7 @@
 
 #include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/error.h"
+#include "pipelines/report/picture.h"
 
 namespace portcal {
 namespace {
@@ -331,72 +332,22 @@ ProjectionDiff ComputeProjectionDiff(const CalibratedLens& a, const CalibratedLe
 
 void WriteProjectionDiffHeatMap(const ProjectionDiff& diff, int width, int height,
                                 const std::string& title, const std::filesystem::path& path) {
-  // The image at most 960 px wide, a colour bar to its right, a title above.
-  const double scale = std::min(1.0, 960.0 / width);
-  const int w = std::max(1, static_cast<int>(width * scale));
-  const int h = std::max(1, static_cast<int>(height * scale));
-  cv::Mat grid(diff.grid_height, diff.grid_width, CV_32F);
+  Eigen::MatrixXd grid(diff.grid_height, diff.grid_width);
   for (int r = 0; r < diff.grid_height; ++r) {
     for (int c = 0; c < diff.grid_width; ++c) {
       const double v = diff.diff_px[r * diff.grid_width + c];
-      grid.at<float>(r, c) = std::isfinite(v) ? static_cast<float>(v) : -1.0f;
+      grid(r, c) = std::isfinite(v) ? v : -1.0;
     }
   }
-  cv::Mat dense;
-  cv::resize(grid, dense, cv::Size(w, h), 0, 0, cv::INTER_LINEAR);
-  const double vmax = diff.max_px > 0 ? diff.max_px : 1.0;
-  cv::Mat gray(h, w, CV_8U);
-  for (int r = 0; r < h; ++r) {
-    for (int c = 0; c < w; ++c) {
-      gray.at<uint8_t>(r, c) =
-          cv::saturate_cast<uint8_t>(255.0 * std::max(0.0f, dense.at<float>(r, c)) / vmax);
-    }
-  }
-  cv::Mat colour;
-  cv::applyColorMap(gray, colour, cv::COLORMAP_VIRIDIS);
-  for (int r = 0; r < h; ++r) {
-    for (int c = 0; c < w; ++c) {
-      if (dense.at<float>(r, c) < 0) colour.at<cv::Vec3b>(r, c) = cv::Vec3b(128, 128, 128);
-    }
-  }
-  // Iso-lines at the mean and the 95th percentile.
-  for (const double level : {diff.mean_px, diff.p95_px}) {
-    cv::Mat above = dense >= level;
-    std::vector<std::vector<cv::Point>> contours;
-    cv::findContours(above, contours, cv::RETR_LIST, cv::CHAIN_APPROX_SIMPLE);
-    cv::drawContours(colour, contours, -1, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
-  }
-
-  const int top = 40, bar = 90;
-  cv::Mat canvas(h + top + 10, w + bar, CV_8UC3, cv::Scalar(255, 255, 255));
-  colour.copyTo(canvas(cv::Rect(0, top, w, h)));
-  for (int r = 0; r < h; ++r) {
-    const uint8_t v = cv::saturate_cast<uint8_t>(255.0 * (h - 1 - r) / std::max(1, h - 1));
-    cv::Mat one(1, 1, CV_8U, cv::Scalar(v)), rgb;
-    cv::applyColorMap(one, rgb, cv::COLORMAP_VIRIDIS);
-    cv::line(canvas, cv::Point(w + 10, top + r), cv::Point(w + 30, top + r),
-             cv::Scalar(rgb.at<cv::Vec3b>(0, 0)), 1);
-  }
-  for (int t = 0; t <= 4; ++t) {
-    const int y = top + (h - 1) - (h - 1) * t / 4;
-    std::ostringstream label;
-    label << std::setprecision(3) << vmax * t / 4;
-    cv::putText(canvas, label.str(), cv::Point(w + 34, y + 5), cv::FONT_HERSHEY_SIMPLEX, 0.4,
-                cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  }
-  cv::putText(canvas, "px", cv::Point(w + 34, top - 8), cv::FONT_HERSHEY_SIMPLEX, 0.45,
-              cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   std::ostringstream heading;
-  heading << std::setprecision(3) << title << ": mean " << diff.mean_px << ", p95 " << diff.p95_px
-          << ", max " << diff.max_px << " px (lines: mean, p95)";
-  cv::putText(canvas, heading.str(), cv::Point(6, 26), cv::FONT_HERSHEY_SIMPLEX, 0.5,
-              cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-
-  std::vector<uchar> png;
-  if (!cv::imencode(".png", canvas, png)) throw InputError(path.string() + ": PNG encoding failed");
-  WriteFileAtomically(path, true, [&](std::ostream& out) {
-    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
-  });
+  heading << std::setprecision(3) << title << ": mean " << diff.mean_px << ", p95 " << diff.p95_px << ", max "
+          << diff.max_px << " px (lines: mean, p95)";
+  HeatMapStyle style;
+  style.title = heading.str();
+  style.unit = "px";
+  style.contour_levels = {diff.mean_px, diff.p95_px};
+  style.max_value = diff.max_px;
+  WritePng(HeatMapPicture(grid, width, height, style), path);
 }
 
 }  // namespace portcal

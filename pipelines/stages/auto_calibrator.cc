@@ -10,6 +10,7 @@
 #include "database/database.h"
 #include "pipelines/calibration/calibration_output.h"
 #include "pipelines/sfm/calibration_start.h"
+#include "pipelines/report/calibration_html.h"
 
 namespace fs = std::filesystem;
 
@@ -307,7 +308,12 @@ AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   std::optional<Database> database;
   if (options.update_database) database.emplace(database_path, Database::OpenMode::kReadWrite);
   WriteCalibrationOutput(result.refined.report, options.output_path, database ? &*database : nullptr,
-                         database ? OnlyCameraId(&*database, database_path) : kInvalidCameraId);
+                         database ? OnlyCameraId(&*database, database_path) : kInvalidCameraId, [&] {
+                           WriteHtml(SelfCalibrationHtml(result.refined.report,
+                                                         ReadSparseModel(fs::path(options.output_path) / "refined"),
+                                                         "Auto-calibration"),
+                                     options.output_path);
+                         });
   std::string times;
   for (const auto& [stage, seconds] : result.stage_seconds) times += " " + stage + " " + std::to_string(seconds) + " s;";
   LOG(INFO) << "auto_calibrator: " << result.num_registered << " of " << result.num_images

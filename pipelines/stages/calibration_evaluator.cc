@@ -12,6 +12,7 @@
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/housing_calibration.h"
 #include "pipelines/calibration/target_views.h"
+#include "pipelines/report/calibration_html.h"
 
 namespace fs = std::filesystem;
 
@@ -56,6 +57,7 @@ std::string Number(double value) {
 }
 
 void WriteEvaluation(const CalibrationEvaluatorOptions& options, const CalibrationReport& report,
+                     const std::vector<CalibrationView>& views,
                      const CalibrationEvaluatorSummary& summary) {
   const HeldOutEvaluation& e = summary.evaluation;
   std::ostringstream yaml, text;
@@ -100,6 +102,7 @@ void WriteEvaluation(const CalibrationEvaluatorOptions& options, const Calibrati
   const std::string yaml_text = yaml.str(), text_text = text.str();
   WriteFileAtomically(dir / "evaluation.yaml", false, [&](std::ostream& out) { out << yaml_text; });
   WriteFileAtomically(dir / "evaluation.txt", false, [&](std::ostream& out) { out << text_text; });
+  WriteHtml(EvaluationHtml(summary.evaluation, views, {report.camera, report.housing}, text_text), dir);
 }
 
 }  // namespace
@@ -136,7 +139,7 @@ CalibrationEvaluatorSummary RunCalibrationEvaluator(const CalibrationEvaluatorOp
     progress.Advance(static_cast<size_t>(options.folds));
   }
   progress.End();
-  WriteEvaluation(options, report, summary);
+  WriteEvaluation(options, report, views, summary);
   LOG(INFO) << "calibration_evaluator: held-out RMS " << summary.evaluation.rms_px << " px over "
             << summary.evaluation.num_points << " points (pattern " << summary.evaluation.systematic_px
             << " px, the cells' scatter alone ~" << summary.evaluation.noise_floor_px << " px)"

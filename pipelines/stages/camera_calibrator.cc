@@ -5,6 +5,7 @@
 #include "colmap_ext/util/logging.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_output.h"
+#include "pipelines/report/calibration_html.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
 #include "pipelines/crosscheck/mrcal_export.h"
@@ -43,7 +44,10 @@ CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& optio
     report.notes.push_back(BoardWarpNote(result, CalibrateCamera(views, camera, flat)));
   }
   WriteCalibrationOutput(report, options.output_path, options.update_database ? &database : nullptr, camera_id,
-                         [&] { WriteCalibrationCameraModel(views, result, options.calibration, options.output_path); });
+                         [&] {
+                           WriteCalibrationCameraModel(views, result, options.calibration, options.output_path);
+                           WriteHtml(CalibrationHtml(report, views, "Camera calibration"), options.output_path);
+                         });
   LOG(INFO) << "camera_calibrator: RMS " << result.overall_rms_px << " px over " << result.num_points
             << " points -> " << options.output_path;
   return result;

@@ -16,6 +16,7 @@
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
 #include "pipelines/crosscheck/mrcal_calibration.h"
+#include "pipelines/report/calibration_html.h"
 
 namespace portcal {
 namespace {
@@ -245,6 +246,29 @@ std::vector<CalibrationView> RerunAsMrcal(const std::vector<CalibrationView>& vi
 
 // What the report says before any comparison: the models, the threshold,
 // the views and portcal's own fit.
+// The projection-difference maps the stage wrote, for the page.
+std::vector<ReportPicture> DifferenceMaps(const CrossCheckResult& result, const CrossCheckOptions& options) {
+  std::vector<ReportPicture> maps = {
+      {"projection_diff.png",
+       "How far portcal's and mrcal's calibrations of the same views project the same ray apart, over the image "
+       "(mrcal's projection difference, with its implied transform). Within the noise: they agree.",
+       {}}};
+  if (result.rerun_diff) {
+    maps.push_back(
+        {"projection_diff_rerun.png", "The same after portcal re-ran as mrcal did (board warp, outliers).", {}});
+  }
+  if (options.folds >= 2) {
+    maps.push_back({"cross_validation_diff.png",
+                    "Fold 0 against fold 1, each calibrated on its own views: the difference the data alone "
+                    "makes.",
+                    {}});
+    if (result.rerun_diff) {
+      maps.push_back({"cross_validation_diff_rerun.png", "The same, calibrated as the re-run.", {}});
+    }
+  }
+  return maps;
+}
+
 CrossCheckResult ResultHeader(const CrossCheckOptions& options, const CalibrationReport& input,
                               const std::string& lensmodel, int num_views, const CameraCalibrationResult& portcal) {
   CrossCheckResult result;
@@ -346,6 +370,9 @@ CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& 
     }
   }
   WriteCrossCheckReport(result, dir);
+  WriteHtml(CrossCheckHtml(ReportOf(portcal, settings.estimate_board_warp, input.target_description), views,
+                           DifferenceMaps(result, options), ReadReportText(dir / "cross_check.txt")),
+            dir);
   LOG(INFO) << "cross_check: " << result.Verdict();
   return result;
 }

@@ -10,6 +10,7 @@
 #include "pipelines/calibration/calibration_output.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
+#include "pipelines/report/calibration_html.h"
 
 namespace portcal {
 
@@ -93,7 +94,9 @@ HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& op
       CalibrateHousing(views, start->camera, housing, options.calibration, in_air ? &*in_air : nullptr);
 
   const CalibrationReport report = ReportOf(result, target_views.target);
-  WriteCalibrationOutput(report, options.output_path, options.update_database ? &database : nullptr, camera_id);
+  WriteCalibrationOutput(report, options.output_path, options.update_database ? &database : nullptr, camera_id, [&] {
+    WriteHtml(CalibrationHtml(report, views, "Housing calibration (" + housing.ModelName() + ")"), options.output_path);
+  });
   LOG(INFO) << "housing_calibrator: RMS " << result.overall_rms_px << " px -> " << options.output_path;
   return result;
 }

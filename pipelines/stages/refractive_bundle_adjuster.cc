@@ -9,6 +9,7 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "pipelines/bundle_adjustment/position_priors.h"
+#include "pipelines/report/calibration_html.h"
 
 namespace fs = std::filesystem;
 
@@ -501,8 +502,10 @@ void WriteAdjusted(const RefractiveBundleAdjusterOptions& options, const Reconst
   FillReport(options, r, camera_id, std_devs, use_priors, &report);
   report.notes = std::move(notes);
   report.warnings = std::move(warnings);
-  WriteSparseModel(r.ToSparseModel(), options.output_path, ModelFormat::kBinary);
+  const SparseModel model = r.ToSparseModel();
+  WriteSparseModel(model, options.output_path, ModelFormat::kBinary);
   WriteCalibrationReport(report, options.output_path);
+  WriteHtml(SelfCalibrationHtml(report, model, "Refractive bundle adjustment"), options.output_path);
   LOG(INFO) << "refractive_bundle_adjuster: RMS " << report.overall_rms_px << " px over " << report.num_points
             << " observations; " << result->num_filtered << " observations dropped; written to "
             << options.output_path;

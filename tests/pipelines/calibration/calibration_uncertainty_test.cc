@@ -144,6 +144,25 @@ HousingCalibrationResult CalibrateJointly(const HousingSets& sets, const Housing
   return CalibrateHousing(views, in_air.camera, guess, settings, &joint);
 }
 
+// Appends the z-scores of the housing's `params` and of the focal length.
+void AddZScores(const HousingCalibrationResult& result, const HousingSets& sets, const std::vector<int>& params,
+                std::vector<std::vector<double>>* z) {
+  for (size_t k = 0; k < params.size(); ++k) {
+    const int i = params[k];
+    ASSERT_GT(result.housing_std_dev[i], 0);
+    (*z)[k].push_back((result.housing.params[i] - sets.underwater.truth.housing->params[i]) /
+                      result.housing_std_dev[i]);
+  }
+  (*z)[params.size()].push_back((result.camera.params[0] - sets.in_air.truth.camera.params[0]) /
+                                result.camera_std_dev[0]);
+}
+
+void PrintRms(const std::string& what, const std::vector<double>& z) {
+  double sum = 0;
+  for (double v : z) sum += v * v;
+  std::cout << "z-score RMS of " << what << ": " << std::sqrt(sum / z.size()) << "\n";
+}
+
 // The dome's decentering with its standard deviations from the joint solve.
 TEST(CalibrationUncertainty, DomeStdDevsIncludeTheInAirCalibration) {
   testing::TempDir dir;
@@ -161,19 +180,10 @@ render: {spp: 4, blur_sigma: 0.5, noise_sigma: 2.0}
     const HousingSets sets = RenderHousingSets(dir.path(), config, 2000 + seed, 0.025);
     Housing guess = *sets.underwater.truth.housing;
     guess.params[0] = guess.params[1] = guess.params[2] = 0;
-    const HousingCalibrationResult result = CalibrateJointly(sets, guess, &held_z, {0, 1, 2});
-    for (int i = 0; i < 3; ++i) {
-      ASSERT_GT(result.housing_std_dev[i], 0);
-      z[i].push_back((result.housing.params[i] - sets.underwater.truth.housing->params[i]) /
-                     result.housing_std_dev[i]);
-    }
-    z[3].push_back((result.camera.params[0] - sets.in_air.truth.camera.params[0]) / result.camera_std_dev[0]);
+    AddZScores(CalibrateJointly(sets, guess, &held_z, {0, 1, 2}), sets, {0, 1, 2}, &z);
   }
   ExpectHonest({"Cx", "Cy", "Cz", "f"}, z);
-  double sum = 0;
-  for (double v : held_z) sum += v * v;
-  std::cout << "z-score RMS of Cx, Cy, Cz with the in-air intrinsics held: " << std::sqrt(sum / held_z.size())
-            << "\n";
+  PrintRms("Cx, Cy, Cz with the in-air intrinsics held", held_z);
 }
 
 // The flat port's normal (Nx, Ny: to first order its tangent angles) and
@@ -197,21 +207,10 @@ render: {spp: 4, blur_sigma: 0.5, noise_sigma: 2.0}
     guess.params[1] = 0;
     guess.params[2] = 1;
     guess.params[3] = 0.05;
-    const HousingCalibrationResult result = CalibrateJointly(sets, guess, &held_z, {0, 1, 3});
-    const int params[] = {0, 1, 3};
-    for (int k = 0; k < 3; ++k) {
-      const int i = params[k];
-      ASSERT_GT(result.housing_std_dev[i], 0);
-      z[k].push_back((result.housing.params[i] - sets.underwater.truth.housing->params[i]) /
-                     result.housing_std_dev[i]);
-    }
-    z[3].push_back((result.camera.params[0] - sets.in_air.truth.camera.params[0]) / result.camera_std_dev[0]);
+    AddZScores(CalibrateJointly(sets, guess, &held_z, {0, 1, 3}), sets, {0, 1, 3}, &z);
   }
   ExpectHonest({"Nx", "Ny", "int_dist", "f"}, z);
-  double sum = 0;
-  for (double v : held_z) sum += v * v;
-  std::cout << "z-score RMS of Nx, Ny, int_dist with the in-air intrinsics held: "
-            << std::sqrt(sum / held_z.size()) << "\n";
+  PrintRms("Nx, Ny, int_dist with the in-air intrinsics held", held_z);
 }
 
 // A stereo rig's relative pose, the intrinsics given.

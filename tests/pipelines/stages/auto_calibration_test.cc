@@ -140,6 +140,13 @@ housing: {model: FLATPORT, params: [0.0697565, 0.0, 0.9975641, 0.015, 0.010, 1.0
   const std::string yaml = testing::ReadFileToString(dir / "out" / "calibration.yaml");
   EXPECT_NE(yaml.find("cam_from_world:"), std::string::npos);
   EXPECT_EQ(yaml.find("cam_from_target"), std::string::npos);
+  // The page with the reconstruction from above beside the reports
+  // (report_page_test loads such a page in a browser).
+  const std::string page = testing::ReadFileToString(dir / "out" / "report.html");
+  for (const char* picture : {"scene.png", "coverage.png", "per_view_rms.png", "residuals.png", "housing.png"}) {
+    EXPECT_NE(page.find(picture), std::string::npos) << picture;
+    EXPECT_TRUE(fs::exists(dir / "out" / picture)) << picture;
+  }
 }
 
 TEST(AutoCalibration, OwnRenderWhoseBestPairStartsAWrongModel) {

@@ -1,0 +1,173 @@
+#include "pipelines/report/calibration_pictures.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <opencv2/imgproc.hpp>
+#include <iomanip>
+#include <sstream>
+
+#include "colmap_ext/cost/board_warp.h"
+#include "colmap_ext/util/string_utils.h"
+#include "pipelines/guidance/calibration_unknowns.h"
+#include "pipelines/guidance/projection_uncertainty.h"
+#include "pipelines/report/picture.h"
+
+namespace portcal {
+
+namespace {
+
+// The image scaled by DrawingScale() under a title.
+struct ImageFrame {
+  double scale;
+  cv::Mat canvas;
+  ImageFrame(const Camera& camera, const std::string& title)
+      : scale(DrawingScale(static_cast<double>(camera.width))),
+        canvas(TitledCanvas(static_cast<int>(camera.width * scale) + 2,
+                            static_cast<int>(camera.height * scale) + kTitleHeight + 2, title)) {
+    cv::rectangle(canvas, cv::Rect(0, kTitleHeight, canvas.cols - 1, canvas.rows - kTitleHeight - 1),
+                  cv::Scalar(0, 0, 0), 1);
+  }
+  // COLMAP pixel (centre of the top-left pixel at 0.5) -> canvas.
+  cv::Point2d operator()(const Eigen::Vector2d& pixel) const {
+    return cv::Point2d(pixel.x() * scale, kTitleHeight + pixel.y() * scale);
+  }
+};
+
+Eigen::Vector4d BoardExtent(const std::vector<CalibrationView>& views) {
+  Eigen::Vector4d extent(1e300, -1e300, 1e300, -1e300);
+  for (const CalibrationView& view : views) {
+    for (const Eigen::Vector3d& p : view.points_in_target) {
+      extent = Eigen::Vector4d(std::min(extent[0], p.x()), std::max(extent[1], p.x()), std::min(extent[2], p.y()),
+                               std::max(extent[3], p.y()));
+    }
+  }
+  return extent;
+}
+
+std::string Fixed(double value, int digits) { return FormatFixed(value, digits); }
+
+}  // namespace
+
+std::vector<PointResidual> ResidualsAtPoses(const ViewsAtPoses& in) {
+  std::map<std::string, const CalibrationView*> by_name;
+  for (const CalibrationView& view : in.views) by_name[view.image_name] = &view;
+  const Eigen::Vector4d extent = BoardExtent(in.views);
+  std::vector<PointResidual> residuals;
+  for (size_t v = 0; v < in.calibrated.size(); ++v) {
+    const auto it = by_name.find(in.calibrated[v].image_name);
+    if (it == by_name.end()) continue;
+    const CalibrationView& view = *it->second;
+    for (size_t i = 0; i < view.pixels.size(); ++i) {
+      Eigen::Vector3d point = view.points_in_target[i];
+      if (in.board_warp) point.z() += BoardSag(in.board_warp->data(), BoardWarpUv(point, extent));
+      const std::optional<Eigen::Vector2d> predicted = in.camera.Project(in.calibrated[v].cam_from_target * point);
+      if (!predicted) continue;
+      residuals.push_back({view.pixels[i], view.pixels[i] - *predicted, static_cast<int>(v), in.calibrated[v].dropped});
+    }
+  }
+  return residuals;
+}
+
+cv::Mat CoveragePicture(const Camera& camera, const std::vector<Eigen::Vector2d>& pixels, const std::string& what) {
+  // Cells of ~1/16 of the image width: fine enough to show a bare corner,
+  // coarse enough that one board's points fill several.
+  const int cols = 16, rows = std::max(2, static_cast<int>(std::lround(16.0 * camera.height / camera.width)));
+  Eigen::MatrixXd counts = Eigen::MatrixXd::Zero(rows, cols);
+  for (const Eigen::Vector2d& p : pixels) {
+    const int c = std::clamp(static_cast<int>(p.x() / camera.width * cols), 0, cols - 1);
+    const int r = std::clamp(static_cast<int>(p.y() / camera.height * rows), 0, rows - 1);
+    counts(r, c) += 1;
+  }
+  const int empty = static_cast<int>((counts.array() == 0).count());
+  HeatMapStyle style;
+  style.title = "Coverage: " + std::to_string(pixels.size()) + " " + what + ", " + std::to_string(empty) + " of " +
+                std::to_string(rows * cols) + " cells empty";
+  style.unit = "per cell";
+  cv::Mat picture = HeatMapPicture(counts, static_cast<int>(camera.width), static_cast<int>(camera.height), style);
+  const double scale = DrawingScale(static_cast<double>(camera.width));
+  for (const Eigen::Vector2d& p : pixels) {
+    cv::circle(picture, cv::Point2d(p.x() * scale, kTitleHeight + p.y() * scale), 1, cv::Scalar(255, 255, 255),
+               cv::FILLED);
+  }
+  return picture;
+}
+
+cv::Mat PerViewRmsPicture(const std::vector<CalibratedView>& views, double residual_sigma_px,
+                          const std::string& title) {
+  std::vector<double> values;
+  std::vector<cv::Scalar> colours;
+  std::vector<std::string> labels;
+  int outliers = 0, dropped = 0;
+  for (const CalibratedView& view : views) {
+    values.push_back(view.rms_px);
+    colours.push_back(view.dropped ? cv::Scalar(150, 150, 150)
+                                   : view.outlier ? cv::Scalar(40, 40, 220) : cv::Scalar(160, 110, 40));
+    std::string name = view.image_name.substr(view.image_name.find_last_of('/') + 1);
+    labels.push_back(name.substr(0, name.find_last_of('.')));
+    outliers += view.outlier && !view.dropped;
+    dropped += view.dropped;
+  }
+  const std::string heading = title + " (" + std::to_string(outliers) + " outliers in red, " +
+                              std::to_string(dropped) + " dropped in grey)";
+  // RMS of 2-D residuals is sqrt(2) x the per-coordinate sigma.
+  return BarChartPicture(values, colours, labels, heading, "px", std::sqrt(2.0) * residual_sigma_px,
+                         "sqrt(2) x residual sigma");
+}
+
+cv::Mat ResidualVectorsPicture(const Camera& camera, const std::vector<PointResidual>& residuals, int num_views,
+                               const std::string& title) {
+  std::vector<double> lengths;
+  for (const PointResidual& r : residuals) {
+    if (!r.dropped) lengths.push_back(r.residual.norm());
+  }
+  std::sort(lengths.begin(), lengths.end());
+  const double p95 = lengths.empty() ? 0 : lengths[lengths.size() * 95 / 100];
+  // The 95th percentile drawn as 2.5 % of the image width.
+  const double magnify = p95 > 0 ? 0.025 * camera.width / p95 : 1;
+  std::ostringstream heading;
+  heading << title << ": magnified x" << std::setprecision(3) << magnify << ", p95 " << Fixed(p95, 3) << " px";
+  ImageFrame frame(camera, heading.str());
+  for (const PointResidual& r : residuals) {
+    if (r.dropped) continue;
+    const cv::Point2d from = frame(r.observed);
+    const cv::Point2d to = frame(r.observed + magnify * r.residual);
+    cv::arrowedLine(frame.canvas, from, to, DistinctColour(r.view, num_views), 1, cv::LINE_AA, 0, 0.2);
+  }
+  return frame.canvas;
+}
+
+cv::Mat UncertaintyPicture(const ViewsAtPoses& in, bool housing_calibration, const std::vector<int>& fixed,
+                           double pixel_sigma_px) {
+  CalibrationUnknowns unknowns{in.camera, housing_calibration, fixed};
+  Eigen::MatrixXd information = Eigen::MatrixXd::Zero(unknowns.NumUnknowns(), unknowns.NumUnknowns());
+  std::vector<double> depths;
+  std::map<std::string, const CalibrationView*> by_name;
+  for (const CalibrationView& view : in.views) by_name[view.image_name] = &view;
+  for (const CalibratedView& view : in.calibrated) {
+    const auto it = by_name.find(view.image_name);
+    if (view.dropped || it == by_name.end()) continue;
+    information += ViewInformation(unknowns, it->second->points_in_target, view.cam_from_target);
+    depths.push_back(view.cam_from_target.translation.z());
+  }
+  ProjectionUncertaintyOptions options;
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  options.working_distance_m = depths.empty() ? 1.0 : std::max(0.05, depths[depths.size() / 2]);
+  options.grid_cols = 32;
+  const Camera& camera = in.camera.camera;
+  options.grid_rows = std::max(2, static_cast<int>(std::lround(32.0 * camera.height / camera.width)));
+  options.pixel_sigma_px = std::max(1e-6, pixel_sigma_px);
+  const ProjectionUncertainty uncertainty = ProjectionUncertaintyModel(unknowns, options).Evaluate(information);
+  HeatMapStyle style;
+  style.unit = "px";
+  style.title = std::string("Projection uncertainty of the ") + (housing_calibration ? "housing" : "intrinsics") +
+                " at " + Fixed(options.working_distance_m, 2) + " m: mean " + Fixed(uncertainty.mean_px, 3) +
+                ", max " + Fixed(uncertainty.max_px, 3) + " px" + (uncertainty.determined ? "" : " (UNDETERMINED)");
+  style.contour_levels = {uncertainty.mean_px};
+  const int width = static_cast<int>(in.camera.camera.width), height = static_cast<int>(in.camera.camera.height);
+  if (!uncertainty.determined) return HeatMapPicture(-Eigen::MatrixXd::Ones(2, 2), width, height, style);
+  return HeatMapPicture(uncertainty.map_px, width, height, style);
+}
+
+}  // namespace portcal

@@ -1,0 +1,69 @@
+#include "pipelines/report/html_report.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "colmap_ext/io/sparse_model.h"
+#include "colmap_ext/util/error.h"
+#include "pipelines/report/picture.h"
+
+namespace portcal {
+
+namespace {
+
+std::string Escaped(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+constexpr const char* kStyle =
+    "body{font-family:sans-serif;max-width:1100px;margin:1em auto;padding:0 1em;color:#222}"
+    "pre{background:#f4f4f4;padding:.8em;overflow-x:auto;font-size:13px}"
+    "figure{display:inline-block;margin:.5em;vertical-align:top;max-width:100%}"
+    "figure img{max-width:100%;border:1px solid #ccc}figcaption{font-size:13px;max-width:960px}"
+    ".warning{color:#b00;font-weight:bold}";
+
+}  // namespace
+
+std::string ReadReportText(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+void WriteHtmlReport(const HtmlReport& report, const std::filesystem::path& dir) {
+  std::ostringstream html;
+  html << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>" << Escaped(report.title)
+       << "</title><style>" << kStyle << "</style></head><body>\n<h1>" << Escaped(report.title) << "</h1>\n";
+  for (const std::string& warning : report.warnings) {
+    html << "<p class=\"warning\">WARNING: " << Escaped(warning) << "</p>\n";
+  }
+  for (const ReportSection& section : report.sections) {
+    html << "<h2>" << Escaped(section.heading) << "</h2>\n";
+    for (const ReportPicture& picture : section.pictures) {
+      if (!picture.image.empty()) {
+        WritePng(picture.image, dir / picture.file_name);
+      } else if (!std::filesystem::exists(dir / picture.file_name)) {
+        throw InputError((dir / picture.file_name).string() + ": a picture of the report is missing");
+      }
+      html << "<figure><img src=\"" << Escaped(picture.file_name) << "\" alt=\"" << Escaped(picture.caption)
+           << "\"><figcaption>" << Escaped(picture.caption) << "</figcaption></figure>\n";
+    }
+    if (!section.text.empty()) html << "<pre>" << Escaped(section.text) << "</pre>\n";
+  }
+  html << "</body></html>\n";
+  const std::string page = html.str();
+  WriteFileAtomically(dir / "report.html", false, [&](std::ostream& out) { out << page; });
+}
+
+}  // namespace portcal

@@ -1,0 +1,38 @@
+// report.html: a page a person reads in any browser, offline: the text
+// report and the pictures, the PNGs beside it (named in the page, relative
+// paths), every file written atomically.
+#pragma once
+
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace portcal {
+
+struct ReportPicture {
+  std::string file_name;  // e.g. "coverage.png", beside report.html
+  std::string caption;    // what to look for
+  cv::Mat image;  // empty: the file is already in the folder (written by the stage)
+};
+
+struct ReportSection {
+  std::string heading;
+  std::string text;  // preformatted (the calibration.txt), may be empty
+  std::vector<ReportPicture> pictures;
+};
+
+struct HtmlReport {
+  std::string title;
+  std::vector<std::string> warnings;  // shown first, in red
+  std::vector<ReportSection> sections;
+};
+
+// The text report a stage has just written, for its page ("" when absent).
+std::string ReadReportText(const std::filesystem::path& path);
+
+// Writes the pictures, then report.html, into `dir` (which exists).
+// Throws InputError naming a picture that is neither given nor there.
+void WriteHtmlReport(const HtmlReport& report, const std::filesystem::path& dir);
+
+}  // namespace portcal
