@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "colmap_ext/util/error.h"
+#include "database/lock_wait.h"
 #include "database/schema.h"
 
 namespace fs = std::filesystem;
@@ -38,7 +39,8 @@ Database::Database(const fs::path& path, OpenMode mode) : path_(path.string()) {
     throw DatabaseError(path_ + ": cannot open database: " + message);
   }
   try {
-    sqlite3_busy_timeout(db_, 1000);
+    lock_wait_ = std::make_unique<LockWait>(path_, DatabaseBusyTimeout());
+    lock_wait_->Install(db_);
     // Fails with "file is not a database" for other files.
     const int64_t num_tables =
         QueryInt("SELECT count(*) FROM sqlite_master WHERE type='table';");

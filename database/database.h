@@ -14,6 +14,7 @@
 
 #include "colmap_ext/housing/housing.h"
 #include "database/feature_types.h"
+#include "database/lock_wait.h"
 #include "database/statement.h"
 
 struct sqlite3;
@@ -33,7 +34,8 @@ class Database {
 
   // Throws DatabaseError naming `path` for: a missing file (unless kCreate),
   // a file that is no SQLite database, a database of another COLMAP or
-  // portcal schema version, or one locked by another process.
+  // portcal schema version, or one locked by another process for longer
+  // than DatabaseBusyTimeout() (lock_wait.h).
   explicit Database(const std::filesystem::path& path,
                     OpenMode mode = OpenMode::kReadWrite);
   ~Database();
@@ -136,6 +138,7 @@ class Database {
   int64_t QueryInt(const std::string& sql);
 
   std::string path_;
+  std::unique_ptr<LockWait> lock_wait_;  // outlives db_ (declared before it)
   sqlite3* db_ = nullptr;
   std::map<std::string, std::unique_ptr<Statement>> statements_;
 };

@@ -14,7 +14,8 @@ namespace {
 std::string Describe(sqlite3* db, int code) {
   std::string message = sqlite3_errmsg(db);
   if ((code & 0xFF) == SQLITE_BUSY || (code & 0xFF) == SQLITE_LOCKED) {
-    message += " (another process holds the database; wait for it to finish)";
+    message += " (another process held the database past --Database.busy_timeout; wait for it to finish, or "
+               "give a longer timeout)";
   }
   return message;
 }

@@ -8,6 +8,7 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/string_utils.h"
+#include "database/lock_wait.h"
 
 namespace po = boost::program_options;
 
@@ -20,6 +21,8 @@ CommandLine::CommandLine(std::string command, std::string summary)
   options_.add_options()("help,h", "print this help and exit")(
       "log_level", po::value<std::string>(&log_level_)->default_value(log_level_),
       "error | warn | info | debug")(
+      "Database.busy_timeout", po::value<double>(&busy_timeout_s_)->default_value(busy_timeout_s_),
+      "seconds a database statement waits for another process's lock")(
       "project_path", po::value<std::string>(&project_path_),
       "ini file with the same options (name = value), as in COLMAP; the "
       "command line takes precedence");
@@ -144,6 +147,7 @@ bool CommandLine::Parse(int argc, char** argv) {
   for (const auto& convert : conversions_) convert();
   try {
     SetLogLevel(log_level_);
+    SetDatabaseBusyTimeout(busy_timeout_s_);
   } catch (const OptionError& e) {
     throw UsageError(e.what());
   }

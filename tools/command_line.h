@@ -102,6 +102,7 @@ class CommandLine {
   std::string command_;
   std::string summary_;
   std::string log_level_ = "info";
+  double busy_timeout_s_ = 60;
   std::string project_path_;
   boost::program_options::options_description options_;
   // Conversions of parsed flags into typed fields, run at the end of Parse.

@@ -1,5 +1,6 @@
 #include <iostream>
 
+#include "colmap_ext/util/error.h"
 #include "colmap_ext/util/progress.h"
 #include "pipelines/stages/model_converter.h"
 #include "pipelines/stages/project_points.h"
@@ -59,6 +60,8 @@ int ProjectPointsCommand(int argc, char** argv) {
     if (!cli.Parse(argc, argv)) return;
     StderrProgress progress;
     for (const std::string& line : RunProjectPoints(options, progress).lines) std::cout << line << "\n";
+    std::cout.flush();
+    if (!std::cout) throw InputError("standard output: writing the answers failed (disk full or closed?)");
   });
 }
 

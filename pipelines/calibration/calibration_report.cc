@@ -342,7 +342,8 @@ std::string HousingUncertaintyNote(const HousingCalibrationResult& result) {
   std::ostringstream note;
   if (!result.in_air_views.empty()) {
     note << "joint solve with " << result.in_air_views.size() << " in-air views (RMS "
-         << FormatFixed(result.in_air_rms_px, 3) << " px, residual sigma " << FormatFixed(result.in_air_residual_sigma_px, 3)
+         << FormatFixed(result.in_air_rms_px, 3) << " px, residual sigma "
+         << FormatFixed(result.in_air_residual_sigma_px, 3)
          << " px; each set weighted by its own): the intrinsics are refined by both sets, and the housing's "
             "standard deviations include their uncertainty";
   } else if (std::any_of(result.camera_std_dev.begin(), result.camera_std_dev.end(),
@@ -385,6 +386,8 @@ CalibrationReport ReportOf(const HousingCalibrationResult& result, const std::st
                      &report);
   return report;
 }
+
+std::string CalibrationReportText(const CalibrationReport& report) { return Text(report); }
 
 void WriteCalibrationReport(const CalibrationReport& report, const fs::path& dir) {
   std::error_code ec;
@@ -457,7 +460,11 @@ CalibrationReport ReadCalibrationReport(const fs::path& path) {
   }
   CalibrationReport report;
   try {
-    report.camera.model_id = CameraModelNameToId(root["model"].as<std::string>());
+    try {
+      report.camera.model_id = CameraModelNameToId(root["model"].as<std::string>());
+    } catch (const InputError& e) {
+      throw InputError(path.string() + ": model: " + e.what());
+    }
     report.camera.width = root["width"].as<uint64_t>();
     report.camera.height = root["height"].as<uint64_t>();
     report.camera.params = root["parameters"].as<std::vector<double>>();

@@ -13,6 +13,12 @@ TargetViews ReadTargetViews(Database* database) {
     CalibrationView view;
     view.image_name = image.name;
     for (const TargetObservation& o : database->ReadTargetObservations(image.image_id)) {
+      // A value no detector writes (an edited or damaged row) would
+      // otherwise surface as a solver that "did not converge".
+      if (!o.xy.allFinite() || !o.point_in_target.allFinite()) {
+        throw InputError(database->path() + ": image " + image.name + ", target point " +
+                         std::to_string(view.pixels.size()) + " of portcal_target_observations is not a finite number");
+      }
       view.points_in_target.push_back(o.point_in_target);
       view.pixels.push_back(o.xy);
     }

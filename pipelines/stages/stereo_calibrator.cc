@@ -8,6 +8,7 @@
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
+#include "pipelines/report/calibration_html.h"
 
 namespace fs = std::filesystem;
 
@@ -17,6 +18,9 @@ void StereoCalibratorOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
   if (pairing != "name" && pairing != "order") throw OptionError("--Stereo.pairing", pairing, "name or order");
+  if (camera1_id >= 0 && camera1_id == camera2_id) {
+    throw OptionError("--Stereo.camera2_id", std::to_string(camera2_id), "another camera than --Stereo.camera1_id");
+  }
   if (input_calibration1.empty() != input_calibration2.empty()) {
     throw OptionError("--input_calibration1/2", input_calibration1.empty() ? input_calibration2 : input_calibration1,
                       "both or neither");
@@ -34,7 +38,13 @@ HousedCamera CameraFor(const std::string& input_calibration, const Camera& datab
   }
   CameraCalibrationSettings settings;
   settings.num_threads = num_threads;
-  const CameraCalibrationResult result = CalibrateCamera(views, database_camera, settings);
+  CameraCalibrationResult result;
+  try {
+    result = CalibrateCamera(views, database_camera, settings);
+  } catch (const NumericalError& e) {
+    throw NumericalError("camera " + std::to_string(database_camera.camera_id) + " (calibrated first from its " +
+                         std::to_string(views.size()) + " views): " + e.what());
+  }
   LOG(INFO) << "stereo_calibrator: camera " << database_camera.camera_id << " calibrated first, RMS "
             << result.overall_rms_px << " px";
   return {result.camera, std::nullopt};
@@ -85,6 +95,13 @@ StereoCalibratorSummary RunStereoCalibrator(const StereoCalibratorOptions& optio
                                       options.stereo.num_threads);
   const StereoCalibrationResult result = CalibrateStereo(frames, camera1, camera2, options.stereo);
   WriteStereoCalibrationReport(result, camera1, camera2, target_views.target, options.output_path);
+  std::vector<CalibrationView> used1, used2;
+  for (const StereoFrame& frame : frames) {
+    used1.push_back(frame.cam1);
+    used2.push_back(frame.cam2);
+  }
+  const std::string text = ReadReportText(fs::path(options.output_path) / "calibration.txt");
+  WriteHtml(StereoCalibrationHtml(result, used1, used2, text), options.output_path);
   LOG(INFO) << "stereo_calibrator: baseline " << result.cam2_from_cam1.translation.norm() << " m, RMS "
             << result.overall_rms_px << " px -> " << options.output_path;
   return result;

@@ -146,6 +146,12 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
     summary.num_found += detection.found;
     summary.num_points += static_cast<int64_t>(detection.points.size());
   }
+  if (summary.num_images == 0) {
+    // Success on nothing would leave a database with no image and a stage
+    // logged as done.
+    throw InputError(options.image_path + ": none of the " + std::to_string(names.size()) +
+                     " image files could be read");
+  }
   run.Finish(&database, {{"images", summary.num_images},
                          {"found", summary.num_found},
                          {"points", summary.num_points}});

@@ -4,10 +4,14 @@
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
+#include <chrono>
 #include <fstream>
+#include <future>
+#include <thread>
 
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
+#include "database/lock_wait.h"
 #include "database/schema.h"
 #include "tests/test_utils.h"
 
@@ -307,6 +311,48 @@ TEST(Database, DeleteMatchesOfImageRemovesBothDirections) {
   EXPECT_TRUE(db.ReadMatches(2, 3).empty());
   EXPECT_EQ(db.ReadMatches(1, 3).size(), 1u);
   EXPECT_FALSE(db.ReadTwoViewGeometry(2, 3).has_value());
+}
+
+// Another process holds the write lock for 1.5 s (here another connection,
+// on a thread): a stage waits for it, up to --Database.busy_timeout,
+// instead of failing after a second; with a shorter timeout it fails with
+// a message that names the option.
+TEST(Database, AWriterWaitsForAnotherConnectionsLockUpToTheBusyTimeout) {
+  testing::TempDir dir;
+  { Database create(dir / "a.db", Database::OpenMode::kCreate); }
+  Database holder(dir / "a.db", Database::OpenMode::kReadWrite);
+  const auto hold = [&](double seconds, std::promise<void>* held) {
+    Transaction transaction = holder.BeginTransaction();
+    held->set_value();
+    std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+  };
+  SetDatabaseBusyTimeout(10);
+  {
+    Database waiter(dir / "a.db", Database::OpenMode::kReadWrite);
+    std::promise<void> held;
+    std::thread holding(hold, 1.5, &held);
+    held.get_future().wait();
+    const auto start = std::chrono::steady_clock::now();
+    { Transaction transaction = waiter.BeginTransaction(); }
+    EXPECT_GT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
+    holding.join();
+  }
+  SetDatabaseBusyTimeout(0.3);
+  {
+    Database waiter(dir / "a.db", Database::OpenMode::kReadWrite);
+    std::promise<void> held;
+    std::thread holding(hold, 1.5, &held);
+    held.get_future().wait();
+    try {
+      Transaction transaction = waiter.BeginTransaction();
+      ADD_FAILURE() << "no wait limit";
+    } catch (const DatabaseError& e) {
+      EXPECT_NE(std::string(e.what()).find("--Database.busy_timeout"), std::string::npos) << e.what();
+    }
+    holding.join();
+  }
+  SetDatabaseBusyTimeout(60);
+  EXPECT_THROW(SetDatabaseBusyTimeout(-1), OptionError);
 }
 
 }  // namespace

@@ -409,5 +409,42 @@ TEST(Cli, PosePriorsNameWhatIsMissing) {
   EXPECT_NE(result.output.find("--database_path"), std::string::npos) << result.output;
 }
 
+// Work not done is an error naming its cause, and leaves nothing behind
+// (issue 27's "success on nothing" and "messages that name nothing").
+TEST(Cli, NothingDoneIsAnErrorNamingTheCause) {
+  testing::TempDir dir;
+  fs::create_directories(dir / "unreadable");
+  std::ofstream(dir / "unreadable/a.png") << "not an image";
+  auto result = RunCommand(Portcal("target_extractor --database_path " + (dir / "t.db").string() +
+                                   " --image_path " + (dir / "unreadable").string() +
+                                   " --Target.cols 8 --Target.rows 6 --Target.square_size 0.03"));
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_NE(result.output.find("could be read"), std::string::npos) << result.output;
+  EXPECT_FALSE(fs::exists(dir / "t.db"));  // the database it would have created
+
+  std::ofstream(dir / "points.txt") << "0.1 0.2 1\n";
+  // The answers to a full disk (stderr stays with the test).
+  result = RunCommand("(" + Portcal("project_points --points_path " + (dir / "points.txt").string() +
+                                    " --Camera.model PINHOLE --Camera.params 800,800,320,240 --Camera.width 640 "
+                                    "--Camera.height 480") +
+                      " > /dev/full)");
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_NE(result.output.find("standard output"), std::string::npos) << result.output;
+
+  result = RunCommand(Portcal("stereo_calibrator --database_path " + (dir / "t.db").string() + " --output_path " +
+                              (dir / "out").string() + " --Stereo.camera1_id 1 --Stereo.camera2_id 1"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--Stereo.camera2_id"), std::string::npos) << result.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+
+  std::ofstream(dir / "bogus.yaml") << "model: BOGUS_MODEL\nwidth: 10\nheight: 10\nparameters: [1]\n";
+  result = RunCommand(Portcal("calibration_evaluator --database_path " + (dir / "t.db").string() +
+                              " --input_calibration " + (dir / "bogus.yaml").string() + " --output_path " +
+                              (dir / "eval").string()));
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("bogus.yaml: model: unknown camera model 'BOGUS_MODEL'"), std::string::npos)
+      << result.output;
+}
+
 }  // namespace
 }  // namespace portcal

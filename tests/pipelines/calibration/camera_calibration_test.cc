@@ -2,6 +2,7 @@
 // renders against their ground truth, agreement with cv::calibrateCamera on
 // the same corners of the real in-air set, fixed parameters, and the report.
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include <opencv2/calib3d.hpp>
 
@@ -181,6 +182,38 @@ TEST(CalibrationReport, NotesAndTargetSurviveQuotesThroughYaml) {
   EXPECT_EQ(read.target_description, report.target_description);
   const std::string text = testing::ReadFileToString(dir / "out/calibration.txt");
   EXPECT_NE(text.find("Note: it's quoted"), std::string::npos);
+}
+
+// A target observation no detector writes (an edited or damaged row: 9e999
+// reads as infinity) is an input error naming the database, the image and
+// the point, not a solver that "did not converge".
+TEST(CameraCalibration, ANonFiniteObservationNamesTheImageAndPoint) {
+  testing::TempDir dir;
+  {
+    Database database(dir / "db.db", Database::OpenMode::kCreate);
+    DatabaseImage image;
+    image.name = "view_7.png";
+    image.camera_id = database.WriteCamera(Camera::FromModelName("PINHOLE", 500, 640, 480));
+    const image_t image_id = database.WriteImage(image);
+    std::vector<TargetObservation> rows(3);
+    for (int i = 0; i < 3; ++i) rows[i] = {i, Eigen::Vector2d(100 + i, 200), Eigen::Vector3d(0.03 * i, 0, 0)};
+    database.WriteTargetObservations(image_id, rows);
+    database.WriteTargetDetectionStatus(image_id, {"chessboard 3x1", true, 3, ""});
+  }
+  // portcal refuses to write it; another tool edits the row.
+  sqlite3* raw = nullptr;
+  ASSERT_EQ(sqlite3_open((dir / "db.db").string().c_str(), &raw), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(raw, "UPDATE portcal_target_observations SET x = 9e999 WHERE point_id = 2;", nullptr,
+                         nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(raw);
+  Database database(dir / "db.db", Database::OpenMode::kReadOnly);
+  try {
+    ReadTargetViews(&database);
+    ADD_FAILURE() << "a non-finite observation was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("view_7.png, target point 2"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
