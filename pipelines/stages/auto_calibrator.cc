@@ -7,10 +7,11 @@
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/new_paths.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_output.h"
-#include "pipelines/sfm/calibration_start.h"
 #include "pipelines/report/calibration_html.h"
+#include "pipelines/sfm/calibration_start.h"
 
 namespace fs = std::filesystem;
 
@@ -256,8 +257,12 @@ camera_t OnlyCameraId(Database* database, const std::string& database_path) {
 
 AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, ProgressSink& progress) {
   options.Check();
-  fs::create_directories(options.output_path);
-  const std::string database_path = (fs::path(options.output_path) / "database.db").string();
+  const fs::path output(options.output_path);
+  // A failed run removes what it made (the folder if it was not there, the
+  // database, the models); the stages inside roll back their own writes.
+  NewPaths new_paths({output, output / "database.db", output / "sparse", output / "refined"});
+  fs::create_directories(output);
+  const std::string database_path = (output / "database.db").string();
   const bool intrinsics_given = !options.camera_params.empty();
   const bool refine_intrinsics = options.refine_intrinsics.value_or(!intrinsics_given);
   AutoCalibratorSummary result;
@@ -318,6 +323,7 @@ AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   for (const auto& [stage, seconds] : result.stage_seconds) times += " " + stage + " " + std::to_string(seconds) + " s;";
   LOG(INFO) << "auto_calibrator: " << result.num_registered << " of " << result.num_images
             << " images calibrated; times:" << times;
+  new_paths.Keep();
   return result;
 }
 

@@ -14,6 +14,7 @@
 #include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/new_paths.h"
 #include "pipelines/synthetic/dataset_config.h"
 #include "pipelines/synthetic/renderer.h"
 #include "pipelines/synthetic/scene.h"
@@ -467,6 +468,9 @@ SynthesizeSummary RunSynthesize(const SynthesizeOptions& options, ProgressSink& 
   const fs::path output(options.output_path);
   const fs::path staging = output / ".synthesize_staging";
   fs::remove_all(staging);
+  // A failed render leaves no staging folder, nor an output folder that
+  // was not there.
+  NewPaths new_paths({output, staging});
   fs::create_directories(staging / "images");
   const std::string dir1 = config.stereo ? "images/cam1" : "images";
   const std::string dir2 = "images/cam2";
@@ -503,6 +507,7 @@ SynthesizeSummary RunSynthesize(const SynthesizeOptions& options, ProgressSink& 
   progress.End();
   const double render_seconds = Seconds(render_start);
   FinishSet(options, config, scene, truth, staging, output);
+  new_paths.Keep();
 
   SynthesizeSummary summary;
   summary.num_images = config.num_images;

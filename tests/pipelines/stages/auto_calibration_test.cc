@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "colmap_ext/io/ground_truth.h"
@@ -100,6 +101,18 @@ void ExpectPrincipalPointRefined(const CalibrationReport& r, const GroundTruth& 
     EXPECT_LT(std::abs(r.camera.params[i] - truth.camera.params[i]), 4 * r.parameters_std_dev[i]);
   }
   EXPECT_EQ(NotesWith(r, "principal point refined").size(), 1u);
+}
+
+// Images without markers: the run fails (the masker finds none) and takes
+// with it what it made: no output folder, no database left behind.
+TEST(AutoCalibration, AFailedRunLeavesNoOutputBehind) {
+  testing::TempDir dir;
+  fs::create_directories(dir / "images");
+  for (int i = 0; i < 3; ++i) {
+    cv::imwrite((dir / ("images/img_" + std::to_string(i) + ".png")).string(), testing::ClutteredScene(320, 240, i));
+  }
+  EXPECT_ANY_THROW(Calibrate(dir / "images", dir / "out", "FLATPORT", "0,0,1,0.015,0.010,1,1.473,1.334"));
+  EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
 TEST(AutoCalibration, OwnRenderFlatPortIntrinsicsUnknown) {

@@ -137,6 +137,27 @@ housing: null
   EXPECT_FALSE(fs::exists(dir / "a/.synthesize_staging"));
 }
 
+// A render that fails part way (a rig whose cameras look apart never sees
+// the target with both) leaves no staging folder, no output folder that
+// was not there, and an existing one as it was.
+TEST(Synthesize, AFailedRunLeavesTheOutputAsItWas) {
+  testing::TempDir dir;
+  const std::string apart = R"(housing: null
+stereo:
+  cam2_from_cam1:
+    rotation_axis_angle_deg: [0.0, 1.0, 0.0, 180.0]
+    translation: [-0.1, 0.0, 0.0]
+)";
+  const fs::path config = WriteConfig(dir, "apart", std::string(kCamera) + apart + kChessboard, 3);
+  EXPECT_THROW(Synthesize(config, dir / "new"), NumericalError);
+  EXPECT_FALSE(fs::exists(dir / "new"));
+  fs::create_directories(dir / "old");
+  std::ofstream(dir / "old/notes.txt") << "mine";
+  EXPECT_THROW(Synthesize(config, dir / "old"), NumericalError);
+  EXPECT_EQ(testing::ReadFileToString(dir / "old/notes.txt"), "mine");
+  EXPECT_FALSE(fs::exists(dir / "old/.synthesize_staging"));
+}
+
 TEST(Synthesize, StereoGroundTruthComposesTheRig) {
   testing::TempDir dir;
   const std::string stereo = R"(housing: null
