@@ -23,7 +23,7 @@ int CrossCheckCommand(int argc, char** argv) {
   cli.AddRequired("database_path", &options.database_path, "database with target observations");
   cli.AddRequired("input_calibration", &options.input_calibration, "portcal's calibration.yaml");
   cli.AddRequired("output_path", &options.output_path,
-                  "directory for cross_check.txt/.yaml, heat maps and .cameramodel files");
+                  "directory for cross_check.txt/.yaml, report.html, heat maps and .cameramodel files");
   cli.Add("camera_id", &options.camera_id, "camera (-1: the only one with observations)");
   cli.Add("CrossCheck.folds", &options.folds, "cross-validation folds (0: none, else >= 2)");
   cli.Add("CrossCheck.max_diff_px", &options.max_diff_px,

@@ -40,7 +40,8 @@ int RefractiveBundleAdjusterCommand(int argc, char** argv) {
                   "Bundle adjustment of a sparse model that self-calibrates the housing (flat: "
                   "normal + distance; dome: decentering) and optionally the intrinsics, with "
                   "standard deviations. --Markers.side_length (with --database_path) fixes the "
-                  "scale by the ArUco markers, --PosePrior.position_sigma by the images' position priors. Writes the model and calibration.yaml/.txt.");
+                  "scale by the ArUco markers, --PosePrior.position_sigma by the images' position priors. "
+                  "Writes the model, calibration.yaml/.txt and report.html.");
   cli.AddRequired("input_path", &options.input_path, "sparse model (+ housings.txt)");
   cli.AddRequired("output_path", &options.output_path, "directory for the model and reports");
   cli.Add("database_path", &options.database_path, "database with marker detections or position priors (scale)");
@@ -61,7 +62,7 @@ int AutoCalibratorCommand(int argc, char** argv) {
   AutoCalibratorOptions options;
   CommandLine cli("auto_calibrator",
                   "Calibration without a known target: extract, mask (ArUco), match, refractive "
-                  "mapper and refractive bundle adjustment in one run. Writes calibration.yaml/.txt, "
+                  "mapper and refractive bundle adjustment in one run. Writes calibration.yaml/.txt, report.html, "
                   "the sparse models and the database under --output_path.");
   cli.AddRequired("image_path", &options.image_path, "directory of images");
   cli.AddRequired("output_path", &options.output_path, "directory for the results");

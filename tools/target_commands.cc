@@ -42,7 +42,7 @@ int CameraCalibratorCommand(int argc, char** argv) {
                   "Calibrates a camera's intrinsics (any COLMAP model) from the target "
                   "observations in the database: Zhang's closed form, then bundle adjustment "
                   "of intrinsics and poses; standard deviations from the covariance scaled by "
-                  "the residual variance. Writes calibration.yaml and calibration.txt.");
+                  "the residual variance. Writes calibration.yaml, calibration.txt and report.html.");
   cli.AddRequired("database_path", &options.database_path, "database with target observations");
   cli.AddRequired("output_path", &options.output_path, "directory for the reports");
   cli.Add("camera_id", &options.camera_id, "camera to calibrate (-1: the only one)");
@@ -74,7 +74,7 @@ int CalibrationEvaluatorCommand(int argc, char** argv) {
                   "calibration fixed, per-view and overall RMS, and the residuals' pattern over the image "
                   "(the mean residual per cell of a 16 x 9 grid against what noise alone gives). With "
                   "--Evaluation.folds K: K-fold cross-validation of the same kind of calibration on these "
-                  "views. Writes evaluation.yaml and evaluation.txt.");
+                  "views. Writes evaluation.yaml, evaluation.txt and report.html (pictures beside it).");
   cli.AddRequired("database_path", &options.database_path, "database with target observations (target_extractor)");
   cli.AddRequired("input_calibration", &options.input_calibration,
                   "calibration.yaml to judge (portcal's or calibmar's; with its housing, if any)");
@@ -98,7 +98,7 @@ int HousingCalibratorCommand(int argc, char** argv) {
                   "their uncertainty; else the in-air intrinsics are given (--input_calibration, "
                   "portcal's or calibmar's calibration.yaml) and fixed unless refined. The port's "
                   "axis and magnitude are initialised from the data; thickness, radius and "
-                  "indices are the constants of --Housing.params. Writes calibration.yaml/.txt.");
+                  "indices are the constants of --Housing.params. Writes calibration.yaml/.txt and report.html.");
   cli.AddRequired("database_path", &options.database_path, "database with target observations");
   cli.Add("input_calibration", &options.input_calibration,
           "in-air calibration.yaml (with --in_air_database_path: the start, optional)");
@@ -132,7 +132,7 @@ int StereoCalibratorCommand(int argc, char** argv) {
                   "target (robust median of the frames' relative poses, then a joint adjustment), "
                   "each camera optionally behind its own housing (from its "
                   "--input_calibration). Without input calibrations each camera is first "
-                  "calibrated in air from its own views. Writes calibration.yaml/.txt.");
+                  "calibrated in air from its own views. Writes calibration.yaml/.txt and report.html.");
   cli.AddRequired("database_path", &options.database_path, "database with both cameras' observations");
   cli.AddRequired("output_path", &options.output_path, "directory for the reports");
   cli.Add("Stereo.camera1_id", &options.camera1_id, "camera 1 (-1: the lower id of the two)");

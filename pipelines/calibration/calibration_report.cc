@@ -198,7 +198,7 @@ std::string CameraBlock(const std::string& key, const Camera& camera, const std:
 
 }  // namespace
 
-void WriteStereoCalibrationReport(const StereoCalibrationResult& r, const HousedCamera& camera1,
+std::string WriteStereoCalibrationReport(const StereoCalibrationResult& r, const HousedCamera& camera1,
                                   const HousedCamera& camera2, const std::string& target_description,
                                   const fs::path& dir) {
   std::error_code ec;
@@ -253,6 +253,7 @@ void WriteStereoCalibrationReport(const StereoCalibrationResult& r, const Housed
   const std::string yaml_text = yaml.str(), text_text = text.str();
   WriteFileAtomically(dir / "calibration.yaml", false, [&](std::ostream& out) { out << yaml_text; });
   WriteFileAtomically(dir / "calibration.txt", false, [&](std::ostream& out) { out << text_text; });
+  return text_text;
 }
 
 namespace {

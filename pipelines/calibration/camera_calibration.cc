@@ -30,6 +30,19 @@ void CameraCalibrationSettings::Check() const {
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
 }
 
+Eigen::Vector4d BoardExtent(const std::vector<CalibrationView>& views) {
+  Eigen::Vector4d extent(1e300, -1e300, 1e300, -1e300);
+  for (const CalibrationView& view : views) ExtendBoardExtent(view, &extent);
+  return extent;
+}
+
+void ExtendBoardExtent(const CalibrationView& view, Eigen::Vector4d* extent) {
+  for (const Eigen::Vector3d& p : view.points_in_target) {
+    *extent = Eigen::Vector4d(std::min((*extent)[0], p.x()), std::max((*extent)[1], p.x()),
+                              std::min((*extent)[2], p.y()), std::max((*extent)[3], p.y()));
+  }
+}
+
 std::vector<int> FixedParamIndices(const Camera& camera, const std::vector<std::string>& names) {
   std::set<int> fixed;
   const std::vector<std::string> param_names = SplitTokens(camera.ParamsInfo(), ", ");
@@ -185,14 +198,11 @@ std::vector<const CalibrationView*> UsableViews(const std::vector<CalibrationVie
                                                 const CameraCalibrationSettings& settings,
                                                 Eigen::Vector4d* extent) {
   std::vector<const CalibrationView*> views;
-  *extent = Eigen::Vector4d(1e300, -1e300, 1e300, -1e300);
+  *extent = BoardExtent({});
   for (const CalibrationView& view : all_views) {
     if (static_cast<int>(view.pixels.size()) < settings.min_points_per_view) continue;
     views.push_back(&view);
-    for (const auto& p : view.points_in_target) {
-      *extent = Eigen::Vector4d(std::min((*extent)[0], p.x()), std::max((*extent)[1], p.x()),
-                                std::min((*extent)[2], p.y()), std::max((*extent)[3], p.y()));
-    }
+    ExtendBoardExtent(view, extent);
   }
   if (views.size() < 2) {
     throw NumericalError("camera calibration needs at least 2 views with >= " +

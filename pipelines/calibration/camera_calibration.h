@@ -64,6 +64,12 @@ struct CameraCalibrationResult {
   std::vector<CalibratedView> views;
 };
 
+// The board's extent (x min, x max, y min, y max) over the views' target
+// points: where board_warp.h's (u, v) run from -1 to 1. ExtendBoardExtent
+// grows one by a view's points (start from BoardExtent({})).
+Eigen::Vector4d BoardExtent(const std::vector<CalibrationView>& views);
+void ExtendBoardExtent(const CalibrationView& view, Eigen::Vector4d* extent);
+
 // Indices of the parameters that `names` hold (CameraCalibrationSettings::
 // fixed_params). Throws OptionError for a name the model does not have.
 std::vector<int> FixedParamIndices(const Camera& camera, const std::vector<std::string>& names);

@@ -118,18 +118,12 @@ struct JointProblem {
   }
 };
 
-Eigen::Vector4d BoardExtent(const std::vector<CalibrationView>& views, const InAirViews* in_air) {
-  Eigen::Vector4d extent(1e300, -1e300, 1e300, -1e300);
-  const auto add = [&](const std::vector<CalibrationView>& set) {
-    for (const CalibrationView& view : set) {
-      for (const Eigen::Vector3d& p : view.points_in_target) {
-        extent = Eigen::Vector4d(std::min(extent[0], p.x()), std::max(extent[1], p.x()),
-                                 std::min(extent[2], p.y()), std::max(extent[3], p.y()));
-      }
-    }
-  };
-  add(views);
-  if (in_air != nullptr && in_air->same_board) add(in_air->views);
+// The board's extent over both sets when they show the same board.
+Eigen::Vector4d SharedBoardExtent(const std::vector<CalibrationView>& views, const InAirViews* in_air) {
+  Eigen::Vector4d extent = BoardExtent(views);
+  if (in_air != nullptr && in_air->same_board) {
+    for (const CalibrationView& view : in_air->views) ExtendBoardExtent(view, &extent);
+  }
   return extent;
 }
 
@@ -414,7 +408,7 @@ HousingCalibrationResult CalibrateHousing(const std::vector<CalibrationView>& vi
   housing.Validate("housing");
   if (views.size() < 2) throw NumericalError("housing calibration needs at least 2 views");
   if (in_air != nullptr && in_air->views.empty()) throw NumericalError("housing calibration: no in-air views");
-  const Inputs in{views, in_air, camera.model_id, BoardExtent(views, in_air), settings};
+  const Inputs in{views, in_air, camera.model_id, SharedBoardExtent(views, in_air), settings};
   State state;
   state.intrinsics = camera.params;
   state.housing = housing;

@@ -138,7 +138,7 @@ std::string CrossCheckText(const CrossCheckResult& r) {
   return out.str();
 }
 
-void WriteCrossCheckReport(const CrossCheckResult& r, const std::filesystem::path& dir) {
+std::string WriteCrossCheckReport(const CrossCheckResult& r, const std::filesystem::path& dir) {
   std::ostringstream yaml;
   yaml << std::setprecision(10) << "# portcal cross_check\n"
        << "camera_model: " << r.camera_model << "\nmrcal_lensmodel: " << r.mrcal_lensmodel
@@ -169,6 +169,7 @@ void WriteCrossCheckReport(const CrossCheckResult& r, const std::filesystem::pat
   const std::string text = CrossCheckText(r);
   WriteFileAtomically(dir / "cross_check.yaml", false, [&](std::ostream& out) { out << yaml.str(); });
   WriteFileAtomically(dir / "cross_check.txt", false, [&](std::ostream& out) { out << text; });
+  return text;
 }
 
 }  // namespace portcal

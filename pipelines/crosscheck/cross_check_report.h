@@ -61,6 +61,6 @@ struct CrossCheckResult {
 
 std::string CrossCheckText(const CrossCheckResult& result);
 // Writes cross_check.txt and cross_check.yaml into `dir`, atomically.
-void WriteCrossCheckReport(const CrossCheckResult& result, const std::filesystem::path& dir);
+std::string WriteCrossCheckReport(const CrossCheckResult& result, const std::filesystem::path& dir);
 
 }  // namespace portcal

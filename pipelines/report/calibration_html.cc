@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "colmap_ext/util/error.h"
+#include "colmap_ext/util/string_utils.h"
 #include "pipelines/report/calibration_pictures.h"
 #include "pipelines/report/geometry_pictures.h"
 #include "pipelines/report/picture.h"
@@ -118,8 +119,8 @@ HtmlReport EvaluationHtml(const HeldOutEvaluation& evaluation, const std::vector
   const Eigen::MatrixXd length =
       (evaluation.mean_residual_x.array().square() + evaluation.mean_residual_y.array().square()).sqrt();
   HeatMapStyle style;
-  style.title = "Mean residual per cell: systematic " + std::to_string(evaluation.systematic_px).substr(0, 5) +
-                " px, noise alone " + std::to_string(evaluation.noise_floor_px).substr(0, 5) + " px";
+  style.title = "Mean residual per cell: systematic " + FormatFixed(evaluation.systematic_px, 3) +
+                " px, noise alone " + FormatFixed(evaluation.noise_floor_px, 3) + " px";
   style.unit = "px";
   section.pictures.push_back(
       {"pattern.png",
@@ -152,7 +153,7 @@ HtmlReport SelfCalibrationHtml(const CalibrationReport& report, const SparseMode
                             housing == model.housings.end() ? std::nullopt : std::optional<Housing>(housing->second)};
   std::vector<Eigen::Vector2d> pixels;
   std::vector<PointResidual> residuals;
-  std::vector<CalibratedView> views;
+  int num_images = 0;
   for (const auto& [id, image] : model.images) {
     if (image.camera_id != camera_id) continue;
     for (const Point2D& p : image.points2D) {
@@ -160,11 +161,10 @@ HtmlReport SelfCalibrationHtml(const CalibrationReport& report, const SparseMode
       if (point == model.points3D.end()) continue;
       pixels.push_back(p.xy);
       const std::optional<Eigen::Vector2d> predicted = camera.Project(image.cam_from_world * point->second.xyz);
-      if (predicted) residuals.push_back({p.xy, p.xy - *predicted, static_cast<int>(views.size()), false});
+      if (predicted) residuals.push_back({p.xy, p.xy - *predicted, num_images, false});
     }
-    views.push_back({});
+    ++num_images;
   }
-  const int num_images = static_cast<int>(views.size());
   ReportSection section{"The observations", "", {}};
   section.pictures.push_back({"coverage.png", "Where the reconstructed points' observations lie over the image.",
                               CoveragePicture(report.camera, pixels, "observations")});

@@ -35,15 +35,11 @@ struct ImageFrame {
   }
 };
 
-Eigen::Vector4d BoardExtent(const std::vector<CalibrationView>& views) {
-  Eigen::Vector4d extent(1e300, -1e300, 1e300, -1e300);
-  for (const CalibrationView& view : views) {
-    for (const Eigen::Vector3d& p : view.points_in_target) {
-      extent = Eigen::Vector4d(std::min(extent[0], p.x()), std::max(extent[1], p.x()), std::min(extent[2], p.y()),
-                               std::max(extent[3], p.y()));
-    }
-  }
-  return extent;
+// The views by image name.
+std::map<std::string, const CalibrationView*> ByName(const std::vector<CalibrationView>& views) {
+  std::map<std::string, const CalibrationView*> by_name;
+  for (const CalibrationView& view : views) by_name[view.image_name] = &view;
+  return by_name;
 }
 
 std::string Fixed(double value, int digits) { return FormatFixed(value, digits); }
@@ -51,8 +47,7 @@ std::string Fixed(double value, int digits) { return FormatFixed(value, digits);
 }  // namespace
 
 std::vector<PointResidual> ResidualsAtPoses(const ViewsAtPoses& in) {
-  std::map<std::string, const CalibrationView*> by_name;
-  for (const CalibrationView& view : in.views) by_name[view.image_name] = &view;
+  const std::map<std::string, const CalibrationView*> by_name = ByName(in.views);
   const Eigen::Vector4d extent = BoardExtent(in.views);
   std::vector<PointResidual> residuals;
   for (size_t v = 0; v < in.calibrated.size(); ++v) {
@@ -143,8 +138,7 @@ cv::Mat UncertaintyPicture(const ViewsAtPoses& in, bool housing_calibration, con
   CalibrationUnknowns unknowns{in.camera, housing_calibration, fixed};
   Eigen::MatrixXd information = Eigen::MatrixXd::Zero(unknowns.NumUnknowns(), unknowns.NumUnknowns());
   std::vector<double> depths;
-  std::map<std::string, const CalibrationView*> by_name;
-  for (const CalibrationView& view : in.views) by_name[view.image_name] = &view;
+  const std::map<std::string, const CalibrationView*> by_name = ByName(in.views);
   for (const CalibratedView& view : in.calibrated) {
     const auto it = by_name.find(view.image_name);
     if (view.dropped || it == by_name.end()) continue;

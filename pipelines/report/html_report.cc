@@ -1,6 +1,5 @@
 #include "pipelines/report/html_report.h"
 
-#include <fstream>
 #include <sstream>
 
 #include "colmap_ext/io/sparse_model.h"
@@ -33,13 +32,6 @@ constexpr const char* kStyle =
     ".warning{color:#b00;font-weight:bold}";
 
 }  // namespace
-
-std::string ReadReportText(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 void WriteHtmlReport(const HtmlReport& report, const std::filesystem::path& dir) {
   std::ostringstream html;

@@ -28,9 +28,6 @@ struct HtmlReport {
   std::vector<ReportSection> sections;
 };
 
-// The text report a stage has just written, for its page ("" when absent).
-std::string ReadReportText(const std::filesystem::path& path);
-
 // Writes the pictures, then report.html, into `dir` (which exists).
 // Throws InputError naming a picture that is neither given nor there.
 void WriteHtmlReport(const HtmlReport& report, const std::filesystem::path& dir);

@@ -369,9 +369,9 @@ CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& 
                                                        dir / "cross_validation_diff_rerun.png"));
     }
   }
-  WriteCrossCheckReport(result, dir);
+  const std::string text = WriteCrossCheckReport(result, dir);
   WriteHtml(CrossCheckHtml(ReportOf(portcal, settings.estimate_board_warp, input.target_description), views,
-                           DifferenceMaps(result, options), ReadReportText(dir / "cross_check.txt")),
+                           DifferenceMaps(result, options), text),
             dir);
   LOG(INFO) << "cross_check: " << result.Verdict();
   return result;
