@@ -70,10 +70,15 @@ Database::~Database() {
 Transaction Database::BeginTransaction() { return Transaction(db_, path_); }
 
 void Database::CreateSchema() {
+  // COLMAP's tables and portcal's in one transaction: a process killed
+  // while creating the database leaves it empty or whole.
   Transaction transaction(db_, path_);
   for (const std::string& sql : ColmapSchemaSql()) ExecuteSql(db_, path_, sql + ";");
   ExecuteSql(db_, path_,
              "PRAGMA user_version = " + std::to_string(kColmapSchemaVersion) + ";");
+  for (const std::string& sql : PortcalSchemaSql()) ExecuteSql(db_, path_, sql + ";");
+  Statement stmt(db_, path_, "INSERT INTO portcal_meta(key, value) VALUES('schema_version', ?);");
+  stmt.Bind(1, std::to_string(kPortcalSchemaVersion)).Execute();
   transaction.Commit();
 }
 
@@ -340,6 +345,11 @@ void Database::WriteKeypoints(image_t image_id, const FeatureKeypoints& keypoint
   stmt.Execute();
 }
 
+std::string Database::ImageLabel(image_t image_id) {
+  const std::optional<DatabaseImage> image = ReadImage(image_id);
+  return "image " + std::to_string(image_id) + (image ? " (" + image->name + ")" : std::string());
+}
+
 FeatureKeypoints Database::ReadKeypoints(image_t image_id) {
   Statement& stmt =
       Prepare("read_keypoints", "SELECT rows, cols, data FROM keypoints WHERE image_id=?;");
@@ -351,9 +361,8 @@ FeatureKeypoints Database::ReadKeypoints(image_t image_id) {
   const std::vector<float> data = BlobAs<float>(stmt.ColumnBlob(2));
   if (rows < 0 || (cols != 2 && cols != 4 && cols != 6) ||
       static_cast<int64_t>(data.size()) != rows * cols) {
-    throw DatabaseError(path_ + ": keypoints of image " + std::to_string(image_id) +
-                        " have an invalid blob (" + std::to_string(rows) + " x " +
-                        std::to_string(cols) + ", " + std::to_string(data.size()) +
+    throw DatabaseError(path_ + ": keypoints of " + ImageLabel(image_id) + " have an invalid blob (" +
+                        std::to_string(rows) + " x " + std::to_string(cols) + ", " + std::to_string(data.size()) +
                         " floats)");
   }
   keypoints.resize(rows);
@@ -389,9 +398,8 @@ FeatureDescriptors Database::ReadDescriptors(image_t image_id) {
   const int64_t cols = stmt.ColumnInt64(1);
   const std::vector<uint8_t> data = stmt.ColumnBlob(2);
   if (rows < 0 || cols != 128 || static_cast<int64_t>(data.size()) != rows * cols) {
-    throw DatabaseError(path_ + ": descriptors of image " + std::to_string(image_id) +
-                        " are not uint8 x 128 (" + std::to_string(rows) + " x " +
-                        std::to_string(cols) + ")");
+    throw DatabaseError(path_ + ": descriptors of " + ImageLabel(image_id) + " are not uint8 x 128 (" +
+                        std::to_string(rows) + " x " + std::to_string(cols) + ")");
   }
   FeatureDescriptors descriptors(rows, 128);
   if (rows > 0) std::memcpy(descriptors.data(), data.data(), data.size());

@@ -55,6 +55,10 @@ class Database {
 
   image_t WriteImage(const DatabaseImage& image, bool use_image_id = false);
   std::optional<DatabaseImage> ReadImage(image_t image_id);
+  // "image 7 (name.png)" for messages; "image 7" when there is no such row.
+  std::string ImageLabel(image_t image_id);
+  // "pair N (image 1 (a.png), image 2 (b.png))" for messages.
+  std::string PairLabel(image_pair_t pair_id);
   // Sets (or, with nullopt, clears) an image's position prior; clears any
   // full pose prior.
   void UpdatePositionPrior(image_t image_id, const std::optional<Eigen::Vector3d>& position);

@@ -2,6 +2,7 @@
 #include <sqlite3.h>
 
 #include <cstring>
+#include <functional>
 
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
@@ -18,11 +19,14 @@ std::vector<uint32_t> FlattenMatches(const FeatureMatches& matches, bool swap) {
   return flat;
 }
 
+// `where` names the row for a message (a query, so made only on an error).
+using Where = std::function<std::string()>;
+
 FeatureMatches MatchesFromBlob(const std::vector<uint8_t>& blob, int64_t rows,
-                               int64_t cols, const std::string& where) {
+                               int64_t cols, const Where& where) {
   if (rows < 0 || (rows > 0 && cols != 2) ||
       blob.size() != static_cast<size_t>(rows) * 2 * sizeof(uint32_t)) {
-    throw DatabaseError(where + ": matches blob is not uint32 x 2 (" +
+    throw DatabaseError(where() + ": matches blob is not uint32 x 2 (" +
                         std::to_string(rows) + " x " + std::to_string(cols) + ")");
   }
   FeatureMatches matches(rows);
@@ -58,11 +62,16 @@ Eigen::Matrix3d MatrixFromBlob(const std::vector<uint8_t>& blob) {
   return m;
 }
 
-TwoViewGeometry GeometryFromRow(const Statement& stmt, const std::string& where) {
+TwoViewGeometry GeometryFromRow(const Statement& stmt, const Where& where) {
   TwoViewGeometry geometry;
   geometry.inlier_matches = MatchesFromBlob(stmt.ColumnBlob(3), stmt.ColumnInt64(1),
                                             stmt.ColumnInt64(2), where);
-  geometry.config = static_cast<TwoViewGeometryConfig>(stmt.ColumnInt64(4));
+  const int64_t config = stmt.ColumnInt64(4);
+  if (config < static_cast<int>(TwoViewGeometryConfig::kUndefined) ||
+      config > static_cast<int>(TwoViewGeometryConfig::kMultiple)) {
+    throw DatabaseError(where() + ": config " + std::to_string(config) + " is none of COLMAP's (0 to 8)");
+  }
+  geometry.config = static_cast<TwoViewGeometryConfig>(config);
   geometry.F = MatrixFromBlob(stmt.ColumnBlob(5));
   geometry.E = MatrixFromBlob(stmt.ColumnBlob(6));
   geometry.H = MatrixFromBlob(stmt.ColumnBlob(7));
@@ -77,6 +86,12 @@ TwoViewGeometry GeometryFromRow(const Statement& stmt, const std::string& where)
 }
 
 }  // namespace
+
+std::string Database::PairLabel(image_pair_t pair_id) {
+  image_t image_id1 = 0, image_id2 = 0;
+  PairIdToImagePair(pair_id, &image_id1, &image_id2);
+  return "pair " + std::to_string(pair_id) + " (" + ImageLabel(image_id1) + ", " + ImageLabel(image_id2) + ")";
+}
 
 void Database::WriteMatches(image_t image_id1, image_t image_id2,
                             const FeatureMatches& matches) {
@@ -96,9 +111,9 @@ FeatureMatches Database::ReadMatches(image_t image_id1, image_t image_id2) {
       Prepare("read_matches", "SELECT rows, cols, data FROM matches WHERE pair_id=?;");
   stmt.Bind(1, static_cast<int64_t>(ImagePairToPairId(image_id1, image_id2)));
   if (!stmt.Step()) return {};
-  FeatureMatches matches = MatchesFromBlob(
-      stmt.ColumnBlob(2), stmt.ColumnInt64(0), stmt.ColumnInt64(1),
-      path_ + ": pair " + std::to_string(image_id1) + "/" + std::to_string(image_id2));
+  FeatureMatches matches =
+      MatchesFromBlob(stmt.ColumnBlob(2), stmt.ColumnInt64(0), stmt.ColumnInt64(1),
+                      [&] { return path_ + ": matches of " + PairLabel(ImagePairToPairId(image_id1, image_id2)); });
   if (SwapImagePair(image_id1, image_id2)) {
     for (FeatureMatch& match : matches) std::swap(match.point2D_idx1, match.point2D_idx2);
   }
@@ -111,10 +126,8 @@ std::vector<std::pair<image_pair_t, FeatureMatches>> Database::ReadAllMatches() 
   std::vector<std::pair<image_pair_t, FeatureMatches>> all;
   while (stmt.Step()) {
     const image_pair_t pair_id = stmt.ColumnInt64(0);
-    all.emplace_back(pair_id,
-                     MatchesFromBlob(stmt.ColumnBlob(3), stmt.ColumnInt64(1),
-                                     stmt.ColumnInt64(2),
-                                     path_ + ": pair_id " + std::to_string(pair_id)));
+    all.emplace_back(pair_id, MatchesFromBlob(stmt.ColumnBlob(3), stmt.ColumnInt64(1), stmt.ColumnInt64(2),
+                                              [&] { return path_ + ": matches of " + PairLabel(pair_id); }));
   }
   return all;
 }
@@ -156,9 +169,9 @@ std::optional<TwoViewGeometry> Database::ReadTwoViewGeometry(image_t image_id1,
       "two_view_geometries WHERE pair_id=?;");
   stmt.Bind(1, static_cast<int64_t>(ImagePairToPairId(image_id1, image_id2)));
   if (!stmt.Step()) return std::nullopt;
-  const TwoViewGeometry geometry = GeometryFromRow(
-      stmt, path_ + ": geometry " + std::to_string(image_id1) + "/" +
-                std::to_string(image_id2));
+  const TwoViewGeometry geometry = GeometryFromRow(stmt, [&] {
+    return path_ + ": two_view_geometries of " + PairLabel(ImagePairToPairId(image_id1, image_id2));
+  });
   return SwapImagePair(image_id1, image_id2) ? geometry.Inverse() : geometry;
 }
 
@@ -170,8 +183,9 @@ std::vector<std::pair<image_pair_t, TwoViewGeometry>> Database::ReadTwoViewGeome
   std::vector<std::pair<image_pair_t, TwoViewGeometry>> all;
   while (stmt.Step()) {
     const image_pair_t pair_id = stmt.ColumnInt64(0);
-    all.emplace_back(pair_id, GeometryFromRow(stmt, path_ + ": pair_id " +
-                                                        std::to_string(pair_id)));
+    all.emplace_back(pair_id, GeometryFromRow(stmt, [&] {
+                       return path_ + ": two_view_geometries of " + PairLabel(pair_id);
+                     }));
   }
   return all;
 }

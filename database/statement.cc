@@ -93,7 +93,10 @@ int64_t Statement::ColumnInt64(int column) const {
 }
 
 double Statement::ColumnDouble(int column) const {
-  if (ColumnIsNull(column)) return std::nan("");
+  // Text or a blob in a REAL column (an edited row) is no number: NaN, which
+  // the readers refuse, rather than SQLite's 0.0.
+  const int type = sqlite3_column_type(stmt_, column);
+  if (type == SQLITE_NULL || type == SQLITE_TEXT || type == SQLITE_BLOB) return std::nan("");
   return sqlite3_column_double(stmt_, column);
 }
 

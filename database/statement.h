@@ -38,7 +38,7 @@ class Statement {
   void Reset();
 
   int64_t ColumnInt64(int column) const;
-  double ColumnDouble(int column) const;  // NULL -> NaN
+  double ColumnDouble(int column) const;  // NULL, text, blob -> NaN
   bool ColumnIsNull(int column) const;
   std::string ColumnText(int column) const;
   std::vector<uint8_t> ColumnBlob(int column) const;

@@ -1,10 +1,12 @@
 #include "tools/command_line.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 
+#include "colmap_ext/housing/housing_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/string_utils.h"
@@ -119,6 +121,29 @@ std::string CommandLine::Suggestions(std::string name) const {
   return text;
 }
 
+std::string CommandLine::StrayWords(int argc, char** argv) const {
+  const po::parsed_options parsed = po::command_line_parser(argc, argv).options(options_).allow_unregistered().run();
+  std::string words;
+  for (const std::string& word : po::collect_unrecognized(parsed.options, po::include_positional)) {
+    words += (words.empty() ? "'" : ", '") + word + "'";
+  }
+  return words;
+}
+
+void CommandLine::StoreProjectFile(const std::string& path, po::variables_map* vm) const {
+  if (!std::filesystem::is_regular_file(path)) throw UsageError("--project_path " + path + ": not a file");
+  std::ifstream file(path);
+  if (!file) throw UsageError("--project_path " + path + ": cannot open");
+  try {
+    po::store(po::parse_config_file(file, options_), *vm);
+  } catch (const po::unknown_option& e) {
+    const std::string suggestions = Suggestions(e.get_option_name());
+    throw UsageError(path + ": " + e.what() + (suggestions.empty() ? "" : "; did you mean " + suggestions + "?"));
+  } catch (const po::error& e) {
+    throw UsageError(path + ": " + e.what());
+  }
+}
+
 bool CommandLine::Parse(int argc, char** argv) {
   if (const std::optional<std::string> group = HelpRequest(argc, argv)) {
     std::cout << Help(*group);
@@ -129,18 +154,19 @@ bool CommandLine::Parse(int argc, char** argv) {
     // No guessing: an abbreviated option is an error, not silently the one
     // it happens to abbreviate.
     const int style = po::command_line_style::default_style & ~po::command_line_style::allow_guessing;
-    po::store(po::command_line_parser(argc, argv).options(options_).style(style).run(), vm);
-    if (vm.count("project_path")) {
-      const std::string path = vm["project_path"].as<std::string>();
-      std::ifstream file(path);
-      if (!file) throw InputError("--project_path " + path + ": cannot open");
-      po::store(po::parse_config_file(file, options_), vm);
-    }
+    // An empty positional description: a stray word is an error, not ignored.
+    const po::positional_options_description no_positional;
+    po::store(po::command_line_parser(argc, argv).options(options_).positional(no_positional).style(style).run(),
+              vm);
+    if (vm.count("project_path")) StoreProjectFile(vm["project_path"].as<std::string>(), &vm);
     po::notify(vm);
   } catch (const po::unknown_option& e) {
     const std::string suggestions = Suggestions(e.get_option_name());
     throw UsageError(std::string(e.what()) + (suggestions.empty() ? "" : "; did you mean " + suggestions + "?") +
                      " (see portcal " + command_ + " -h)");
+  } catch (const po::too_many_positional_options_error&) {
+    throw UsageError(StrayWords(argc, argv) + ": not an option; options are --name value (see portcal " + command_ +
+                     " -h)");
   } catch (const po::error& e) {
     throw UsageError(std::string(e.what()) + " (see portcal " + command_ + " -h)");
   }
@@ -201,6 +227,7 @@ void CommandLine::AddHousing(std::optional<Housing>* housing, const std::string&
       return;
     }
     if (params.empty()) throw OptionError("--Housing.params", "''", "the parameters of --Housing.model " + model);
+    if (!ExistsHousingModelWithName(model)) throw OptionError("--Housing.model", model, "FLATPORT, DOMEPORT or NONE");
     *housing = Housing::FromName(model, ParseDoubleList(params, "--Housing.params"), "--Housing.params");
     (*housing)->ValidateInput("--Housing.params");
   });

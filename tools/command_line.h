@@ -98,6 +98,10 @@ class CommandLine {
   std::string GroupNames() const;
   // Up to three registered options `name` abbreviates or nearly spells.
   std::string Suggestions(std::string name) const;
+  // The words of a command line that are no option nor an option's value.
+  std::string StrayWords(int argc, char** argv) const;
+  // Adds an ini file's options (--project_path); errors name the file.
+  void StoreProjectFile(const std::string& path, boost::program_options::variables_map* vm) const;
 
   std::string command_;
   std::string summary_;

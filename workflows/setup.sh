@@ -2,9 +2,13 @@
 # Installs portcal's dependencies from Debian's packages (idempotent: only
 # missing packages are installed, so a second run takes seconds) and builds
 # portcal into build/ (Release). Used by test.sh and demo.sh; arguments are
-# more packages to install (test.sh: the browser of the page test).
+# more packages to install (test.sh: the browser of the page test); with
+# --packages-only first, nothing is built (fuzz.sh and sanitize.sh build
+# their own clang tree).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+build=1
+if [ "${1:-}" = "--packages-only" ]; then build=0; shift; fi
 
 packages=(
   build-essential cmake ccache pkg-config
@@ -34,6 +38,7 @@ if [ "${#missing[@]}" -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${missing[@]}"
 fi
 
+[ "$build" -eq 1 ] || exit 0
 jobs="$(nproc 2>/dev/null || echo 2)"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$jobs"

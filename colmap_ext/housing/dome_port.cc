@@ -17,8 +17,10 @@ std::optional<std::string> DomePort::Invalidity(const double* port) {
   }
   if (!(InnerRadius(port) > 0)) return "DOMEPORT int_radius must be positive";
   if (!(port[4] > 0)) return "DOMEPORT int_thick must be positive";
-  if (!(AirIndex(port) > 0 && GlassIndex(port) > 0 && WaterIndex(port) > 0)) {
-    return "DOMEPORT refractive indices must be positive";
+  // No medium has an index below vacuum's 1 (air 1.0, glass about 1.5,
+  // water 1.33); a smaller one is a typo, and the solve would fail on it.
+  if (!(AirIndex(port) >= 1 && GlassIndex(port) >= 1 && WaterIndex(port) >= 1)) {
+    return "DOMEPORT refractive indices na, ng, nw must be at least 1 (air 1.0, glass ~1.5, water ~1.33)";
   }
   const double decentering = Center(port).norm();
   if (!(decentering < InnerRadius(port))) {

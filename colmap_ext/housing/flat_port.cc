@@ -26,8 +26,10 @@ std::optional<std::string> FlatPort::Invalidity(const double* port) {
     return "FLATPORT int_dist must be positive";
   }
   if (!(Thickness(port) > 0)) return "FLATPORT int_thick must be positive";
-  if (!(AirIndex(port) > 0 && GlassIndex(port) > 0 && WaterIndex(port) > 0)) {
-    return "FLATPORT refractive indices must be positive";
+  // No medium has an index below vacuum's 1 (air 1.0, glass about 1.5,
+  // water 1.33); a smaller one is a typo, and the solve would fail on it.
+  if (!(AirIndex(port) >= 1 && GlassIndex(port) >= 1 && WaterIndex(port) >= 1)) {
+    return "FLATPORT refractive indices na, ng, nw must be at least 1 (air 1.0, glass ~1.5, water ~1.33)";
   }
   return std::nullopt;
 }

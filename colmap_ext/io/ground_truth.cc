@@ -350,7 +350,11 @@ void WriteTarget(std::ostream& out, const TargetDescription& t) {
 
 }  // namespace
 
-GroundTruth ReadGroundTruth(const fs::path& path) {
+namespace {
+
+// The body of ReadGroundTruth; yaml-cpp's exceptions (a key looked up in a scalar, a
+// value of the wrong type) are turned into InputError by the caller.
+GroundTruth ReadGroundTruthUnguarded(const fs::path& path) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(path.string());
@@ -402,6 +406,16 @@ GroundTruth ReadGroundTruth(const fs::path& path) {
     truth.images.push_back(frame);
   }
   return truth;
+}
+
+}  // namespace
+
+GroundTruth ReadGroundTruth(const fs::path& path) {
+  try {
+    return ReadGroundTruthUnguarded(path);
+  } catch (const YAML::Exception& e) {
+    throw InputError(path.string() + ": " + e.what());
+  }
 }
 
 void WriteGroundTruth(const GroundTruth& truth, const fs::path& path,

@@ -1,11 +1,15 @@
 #include "colmap_ext/io/mrcal_model.h"
 
 #include <Eigen/Geometry>
+#include <cctype>
 #include <cstdlib>
+#include <fstream>
 #include <iomanip>
+#include <iterator>
+#include <limits>
 #include <memory>
-#include <stdexcept>
 #include <ostream>
+#include <stdexcept>
 
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/io/npz_archive.h"
@@ -160,9 +164,59 @@ std::array<double, 6> RtFromRigid(const Rigid3d& b_from_a) {
   return {r[0], r[1], r[2], b_from_a.translation[0], b_from_a.translation[1], b_from_a.translation[2]};
 }
 
+namespace {
+
+// Debian's libmrcal parses a .cameramodel without looking at its end: a
+// truncated file (an unclosed string, a comment or list running to the end)
+// makes it read past the buffer (found by fuzzing). So the text is first
+// checked to be one complete Python dict literal -- strings closed, brackets
+// matched, nothing after the closing brace -- before mrcal sees it.
+void CheckCompleteDictLiteral(const std::string& text, const std::string& path) {
+  const auto fail = [&](const std::string& what, size_t at) {
+    throw InputError(path + ": not a complete mrcal .cameramodel (" + what + " at byte " + std::to_string(at) + ")");
+  };
+  std::string open;  // the brackets not yet closed
+  bool seen_dict = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\0') fail("a NUL byte", i);
+    if (c == '#') {
+      i = text.find('\n', i);
+      if (i == std::string::npos) break;
+    } else if (c == '\'' || c == '"') {
+      size_t j = i + 1;
+      while (j < text.size() && text[j] != c && text[j] != '\n') j += text[j] == '\\' ? 2 : 1;
+      if (j >= text.size() || text[j] != c) fail("an unclosed string", i);
+      i = j;
+    } else if (c == '{' || c == '[' || c == '(') {
+      if (open.empty() && (seen_dict || c != '{')) fail("text outside the dict", i);
+      seen_dict = true;
+      open += c == '{' ? '}' : c == '[' ? ']' : ')';
+    } else if (c == '}' || c == ']' || c == ')') {
+      if (open.empty() || open.back() != c) fail("an unmatched '" + std::string(1, c) + "'", i);
+      open.pop_back();
+    } else if (open.empty() && !std::isspace(static_cast<unsigned char>(c))) {
+      fail("text outside the dict", i);
+    }
+  }
+  if (!seen_dict) fail("no dict", 0);
+  if (!open.empty()) fail("an unclosed bracket", text.size());
+}
+
+}  // namespace
+
 MrcalCameraModelFile ReadMrcalCameraModel(const std::filesystem::path& path) {
+  // Read here and parsed from a checked, NUL-terminated string: mrcal's
+  // file reader parses an mmap of the file, which has no terminator.
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot open");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (text.size() > static_cast<size_t>(std::numeric_limits<int>::max())) {
+    throw InputError(path.string() + ": too large for a .cameramodel");
+  }
+  CheckCompleteDictLiteral(text, path.string());
   std::unique_ptr<mrcal_cameramodel_t, CameraModelDeleter> model(
-      mrcal_read_cameramodel_file(path.c_str()));
+      mrcal_read_cameramodel_string(text.c_str(), static_cast<int>(text.size())));
   if (!model) {
     throw InputError(path.string() + ": not a readable mrcal .cameramodel (mrcal's parser "
                      "rejected it; its message is above)");

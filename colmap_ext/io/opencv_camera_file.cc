@@ -204,7 +204,11 @@ bool IsOpenCvOrRosCameraYaml(const std::filesystem::path& path) {
   return false;
 }
 
-Camera ReadOpenCvCameraYaml(const std::filesystem::path& path) {
+namespace {
+
+// The body of ReadOpenCvCameraYaml; yaml-cpp's exceptions (a key looked up in a scalar, a
+// value of the wrong type) are turned into InputError by the caller.
+Camera ReadOpenCvCameraYamlUnguarded(const std::filesystem::path& path) {
   const YAML::Node root = LoadOpenCvYaml(path);
   const std::vector<double> k = MatrixData(root, "camera_matrix", path);
   if (k.size() != 9) throw InputError(path.string() + ": 'camera_matrix' needs 9 values");
@@ -222,6 +226,16 @@ Camera ReadOpenCvCameraYaml(const std::filesystem::path& path) {
   if (k[1] != 0) throw InputError(path.string() + ": a skewed camera_matrix (COLMAP's models have no skew)");
   return CameraOfOpenCv(k[0], k[4], k[2], k[5], d, fisheye, ImageSize(root, "image_width", path),
                         ImageSize(root, "image_height", path), path);
+}
+
+}  // namespace
+
+Camera ReadOpenCvCameraYaml(const std::filesystem::path& path) {
+  try {
+    return ReadOpenCvCameraYamlUnguarded(path);
+  } catch (const YAML::Exception& e) {
+    throw InputError(path.string() + ": " + e.what());
+  }
 }
 
 }  // namespace portcal

@@ -9,57 +9,51 @@ namespace fs = std::filesystem;
 
 namespace portcal {
 
-void SparseModel::Validate(const std::string& context) const {
+void SparseModel::Validate(const std::string& context, const std::string& extension) const {
+  // Read from files, the messages name the file whose row is at fault.
+  const auto in = [&](const std::string& file) {
+    return extension.empty() ? context : (fs::path(context) / (file + extension)).string();
+  };
   for (const auto& [camera_id, camera] : cameras) {
-    camera.Validate(context + ": camera " + std::to_string(camera_id));
+    camera.Validate(in("cameras") + ": camera " + std::to_string(camera_id));
   }
   for (const auto& [image_id, image] : images) {
+    const std::string where = in("images") + ": image " + std::to_string(image_id) + " (" + image.name + ")";
     if (cameras.count(image.camera_id) == 0) {
-      throw InputError(context + ": image " + std::to_string(image_id) + " (" +
-                       image.name + ") refers to unknown camera " +
-                       std::to_string(image.camera_id));
+      throw InputError(where + " refers to unknown camera " + std::to_string(image.camera_id));
     }
-    if (!image.cam_from_world.rotation.coeffs().allFinite() ||
-        !image.cam_from_world.translation.allFinite()) {
-      throw InputError(context + ": image " + image.name +
-                       " has a non-finite pose");
+    if (!image.cam_from_world.rotation.coeffs().allFinite() || !image.cam_from_world.translation.allFinite()) {
+      throw InputError(where + " has a non-finite pose");
+    }
+    // The readers normalise; a zero quaternion stays zero and is no rotation.
+    if (std::abs(image.cam_from_world.rotation.norm() - 1) > 1e-3) {
+      throw InputError(where + " has a rotation quaternion of norm " +
+                       std::to_string(image.cam_from_world.rotation.norm()) + ", not a rotation");
     }
     for (const Point2D& point2D : image.points2D) {
-      if (!point2D.xy.allFinite()) {
-        throw InputError(context + ": image " + image.name +
-                         " has a non-finite 2D point");
-      }
-      if (point2D.point3D_id != kInvalidPoint3DId &&
-          points3D.count(point2D.point3D_id) == 0) {
-        throw InputError(context + ": image " + image.name +
-                         " refers to unknown 3D point " +
-                         std::to_string(point2D.point3D_id));
+      if (!point2D.xy.allFinite()) throw InputError(where + " has a non-finite 2D point");
+      if (point2D.point3D_id != kInvalidPoint3DId && points3D.count(point2D.point3D_id) == 0) {
+        throw InputError(where + " refers to unknown 3D point " + std::to_string(point2D.point3D_id));
       }
     }
   }
   for (const auto& [point3D_id, point3D] : points3D) {
-    if (!point3D.xyz.allFinite() || !std::isfinite(point3D.error)) {
-      throw InputError(context + ": 3D point " + std::to_string(point3D_id) +
-                       " is not finite");
-    }
+    const std::string where = in("points3D") + ": 3D point " + std::to_string(point3D_id);
+    if (!point3D.xyz.allFinite() || !std::isfinite(point3D.error)) throw InputError(where + " is not finite");
     for (const TrackElement& element : point3D.track) {
       const auto image = images.find(element.image_id);
-      if (image == images.end() ||
-          element.point2D_idx >= image->second.points2D.size()) {
-        throw InputError(context + ": 3D point " + std::to_string(point3D_id) +
-                         " observes unknown image " +
-                         std::to_string(element.image_id) + " / point " +
+      if (image == images.end() || element.point2D_idx >= image->second.points2D.size()) {
+        throw InputError(where + " observes unknown image " + std::to_string(element.image_id) + " / point " +
                          std::to_string(element.point2D_idx));
       }
     }
   }
+  const std::string housings_file = extension.empty() ? context : (fs::path(context) / "housings.txt").string();
   for (const auto& [camera_id, housing] : housings) {
     if (cameras.count(camera_id) == 0) {
-      throw InputError(context + ": housing of unknown camera " +
-                       std::to_string(camera_id));
+      throw InputError(housings_file + ": housing of unknown camera " + std::to_string(camera_id));
     }
-    housing.Validate(context + ": housing of camera " +
-                     std::to_string(camera_id));
+    housing.Validate(housings_file + ": housing of camera " + std::to_string(camera_id));
   }
 }
 
@@ -68,8 +62,10 @@ SparseModel ReadSparseModel(const fs::path& dir) {
     throw InputError(dir.string() + ": not a directory with a sparse model");
   }
   SparseModel model;
+  std::string extension = ".txt";
   if (fs::exists(dir / "cameras.bin") && fs::exists(dir / "images.bin") &&
       fs::exists(dir / "points3D.bin")) {
+    extension = ".bin";
     model.cameras = ReadCamerasBinary(dir / "cameras.bin");
     model.images = ReadImagesBinary(dir / "images.bin");
     model.points3D = ReadPoints3DBinary(dir / "points3D.bin");
@@ -92,7 +88,7 @@ SparseModel ReadSparseModel(const fs::path& dir) {
     }
     model.housings = ReadHousingsText(dir / "housings.txt");
   }
-  model.Validate(dir.string());
+  model.Validate(dir.string(), extension);
   return model;
 }
 

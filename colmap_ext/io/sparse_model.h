@@ -53,8 +53,10 @@ struct SparseModel {
 
   // Throws InputError (prefixed by `context`) on dangling references: images
   // of unknown cameras, tracks naming unknown images or observations,
-  // housings of unknown cameras, invalid camera or housing parameters.
-  void Validate(const std::string& context) const;
+  // housings of unknown cameras, invalid camera or housing parameters. With
+  // `extension` (".bin", ".txt"), `context` is the model's folder and the
+  // message names the file: context/images.bin, context/housings.txt.
+  void Validate(const std::string& context, const std::string& extension = "") const;
 };
 
 enum class ModelFormat { kBinary, kText };

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace portcal {
@@ -23,5 +24,9 @@ class NewPaths {
   std::vector<std::filesystem::path> created_;
   bool keep_ = false;
 };
+
+// For Options::Check(): an output folder that is a file is an OptionError
+// naming `option`, before any work.
+void CheckOutputFolder(const std::string& option, const std::string& path);
 
 }  // namespace portcal

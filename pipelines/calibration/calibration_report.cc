@@ -444,8 +444,13 @@ void ReadCalibmarComments(const fs::path& path, CalibrationReport* report) {
 
 }  // namespace
 
-CalibrationReport ReadCalibrationReport(const fs::path& path) {
+namespace {
+
+// The body of ReadCalibrationReport; yaml-cpp's exceptions (a key looked up in a scalar, a
+// value of the wrong type) are turned into InputError by the caller.
+CalibrationReport ReadCalibrationReportUnguarded(const fs::path& path) {
   if (!fs::exists(path)) throw InputError(path.string() + ": no such file");
+  if (!fs::is_regular_file(path)) throw InputError(path.string() + ": not a file (" + kCalibrationFormats + ")");
   if (path.extension() == ".cameramodel") return ReportOfCamera(ReadMrcalCameraModel(path).camera);
   if (IsOpenCvOrRosCameraYaml(path)) return ReportOfCamera(ReadOpenCvCameraYaml(path));
   YAML::Node root;
@@ -510,6 +515,16 @@ CalibrationReport ReadCalibrationReport(const fs::path& path) {
   ReadCalibmarComments(path, &report);
   report.camera.Validate(path.string());
   return report;
+}
+
+}  // namespace
+
+CalibrationReport ReadCalibrationReport(const fs::path& path) {
+  try {
+    return ReadCalibrationReportUnguarded(path);
+  } catch (const YAML::Exception& e) {
+    throw InputError(path.string() + ": " + e.what());
+  }
 }
 
 }  // namespace portcal

@@ -3,6 +3,16 @@
 #include "colmap_ext/util/error.h"
 
 namespace portcal {
+namespace {
+
+// Detected corners lie in the image; one more than an image size outside it
+// is a damaged row, not a measurement.
+bool NearTheImage(const Eigen::Vector2d& xy, const Camera& camera) {
+  const double w = static_cast<double>(camera.width), h = static_cast<double>(camera.height);
+  return xy.x() > -w && xy.x() < 2 * w && xy.y() > -h && xy.y() < 2 * h;
+}
+
+}  // namespace
 
 TargetViews ReadTargetViews(Database* database) {
   TargetViews views;
@@ -12,12 +22,17 @@ TargetViews ReadTargetViews(Database* database) {
     views.target = status->target;
     CalibrationView view;
     view.image_name = image.name;
+    const std::optional<Camera> camera = database->ReadCamera(image.camera_id);
     for (const TargetObservation& o : database->ReadTargetObservations(image.image_id)) {
       // A value no detector writes (an edited or damaged row) would
       // otherwise surface as a solver that "did not converge".
-      if (!o.xy.allFinite() || !o.point_in_target.allFinite()) {
-        throw InputError(database->path() + ": image " + image.name + ", target point " +
-                         std::to_string(view.pixels.size()) + " of portcal_target_observations is not a finite number");
+      const std::string where = database->path() + ": image " + image.name + ", target point " +
+                                std::to_string(o.point_id) + " of portcal_target_observations";
+      if (!o.xy.allFinite() || !o.point_in_target.allFinite()) throw InputError(where + " is not a finite number");
+      if (camera && !NearTheImage(o.xy, *camera)) {
+        throw InputError(where + " is at (" + std::to_string(o.xy.x()) + ", " + std::to_string(o.xy.y()) +
+                         "), far outside the " + std::to_string(camera->width) + "x" +
+                         std::to_string(camera->height) + " image");
       }
       view.points_in_target.push_back(o.point_in_target);
       view.pixels.push_back(o.xy);
@@ -30,17 +45,18 @@ TargetViews ReadTargetViews(Database* database) {
   return views;
 }
 
-camera_t ChooseCamera(const TargetViews& views, int camera_id, const std::string& database_path) {
+camera_t ChooseCamera(const TargetViews& views, int camera_id, const std::string& database_path,
+                      const std::string& option) {
   if (camera_id >= 0) {
     if (!views.by_camera.count(static_cast<camera_t>(camera_id))) {
-      throw InputError(database_path + ": camera " + std::to_string(camera_id) +
-                       " (--camera_id) has no target observations");
+      throw InputError(database_path + ": camera " + std::to_string(camera_id) + " (" + option +
+                       ") has no target observations");
     }
     return static_cast<camera_t>(camera_id);
   }
   if (views.by_camera.size() > 1) {
     throw InputError(database_path + ": " + std::to_string(views.by_camera.size()) +
-                     " cameras have target observations; choose one with --camera_id (or "
+                     " cameras have target observations; choose one with " + option + " (or "
                      "extract with --ImageReader.single_camera 1)");
   }
   return views.by_camera.begin()->first;

@@ -20,7 +20,9 @@ struct TargetViews {
 TargetViews ReadTargetViews(Database* database);
 
 // The camera to calibrate: `camera_id` if >= 0 (must have views), else the
-// only camera with views. Throws InputError naming the database and option.
-camera_t ChooseCamera(const TargetViews& views, int camera_id, const std::string& database_path);
+// only camera with views. Throws InputError naming the database and
+// `option`, the flag that chooses the camera.
+camera_t ChooseCamera(const TargetViews& views, int camera_id, const std::string& database_path,
+                      const std::string& option = "--camera_id");
 
 }  // namespace portcal

@@ -1,6 +1,7 @@
 #include "pipelines/detection/target_detector.h"
 
 #include "colmap_ext/util/error.h"
+#include "colmap_ext/util/string_utils.h"
 
 namespace portcal {
 namespace {
@@ -43,6 +44,15 @@ void TargetDetectorOptions::Check() const {
     throw OptionError("--Target.type", type, "chessboard, aruco_grid or charuco");
   }
   if (!(square_size_m > 0)) throw OptionError("--Target.square_size", std::to_string(square_size_m), "> 0 m");
+  // A board's squares and markers are millimetres to decimetres: a metre or
+  // more is a size in millimetres given as metres.
+  for (const auto& [option, size] : {std::pair("--Target.square_size", square_size_m),
+                                     std::pair("--Target.marker_size", markers.marker_size_m)}) {
+    if (size >= 1) {
+      throw OptionError(option, FormatShortest(size),
+                        "metres (" + FormatShortest(size) + " mm is " + FormatShortest(size / 1000) + " m)");
+    }
+  }
   if (type == "chessboard") {
     ChessboardOptions(*this).Check();
   } else {

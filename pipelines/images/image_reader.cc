@@ -30,6 +30,12 @@ void ImageReaderOptions::Check() const {
   }
 }
 
+std::string ImageSizeProblem(int width, int height) {
+  if (width >= kMinImageSide && height >= kMinImageSide) return "";
+  return std::to_string(width) + "x" + std::to_string(height) + " pixels, under " + std::to_string(kMinImageSide) +
+         " a side";
+}
+
 std::vector<std::string> ListImages(const fs::path& dir) {
   if (!fs::is_directory(dir)) throw InputError(dir.string() + ": not a directory of images");
   std::vector<std::string> names;

@@ -33,6 +33,13 @@ struct ImageReaderOptions {
 // sorted, as paths relative to `dir`. Throws InputError if there are none.
 std::vector<std::string> ListImages(const std::filesystem::path& dir);
 
+// Images with a side under this many pixels hold neither a target nor SIFT
+// features worth the name (OpenCV's adaptive threshold asserts on them): a
+// stage skips them, like unreadable files, with a warning naming them.
+constexpr int kMinImageSide = 16;
+// "" for an image of usable size, else why it is skipped.
+std::string ImageSizeProblem(int width, int height);
+
 // The cameras of one import: shared between images (single_camera, or per
 // folder), and every camera an image was given.
 struct SharedCameras {

@@ -74,6 +74,9 @@ void LiveSessionOptions::Check() const {
   hands_free.Check();
   estimator.guidance.Check();
   if (max_views < 0) throw OptionError("--Live.max_views", std::to_string(max_views), ">= 0");
+  if (!(pair_tolerance_s >= 0)) {
+    throw OptionError("--Live.pair_tolerance", std::to_string(pair_tolerance_s), ">= 0 s (0: the frames' own order)");
+  }
   if (Stereo() && source2 == source.source) throw OptionError("--source2", source2, "a source other than --source");
 }
 

@@ -1,5 +1,6 @@
 #include "pipelines/markers/aruco.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "colmap_ext/util/error.h"
@@ -42,6 +43,14 @@ cv::Ptr<cv::aruco::Dictionary> ArucoDictionaryByName(const std::string& name) {
   std::string names;
   for (const auto& known : ArucoDictionaryNames()) names += (names.empty() ? "" : ", ") + known;
   throw InputError("unknown ArUco dictionary '" + name + "' (expected one of " + names + ")");
+}
+
+void CheckArucoDictionaryOption(const std::string& option, const std::string& name) {
+  const std::vector<std::string> known = ArucoDictionaryNames();
+  if (std::find(known.begin(), known.end(), name) != known.end()) return;
+  std::string names;
+  for (const auto& each : known) names += (names.empty() ? "" : ", ") + each;
+  throw OptionError(option, name, "an ArUco dictionary: " + names);
 }
 
 std::vector<uint8_t> ArucoMarkerModules(const cv::aruco::Dictionary& dictionary,

@@ -12,6 +12,8 @@ namespace portcal {
 // names for an unknown one.
 cv::Ptr<cv::aruco::Dictionary> ArucoDictionaryByName(const std::string& name);
 std::vector<std::string> ArucoDictionaryNames();
+// Throws an OptionError naming `option` when `name` is no known dictionary.
+void CheckArucoDictionaryOption(const std::string& option, const std::string& name);
 
 // The marker's modules including its one-module black border, row-major,
 // (bits + 2)^2 entries: 1 white, 0 black. Row 0 is the top edge (top-left to

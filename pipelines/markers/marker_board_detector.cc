@@ -17,7 +17,7 @@ void MarkerBoardOptions::Check() const {
   if (type != "aruco_grid" && type != "charuco") {
     throw OptionError("--Target.type", type, "aruco_grid or charuco here");
   }
-  ArucoDictionaryByName(dictionary);
+  CheckArucoDictionaryOption("--Target.dictionary", dictionary);
   if (type == "aruco_grid" && (markers_x < 1 || markers_y < 1)) {
     throw OptionError("--Target.markers_x/markers_y", std::to_string(markers_x), ">= 1 each");
   }

@@ -17,6 +17,10 @@ SfmInputs SfmInputs::Read(Database* database) {
     if (it != housings.end()) c.housing = it->second;
   }
   for (const DatabaseImage& row : database->ReadAllImages()) {
+    if (!inputs.cameras.count(row.camera_id)) {
+      throw InputError(database->path() + ": image '" + row.name + "' has camera " + std::to_string(row.camera_id) +
+                       ", which the cameras table does not hold");
+    }
     SfmImage& image = inputs.images[row.image_id];
     image.image_id = row.image_id;
     image.name = row.name;
@@ -33,6 +37,10 @@ SfmInputs SfmInputs::Read(Database* database) {
     if (geometry.inlier_matches.empty()) continue;
     image_t id1, id2;
     PairIdToImagePair(pair_id, &id1, &id2);
+    if (!inputs.images.count(id1) || !inputs.images.count(id2)) {
+      throw InputError(database->path() + ": two_view_geometries of " + database->PairLabel(pair_id) +
+                       " names an image the images table does not hold");
+    }
     SfmImage& image1 = inputs.images.at(id1);
     SfmImage& image2 = inputs.images.at(id2);
     for (const FeatureMatch& m : geometry.inlier_matches) {

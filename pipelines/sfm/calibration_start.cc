@@ -41,8 +41,9 @@ void StartRadialFromMatches(const SfmInputs& inputs, std::optional<bool> mode, b
   if (mode == false || (!mode && !distortion_refined)) return;
   for (auto& [camera_id, camera] : *cameras) {
     const std::vector<int> extra = CameraModelExtraParamsIdxs(camera.camera.model_id);
-    const bool undistorted = std::all_of(extra.begin(), extra.end(),
-                                         [&](int idx) { return camera.camera.params[idx] == 0; });
+    const std::vector<double>& params = camera.camera.params;  // a lambda may not capture a binding (C++17)
+    const bool undistorted =
+        std::all_of(extra.begin(), extra.end(), [&params](int idx) { return params[idx] == 0; });
     // A fisheye model at k = 0 is the equidistant projection, near what
     // fisheye lenses are built to, where k = 0 of a pinhole model is far
     // from a wide angle's; and for a fisheye a focal length error is not

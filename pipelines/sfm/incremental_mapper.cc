@@ -36,6 +36,20 @@ void IncrementalMapperOptions::Check() const {
   if (!(position_prior_sigma_m >= 0)) {
     throw OptionError("--PosePrior.position_sigma", std::to_string(position_prior_sigma_m), ">= 0 m");
   }
+  const auto angle = [](double v, const char* name) {
+    if (!(v >= 0 && v < 90)) {
+      throw OptionError(std::string("--Mapper.") + name, std::to_string(v), "in [0, 90) degrees");
+    }
+  };
+  angle(init_min_tri_angle_deg, "init_min_tri_angle");
+  angle(filter_min_tri_angle_deg, "filter_min_tri_angle");
+  angle(tri_min_angle_deg, "tri_min_angle");
+  if (!(marker_scale.side_length_m >= 0)) {
+    throw OptionError("--Markers.side_length", std::to_string(marker_scale.side_length_m), ">= 0 m");
+  }
+  if (!(marker_scale.sigma_m > 0)) {
+    throw OptionError("--Markers.side_sigma", std::to_string(marker_scale.sigma_m), "> 0 m");
+  }
   if (abs_pose_min_num_inliers < 6) {
     throw OptionError("--Mapper.abs_pose_min_num_inliers", std::to_string(abs_pose_min_num_inliers), ">= 6");
   }

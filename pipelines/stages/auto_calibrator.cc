@@ -10,6 +10,7 @@
 #include "colmap_ext/util/new_paths.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_output.h"
+#include "pipelines/markers/aruco.h"
 #include "pipelines/report/calibration_html.h"
 #include "pipelines/sfm/calibration_start.h"
 
@@ -20,7 +21,9 @@ namespace portcal {
 void AutoCalibratorOptions::Check() const {
   if (image_path.empty()) throw OptionError("--image_path", "''", "a directory of images");
   if (output_path.empty()) throw OptionError("--output_path", "''", "a directory for the results");
+  CheckOutputFolder("--output_path", output_path);
   if (housing) housing->ValidateInput("--Housing.params");
+  CheckArucoDictionaryOption("--Markers.dictionary", marker_dictionary);
   if (matcher == PairingMode::kSpatial) {
     throw OptionError("--AutoCalibration.matcher", "spatial", "exhaustive or sequential");
   }

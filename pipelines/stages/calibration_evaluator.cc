@@ -8,6 +8,7 @@
 #include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/new_paths.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/housing_calibration.h"
@@ -22,6 +23,7 @@ void CalibrationEvaluatorOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database with target observations");
   if (input_calibration.empty()) throw OptionError("--input_calibration", "''", "the calibration.yaml to judge");
   if (output_path.empty()) throw OptionError("--output_path", "''", "a folder for evaluation.yaml/.txt");
+  CheckOutputFolder("--output_path", output_path);
   if (folds != 0 && folds < 2) throw OptionError("--Evaluation.folds", std::to_string(folds), "0 (none) or >= 2");
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
 }
@@ -110,6 +112,7 @@ void WriteEvaluation(const CalibrationEvaluatorOptions& options, const Calibrati
 CalibrationEvaluatorSummary RunCalibrationEvaluator(const CalibrationEvaluatorOptions& options,
                                                     ProgressSink& progress) {
   options.Check();
+  NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
   const CalibrationReport report = ReadCalibrationReport(options.input_calibration);
   Database database(options.database_path, Database::OpenMode::kReadOnly);
   const TargetViews target_views = ReadTargetViews(&database);
@@ -146,6 +149,7 @@ CalibrationEvaluatorSummary RunCalibrationEvaluator(const CalibrationEvaluatorOp
             << (summary.folds.empty() ? std::string()
                                       : ", cross-validated " + Number(summary.cross_validation_rms_px) + " px")
             << " -> " << options.output_path;
+  new_output.Keep();
   return summary;
 }
 

@@ -3,6 +3,7 @@
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/new_paths.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_output.h"
 #include "pipelines/report/calibration_html.h"
@@ -15,6 +16,7 @@ namespace portcal {
 void CameraCalibratorOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
+  CheckOutputFolder("--output_path", output_path);
   if (!camera_model.empty() && !ExistsCameraModelWithName(camera_model)) {
     throw OptionError("--Calibration.camera_model", camera_model, "one of " + CameraModelNames());
   }
@@ -23,6 +25,7 @@ void CameraCalibratorOptions::Check() const {
 
 CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& options, ProgressSink& progress) {
   options.Check();
+  NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
   Database database(options.database_path,
                     options.update_database ? Database::OpenMode::kReadWrite : Database::OpenMode::kReadOnly);
   const TargetViews target_views = ReadTargetViews(&database);
@@ -50,6 +53,7 @@ CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& optio
                          });
   LOG(INFO) << "camera_calibrator: RMS " << result.overall_rms_px << " px over " << result.num_points
             << " points -> " << options.output_path;
+  new_output.Keep();
   return result;
 }
 

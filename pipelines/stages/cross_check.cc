@@ -12,6 +12,7 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/string_utils.h"
+#include "colmap_ext/util/new_paths.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
@@ -298,6 +299,7 @@ void CrossCheckOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (input_calibration.empty()) throw OptionError("--input_calibration", "''", "a calibration.yaml");
   if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
+  CheckOutputFolder("--output_path", output_path);
   if (folds == 1 || folds < 0) throw OptionError("--CrossCheck.folds", std::to_string(folds), "0 or >= 2");
   if (!(max_diff_px > 0)) throw OptionError("--CrossCheck.max_diff_px", std::to_string(max_diff_px), "> 0");
   if (gridn_width < 3) throw OptionError("--CrossCheck.gridn_width", std::to_string(gridn_width), ">= 3");
@@ -306,7 +308,13 @@ void CrossCheckOptions::Check() const {
 
 CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& progress) {
   options.Check();
+  NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
   const CalibrationReport input = ReadCalibrationReport(options.input_calibration);
+  if (input.housing) {
+    throw InputError(options.input_calibration + ": a calibration behind a " + input.housing->ModelName() +
+                     " housing; mrcal has no refraction, so cross_check compares in-air intrinsics only (give "
+                     "camera_calibrator's calibration.yaml of the in-air views)");
+  }
   // A model mrcal cannot express stops here, naming the nearest one.
   const std::string lensmodel = MrcalLensModelFor(input.camera.ModelName());
 
@@ -374,6 +382,7 @@ CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& 
                            DifferenceMaps(result, options), text),
             dir);
   LOG(INFO) << "cross_check: " << result.Verdict();
+  new_output.Keep();
   return result;
 }
 

@@ -8,6 +8,7 @@
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/parallel.h"
 #include "database/database.h"
+#include "database/new_database_file.h"
 #include "database/stage_run.h"
 
 namespace fs = std::filesystem;
@@ -41,6 +42,7 @@ std::string OptionsText(const FeatureExtractorOptions& o) {
 
 struct Extracted {
   bool readable = false;
+  std::string skip_reason;  // why an image is not used: unreadable, too small
   int width = 0, height = 0;
   SiftFeatures features;
 };
@@ -52,6 +54,7 @@ FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& optio
   options.Check();
   StageRun run("feature_extractor", OptionsText(options));
   const std::vector<std::string> names = ListImages(options.image_path);
+  NewDatabaseFile new_file(options.database_path);
   Database database(options.database_path, Database::OpenMode::kCreate);
   Transaction transaction = database.BeginTransaction();
 
@@ -85,7 +88,8 @@ FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& optio
       [&](size_t i) {
         const cv::Mat gray = cv::imread((fs::path(options.image_path) / todo[i]).string(),
                                         cv::IMREAD_GRAYSCALE);
-        if (gray.empty()) return;
+        slots[i].skip_reason = gray.empty() ? "cannot read the image" : ImageSizeProblem(gray.cols, gray.rows);
+        if (!slots[i].skip_reason.empty()) return;
         slots[i].readable = true;
         slots[i].width = gray.cols;
         slots[i].height = gray.rows;
@@ -95,7 +99,7 @@ FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& optio
         Extracted extracted = std::move(slots[i]);
         progress.Advance(1);
         if (!extracted.readable) {
-          LOG(WARNING) << todo[i] << ": cannot read the image; skipped";
+          LOG(WARNING) << todo[i] << ": " << extracted.skip_reason << "; skipped";
           ++summary.num_unreadable;
           return;
         }
@@ -111,6 +115,12 @@ FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& optio
         summary.num_features += static_cast<int64_t>(extracted.features.keypoints.size());
       });
   progress.End();
+  if (summary.num_extracted == 0 && summary.num_skipped == 0) {
+    // Success on nothing would log the stage as done with no image.
+    throw InputError(options.image_path + ": none of the " + std::to_string(names.size()) +
+                     " image files could be read and used (unreadable, or under " + std::to_string(kMinImageSide) +
+                     " px a side)");
+  }
   run.Finish(&database, {{"images", summary.num_images},
                          {"extracted", summary.num_extracted},
                          {"skipped", summary.num_skipped},
@@ -118,6 +128,7 @@ FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& optio
                          {"features", summary.num_features}});
   CancelFlag::ThrowIfRequested();
   transaction.Commit();
+  new_file.Keep();
   LOG(INFO) << "feature_extractor: " << summary.num_extracted << " images extracted ("
             << summary.num_features << " features), " << summary.num_skipped << " skipped, "
             << summary.num_unreadable << " unreadable";

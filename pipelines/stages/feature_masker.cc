@@ -24,7 +24,7 @@ void FeatureMaskerOptions::Check() const {
     throw OptionError("--Mask.enlargement_factor", std::to_string(enlargement_factor), ">= 1");
   }
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
-  ArucoDictionaryByName(dictionary);  // throws naming the known ones
+  CheckArucoDictionaryOption("--Markers.dictionary", dictionary);
 }
 
 namespace {

@@ -250,7 +250,7 @@ void MatchInBatches(const FeatureMatcherOptions& options, const std::vector<std:
         f.keypoints = db->ReadKeypoints(id);
         f.descriptors = ToUnitDescriptors(db->ReadDescriptors(id));
         if (static_cast<size_t>(f.descriptors.rows()) != f.keypoints.size()) {
-          throw InputError(options.database_path + ": image id " + std::to_string(id) + " has " +
+          throw InputError(options.database_path + ": " + db->ImageLabel(id) + " has " +
                            std::to_string(f.keypoints.size()) + " keypoints but " +
                            std::to_string(f.descriptors.rows()) + " descriptors");
         }
@@ -294,6 +294,17 @@ FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, Pr
   if (images.size() < 2) {
     throw InputError(options.database_path + ": " + std::to_string(images.size()) +
                      " image(s); matching needs at least 2 (run feature_extractor first)");
+  }
+  // Pairs without features would be written as empty rows and the stage
+  // logged as done: success on nothing.
+  const size_t with_features =
+      static_cast<size_t>(std::count_if(images.begin(), images.end(), [&](const DatabaseImage& image) {
+        return database.ExistsKeypoints(image.image_id);
+      }));
+  if (with_features < 2) {
+    throw InputError(options.database_path + ": " + std::to_string(with_features) + " of " +
+                     std::to_string(images.size()) +
+                     " images have features; matching needs at least 2 (run feature_extractor first)");
   }
   std::sort(images.begin(), images.end(),
             [](const DatabaseImage& a, const DatabaseImage& b) { return a.name < b.name; });

@@ -6,6 +6,7 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/string_utils.h"
+#include "colmap_ext/util/new_paths.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_output.h"
 #include "pipelines/calibration/calibration_report.h"
@@ -21,6 +22,7 @@ void HousingCalibratorOptions::Check() const {
                       "the in-air calibration.yaml, or the in-air views (--in_air_database_path)");
   }
   if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
+  CheckOutputFolder("--output_path", output_path);
   if (!housing) throw OptionError("--Housing.model", "''", "FLATPORT or DOMEPORT");
   housing->ValidateInput("--Housing.params");
   calibration.Check();
@@ -44,7 +46,8 @@ InAirViews ReadInAirViews(const HousingCalibratorOptions& options, const std::st
                           const Camera& underwater_camera, std::optional<CalibrationReport>* start) {
   Database database(options.in_air_database_path, Database::OpenMode::kReadOnly);
   const TargetViews target_views = ReadTargetViews(&database);
-  const camera_t camera_id = ChooseCamera(target_views, options.in_air_camera_id, options.in_air_database_path);
+  const camera_t camera_id = ChooseCamera(target_views, options.in_air_camera_id, options.in_air_database_path,
+                                             "--in_air_camera_id");
   InAirViews in_air;
   in_air.views = target_views.by_camera.at(camera_id);
   in_air.same_board = target_views.target == underwater_target;
@@ -74,6 +77,7 @@ InAirViews ReadInAirViews(const HousingCalibratorOptions& options, const std::st
 
 HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& options, ProgressSink& progress) {
   options.Check();
+  NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
   const Housing& housing = *options.housing;
   std::optional<CalibrationReport> start;
   if (!options.input_calibration.empty()) start = ReadCalibrationReport(options.input_calibration);
@@ -98,6 +102,7 @@ HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& op
     WriteHtml(CalibrationHtml(report, views, "Housing calibration (" + housing.ModelName() + ")"), options.output_path);
   });
   LOG(INFO) << "housing_calibrator: RMS " << result.overall_rms_px << " px -> " << options.output_path;
+  new_output.Keep();
   return result;
 }
 

@@ -7,6 +7,7 @@
 #include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/new_paths.h"
 #include "pipelines/calibration/calibration_report.h"
 
 namespace portcal {
@@ -65,11 +66,13 @@ void ModelConverterOptions::Check() const {
       output_type != "ROS_YAML") {
     throw OptionError("--output_type", output_type, "BIN, TXT, CAMERAMODEL, OPENCV_YAML or ROS_YAML");
   }
+  if (IsModelType(output_type)) CheckOutputFolder("--output_path", output_path);
 }
 
 ModelConverterSummary RunModelConverter(const ModelConverterOptions& options, ProgressSink& progress) {
   options.Check();
   const SparseModel model = ReadInput(options.input_path);
+  NewPaths new_output({options.output_path});  // a failed run leaves no output it made
   std::string summary;
   if (IsModelType(options.output_type)) {
     WriteSparseModel(model, options.output_path,
@@ -98,6 +101,7 @@ ModelConverterSummary RunModelConverter(const ModelConverterOptions& options, Pr
     summary = "camera " + std::to_string(camera.camera_id) + " (" + camera.ModelName() +
               ") written as " + options.output_type + " to " + options.output_path;
   }
+  new_output.Keep();
   LOG(INFO) << summary;
   return {summary};
 }

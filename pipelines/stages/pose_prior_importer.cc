@@ -21,9 +21,7 @@ void PosePriorImporterOptions::Check() const {
   if (input_path.empty()) throw OptionError("--input_path", "''", "a file of 'NAME X Y Z' lines");
 }
 
-namespace {
-
-std::map<std::string, Eigen::Vector3d> ReadPositions(const std::string& path) {
+std::map<std::string, Eigen::Vector3d> ReadPositionsFile(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open");
   std::map<std::string, Eigen::Vector3d> positions;
@@ -47,11 +45,9 @@ std::map<std::string, Eigen::Vector3d> ReadPositions(const std::string& path) {
   return positions;
 }
 
-}  // namespace
-
 PosePriorImporterSummary RunPosePriorImporter(const PosePriorImporterOptions& options, ProgressSink& progress) {
   options.Check();
-  const std::map<std::string, Eigen::Vector3d> positions = ReadPositions(options.input_path);
+  const std::map<std::string, Eigen::Vector3d> positions = ReadPositionsFile(options.input_path);
   StageRun run("pose_prior_importer", "input_path=" + options.input_path + "\n");
   Database database(options.database_path, Database::OpenMode::kReadWrite);
   Transaction transaction = database.BeginTransaction();

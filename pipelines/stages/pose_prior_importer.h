@@ -10,7 +10,10 @@
 // line or an unknown image name stores nothing.
 #pragma once
 
+#include <map>
 #include <string>
+
+#include <Eigen/Core>
 
 #include "colmap_ext/util/progress.h"
 
@@ -26,6 +29,10 @@ struct PosePriorImporterSummary {
   int num_imported = 0;
   int num_images_without = 0;  // database images the file does not list
 };
+
+// The positions of a file of "NAME X Y Z" lines ('#' comments, blank lines);
+// throws InputError naming the file and line.
+std::map<std::string, Eigen::Vector3d> ReadPositionsFile(const std::string& path);
 
 PosePriorImporterSummary RunPosePriorImporter(const PosePriorImporterOptions& options, ProgressSink& progress);
 

@@ -8,9 +8,11 @@
 #include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/new_paths.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
+#include "pipelines/detection/detection_rows.h"
 #include "pipelines/live/live_session.h"
 #include "pipelines/live/pose_preview.h"
 
@@ -21,6 +23,7 @@ namespace portcal {
 void PoseSuggesterOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (output_path.empty()) throw OptionError("--output_path", "''", "a folder for the suggestions");
+  CheckOutputFolder("--output_path", output_path);
   if (num_poses < 1) throw OptionError("--num_poses", std::to_string(num_poses), ">= 1");
   if (housing.has_value() != !input_calibration.empty()) {
     throw OptionError(housing ? "--input_calibration" : "--Housing.model", "''",
@@ -35,6 +38,7 @@ namespace {
 struct DatabaseViews {
   Camera camera;
   std::vector<CalibrationView> views;
+  std::string target;  // as target_extractor described it; "" without views
 };
 
 // The camera's views so far (none in a database without observations).
@@ -47,6 +51,7 @@ DatabaseViews ReadViews(const PoseSuggesterOptions& options) {
     const TargetViews views = ReadTargetViews(&database);
     camera_id = ChooseCamera(views, options.camera_id, options.database_path);
     result.views = views.by_camera.at(*camera_id);
+    result.target = views.target;
   } catch (const InputError&) {
     const std::vector<Camera> cameras = database.ReadAllCameras();
     if (!camera_id && cameras.size() == 1) camera_id = cameras[0].camera_id;
@@ -58,6 +63,13 @@ DatabaseViews ReadViews(const PoseSuggesterOptions& options) {
                      " (import images first: live_calibrator or target_extractor)");
   }
   result.camera = *camera;
+  // Poses of another board than the views' would be planned in the wrong
+  // units and shape.
+  const std::string asked = TargetDescriptionText(options.target);
+  if (!result.target.empty() && result.target != asked) {
+    throw InputError(options.database_path + ": its views are of the target '" + result.target +
+                     "', the --Target.* options describe '" + asked + "'");
+  }
   return result;
 }
 
@@ -97,6 +109,7 @@ void WriteSuggestions(const PoseSuggesterOptions& options, const HousedCamera& c
 
 PoseSuggesterSummary RunPoseSuggester(const PoseSuggesterOptions& options, ProgressSink& progress) {
   options.Check();
+  NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
   const DatabaseViews data = ReadViews(options);
   LiveEstimatorOptions estimator_options;
   estimator_options.camera = data.camera;
@@ -119,6 +132,7 @@ PoseSuggesterSummary RunPoseSuggester(const PoseSuggesterOptions& options, Progr
   progress.End();
   WriteSuggestions(options, summary.estimate.camera, estimator.target(), summary.poses);
   LOG(INFO) << "pose_suggester: " << summary.poses.size() << " poses -> " << options.output_path;
+  new_output.Keep();
   return summary;
 }
 

@@ -1,5 +1,6 @@
 #include "pipelines/stages/project_points.h"
 
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <optional>
@@ -57,7 +58,7 @@ HousedCamera CameraOfModel(const std::string& input_path, int camera_id) {
   }
   const auto it = model.cameras.find(id);
   if (it == model.cameras.end()) {
-    throw InputError(input_path + ": no camera with id " + std::to_string(camera_id));
+    throw InputError(input_path + ": no camera with id " + std::to_string(camera_id) + " (--camera_id)");
   }
   HousedCamera housed;
   housed.camera = it->second;
@@ -109,6 +110,9 @@ std::optional<std::string> Answer(const HousedCamera& camera, const std::vector<
 ProjectPointsSummary RunProjectPoints(const ProjectPointsOptions& options, ProgressSink& progress) {
   options.Check();
   const HousedCamera camera = LoadCamera(options);
+  if (!std::filesystem::is_regular_file(options.points_path)) {
+    throw InputError(options.points_path + ": not a file of points (--points_path)");
+  }
   std::ifstream in(options.points_path);
   if (!in) throw InputError(options.points_path + ": cannot open");
   const size_t expected = options.unproject ? 2 : 3;

@@ -8,6 +8,7 @@
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/new_paths.h"
 #include "pipelines/bundle_adjustment/position_priors.h"
 #include "pipelines/report/calibration_html.h"
 
@@ -18,6 +19,7 @@ namespace portcal {
 void RefractiveBundleAdjusterOptions::Check() const {
   if (input_path.empty()) throw OptionError("--input_path", "''", "a sparse model directory");
   if (output_path.empty()) throw OptionError("--output_path", "''", "a directory for the results");
+  CheckOutputFolder("--output_path", output_path);
   if (marker_scale.side_length_m > 0 && database_path.empty()) {
     throw OptionError("--database_path", "''", "the database with the marker detections (--Markers.side_length)");
   }
@@ -522,11 +524,16 @@ void WriteAdjusted(const RefractiveBundleAdjusterOptions& options, const Reconst
 RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options,
                                                             ProgressSink& progress) {
   options.Check();
+  NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
   const SparseModel model = ReadSparseModel(options.input_path);
   model.Validate(options.input_path);
   if (model.images.size() < 2) {
     throw InputError(options.input_path + ": " + std::to_string(model.images.size()) +
                      " registered image(s); bundle adjustment needs at least 2");
+  }
+  if (model.points3D.empty()) {
+    // Nothing to adjust: the output would be the input, logged as refined.
+    throw InputError(options.input_path + ": no 3D point; bundle adjustment needs the points the images observe");
   }
   SfmInputs inputs = ReadAdjusterInputs(options, model);
   Reconstruction r = Reconstruction::FromSparseModel(&inputs, model);
@@ -567,6 +574,7 @@ RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBund
   std::vector<std::string> warnings = adjustment.warnings();
   AddCalibrationWarnings(options, r, adjustment.HousingAtBound(), std_devs, &warnings, &notes, &result);
   WriteAdjusted(options, r, std_devs, use_priors, std::move(notes), std::move(warnings), &result);
+  new_output.Keep();
   return result;
 }
 

@@ -5,6 +5,7 @@
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/new_paths.h"
 #include "pipelines/sfm/calibration_start.h"
 
 namespace fs = std::filesystem;
@@ -14,6 +15,7 @@ namespace portcal {
 void RefractiveMapperOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (output_path.empty()) throw OptionError("--output_path", "''", "a directory for the models");
+  CheckOutputFolder("--output_path", output_path);
   radial_start.Check();
   if (housing) housing->ValidateInput("--Housing.params");
   mapper.Check();
@@ -21,6 +23,7 @@ void RefractiveMapperOptions::Check() const {
 
 RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& options, ProgressSink& progress) {
   options.Check();
+  NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
   SfmInputs inputs;
   {
     Database database(options.database_path, Database::OpenMode::kReadOnly);
@@ -70,6 +73,7 @@ RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& optio
   summary.num_models = static_cast<int>(models.size());
   LOG(INFO) << "refractive_mapper: " << summary.num_models << " model(s), " << summary.num_registered << " of "
             << summary.num_images << " images registered; written to " << options.output_path;
+  new_output.Keep();
   return summary;
 }
 

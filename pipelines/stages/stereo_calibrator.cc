@@ -5,6 +5,7 @@
 
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/new_paths.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
@@ -17,6 +18,7 @@ namespace portcal {
 void StereoCalibratorOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
+  CheckOutputFolder("--output_path", output_path);
   if (pairing != "name" && pairing != "order") throw OptionError("--Stereo.pairing", pairing, "name or order");
   if (camera1_id >= 0 && camera1_id == camera2_id) {
     throw OptionError("--Stereo.camera2_id", std::to_string(camera2_id), "another camera than --Stereo.camera1_id");
@@ -54,6 +56,7 @@ HousedCamera CameraFor(const std::string& input_calibration, const Camera& datab
 
 StereoCalibratorSummary RunStereoCalibrator(const StereoCalibratorOptions& options, ProgressSink& progress) {
   options.Check();
+  NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
   Database database(options.database_path, Database::OpenMode::kReadOnly);
   TargetViews target_views = ReadTargetViews(&database);
   auto& views_by_camera = target_views.by_camera;
@@ -69,9 +72,10 @@ StereoCalibratorSummary RunStereoCalibrator(const StereoCalibratorOptions& optio
     id1 = ids[0];
     id2 = ids[1];
   }
-  for (const camera_t id : {id1, id2}) {
+  for (const auto& [id, option] : {std::pair(id1, "--Stereo.camera1_id"), std::pair(id2, "--Stereo.camera2_id")}) {
     if (!views_by_camera.count(id)) {
-      throw InputError(options.database_path + ": camera " + std::to_string(id) + " has no target observations");
+      throw InputError(options.database_path + ": camera " + std::to_string(id) + " (" + option +
+                       ") has no target observations");
     }
   }
   const std::vector<CalibrationView>& views1 = views_by_camera[id1];
@@ -89,6 +93,11 @@ StereoCalibratorSummary RunStereoCalibrator(const StereoCalibratorOptions& optio
   }
   LOG(INFO) << "stereo_calibrator: cameras " << id1 << " and " << id2 << ", " << frames.size()
             << " frames paired by " << options.pairing;
+  if (frames.empty()) {
+    throw InputError(options.database_path + ": no frame in which both cameras see the target (--Stereo.pairing " +
+                     options.pairing + ": " +
+                     (options.pairing == "name" ? "the same file name in both cameras' folders)" : "by order)"));
+  }
   const HousedCamera camera1 = CameraFor(options.input_calibration1, *database.ReadCamera(id1), views1,
                                       options.stereo.num_threads);
   const HousedCamera camera2 = CameraFor(options.input_calibration2, *database.ReadCamera(id2), views2,
@@ -104,6 +113,7 @@ StereoCalibratorSummary RunStereoCalibrator(const StereoCalibratorOptions& optio
   WriteHtml(StereoCalibrationHtml(result, used1, used2, text), options.output_path);
   LOG(INFO) << "stereo_calibrator: baseline " << result.cam2_from_cam1.translation.norm() << " m, RMS "
             << result.overall_rms_px << " px -> " << options.output_path;
+  new_output.Keep();
   return result;
 }
 

@@ -496,8 +496,13 @@ SynthesizeSummary RunSynthesize(const SynthesizeOptions& options, ProgressSink& 
         config.poses.visibility == "markers" ? scene.target.marker_points : scene.target.outline_points;
     for (int frame = 0; frame < config.num_images; ++frame) {
       CancelFlag::ThrowIfRequested();
-      const Rigid3d cam_from_target = config.survey ? scene.survey.cam_from_world[frame]
-                                                    : SampleRigView(config, scene, camera1, camera2, check_points, &rng);
+      Rigid3d cam_from_target;
+      try {
+        cam_from_target = config.survey ? scene.survey.cam_from_world[frame]
+                                        : SampleRigView(config, scene, camera1, camera2, check_points, &rng);
+      } catch (const NumericalError& e) {
+        throw NumericalError(options.config_path + ": " + e.what());  // the config asks what cannot be
+      }
       truth.images.push_back(renderer.Render(frame, cam_from_target, config.render, &rng));
       progress.Advance(1);
     }

@@ -44,6 +44,7 @@ struct ImageResult {
   std::string name;
   int width = 0, height = 0;
   bool readable = false;
+  std::string skip_reason;  // why an image is not used: unreadable, too small
   TargetDetection detection;
 };
 
@@ -95,7 +96,8 @@ std::vector<ImageResult> DetectAll(const TargetExtractorOptions& options, const 
     ImageResult& result = results[i];
     result.name = names[i];
     const cv::Mat gray = cv::imread((fs::path(options.image_path) / names[i]).string(), cv::IMREAD_GRAYSCALE);
-    if (!gray.empty()) {
+    result.skip_reason = gray.empty() ? "cannot read the image" : ImageSizeProblem(gray.cols, gray.rows);
+    if (result.skip_reason.empty()) {
       result.readable = true;
       result.width = gray.cols;
       result.height = gray.rows;
@@ -133,7 +135,7 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
   const std::string target = TargetDescriptionText(DetectorOptions(options));
   for (const ImageResult& result : results) {
     if (!result.readable) {
-      LOG(WARNING) << result.name << ": cannot read the image; skipped";
+      LOG(WARNING) << result.name << ": " << result.skip_reason << "; skipped";
       continue;
     }
     const image_t image_id = ImportImage(&database, options.reader, result.name, result.width,
@@ -150,7 +152,15 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
     // Success on nothing would leave a database with no image and a stage
     // logged as done.
     throw InputError(options.image_path + ": none of the " + std::to_string(names.size()) +
-                     " image files could be read");
+                     " image files could be read and used (unreadable, or under " + std::to_string(kMinImageSide) +
+                     " px a side)");
+  }
+  if (summary.num_found == 0) {
+    // Loud, not an error: each image's reason is stored for a look, and a
+    // rerun may add images that show it.
+    LOG(WARNING) << options.image_path << ": the target (" << target << ") was found in none of the "
+                 << summary.num_images << " images; check --Target.type and, for a chessboard, "
+                 << "--Target.cols/--Target.rows (inner corners, not squares)";
   }
   run.Finish(&database, {{"images", summary.num_images},
                          {"found", summary.num_found},

@@ -186,7 +186,11 @@ class ConfigReader {
 
 }  // namespace
 
-DatasetConfig ReadDatasetConfig(const std::filesystem::path& path) {
+namespace {
+
+// The body of ReadDatasetConfig; yaml-cpp's exceptions (a key looked up in a scalar, a
+// value of the wrong type) are turned into InputError by the caller.
+DatasetConfig ReadDatasetConfigUnguarded(const std::filesystem::path& path) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(path.string());
@@ -273,6 +277,16 @@ DatasetConfig ReadDatasetConfig(const std::filesystem::path& path) {
     throw InputError(path.string() + ": " + e.what());
   }
   return config;
+}
+
+}  // namespace
+
+DatasetConfig ReadDatasetConfig(const std::filesystem::path& path) {
+  try {
+    return ReadDatasetConfigUnguarded(path);
+  } catch (const YAML::Exception& e) {
+    throw InputError(path.string() + ": " + e.what());
+  }
 }
 
 }  // namespace portcal

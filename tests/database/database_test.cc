@@ -277,6 +277,7 @@ TEST(Database, PortcalTablesOfVersionOneAreUpgraded) {
 
 TEST(Database, LockedDatabaseIsAClearError) {
   testing::TempDir dir;
+  SetDatabaseBusyTimeout(0.2);  // not the 60 s default
   Database writer(dir / "db.db", Database::OpenMode::kCreate);
   Transaction hold = writer.BeginTransaction();
   writer.WriteCamera(TestCamera());
@@ -288,6 +289,7 @@ TEST(Database, LockedDatabaseIsAClearError) {
     EXPECT_NE(std::string(e.what()).find("locked"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("db.db"), std::string::npos) << e.what();
   }
+  SetDatabaseBusyTimeout(60);
 }
 
 TEST(Database, DeleteMatchesOfImageRemovesBothDirections) {

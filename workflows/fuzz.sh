@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# libFuzzer runs of every parser of user files (tests/fuzz/*_fuzzer.cc), built
+# with clang, AddressSanitizer and UndefinedBehaviorSanitizer into
+# build-sanitize/ (shared with workflows/sanitize.sh). Each target starts
+# from its seed corpus in tests/fuzz/corpus and runs RUNS executions (default
+# 10 million); a crash, a sanitizer report or an exception other than
+# portcal's stops it and leaves the input in build-sanitize/fuzz/TARGET/ (make
+# it a file of tests/fuzz/regressions/TARGET, which ctest replays). Prints a
+# table: target, executions, seconds, coverage, result.
+# Usage: workflows/fuzz.sh [RUNS=10000000] [TARGET...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build="${PORTCAL_SANITIZE_BUILD:-build-sanitize}"  # the clang tree
+runs="${1:-10000000}"; shift || true
+targets=("$@")
+if [ "${#targets[@]}" -eq 0 ]; then
+  targets=(pose_priors housings points_file cameramodel sparse_model_binary sparse_model_text opencv_yaml
+           dataset_config database_blobs calibration_file ground_truth)
+fi
+bash workflows/setup.sh --packages-only clang libclang-rt-14-dev >/dev/null
+CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DPORTCAL_SANITIZE=address,undefined -DPORTCAL_FUZZ=ON -DPORTCAL_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build "$build" -j"$(nproc)" --target "${targets[@]/%/_fuzzer}" >/dev/null
+# The targets write their input to a file each run: tmpfs, not the disk.
+export TMPDIR=/dev/shm
+export ASAN_OPTIONS=detect_leaks=0  # OpenCV's and yaml-cpp's caches live to the end
+printf '%-20s %12s %8s %8s  %s\n' target executions seconds coverage result
+status=0
+for target in "${targets[@]}"; do
+  work="$build/fuzz/$target"
+  mkdir -p "$work/corpus"
+  cp -n "tests/fuzz/corpus/$target"/* "$work/corpus/" 2>/dev/null || true
+  # Inputs up to twice the largest seed (4 KB at least): longer ones only
+  # slow the run down.
+  max_len=$(( $(ls -S -l "tests/fuzz/corpus/$target" | awk 'NR==2 {print $5}') * 2 ))
+  [ "$max_len" -ge 4096 ] || max_len=4096
+  start=$(date +%s)
+  if "$build/tests/${target}_fuzzer" -runs="$runs" -max_len="$max_len" -print_final_stats=1 \
+       -artifact_prefix="$work/" "$work/corpus" > "$work/log.txt" 2>&1; then
+    result="0 crashes, 0 sanitizer reports"
+  else
+    result="FAILED: see $work/log.txt and $work/crash-*"; status=1
+  fi
+  done_runs=$(grep -oP 'stat::number_of_executed_units:\s*\K[0-9]+' "$work/log.txt" || echo '?')
+  coverage=$(grep -oP 'cov: \K[0-9]+' "$work/log.txt" | tail -1 || echo '?')
+  printf '%-20s %12s %8s %8s  %s\n' "$target" "$done_runs" $(( $(date +%s) - start )) "$coverage" "$result"
+done
+exit "$status"
