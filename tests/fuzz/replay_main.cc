@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
   size_t files = 0, runs = 0;
   for (int i = 1; i < argc; ++i) {
     std::vector<std::filesystem::path> paths;
+    if (!std::filesystem::exists(argv[i])) continue;  // no regressions yet: git keeps no empty folder
     if (std::filesystem::is_directory(argv[i])) {
       for (const auto& entry : std::filesystem::directory_iterator(argv[i])) paths.push_back(entry.path());
     } else {
