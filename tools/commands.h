@@ -6,6 +6,7 @@ namespace portcal {
 int DatabaseCreatorCommand(int argc, char** argv);
 int PosePriorImporterCommand(int argc, char** argv);
 int ModelConverterCommand(int argc, char** argv);
+int ImageUndistorterCommand(int argc, char** argv);
 int ProjectPointsCommand(int argc, char** argv);
 int SynthesizeCommand(int argc, char** argv);
 int TargetExtractorCommand(int argc, char** argv);

@@ -29,6 +29,8 @@ const std::vector<Command>& Commands() {
       {"model_converter", portcal::ModelConverterCommand,
        "convert sparse models between BIN and TXT (and import the refractive "
        "fork's cameras.txt)"},
+      {"image_undistorter", portcal::ImageUndistorterCommand,
+       "pinhole images and model (a COLMAP dense workspace) from a refractive or distorted camera"},
       {"project_points", portcal::ProjectPointsCommand,
        "project 3-D points through a camera and housing (or unproject pixels "
        "to rays)"},
