@@ -1,5 +1,11 @@
-// A COLMAP 3.8 database (the six tables, byte-compatible, PRAGMA
-// user_version = 3800) plus portcal's own tables, all prefixed portcal_.
+// A COLMAP database of any version from 3.8 to 4.1 (colmap_layout.h: the
+// layout is read from the tables) plus portcal's own tables, all prefixed
+// portcal_. Rows are read from, and written to, where that version keeps
+// them, as that version writes them (docs/database.md): pose priors in
+// images.prior_* or in pose_priors, a rig and a frame for each new image
+// where there are rigs and frames, the descriptors' type, NULL for the
+// two-view geometry a COLMAP 4 did not estimate. Tables and columns
+// portcal does not know are left as they are.
 //
 // Stages write inside one Transaction: it rolls back unless committed, so a
 // failed or interrupted stage leaves the file as it was.
@@ -13,6 +19,7 @@
 #include <vector>
 
 #include "colmap_ext/housing/housing.h"
+#include "database/colmap_layout.h"
 #include "database/feature_types.h"
 #include "database/lock_wait.h"
 #include "database/statement.h"
@@ -23,7 +30,6 @@ namespace portcal {
 
 class Database {
  public:
-  static constexpr int kColmapSchemaVersion = 3800;
   static constexpr int kPortcalSchemaVersion = 2;
 
   enum class OpenMode {
@@ -33,16 +39,19 @@ class Database {
   };
 
   // Throws DatabaseError naming `path` for: a missing file (unless kCreate),
-  // a file that is no SQLite database, a database of another COLMAP or
-  // portcal schema version, or one locked by another process for longer
-  // than DatabaseBusyTimeout() (lock_wait.h).
-  explicit Database(const std::filesystem::path& path,
-                    OpenMode mode = OpenMode::kReadWrite);
+  // a file that is no SQLite database, a database of a COLMAP version
+  // portcal does not know (colmap_layout.h) or of another portcal schema
+  // version, or one locked by another process for longer than
+  // DatabaseBusyTimeout() (lock_wait.h). kCreate creates a missing file
+  // with `version_if_created`'s layout.
+  explicit Database(const std::filesystem::path& path, OpenMode mode = OpenMode::kReadWrite,
+                    ColmapVersion version_if_created = ColmapVersion::k3_8);
   ~Database();
   Database(const Database&) = delete;
   Database& operator=(const Database&) = delete;
 
   const std::string& path() const { return path_; }
+  const ColmapLayout& layout() const { return layout_; }
   // BEGIN IMMEDIATE; ROLLBACK unless Commit() is called.
   Transaction BeginTransaction();
 
@@ -59,8 +68,8 @@ class Database {
   std::string ImageLabel(image_t image_id);
   // "pair N (image 1 (a.png), image 2 (b.png))" for messages.
   std::string PairLabel(image_pair_t pair_id);
-  // Sets (or, with nullopt, clears) an image's position prior; clears any
-  // full pose prior.
+  // Sets (or, with nullopt, clears) an image's position prior (Cartesian,
+  // metres) where the layout keeps priors; clears any full pose prior.
   void UpdatePositionPrior(image_t image_id, const std::optional<Eigen::Vector3d>& position);
   std::optional<DatabaseImage> ReadImageWithName(const std::string& name);
   // Gives the image another camera (a rerun that imports the cameras again).
@@ -135,13 +144,41 @@ class Database {
   int64_t WriteStageLog(const StageLogEntry& entry);
   std::vector<StageLogEntry> ReadStageLog();
 
+  // Converts the database, inside one transaction, to `target`'s layout as
+  // that COLMAP's migration would, keeping every row (layout_conversion.cc):
+  // pose priors move between images.prior_* and pose_priors, rigs and
+  // frames are made one per camera and per image (or dropped where they
+  // were that), descriptors gain or lose their type, unset two-view
+  // geometry becomes NULL or zeros. Throws InputError, changing nothing,
+  // where `target` cannot hold a row (a rig of two cameras, a prior's
+  // covariance, ALIKED descriptors in 3.x).
+  void ConvertTo(ColmapVersion target);
+  // A consistent copy of the whole file at `path` (VACUUM INTO: the
+  // write-ahead log that COLMAP 3.9 on leaves included).
+  void CopyTo(const std::filesystem::path& path);
+
  private:
-  void CreateSchema();
+  void CreateSchema(ColmapVersion version);
   void CheckSchema();
+  // Rigs and frames (layout().rigs_and_frames): the rig whose sensor the
+  // camera is, made (with the camera its reference) when there is none;
+  // the new image's frame; the image's frames removed.
+  int64_t RigOfCamera(camera_t camera_id);
+  void AddFrame(image_t image_id, camera_t camera_id);
+  void DeleteFrames(image_t image_id);
+  // pose_priors rows (layout().pose_priors != kNone).
+  void WritePosePriorRow(image_t image_id, camera_t camera_id, const Eigen::Vector3d& position);
+  void DeletePosePriorRows(image_t image_id);
+  // layout_conversion.cc's steps, each inside ConvertTo's transaction.
+  void ConvertPosePriors(ColmapVersion target);
+  void ConvertRigsAndFrames(ColmapVersion target);
+  void ConvertDescriptors(const ColmapLayout& target);
+  void ConvertTwoViewGeometries(const ColmapLayout& target);
   Statement& Prepare(const std::string& key, const std::string& sql);
   int64_t QueryInt(const std::string& sql);
 
   std::string path_;
+  ColmapLayout layout_;
   std::unique_ptr<LockWait> lock_wait_;  // outlives db_ (declared before it)
   sqlite3* db_ = nullptr;
   std::map<std::string, std::unique_ptr<Statement>> statements_;

@@ -152,12 +152,28 @@ void Database::WriteTwoViewGeometry(image_t image_id1, image_t image_id2,
   stmt.Bind(1, static_cast<int64_t>(ImagePairToPairId(image_id1, image_id2)))
       .Bind(2, static_cast<int64_t>(geometry.inlier_matches.size()))
       .BindBlob(3, flat.data(), flat.size() * sizeof(uint32_t))
-      .Bind(4, static_cast<int64_t>(geometry.config))
-      .BindBlob(5, F.data(), has_inliers ? 72 : 0)
-      .BindBlob(6, E.data(), has_inliers ? 72 : 0)
-      .BindBlob(7, H.data(), has_inliers ? 72 : 0)
-      .BindBlob(8, qvec.data(), has_inliers ? 32 : 0)
-      .BindBlob(9, tvec.data(), has_inliers ? 24 : 0);
+      .Bind(4, static_cast<int64_t>(geometry.config));
+  // COLMAP 3.x: the five blobs always (zeros, the identity), empty without
+  // inliers. COLMAP 4: NULL for what was not estimated, which its
+  // migration tells by the same zeros and identity.
+  const bool null_for_unset = layout_.NullForUnset();
+  const bool has_pose = !(geometry.cam2_from_cam1.rotation.coeffs() == Eigen::Quaterniond::Identity().coeffs() &&
+                          geometry.cam2_from_cam1.translation.isZero(0));
+  const auto bind_matrix = [&](int index, const std::vector<double>& values, const Eigen::Matrix3d& m) {
+    if (null_for_unset && (!has_inliers || m.isZero(0))) {
+      stmt.BindNull(index);
+    } else {
+      stmt.BindBlob(index, values.data(), has_inliers ? 72 : 0);
+    }
+  };
+  bind_matrix(5, F, geometry.F);
+  bind_matrix(6, E, geometry.E);
+  bind_matrix(7, H, geometry.H);
+  if (null_for_unset && (!has_inliers || !has_pose)) {
+    stmt.BindNull(8).BindNull(9);
+  } else {
+    stmt.BindBlob(8, qvec.data(), has_inliers ? 32 : 0).BindBlob(9, tvec.data(), has_inliers ? 24 : 0);
+  }
   stmt.Execute();
 }
 
@@ -211,6 +227,8 @@ void Database::DeleteMatchesOfImage(image_t image_id) {
 
 void Database::DeleteImage(image_t image_id) {
   DeleteMatchesOfImage(image_id);
+  if (layout_.rigs_and_frames) DeleteFrames(image_id);
+  if (layout_.pose_priors != ColmapLayout::PosePriors::kNone) DeletePosePriorRows(image_id);
   // Explicitly, not by ON DELETE CASCADE: COLMAP opens databases without
   // foreign keys enforced, and so may whoever wrote this one.
   for (const char* table : {"keypoints", "descriptors", "portcal_target_observations", "portcal_target_detections",

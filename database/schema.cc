@@ -1,29 +1,7 @@
-// The SQL that creates the schema: COLMAP 3.8's six tables and index,
-// character for character as COLMAP writes them (so sqlite_master matches a
-// database made by `colmap database_creator`), and portcal's own tables.
+// The SQL that creates portcal's own tables (COLMAP's: colmap_schemas.cc).
 #include "database/schema.h"
 
 namespace portcal {
-
-const std::vector<std::string>& ColmapSchemaSql() {
-  static const std::vector<std::string> kSql = {
-    // cameras
-    R"sql(CREATE TABLE IF NOT EXISTS cameras   (camera_id            INTEGER  PRIMARY KEY AUTOINCREMENT  NOT NULL,    model                INTEGER                             NOT NULL,    width                INTEGER                             NOT NULL,    height               INTEGER                             NOT NULL,    params               BLOB,    prior_focal_length   INTEGER                             NOT NULL))sql",
-    // images
-    R"sql(CREATE TABLE IF NOT EXISTS images   (image_id   INTEGER  PRIMARY KEY AUTOINCREMENT  NOT NULL,    name       TEXT                                NOT NULL UNIQUE,    camera_id  INTEGER                             NOT NULL,    prior_qw   REAL,    prior_qx   REAL,    prior_qy   REAL,    prior_qz   REAL,    prior_tx   REAL,    prior_ty   REAL,    prior_tz   REAL,CONSTRAINT image_id_check CHECK(image_id >= 0 and image_id < 2147483647),FOREIGN KEY(camera_id) REFERENCES cameras(camera_id)))sql",
-    // index_name
-    R"sql(CREATE UNIQUE INDEX IF NOT EXISTS index_name ON images(name))sql",
-    // keypoints
-    R"sql(CREATE TABLE IF NOT EXISTS keypoints   (image_id  INTEGER  PRIMARY KEY  NOT NULL,    rows      INTEGER               NOT NULL,    cols      INTEGER               NOT NULL,    data      BLOB,FOREIGN KEY(image_id) REFERENCES images(image_id) ON DELETE CASCADE))sql",
-    // descriptors
-    R"sql(CREATE TABLE IF NOT EXISTS descriptors   (image_id  INTEGER  PRIMARY KEY  NOT NULL,    rows      INTEGER               NOT NULL,    cols      INTEGER               NOT NULL,    data      BLOB,FOREIGN KEY(image_id) REFERENCES images(image_id) ON DELETE CASCADE))sql",
-    // matches
-    R"sql(CREATE TABLE IF NOT EXISTS matches   (pair_id  INTEGER  PRIMARY KEY  NOT NULL,    rows     INTEGER               NOT NULL,    cols     INTEGER               NOT NULL,    data     BLOB))sql",
-    // two_view_geometries
-    R"sql(CREATE TABLE IF NOT EXISTS two_view_geometries   (pair_id  INTEGER  PRIMARY KEY  NOT NULL,    rows     INTEGER               NOT NULL,    cols     INTEGER               NOT NULL,    data     BLOB,    config   INTEGER               NOT NULL,    F        BLOB,    E        BLOB,    H        BLOB,    qvec     BLOB,    tvec     BLOB))sql",
-  };
-  return kSql;
-}
 
 const std::vector<std::string>& PortcalSchemaSql() {
   static const std::vector<std::string> kSql = {

@@ -1,4 +1,5 @@
 #include "colmap_ext/util/progress.h"
+#include "pipelines/stages/database_converter.h"
 #include "pipelines/stages/database_creator.h"
 #include "pipelines/stages/pose_prior_importer.h"
 #include "tools/command_line.h"
@@ -9,13 +10,36 @@ namespace portcal {
 int DatabaseCreatorCommand(int argc, char** argv) {
   DatabaseCreatorOptions options;
   CommandLine cli("database_creator",
-                  "Creates a COLMAP 3.8 database (with portcal's tables), or "
-                  "checks an existing one.");
+                  "Creates a COLMAP database (with portcal's tables) of the layout of COLMAP 3.8 (Debian 12's, "
+                  "the default) to 4.1, or checks an existing one.");
   cli.AddRequired("database_path", &options.database_path, "database file to create");
+  std::vector<std::pair<std::string, std::optional<ColmapVersion>>> versions = {{"auto", std::nullopt}};
+  for (const auto& [name, version] : ColmapVersionChoices()) versions.emplace_back(name, version);
+  cli.AddChoice("Database.colmap_version", &options.colmap_version, versions,
+                "the layout of a new database (auto: 3.8), or the one an existing database must have");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;
     StderrProgress progress;
     RunDatabaseCreator(options, progress);
+  });
+}
+
+int DatabaseConverterCommand(int argc, char** argv) {
+  DatabaseConverterOptions options;
+  CommandLine cli("database_converter",
+                  "Converts a database to the layout of another COLMAP version (3.8 to 4.1, up or down) as that "
+                  "version's migration does, keeping every row: pose priors between images.prior_* and "
+                  "pose_priors, one rig per camera and one frame per image, the descriptors' type, NULL for "
+                  "unset two-view geometry. Refuses, changing nothing, what the target cannot hold (a rig of "
+                  "several cameras or ALIKED descriptors in 3.x). In place, or into --output_path.");
+  cli.AddRequired("database_path", &options.database_path, "database to convert");
+  cli.Add("output_path", &options.output_path, "write the converted copy here instead (a new file)");
+  cli.AddChoice("Database.colmap_version", &options.colmap_version, ColmapVersionChoices(),
+                "the COLMAP version whose layout to convert to");
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    StderrProgress progress;
+    RunDatabaseConverter(options, progress);
   });
 }
 

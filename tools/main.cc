@@ -23,7 +23,9 @@ struct Command {
 const std::vector<Command>& Commands() {
   static const std::vector<Command> kCommands = {
       {"database_creator", portcal::DatabaseCreatorCommand,
-       "create a COLMAP 3.8 database with portcal's tables"},
+       "create a COLMAP database (the layout of 3.8, default, to 4.1) with portcal's tables"},
+      {"database_converter", portcal::DatabaseConverterCommand,
+       "convert a database between COLMAP versions' layouts (3.8 to 4.1), keeping every row"},
       {"pose_prior_importer", portcal::PosePriorImporterCommand,
        "store navigation positions as the images' position priors"},
       {"model_converter", portcal::ModelConverterCommand,

@@ -15,7 +15,7 @@ runs="${1:-10000000}"; shift || true
 targets=("$@")
 if [ "${#targets[@]}" -eq 0 ]; then
   targets=(pose_priors housings points_file cameramodel sparse_model_binary sparse_model_text opencv_yaml
-           dataset_config database_blobs calibration_file ground_truth stereo_calibration)
+           dataset_config database_blobs calibration_file ground_truth stereo_calibration model_rigs)
 fi
 bash workflows/setup.sh --packages-only clang libclang-rt-14-dev >/dev/null
 CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \

@@ -55,6 +55,16 @@ void SparseModel::Validate(const std::string& context, const std::string& extens
     }
     housing.Validate(housings_file + ": housing of camera " + std::to_string(camera_id));
   }
+  const std::string frames_file = extension.empty() ? context : (fs::path(context) / ("frames" + extension)).string();
+  for (const auto& [frame_id, frame] : frames) {
+    const std::string where = frames_file + ": frame " + std::to_string(frame_id);
+    if (rigs.count(frame.rig_id) == 0) throw InputError(where + " of unknown rig " + std::to_string(frame.rig_id));
+    for (const auto& [sensor, data_id] : frame.data) {
+      if (sensor.type == kModelSensorCamera && cameras.count(sensor.id) == 0) {
+        throw InputError(where + " holds data of unknown camera " + std::to_string(sensor.id));
+      }
+    }
+  }
 }
 
 SparseModel ReadSparseModel(const fs::path& dir) {
@@ -69,6 +79,10 @@ SparseModel ReadSparseModel(const fs::path& dir) {
     model.cameras = ReadCamerasBinary(dir / "cameras.bin");
     model.images = ReadImagesBinary(dir / "images.bin");
     model.points3D = ReadPoints3DBinary(dir / "points3D.bin");
+    if (fs::exists(dir / "rigs.bin") && fs::exists(dir / "frames.bin")) {
+      model.rigs = ReadRigsBinary(dir / "rigs.bin");
+      model.frames = ReadFramesBinary(dir / "frames.bin");
+    }
   } else if (fs::exists(dir / "cameras.txt") && fs::exists(dir / "images.txt") &&
              fs::exists(dir / "points3D.txt")) {
     // Accepts the refractive fork's cameras.txt too (port after the camera).
@@ -76,6 +90,10 @@ SparseModel ReadSparseModel(const fs::path& dir) {
                                 &model.housings);
     model.images = ReadImagesText(dir / "images.txt");
     model.points3D = ReadPoints3DText(dir / "points3D.txt");
+    if (fs::exists(dir / "rigs.txt") && fs::exists(dir / "frames.txt")) {
+      model.rigs = ReadRigsText(dir / "rigs.txt");
+      model.frames = ReadFramesText(dir / "frames.txt");
+    }
   } else {
     throw InputError(dir.string() +
                      ": no cameras/images/points3D .bin or .txt files");
@@ -131,6 +149,20 @@ void WriteSparseModel(const SparseModel& model, const fs::path& dir,
   WriteFileAtomically(dir / ("points3D" + ext), binary, [&](std::ostream& out) {
     binary ? WritePoints3DBinary(model, out) : WritePoints3DText(model, out);
   });
+  for (const char* name : {"rigs", "frames"}) {
+    const fs::path path = dir / (name + ext);
+    if (model.rigs.empty() && model.frames.empty()) {
+      if (fs::exists(path)) fs::remove(path);  // stale: would give the images other rigs
+      continue;
+    }
+    WriteFileAtomically(path, binary, [&](std::ostream& out) {
+      if (std::string(name) == "rigs") {
+        binary ? WriteRigsBinary(model, out) : WriteRigsText(model, out);
+      } else {
+        binary ? WriteFramesBinary(model, out) : WriteFramesText(model, out);
+      }
+    });
+  }
   const fs::path housings_path = dir / "housings.txt";
   if (!model.housings.empty()) {
     WriteFileAtomically(housings_path, false, [&](std::ostream& out) {

@@ -8,6 +8,7 @@
 #include <functional>
 #include <ostream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,11 +46,37 @@ struct Point3D {
   std::vector<TrackElement> track;
 };
 
+// COLMAP 3.12 on: sensors (cameras, IMUs) grouped into rigs, and frames
+// (one rig's pose at one time) holding the data each sensor took then.
+constexpr int kModelSensorCamera = 0;  // COLMAP's SensorType: INVALID -1, CAMERA 0, IMU 1
+
+struct ModelSensor {
+  int type = kModelSensorCamera;
+  uint32_t id = 0;
+  bool operator==(const ModelSensor& other) const { return type == other.type && id == other.id; }
+};
+
+struct ModelRig {
+  std::optional<ModelSensor> ref_sensor;  // none: a rig without sensors
+  // The other sensors and, where known, sensor_from_rig.
+  std::vector<std::pair<ModelSensor, std::optional<Rigid3d>>> sensors;
+};
+
+struct ModelFrame {
+  uint32_t rig_id = 0;
+  Rigid3d rig_from_world;
+  std::vector<std::pair<ModelSensor, uint64_t>> data;  // (sensor, data id: an image id for a camera)
+};
+
 struct SparseModel {
   std::map<camera_t, Camera> cameras;
   std::map<image_t, Image> images;  // registered images
   std::map<point3D_t, Point3D> points3D;
   std::map<camera_t, Housing> housings;  // cameras behind a port
+  // rigs.{bin,txt} and frames.{bin,txt} of a COLMAP 3.12+ model; empty for
+  // an older one (read and written only when present).
+  std::map<uint32_t, ModelRig> rigs;
+  std::map<uint32_t, ModelFrame> frames;
 
   // Throws InputError (prefixed by `context`) on dangling references: images
   // of unknown cameras, tracks naming unknown images or observations,
@@ -86,6 +113,21 @@ void WritePoints3DText(const SparseModel& model, std::ostream& out);
 void WriteCamerasBinary(const SparseModel& model, std::ostream& out);
 void WriteImagesBinary(const SparseModel& model, std::ostream& out);
 void WritePoints3DBinary(const SparseModel& model, std::ostream& out);
+
+// Rig and frame files (COLMAP 3.12 on; formats of its
+// reconstruction_io_{text,binary}.cc at 4.1.0).
+std::map<uint32_t, ModelRig> ReadRigsText(const std::filesystem::path& path);
+std::map<uint32_t, ModelFrame> ReadFramesText(const std::filesystem::path& path);
+std::map<uint32_t, ModelRig> ReadRigsBinary(const std::filesystem::path& path);
+std::map<uint32_t, ModelFrame> ReadFramesBinary(const std::filesystem::path& path);
+void WriteRigsText(const SparseModel& model, std::ostream& out);
+void WriteFramesText(const SparseModel& model, std::ostream& out);
+void WriteRigsBinary(const SparseModel& model, std::ostream& out);
+void WriteFramesBinary(const SparseModel& model, std::ostream& out);
+// What COLMAP 3.12 on makes of a model without rigs and frames: a rig per
+// camera (rig id = camera id, the camera its reference) and a frame per
+// image (frame id = image id, rig_from_world = the image's cam_from_world).
+void AddOneRigPerCamera(SparseModel* model);
 
 // housings.txt: "CAMERA_ID MODEL PARAMS..." per line, '#' comments.
 std::map<camera_t, Housing> ReadHousingsText(const std::filesystem::path& path);

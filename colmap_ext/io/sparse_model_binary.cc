@@ -3,78 +3,13 @@
 #include <fstream>
 
 #include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/io/binary_reader.h"
 #include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/error.h"
 
 namespace fs = std::filesystem;
 
 namespace portcal {
-namespace {
-
-class BinaryReader {
- public:
-  explicit BinaryReader(const fs::path& path)
-      : path_(path), file_(path, std::ios::binary) {
-    if (!file_) throw InputError(path.string() + ": cannot open");
-  }
-
-  template <typename T>
-  T Read(const char* what) {
-    T value;
-    file_.read(reinterpret_cast<char*>(&value), sizeof(T));
-    if (!file_) {
-      throw InputError(path_.string() + ": truncated file while reading " + what);
-    }
-    return value;
-  }
-
-  double ReadFinite(const char* what) {
-    const double value = Read<double>(what);
-    if (!std::isfinite(value)) {
-      throw InputError(path_.string() + ": non-finite " + what);
-    }
-    return value;
-  }
-
-  std::string ReadName() {
-    std::string name;
-    char c;
-    while (true) {
-      c = Read<char>("image name");
-      if (c == '\0') break;
-      name.push_back(c);
-    }
-    return name;
-  }
-
-  // Guards counts before allocating: each item takes at least `item_bytes`.
-  uint64_t ReadCount(const char* what, uint64_t item_bytes) {
-    const uint64_t count = Read<uint64_t>(what);
-    const auto position = file_.tellg();
-    file_.seekg(0, std::ios::end);
-    const auto end = file_.tellg();
-    file_.seekg(position);
-    if (item_bytes > 0 &&
-        count > static_cast<uint64_t>(end - position) / item_bytes) {
-      throw InputError(path_.string() + ": implausible " + what + " " +
-                       std::to_string(count) + " (file too short)");
-    }
-    return count;
-  }
-
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-  std::ifstream file_;
-};
-
-template <typename T>
-void Write(std::ostream& out, const T& value) {
-  out.write(reinterpret_cast<const char*>(&value), sizeof(T));
-}
-
-}  // namespace
 
 std::map<camera_t, Camera> ReadCamerasBinary(const fs::path& path) {
   BinaryReader reader(path);
@@ -149,48 +84,48 @@ std::map<point3D_t, Point3D> ReadPoints3DBinary(const fs::path& path) {
 }
 
 void WriteCamerasBinary(const SparseModel& model, std::ostream& out) {
-  Write<uint64_t>(out, model.cameras.size());
+  WriteLittleEndian<uint64_t>(out, model.cameras.size());
   for (const auto& [camera_id, camera] : model.cameras) {
-    Write<uint32_t>(out, camera_id);
-    Write<int32_t>(out, camera.model_id);
-    Write<uint64_t>(out, camera.width);
-    Write<uint64_t>(out, camera.height);
-    for (const double param : camera.params) Write<double>(out, param);
+    WriteLittleEndian<uint32_t>(out, camera_id);
+    WriteLittleEndian<int32_t>(out, camera.model_id);
+    WriteLittleEndian<uint64_t>(out, camera.width);
+    WriteLittleEndian<uint64_t>(out, camera.height);
+    for (const double param : camera.params) WriteLittleEndian<double>(out, param);
   }
 }
 
 void WriteImagesBinary(const SparseModel& model, std::ostream& out) {
-  Write<uint64_t>(out, model.images.size());
+  WriteLittleEndian<uint64_t>(out, model.images.size());
   for (const auto& [image_id, image] : model.images) {
-    Write<uint32_t>(out, image_id);
+    WriteLittleEndian<uint32_t>(out, image_id);
     const Eigen::Vector4d wxyz =
         QuaternionToWxyz(image.cam_from_world.rotation.normalized());
-    for (int k = 0; k < 4; ++k) Write<double>(out, wxyz[k]);
+    for (int k = 0; k < 4; ++k) WriteLittleEndian<double>(out, wxyz[k]);
     for (int k = 0; k < 3; ++k) {
-      Write<double>(out, image.cam_from_world.translation[k]);
+      WriteLittleEndian<double>(out, image.cam_from_world.translation[k]);
     }
-    Write<uint32_t>(out, image.camera_id);
+    WriteLittleEndian<uint32_t>(out, image.camera_id);
     out.write(image.name.c_str(), image.name.size() + 1);
-    Write<uint64_t>(out, image.points2D.size());
+    WriteLittleEndian<uint64_t>(out, image.points2D.size());
     for (const Point2D& point2D : image.points2D) {
-      Write<double>(out, point2D.xy.x());
-      Write<double>(out, point2D.xy.y());
-      Write<uint64_t>(out, point2D.point3D_id);
+      WriteLittleEndian<double>(out, point2D.xy.x());
+      WriteLittleEndian<double>(out, point2D.xy.y());
+      WriteLittleEndian<uint64_t>(out, point2D.point3D_id);
     }
   }
 }
 
 void WritePoints3DBinary(const SparseModel& model, std::ostream& out) {
-  Write<uint64_t>(out, model.points3D.size());
+  WriteLittleEndian<uint64_t>(out, model.points3D.size());
   for (const auto& [id, point] : model.points3D) {
-    Write<uint64_t>(out, id);
-    for (int k = 0; k < 3; ++k) Write<double>(out, point.xyz[k]);
-    for (int k = 0; k < 3; ++k) Write<uint8_t>(out, point.color[k]);
-    Write<double>(out, point.error);
-    Write<uint64_t>(out, point.track.size());
+    WriteLittleEndian<uint64_t>(out, id);
+    for (int k = 0; k < 3; ++k) WriteLittleEndian<double>(out, point.xyz[k]);
+    for (int k = 0; k < 3; ++k) WriteLittleEndian<uint8_t>(out, point.color[k]);
+    WriteLittleEndian<double>(out, point.error);
+    WriteLittleEndian<uint64_t>(out, point.track.size());
     for (const TrackElement& element : point.track) {
-      Write<uint32_t>(out, element.image_id);
-      Write<uint32_t>(out, element.point2D_idx);
+      WriteLittleEndian<uint32_t>(out, element.image_id);
+      WriteLittleEndian<uint32_t>(out, element.point2D_idx);
     }
   }
 }

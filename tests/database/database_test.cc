@@ -243,12 +243,17 @@ TEST(Database, ClearErrorsForBadFiles) {
   const std::string not_db = message(dir / "text.db", Database::OpenMode::kReadWrite);
   EXPECT_NE(not_db.find("text.db"), std::string::npos);
   EXPECT_NE(not_db.find("not a database"), std::string::npos) << not_db;
-  // Another schema version.
+  // A newer COLMAP's database: both versions named.
+  { Database db(dir / "new.db", Database::OpenMode::kCreate); }
+  RawSql(dir / "new.db", "PRAGMA user_version = 4020000;");
+  const std::string version = message(dir / "new.db", Database::OpenMode::kReadWrite);
+  EXPECT_NE(version.find("COLMAP 4.2"), std::string::npos) << version;
+  EXPECT_NE(version.find("COLMAP 3.8 to 4.1"), std::string::npos) << version;
+  EXPECT_NE(version.find("new.db"), std::string::npos) << version;
+  // An older one, from before user_version was numbered as now.
   { Database db(dir / "old.db", Database::OpenMode::kCreate); }
-  RawSql(dir / "old.db", "PRAGMA user_version = 3900;");
-  const std::string version = message(dir / "old.db", Database::OpenMode::kReadWrite);
-  EXPECT_NE(version.find("3900"), std::string::npos) << version;
-  EXPECT_NE(version.find("old.db"), std::string::npos) << version;
+  RawSql(dir / "old.db", "PRAGMA user_version = 3600;");
+  EXPECT_NE(message(dir / "old.db", Database::OpenMode::kReadWrite).find("3600"), std::string::npos);
   // portcal tables of another version.
   { Database db(dir / "p.db", Database::OpenMode::kCreate); }
   RawSql(dir / "p.db", "UPDATE portcal_meta SET value='7' WHERE key='schema_version';");

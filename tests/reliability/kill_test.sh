@@ -106,6 +106,8 @@ check_stage sequential_matcher "$f/feat.db" "$portcal" sequential_matcher --data
   --SequentialMatching.overlap 3
 check_stage pose_prior_importer "$f/feat.db" "$portcal" pose_prior_importer --database_path @DB \
   --input_path "$f/priors.txt"
+check_stage database_converter "$f/matched.db" "$portcal" database_converter --database_path @DB \
+  --Database.colmap_version 4.1
 # The calibrators on one thread: with two, Ceres sums its threads' costs in
 # varying order and the last bits of the parameters vary from run to run.
 check_stage camera_calibrator "$f/cam1.db" "$portcal" camera_calibrator --database_path @DB \
