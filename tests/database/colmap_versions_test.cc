@@ -4,9 +4,10 @@
 // version's writer fills it: two images with their own cameras, a pose
 // prior where the version keeps one (a WGS84 one), a rig per camera and a
 // frame per image from 3.12 on, and a table of the user's. portcal's
-// feature_extractor (a third image), pose_prior_importer and
-// exhaustive_matcher, and target_extractor and camera_calibrator
-// (--update_database) on a rendered chessboard set, then run on it; the user's table and COLMAP's rows
+// feature_extractor (a third image), pose_prior_importer, the spatial,
+// sequential and exhaustive matchers, and target_extractor,
+// camera_calibrator (--update_database) and calibration_evaluator on a
+// rendered chessboard set, then run on it; the user's table and COLMAP's rows
 // stay byte for byte, and the rows portcal adds follow the version's
 // conventions. Conversions between layouts keep every row; what a target
 // cannot hold is refused with nothing changed; a newer COLMAP is refused.
@@ -21,6 +22,7 @@
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
 #include "database/schema.h"
+#include "pipelines/stages/calibration_evaluator.h"
 #include "pipelines/stages/camera_calibrator.h"
 #include "pipelines/stages/database_converter.h"
 #include "pipelines/stages/feature_extractor.h"
@@ -172,6 +174,14 @@ void RunStages(const fs::path& dir, const fs::path& database) {
   FeatureMatcherOptions match;
   match.database_path = database.string();
   match.num_threads = 1;
+  // The spatial (by the priors) and sequential matchers, then the
+  // exhaustive one, each matching again.
+  match.mode = PairingMode::kSpatial;
+  EXPECT_GT(RunFeatureMatcher(match, NoProgress()).num_pairs, 0);
+  match.overwrite = true;
+  match.mode = PairingMode::kSequential;
+  EXPECT_GT(RunFeatureMatcher(match, NoProgress()).num_pairs, 0);
+  match.mode = PairingMode::kExhaustive;
   EXPECT_EQ(RunFeatureMatcher(match, NoProgress()).num_pairs, 3);
 }
 
@@ -296,6 +306,11 @@ TEST_P(ColmapVersions, CalibrationStagesKeepColmapsRowsAndWriteAsTheVersionDoes)
   calibrate.output_path = (dir / "cal").string();
   calibrate.update_database = true;
   RunCameraCalibrator(calibrate, NoProgress());
+  CalibrationEvaluatorOptions evaluate;
+  evaluate.database_path = database.string();
+  evaluate.input_calibration = (dir / "cal" / "calibration.yaml").string();
+  evaluate.output_path = (dir / "evaluation").string();
+  EXPECT_EQ(RunCalibrationEvaluator(evaluate, NoProgress()).evaluation.views.size(), 6u) << name;
   RawDatabase db(database);
   EXPECT_EQ(ColmapRows(&db, layout), before) << name;
   EXPECT_EQ(db.Int("PRAGMA user_version;"), ColmapUserVersion(version)) << name;
