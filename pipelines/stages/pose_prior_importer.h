@@ -1,7 +1,8 @@
 // `portcal pose_prior_importer`: stores where navigation (DVL/INS, USBL,
-// GPS) says each image's camera centre was, as position priors in the
-// images table (prior_tx..tz, prior_q NULL: the way COLMAP 3.8 stores the
-// positions it reads from EXIF GPS). The refractive bundle adjuster takes
+// GPS) says each image's camera centre was, as position priors where the
+// database's COLMAP version keeps them: images.prior_tx..tz with prior_q
+// NULL in 3.8-3.9 (as COLMAP 3.8 stores EXIF GPS), pose_priors (Cartesian)
+// from 3.10 on (docs/database.md). The refractive bundle adjuster takes
 // a survey's metric scale from them (--PosePrior.position_sigma).
 //
 // The file has one image per line, "NAME X Y Z" (metres, a local Cartesian
