@@ -6,7 +6,9 @@
 # 10 million); a crash, a sanitizer report or an exception other than
 # portcal's stops it and leaves the input in build-sanitize/fuzz/TARGET/ (make
 # it a file of tests/fuzz/regressions/TARGET, which ctest replays). Prints a
-# table: target, executions, seconds, coverage, result.
+# table: target, executions, seconds, coverage, result. Do not pause a run
+# (kill -STOP): libFuzzer's 1200 s timeout counts wall time, so a long pause
+# is reported as a hang (replay the timeout-* input to tell).
 # Usage: workflows/fuzz.sh [RUNS=10000000] [TARGET...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
