@@ -7,7 +7,8 @@
 // feature_extractor (a third image), pose_prior_importer, the spatial,
 // sequential and exhaustive matchers, and target_extractor,
 // camera_calibrator (--update_database) and calibration_evaluator on a
-// rendered chessboard set, then run on it; the user's table and COLMAP's rows
+// rendered chessboard set, and feature_extractor and feature_masker on a
+// rendered ArUco target, then run on it; the user's table and COLMAP's rows
 // stay byte for byte, and the rows portcal adds follow the version's
 // conventions. Conversions between layouts keep every row; what a target
 // cannot hold is refused with nothing changed; a newer COLMAP is refused.
@@ -26,6 +27,7 @@
 #include "pipelines/stages/camera_calibrator.h"
 #include "pipelines/stages/database_converter.h"
 #include "pipelines/stages/feature_extractor.h"
+#include "pipelines/stages/feature_masker.h"
 #include "pipelines/stages/feature_matcher.h"
 #include "pipelines/stages/pose_prior_importer.h"
 #include "tests/pipelines/stages/live_test_setup.h"
@@ -328,6 +330,61 @@ TEST_P(ColmapVersions, CalibrationStagesKeepColmapsRowsAndWriteAsTheVersionDoes)
   }
   Database reopened(database, Database::OpenMode::kReadOnly);
   EXPECT_EQ(reopened.ReadTargetObservations(3).size(), 54u) << name;
+}
+
+// Three rendered views of the two-face ArUco target, shared by the
+// versions' masking runs.
+const fs::path& MarkerSet() {
+  static const testing::TempDir dir;  // removed at exit
+  static const bool rendered = [] {
+    testing::RenderSet(dir,
+                       std::string("name: versions_markers\nnum_images: 3\nseed: 3\n") +
+                           "camera: {model: RADIAL, width: 480, height: 270, params: [330.0, 240.0, 135.0, 0, 0]}\n"
+                           "housing: null\n" +
+                           testing::kTwoFaceTargetYaml +
+                           "poses: {distance: [0.4, 0.7], tilt_max_deg: 30, roll_max_deg: 30, visibility: markers}\n"
+                           "render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}\n");
+    return true;
+  }();
+  static const fs::path images = rendered ? dir.path() / "set" / "images" : fs::path();
+  return images;
+}
+
+TEST_P(ColmapVersions, FeatureMaskerKeepsColmapsRowsAndWritesAsTheVersionDoes) {
+  const ColmapVersion version = GetParam();
+  const std::string name = ColmapVersionName(version);
+  testing::TempDir dir;
+  const fs::path database = dir / "colmap.db";
+  WriteFixture(database, version);
+  const ColmapLayout layout = LayoutOf(version);
+  std::string before;
+  {
+    RawDatabase db(database);
+    before = ColmapRows(&db, layout);
+  }
+  // COLMAP's a.png and b.png (no markers) beside the target's views.
+  WriteImages(dir / "images");
+  fs::remove(dir / "images" / "c.png");
+  for (const auto& entry : fs::directory_iterator(MarkerSet())) {
+    fs::copy_file(entry.path(), dir / "images" / entry.path().filename());
+  }
+  FeatureExtractorOptions extract;
+  extract.database_path = database.string();
+  extract.image_path = (dir / "images").string();
+  RunFeatureExtractor(extract, NoProgress());
+  FeatureMaskerOptions mask;
+  mask.database_path = database.string();
+  mask.image_path = extract.image_path;
+  const FeatureMaskerSummary masked = RunFeatureMasker(mask, NoProgress());
+  EXPECT_LT(masked.num_features_kept, masked.num_features_before) << name;
+  RawDatabase db(database);
+  EXPECT_EQ(ColmapRows(&db, layout), before) << name;
+  EXPECT_GE(db.Int("SELECT count(*) FROM portcal_unmasked_features;"), 3) << name;
+  EXPECT_EQ(db.Int("SELECT sum(rows) FROM descriptors;"), masked.num_features_kept) << name;
+  if (layout.descriptor_type) {
+    EXPECT_EQ(db.Int("SELECT count(*) FROM descriptors WHERE type = 0;"), 5) << name;
+  }
+  if (layout.rigs_and_frames) EXPECT_EQ(db.Int("SELECT count(*) FROM frame_data;"), 5) << name;
 }
 
 INSTANTIATE_TEST_SUITE_P(AllVersions, ColmapVersions, ::testing::ValuesIn(AllColmapVersions()),
