@@ -18,6 +18,8 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <map>
+#include <memory>
 #include <opencv2/imgcodecs.hpp>
 
 #include "colmap_ext/util/error.h"
@@ -245,6 +247,13 @@ void ExpectConventions(RawDatabase* db, const ColmapLayout& layout, const std::s
   }
 }
 
+// The fixture of `version` at `path`, and what COLMAP wrote in it.
+std::string WriteFixtureAndSnapshot(const fs::path& path, ColmapVersion version) {
+  WriteFixture(path, version);
+  RawDatabase db(path);
+  return ColmapRows(&db, LayoutOf(version));
+}
+
 class ColmapVersions : public ::testing::TestWithParam<ColmapVersion> {};
 
 TEST_P(ColmapVersions, StagesKeepColmapsRowsAndWriteAsTheVersionDoes) {
@@ -253,13 +262,8 @@ TEST_P(ColmapVersions, StagesKeepColmapsRowsAndWriteAsTheVersionDoes) {
   testing::TempDir dir;
   WriteImages(dir / "images");
   const fs::path database = dir / "colmap.db";
-  WriteFixture(database, version);
   const ColmapLayout layout = LayoutOf(version);
-  std::string before;
-  {
-    RawDatabase db(database);
-    before = ColmapRows(&db, layout);
-  }
+  const std::string before = WriteFixtureAndSnapshot(database, version);
   RunStages(dir.path(), database);
   RawDatabase db(database);
   EXPECT_EQ(ColmapRows(&db, layout), before) << name;
@@ -271,11 +275,21 @@ TEST_P(ColmapVersions, StagesKeepColmapsRowsAndWriteAsTheVersionDoes) {
   EXPECT_TRUE(reopened.ReadAllImages()[2].PriorPosition().has_value());
 }
 
-// A rendered chessboard set shared by the versions' calibration runs.
-const fs::path& ChessboardSet() {
-  static const testing::TempDir dir;  // removed at exit
-  static const bool rendered = [] {
-    testing::RenderSet(dir, R"(name: versions
+// The images of a set rendered once from `config_yaml` and shared by the
+// versions' runs (the folder removed at exit).
+fs::path SharedRenderedImages(const std::string& config_yaml) {
+  static std::map<std::string, std::unique_ptr<testing::TempDir>> sets;
+  std::unique_ptr<testing::TempDir>& dir = sets[config_yaml];
+  if (!dir) {
+    dir = std::make_unique<testing::TempDir>();
+    testing::RenderSet(*dir, config_yaml);
+  }
+  return dir->path() / "set" / "images";
+}
+
+// A chessboard set for the calibration stages.
+fs::path ChessboardSet() {
+  return SharedRenderedImages(R"(name: versions
 seed: 29
 num_images: 6
 camera: {model: OPENCV, width: 480, height: 360, params: [380, 378, 243.5, 177.0, -0.2, 0.05, 0.001, -0.0005]}
@@ -284,10 +298,6 @@ target: {type: chessboard, cols: 9, rows: 6, square_size: 0.03, margin: 0.015}
 poses: {distance: [0.35, 0.7], tilt_max_deg: 40, roll_max_deg: 20, border_margin_px: 10}
 render: {spp: 1, noise_sigma: 1.0}
 )");
-    return true;
-  }();
-  static const fs::path images = rendered ? dir.path() / "set" / "images" : fs::path();
-  return images;
 }
 
 TEST_P(ColmapVersions, CalibrationStagesKeepColmapsRowsAndWriteAsTheVersionDoes) {
@@ -295,13 +305,8 @@ TEST_P(ColmapVersions, CalibrationStagesKeepColmapsRowsAndWriteAsTheVersionDoes)
   const std::string name = ColmapVersionName(version);
   testing::TempDir dir;
   const fs::path database = dir / "colmap.db";
-  WriteFixture(database, version);
   const ColmapLayout layout = LayoutOf(version);
-  std::string before;
-  {
-    RawDatabase db(database);
-    before = ColmapRows(&db, layout);
-  }
+  const std::string before = WriteFixtureAndSnapshot(database, version);
   testing::ExtractBoard(ChessboardSet(), database, false);
   CameraCalibratorOptions calibrate;
   calibrate.database_path = database.string();
@@ -332,22 +337,14 @@ TEST_P(ColmapVersions, CalibrationStagesKeepColmapsRowsAndWriteAsTheVersionDoes)
   EXPECT_EQ(reopened.ReadTargetObservations(3).size(), 54u) << name;
 }
 
-// Three rendered views of the two-face ArUco target, shared by the
-// versions' masking runs.
-const fs::path& MarkerSet() {
-  static const testing::TempDir dir;  // removed at exit
-  static const bool rendered = [] {
-    testing::RenderSet(dir,
-                       std::string("name: versions_markers\nnum_images: 3\nseed: 3\n") +
-                           "camera: {model: RADIAL, width: 480, height: 270, params: [330.0, 240.0, 135.0, 0, 0]}\n"
-                           "housing: null\n" +
-                           testing::kTwoFaceTargetYaml +
-                           "poses: {distance: [0.4, 0.7], tilt_max_deg: 30, roll_max_deg: 30, visibility: markers}\n"
-                           "render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}\n");
-    return true;
-  }();
-  static const fs::path images = rendered ? dir.path() / "set" / "images" : fs::path();
-  return images;
+// Three views of the two-face ArUco target for feature_masker.
+fs::path MarkerSet() {
+  return SharedRenderedImages(
+      std::string("name: versions_markers\nnum_images: 3\nseed: 3\n") +
+      "camera: {model: RADIAL, width: 480, height: 270, params: [330.0, 240.0, 135.0, 0, 0]}\nhousing: null\n" +
+      testing::kTwoFaceTargetYaml +
+      "poses: {distance: [0.4, 0.7], tilt_max_deg: 30, roll_max_deg: 30, visibility: markers}\n"
+      "render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}\n");
 }
 
 TEST_P(ColmapVersions, FeatureMaskerKeepsColmapsRowsAndWritesAsTheVersionDoes) {
@@ -355,13 +352,8 @@ TEST_P(ColmapVersions, FeatureMaskerKeepsColmapsRowsAndWritesAsTheVersionDoes) {
   const std::string name = ColmapVersionName(version);
   testing::TempDir dir;
   const fs::path database = dir / "colmap.db";
-  WriteFixture(database, version);
   const ColmapLayout layout = LayoutOf(version);
-  std::string before;
-  {
-    RawDatabase db(database);
-    before = ColmapRows(&db, layout);
-  }
+  const std::string before = WriteFixtureAndSnapshot(database, version);
   // COLMAP's a.png and b.png (no markers) beside the target's views.
   WriteImages(dir / "images");
   fs::remove(dir / "images" / "c.png");
