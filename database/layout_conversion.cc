@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
@@ -257,15 +259,22 @@ void Database::ConvertRigsAndFrames(ColmapVersion target_version) {
             camera + " FROM images ORDER BY image_id;");
     return;
   }
-  const int64_t rig_sensors = QueryInt("SELECT count(*) FROM rig_sensors;");
-  const int64_t shared_frames =
-      QueryInt("SELECT count(*) FROM (SELECT frame_id FROM frame_data GROUP BY frame_id HAVING count(*) > 1);");
-  const int64_t other_sensors =
-      QueryInt("SELECT count(*) FROM frame_data WHERE sensor_type != " + std::to_string(kSensorTypeCamera) + ";");
-  if (rig_sensors > 0 || shared_frames > 0 || other_sensors > 0) {
-    throw InputError(path_ + ": " + std::to_string(rig_sensors) + " rig sensors beside the reference cameras, " +
-                     std::to_string(shared_frames) + " frames of several images and " + std::to_string(other_sensors) +
-                     " data of other sensors: COLMAP " + ColmapVersionName(target_version) +
+  const std::string camera = std::to_string(kSensorTypeCamera);
+  // What COLMAP 3.x could not hold, each with how it reads in the refusal.
+  const std::vector<std::pair<std::string, std::string>> kept_only_by_rigs = {
+      {"SELECT count(*) FROM rig_sensors;", "rig sensors beside the reference cameras"},
+      {"SELECT count(*) FROM rigs WHERE ref_sensor_type != " + camera + ";",
+       "rigs whose reference sensor is not a camera"},
+      {"SELECT count(*) FROM (SELECT frame_id FROM frame_data GROUP BY frame_id HAVING count(*) > 1);",
+       "frames of several images"},
+      {"SELECT count(*) FROM frame_data WHERE sensor_type != " + camera + ";", "data of other sensors"}};
+  std::string refused;
+  for (const auto& [query, what] : kept_only_by_rigs) {
+    const int64_t count = QueryInt(query);
+    if (count > 0) refused += (refused.empty() ? "" : ", ") + std::to_string(count) + " " + what;
+  }
+  if (!refused.empty()) {
+    throw InputError(path_ + ": " + refused + ": COLMAP " + ColmapVersionName(target_version) +
                      " has no rigs to keep them (convert to 3.12 or later)");
   }
   for (const char* table : {"frame_data", "frames", "rig_sensors", "rigs"}) {

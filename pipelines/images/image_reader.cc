@@ -88,14 +88,18 @@ std::string ImportDifference(const Camera& camera, const ImageReaderOptions& opt
 }
 
 // The camera an image the database already holds in `folder` (anywhere
-// with single_camera) has, where it is what the options ask for: a new
-// image of a rerun joins it.
+// with single_camera) has, where it is what the options ask for and of the
+// new image's size: a new image of a rerun joins it. Images of another
+// camera (in a database COLMAP or another import filled) keep theirs.
 std::optional<camera_t> ExistingSharedCamera(Database* database, const ImageReaderOptions& options,
-                                             const std::string& folder) {
+                                             const std::string& folder, int width, int height) {
   for (const DatabaseImage& image : database->ReadAllImages()) {
     if (!options.single_camera && fs::path(image.name).parent_path().generic_string() != folder) continue;
     const std::optional<Camera> camera = database->ReadCamera(image.camera_id);
-    if (camera && camera->ModelName() == options.camera_model) return image.camera_id;
+    if (camera && camera->ModelName() == options.camera_model && camera->width == static_cast<uint64_t>(width) &&
+        camera->height == static_cast<uint64_t>(height)) {
+      return image.camera_id;
+    }
   }
   return std::nullopt;
 }
@@ -106,7 +110,7 @@ camera_t CameraForImport(Database* database, const ImageReaderOptions& options, 
                          const std::string& folder, int width, int height, SharedCameras* shared) {
   const bool sharing = options.single_camera || options.single_camera_per_folder;
   if (sharing && !shared->by_folder.count(folder) && !options.overwrite) {
-    if (const std::optional<camera_t> existing = ExistingSharedCamera(database, options, folder)) {
+    if (const std::optional<camera_t> existing = ExistingSharedCamera(database, options, folder, width, height)) {
       shared->by_folder.emplace(folder, *existing);
     }
   }

@@ -13,13 +13,9 @@
 // conventions. Conversions between layouts keep every row; what a target
 // cannot hold is refused with nothing changed; a newer COLMAP is refused.
 #include <gtest/gtest.h>
-#include <sqlite3.h>
 
 #include <cmath>
-#include <cstring>
 #include <fstream>
-#include <map>
-#include <memory>
 #include <opencv2/imgcodecs.hpp>
 
 #include "colmap_ext/util/error.h"
@@ -32,6 +28,7 @@
 #include "pipelines/stages/feature_masker.h"
 #include "pipelines/stages/feature_matcher.h"
 #include "pipelines/stages/pose_prior_importer.h"
+#include "tests/database/colmap_fixture.h"
 #include "tests/pipelines/stages/live_test_setup.h"
 #include "tests/test_utils.h"
 
@@ -40,69 +37,13 @@ namespace fs = std::filesystem;
 namespace portcal {
 namespace {
 
-class RawDatabase {
- public:
-  explicit RawDatabase(const fs::path& path) { EXPECT_EQ(sqlite3_open(path.c_str(), &db_), SQLITE_OK); }
-  ~RawDatabase() { sqlite3_close(db_); }
-  void Exec(const std::string& sql) {
-    char* error = nullptr;
-    ASSERT_EQ(sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &error), SQLITE_OK) << sql << ": " << error;
-  }
-  // Every row of `query`, values as text (blobs in hex), one line per row.
-  std::string Dump(const std::string& query) {
-    sqlite3_stmt* stmt = nullptr;
-    if (sqlite3_prepare_v2(db_, query.c_str(), -1, &stmt, nullptr) != SQLITE_OK) return "error: " + query;
-    std::string out;
-    while (sqlite3_step(stmt) == SQLITE_ROW) {
-      for (int c = 0; c < sqlite3_column_count(stmt); ++c) {
-        if (sqlite3_column_type(stmt, c) == SQLITE_BLOB) {
-          const auto* bytes = static_cast<const unsigned char*>(sqlite3_column_blob(stmt, c));
-          static const char* const kHex = "0123456789abcdef";
-          out += "x'";
-          for (int i = 0; i < sqlite3_column_bytes(stmt, c); ++i) {
-            out += kHex[bytes[i] >> 4];
-            out += kHex[bytes[i] & 15];
-          }
-          out += "'";
-        } else if (sqlite3_column_type(stmt, c) == SQLITE_NULL) {
-          out += "NULL";
-        } else {
-          out += reinterpret_cast<const char*>(sqlite3_column_text(stmt, c));
-        }
-        out += "|";
-      }
-      out += "\n";
-    }
-    sqlite3_finalize(stmt);
-    return out;
-  }
-  int64_t Int(const std::string& query) {
-    sqlite3_stmt* stmt = nullptr;
-    sqlite3_prepare_v2(db_, query.c_str(), -1, &stmt, nullptr);
-    const int64_t value = sqlite3_step(stmt) == SQLITE_ROW ? sqlite3_column_int64(stmt, 0) : -1;
-    sqlite3_finalize(stmt);
-    return value;
-  }
-
- private:
-  sqlite3* db_ = nullptr;
-};
-
-std::string Hex(const void* data, size_t size) {
-  static const char* const kHex = "0123456789abcdef";
-  std::string out = "x'";
-  for (size_t i = 0; i < size; ++i) {
-    const unsigned char byte = static_cast<const unsigned char*>(data)[i];
-    out += kHex[byte >> 4];
-    out += kHex[byte & 15];
-  }
-  return out + "'";
-}
-
-std::string DoublesHex(std::initializer_list<double> values) {
-  std::vector<double> v(values);
-  return Hex(v.data(), v.size() * sizeof(double));
-}
+using testing::ColmapRows;
+using testing::DoublesHex;
+using testing::Hex;
+using testing::RawDatabase;
+using testing::SharedRenderedImages;
+using testing::WriteFixture;
+using testing::WriteFixtureAndSnapshot;
 
 // Three overlapping views of one cluttered scene, 320 x 240.
 void WriteImages(const fs::path& dir) {
@@ -112,56 +53,6 @@ void WriteImages(const fs::path& dir) {
     cv::imwrite((dir / (std::string(1, static_cast<char>('a' + i)) + ".png")).string(),
                 scene(cv::Rect(40 * i, 0, 320, 240)));
   }
-}
-
-// A database as COLMAP `version` leaves it after importing a.png and b.png
-// (one SIMPLE_RADIAL camera each, COLMAP's default parameters), a.png with
-// a GPS prior, plus the user's own table.
-void WriteFixture(const fs::path& path, ColmapVersion version) {
-  RawDatabase db(path);
-  for (const std::string& sql : ColmapSchemaSql(version)) db.Exec(sql + ";");
-  db.Exec("PRAGMA user_version = " + std::to_string(ColmapUserVersion(version)) + ";");
-  const ColmapLayout layout = LayoutOf(version);
-  const std::string params = DoublesHex({384, 160, 120, 0});
-  for (int id : {1, 2}) {
-    const std::string name = id == 1 ? "a.png" : "b.png";
-    db.Exec("INSERT INTO cameras VALUES(" + std::to_string(id) + ", 2, 320, 240, " + params + ", 0);");
-    if (layout.image_prior_columns) {
-      db.Exec(
-          "INSERT INTO images VALUES(" + std::to_string(id) + ", '" + name + "', " + std::to_string(id) +
-          (id == 1 ? ", NULL, NULL, NULL, NULL, 47.1, 8.5, 420.0);" : ", NULL, NULL, NULL, NULL, NULL, NULL, NULL);"));
-    } else {
-      db.Exec("INSERT INTO images VALUES(" + std::to_string(id) + ", '" + name + "', " + std::to_string(id) + ");");
-    }
-    if (layout.rigs_and_frames) {
-      db.Exec("INSERT INTO rigs VALUES(" + std::to_string(id) + ", " + std::to_string(id) + ", 0);");
-      db.Exec("INSERT INTO frames VALUES(" + std::to_string(id) + ", " + std::to_string(id) + ");");
-      db.Exec("INSERT INTO frame_data VALUES(" + std::to_string(id) + ", " + std::to_string(id) + ", " +
-              std::to_string(id) + ", 0);");
-    }
-  }
-  const std::string gps = DoublesHex({47.1, 8.5, 420.0});
-  const double nan = std::nan("");
-  const std::string nan9 = DoublesHex({nan, nan, nan, nan, nan, nan, nan, nan, nan});
-  if (layout.pose_priors == ColmapLayout::PosePriors::kPerImage) {
-    db.Exec("INSERT INTO pose_priors VALUES(1, " + gps + ", 0" + (layout.pose_prior_covariance ? ", " + nan9 : "") +
-            ");");
-  } else if (layout.pose_priors == ColmapLayout::PosePriors::kPerData) {
-    db.Exec("INSERT INTO pose_priors VALUES(1, 1, 1, 0, " + gps + ", " + nan9 + ", " + DoublesHex({nan, nan, nan}) +
-            ", 0);");
-  }
-  db.Exec("CREATE TABLE user_notes(note TEXT); INSERT INTO user_notes VALUES('keep me');");
-}
-
-// What COLMAP wrote that portcal's stages must leave as it was.
-std::string ColmapRows(RawDatabase* db, const ColmapLayout& layout) {
-  std::string rows = db->Dump("SELECT * FROM user_notes;") + db->Dump("SELECT * FROM cameras WHERE camera_id <= 2;") +
-                     db->Dump("SELECT image_id, name, camera_id FROM images WHERE image_id <= 2;");
-  if (layout.rigs_and_frames) {
-    rows += db->Dump("SELECT * FROM rigs WHERE rig_id <= 2;") + db->Dump("SELECT * FROM frames WHERE frame_id <= 2;") +
-            db->Dump("SELECT * FROM frame_data WHERE frame_id <= 2;") + db->Dump("SELECT * FROM rig_sensors;");
-  }
-  return rows;
 }
 
 void RunStages(const fs::path& dir, const fs::path& database) {
@@ -247,13 +138,6 @@ void ExpectConventions(RawDatabase* db, const ColmapLayout& layout, const std::s
   }
 }
 
-// The fixture of `version` at `path`, and what COLMAP wrote in it.
-std::string WriteFixtureAndSnapshot(const fs::path& path, ColmapVersion version) {
-  WriteFixture(path, version);
-  RawDatabase db(path);
-  return ColmapRows(&db, LayoutOf(version));
-}
-
 class ColmapVersions : public ::testing::TestWithParam<ColmapVersion> {};
 
 TEST_P(ColmapVersions, StagesKeepColmapsRowsAndWriteAsTheVersionDoes) {
@@ -273,18 +157,6 @@ TEST_P(ColmapVersions, StagesKeepColmapsRowsAndWriteAsTheVersionDoes) {
   EXPECT_EQ(reopened.layout().VersionRange(), LayoutOf(version).VersionRange());
   EXPECT_EQ(reopened.ReadAllImages().size(), 3u);
   EXPECT_TRUE(reopened.ReadAllImages()[2].PriorPosition().has_value());
-}
-
-// The images of a set rendered once from `config_yaml` and shared by the
-// versions' runs (the folder removed at exit).
-fs::path SharedRenderedImages(const std::string& config_yaml) {
-  static std::map<std::string, std::unique_ptr<testing::TempDir>> sets;
-  std::unique_ptr<testing::TempDir>& dir = sets[config_yaml];
-  if (!dir) {
-    dir = std::make_unique<testing::TempDir>();
-    testing::RenderSet(*dir, config_yaml);
-  }
-  return dir->path() / "set" / "images";
 }
 
 // A chessboard set for the calibration stages.
@@ -376,14 +248,14 @@ TEST_P(ColmapVersions, FeatureMaskerKeepsColmapsRowsAndWritesAsTheVersionDoes) {
   if (layout.descriptor_type) {
     EXPECT_EQ(db.Int("SELECT count(*) FROM descriptors WHERE type = 0;"), 5) << name;
   }
-  if (layout.rigs_and_frames) EXPECT_EQ(db.Int("SELECT count(*) FROM frame_data;"), 5) << name;
+  if (layout.rigs_and_frames) {
+    EXPECT_EQ(db.Int("SELECT count(*) FROM frame_data;"), 5) << name;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(AllVersions, ColmapVersions, ::testing::ValuesIn(AllColmapVersions()),
                          [](const ::testing::TestParamInfo<ColmapVersion>& info) {
-                           std::string name = "COLMAP_" + ColmapVersionName(info.param);
-                           std::replace(name.begin(), name.end(), '.', '_');
-                           return name;
+                           return testing::VersionTestName(info.param);
                          });
 
 // Every table's rows, in a form two layouts can be compared by: images
@@ -485,6 +357,13 @@ TEST(ColmapVersionConversion, WhatThreeXCannotHoldIsRefused) {
     db.Exec("DELETE FROM rigs WHERE rig_id=2; INSERT INTO rig_sensors VALUES(1, 2, 0, NULL);");
   }
   ExpectRefusal(dir / "rig.db", ColmapVersion::k3_11, "rig sensors");
+  // A rig on an IMU without frames yet.
+  WriteFixture(dir / "imu.db", ColmapVersion::k3_12);
+  {
+    RawDatabase db(dir / "imu.db");
+    db.Exec("INSERT INTO rigs VALUES(3, 1, 1);");  // reference sensor 1 of type IMU
+  }
+  ExpectRefusal(dir / "imu.db", ColmapVersion::k3_10, "1 rigs whose reference sensor is not a camera");
   // ALIKED descriptors.
   WriteFixture(dir / "aliked.db", ColmapVersion::k4_1);
   {
