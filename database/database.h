@@ -99,6 +99,8 @@ class Database {
   std::optional<TwoViewGeometry> ReadTwoViewGeometry(image_t image_id1,
                                                      image_t image_id2);
   std::vector<std::pair<image_pair_t, TwoViewGeometry>> ReadTwoViewGeometries();
+  // Pair ids that have a matches row.
+  std::vector<image_pair_t> ReadMatchPairIds();
   // Pair ids that have a two_view_geometries row (verified or not).
   std::vector<image_pair_t> ReadTwoViewGeometryPairIds();
   // Deletes matches and geometries of every pair involving the image.

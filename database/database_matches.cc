@@ -206,6 +206,13 @@ std::vector<std::pair<image_pair_t, TwoViewGeometry>> Database::ReadTwoViewGeome
   return all;
 }
 
+std::vector<image_pair_t> Database::ReadMatchPairIds() {
+  Statement& stmt = Prepare("read_match_pair_ids", "SELECT pair_id FROM matches ORDER BY pair_id;");
+  std::vector<image_pair_t> pair_ids;
+  while (stmt.Step()) pair_ids.push_back(static_cast<image_pair_t>(stmt.ColumnInt64(0)));
+  return pair_ids;
+}
+
 std::vector<image_pair_t> Database::ReadTwoViewGeometryPairIds() {
   Statement& stmt = Prepare("read_geometry_pair_ids",
                             "SELECT pair_id FROM two_view_geometries ORDER BY pair_id;");

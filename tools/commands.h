@@ -5,6 +5,7 @@ namespace portcal {
 
 int DatabaseCreatorCommand(int argc, char** argv);
 int DatabaseConverterCommand(int argc, char** argv);
+int DatabaseMergerCommand(int argc, char** argv);
 int PosePriorImporterCommand(int argc, char** argv);
 int ModelConverterCommand(int argc, char** argv);
 int ImageUndistorterCommand(int argc, char** argv);

@@ -1,6 +1,7 @@
 #include "colmap_ext/util/progress.h"
 #include "pipelines/stages/database_converter.h"
 #include "pipelines/stages/database_creator.h"
+#include "pipelines/stages/database_merger.h"
 #include "pipelines/stages/pose_prior_importer.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
@@ -40,6 +41,23 @@ int DatabaseConverterCommand(int argc, char** argv) {
     if (!cli.Parse(argc, argv)) return;
     StderrProgress progress;
     RunDatabaseConverter(options, progress);
+  });
+}
+
+int DatabaseMergerCommand(int argc, char** argv) {
+  DatabaseMergerOptions options;
+  CommandLine cli("database_merger",
+                  "Merges two databases into a new one, as COLMAP's database_merger: the first's rows, then the "
+                  "second's cameras and images with new ids and every row about them (features, matches, "
+                  "geometries, pose priors, portcal's tables), in the first's COLMAP layout. An image name in "
+                  "both is an error.");
+  cli.AddRequired("database_path1", &options.database_path1, "first database");
+  cli.AddRequired("database_path2", &options.database_path2, "second database");
+  cli.AddRequired("merged_database_path", &options.merged_database_path, "the merged database (a new file)");
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    StderrProgress progress;
+    RunDatabaseMerger(options, progress);
   });
 }
 

@@ -9,6 +9,7 @@
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/memory.h"
 #include "colmap_ext/util/progress.h"
+#include "pipelines/distributed/mpi_world.h"
 #include "tools/command_line.h"
 #include "tools/commands.h"
 
@@ -26,6 +27,8 @@ const std::vector<Command>& Commands() {
        "create a COLMAP database (the layout of 3.8, default, to 4.1) with portcal's tables"},
       {"database_converter", portcal::DatabaseConverterCommand,
        "convert a database between COLMAP versions' layouts (3.8 to 4.1), keeping every row"},
+      {"database_merger", portcal::DatabaseMergerCommand,
+       "merge two databases into a new one (ids remapped, portcal's tables included)"},
       {"pose_prior_importer", portcal::PosePriorImporterCommand,
        "store navigation positions as the images' position priors"},
       {"model_converter", portcal::ModelConverterCommand,
@@ -100,7 +103,9 @@ void HandleSignal(int signal) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int RunCommandLine(int argc, char** argv) {
   portcal::InitializeLogging(argv[0]);
   portcal::KeepImageBuffersInTheHeap();
   std::signal(SIGINT, HandleSignal);
@@ -133,4 +138,15 @@ int main(int argc, char** argv) {
   std::cerr << "error: unknown command '" << argv[1]
             << "' (portcal help lists the commands)\n";
   return portcal::kExitUsage;
+}
+
+}  // namespace
+
+// Under mpirun or srun every rank runs the same command line (the stages
+// split their work: pipelines/distributed/).
+int main(int argc, char** argv) {
+  portcal::MpiWorld::Init(&argc, &argv);
+  const int code = RunCommandLine(argc, argv);
+  portcal::MpiWorld::Finalize();
+  return code;
 }

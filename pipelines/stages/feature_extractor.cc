@@ -1,15 +1,20 @@
 #include "pipelines/stages/feature_extractor.h"
 
 #include <opencv2/imgcodecs.hpp>
+#include <algorithm>
+#include <map>
 #include <set>
+#include <system_error>
 #include <sstream>
 
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/parallel.h"
 #include "database/database.h"
+#include "database/database_merge.h"
 #include "database/new_database_file.h"
 #include "database/stage_run.h"
+#include "pipelines/distributed/mpi_world.h"
 
 namespace fs = std::filesystem;
 
@@ -21,6 +26,7 @@ void FeatureExtractorOptions::Check() const {
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
   reader.Check();
   sift.Check();
+  shard.Check();
 }
 
 namespace {
@@ -47,13 +53,111 @@ struct Extracted {
   SiftFeatures features;
 };
 
+std::map<std::string, int64_t> Counts(const FeatureExtractorSummary& summary) {
+  return {{"images", summary.num_images},
+          {"extracted", summary.num_extracted},
+          {"skipped", summary.num_skipped},
+          {"unreadable", summary.num_unreadable},
+          {"features", summary.num_features}};
+}
+
+// Success on nothing would log the stage as done with no image.
+void CheckSomethingExtracted(const FeatureExtractorOptions& options, const FeatureExtractorSummary& summary) {
+  if (summary.num_extracted > 0 || summary.num_skipped > 0) return;
+  throw InputError(options.image_path + ": none of the " + std::to_string(summary.num_images) +
+                   " image files could be read and used (unreadable, or under " + std::to_string(kMinImageSide) +
+                   " px a side)");
+}
+
+FeatureExtractorSummary SumOverRanks(const FeatureExtractorSummary& mine) {
+  FeatureExtractorSummary sum;
+  sum.num_images = static_cast<int>(MpiWorld::Sum(mine.num_images));
+  sum.num_extracted = static_cast<int>(MpiWorld::Sum(mine.num_extracted));
+  sum.num_skipped = static_cast<int>(MpiWorld::Sum(mine.num_skipped));
+  sum.num_unreadable = static_cast<int>(MpiWorld::Sum(mine.num_unreadable));
+  sum.num_features = MpiWorld::Sum(mine.num_features);
+  return sum;
+}
+
+MergeOptions::CameraSharing SharingOf(const ImageReaderOptions& reader) {
+  if (reader.single_camera) return MergeOptions::CameraSharing::kAll;
+  if (reader.single_camera_per_folder) return MergeOptions::CameraSharing::kPerFolder;
+  return MergeOptions::CameraSharing::kNone;
+}
+
+// Rank 0: the shards into the database, in rank order, in one transaction.
+void MergeShards(const FeatureExtractorOptions& options, const MergeOptions& merge,
+                 const FeatureExtractorSummary& total, StageRun* run) {
+  CheckSomethingExtracted(options, total);
+  NewDatabaseFile new_file(options.database_path);
+  Database database(options.database_path, Database::OpenMode::kCreate);
+  Transaction transaction = database.BeginTransaction();
+  for (int index = 0; index < MpiWorld::Size(); ++index) {
+    Database shard(ShardDatabasePath(options.database_path, Shard{index, MpiWorld::Size()}),
+                   Database::OpenMode::kReadOnly);
+    MergeDatabase(&shard, &database, merge);
+  }
+  run->Finish(&database, Counts(total));
+  CancelFlag::ThrowIfRequested();
+  transaction.Commit();
+  new_file.Keep();
+}
+
+// RunFeatureExtractor on every rank of the MPI job (see the header).
+FeatureExtractorSummary RunOnRanks(const FeatureExtractorOptions& options, ProgressSink& progress) {
+  if (options.overwrite || options.reader.overwrite) {
+    throw OptionError(options.overwrite ? "--overwrite" : "--ImageReader.overwrite", "1",
+                      "0 under mpirun (re-extract or re-import in one process)");
+  }
+  StageRun run("feature_extractor", OptionsText(options));
+  const Shard shard = ThisRanksShard();
+  const fs::path shard_path = ShardDatabasePath(options.database_path, shard);
+  const auto remove_shard = [&] {
+    std::error_code ignored;  // nothing to do about a file that cannot go
+    fs::remove(shard_path, ignored);
+    fs::remove(shard_path.string() + "-journal", ignored);
+  };
+  MergeOptions merge;
+  merge.camera_sharing = SharingOf(options.reader);
+  FeatureExtractorSummary mine;
+  RunOnEveryRank(
+      "feature_extractor",
+      [&] {
+        remove_shard();
+        if (fs::exists(options.database_path)) {
+          Database base(options.database_path, Database::OpenMode::kReadOnly);
+          for (const Camera& camera : base.ReadAllCameras()) {
+            merge.base_camera_id = std::max(merge.base_camera_id, camera.camera_id);
+          }
+          for (const DatabaseImage& image : base.ReadAllImages()) {
+            merge.base_image_id = std::max(merge.base_image_id, image.image_id);
+          }
+          base.CopyTo(shard_path);
+        }
+        FeatureExtractorOptions part = options;
+        part.database_path = shard_path.string();
+        part.shard = shard;
+        mine = RunFeatureExtractor(part, progress);
+      },
+      remove_shard);
+  const FeatureExtractorSummary total = SumOverRanks(mine);
+  RunOnEveryRank(
+      "feature_extractor", [&] { if (shard.index == 0) MergeShards(options, merge, total, &run); }, remove_shard);
+  remove_shard();
+  LOG(INFO) << "feature_extractor: " << MpiWorld::Size() << " ranks: " << total.num_extracted
+            << " images extracted (" << total.num_features << " features), " << total.num_skipped << " skipped, "
+            << total.num_unreadable << " unreadable";
+  return total;
+}
+
 }  // namespace
 
 FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& options,
                                          ProgressSink& progress) {
   options.Check();
+  if (options.shard.Whole() && MpiWorld::Distributed()) return RunOnRanks(options, progress);
   StageRun run("feature_extractor", OptionsText(options));
-  const std::vector<std::string> names = ListImages(options.image_path);
+  const std::vector<std::string> names = options.shard.Block(ListImages(options.image_path));
   NewDatabaseFile new_file(options.database_path);
   Database database(options.database_path, Database::OpenMode::kCreate);
   Transaction transaction = database.BeginTransaction();
@@ -115,17 +219,8 @@ FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& optio
         summary.num_features += static_cast<int64_t>(extracted.features.keypoints.size());
       });
   progress.End();
-  if (summary.num_extracted == 0 && summary.num_skipped == 0) {
-    // Success on nothing would log the stage as done with no image.
-    throw InputError(options.image_path + ": none of the " + std::to_string(names.size()) +
-                     " image files could be read and used (unreadable, or under " + std::to_string(kMinImageSide) +
-                     " px a side)");
-  }
-  run.Finish(&database, {{"images", summary.num_images},
-                         {"extracted", summary.num_extracted},
-                         {"skipped", summary.num_skipped},
-                         {"unreadable", summary.num_unreadable},
-                         {"features", summary.num_features}});
+  if (options.shard.Whole()) CheckSomethingExtracted(options, summary);  // a shard's block may be all unreadable
+  run.Finish(&database, Counts(summary));
   CancelFlag::ThrowIfRequested();
   transaction.Commit();
   new_file.Keep();

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "colmap_ext/util/progress.h"
+#include "pipelines/distributed/shards.h"
 #include "pipelines/features/sift.h"
 #include "pipelines/images/image_reader.h"
 
@@ -21,6 +22,9 @@ struct FeatureExtractorOptions {
   // geometries are deleted in the same transaction).
   bool overwrite = false;
   int num_threads = 2;
+  // Only this block of the images (by name), as one rank of a distributed
+  // run writes its shard database.
+  Shard shard;
   void Check() const;  // throws OptionError naming the option
 };
 
@@ -33,7 +37,10 @@ struct FeatureExtractorSummary {
 };
 
 // Throws InputError, DatabaseError, Cancelled; the database is then left
-// as it was.
+// as it was. In an MPI job (mpirun, srun: mpi_world.h) every rank extracts
+// its block of the images into a shard database beside the database (a
+// copy of it, if it exists) and rank 0 merges the shards in one
+// transaction: the same rows as one process's run. Every rank calls it.
 FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& options,
                                          ProgressSink& progress);
 

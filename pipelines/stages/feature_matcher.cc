@@ -4,14 +4,19 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <system_error>
 #include <unordered_set>
 
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/parallel.h"
 #include "database/database.h"
+#include "database/database_merge.h"
 #include "database/stage_run.h"
+#include "pipelines/distributed/mpi_world.h"
 #include "pipelines/features/image_retrieval.h"
+
+namespace fs = std::filesystem;
 
 namespace portcal {
 
@@ -55,6 +60,7 @@ void FeatureMatcherOptions::Check() const {
   spatial.Check();
   matching.Check();
   verification.Check();
+  shard.Check();
 }
 
 std::vector<std::pair<image_t, image_t>> ExhaustivePairs(const std::vector<image_t>& images) {
@@ -224,13 +230,14 @@ std::vector<std::pair<image_t, image_t>> PairsToMatch(const std::vector<std::pai
   return pairs;
 }
 
-// Matches and verifies `pairs` in batches and writes them; the features a
+// Matches and verifies `pairs` in batches and writes them to `out`; the features a
 // batch needs are loaded once, by this thread (the database connection is
 // not shared), and dropped when no later batch needs them, so memory stays
 // bounded on long surveys.
 void MatchInBatches(const FeatureMatcherOptions& options, const std::vector<std::pair<image_t, image_t>>& pairs,
                     const std::map<image_t, camera_t>& camera_of, const std::map<camera_t, Camera>& cameras,
-                    const std::string& stage, Database* db, ProgressSink& progress, FeatureMatcherSummary* summary) {
+                    const std::string& stage, Database* db, Database* out, ProgressSink& progress,
+                    FeatureMatcherSummary* summary) {
   constexpr size_t kBatchSize = 256;
   std::map<image_t, size_t> last_use;
   for (size_t p = 0; p < pairs.size(); ++p) {
@@ -269,8 +276,8 @@ void MatchInBatches(const FeatureMatcherOptions& options, const std::vector<std:
     });
     for (size_t k = 0; k < matches.size(); ++k) {
       const auto& [a, b] = pairs[start + k];
-      db->WriteMatches(a, b, matches[k]);
-      db->WriteTwoViewGeometry(a, b, geometries[k]);
+      out->WriteMatches(a, b, matches[k]);
+      out->WriteTwoViewGeometry(a, b, geometries[k]);
       ++summary->num_matched;
       summary->num_verified += !geometries[k].inlier_matches.empty();
     }
@@ -281,16 +288,11 @@ void MatchInBatches(const FeatureMatcherOptions& options, const std::vector<std:
   progress.End();
 }
 
-}  // namespace
-
-FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, ProgressSink& progress) {
-  options.Check();
-  const std::string stage = PairingModeName(options.mode) + "_matcher";
-  StageRun run(stage, OptionsText(options));
-  Database database(options.database_path, Database::OpenMode::kReadWrite);
-  Transaction transaction = database.BeginTransaction();
-
-  std::vector<DatabaseImage> images = database.ReadAllImages();
+// Matches this shard's block of the pairs (all of them for a whole run)
+// from `database` into `out`.
+FeatureMatcherSummary MatchPairs(const FeatureMatcherOptions& options, const std::string& stage, Database* database,
+                                 Database* out, ProgressSink& progress) {
+  std::vector<DatabaseImage> images = database->ReadAllImages();
   if (images.size() < 2) {
     throw InputError(options.database_path + ": " + std::to_string(images.size()) +
                      " image(s); matching needs at least 2 (run feature_extractor first)");
@@ -299,7 +301,7 @@ FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, Pr
   // logged as done: success on nothing.
   const size_t with_features =
       static_cast<size_t>(std::count_if(images.begin(), images.end(), [&](const DatabaseImage& image) {
-        return database.ExistsKeypoints(image.image_id);
+        return database->ExistsKeypoints(image.image_id);
       }));
   if (with_features < 2) {
     throw InputError(options.database_path + ": " + std::to_string(with_features) + " of " +
@@ -315,21 +317,100 @@ FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, Pr
     camera_of[image.image_id] = image.camera_id;
   }
   std::map<camera_t, Camera> cameras;
-  for (const Camera& camera : database.ReadAllCameras()) cameras[camera.camera_id] = camera;
+  for (const Camera& camera : database->ReadAllCameras()) cameras[camera.camera_id] = camera;
 
   FeatureMatcherSummary summary;
   const std::vector<std::pair<image_t, image_t>> candidates =
-      CandidatePairs(options, images, ids, stage, &database, progress, &summary);
-  const std::vector<std::pair<image_t, image_t>> pairs = PairsToMatch(candidates, options.overwrite, &database, &summary);
-  LOG(INFO) << stage << ": " << images.size() << " images, " << summary.num_pairs << " pairs, "
-            << pairs.size() << " to match";
+      CandidatePairs(options, images, ids, stage, database, progress, &summary);
+  const std::vector<std::pair<image_t, image_t>> pairs =
+      options.shard.Block(PairsToMatch(candidates, options.overwrite, database, &summary));
+  LOG(INFO) << stage << ": " << images.size() << " images, " << summary.num_pairs << " pairs, " << pairs.size()
+            << " to match" << (options.shard.Whole() ? "" : " in this shard");
+  MatchInBatches(options, pairs, camera_of, cameras, stage, database, out, progress, &summary);
+  return summary;
+}
 
-  MatchInBatches(options, pairs, camera_of, cameras, stage, &database, progress, &summary);
-  run.Finish(&database, {{"pairs", summary.num_pairs},
-                         {"matched", summary.num_matched},
-                         {"skipped", summary.num_skipped},
-                         {"verified", summary.num_verified},
-                         {"loop_pairs", summary.num_loop_pairs}});
+std::map<std::string, int64_t> Counts(const FeatureMatcherSummary& summary) {
+  return {{"pairs", summary.num_pairs},
+          {"matched", summary.num_matched},
+          {"skipped", summary.num_skipped},
+          {"verified", summary.num_verified},
+          {"loop_pairs", summary.num_loop_pairs}};
+}
+
+// One rank's block into its shard database (a new file, the database's
+// layout).
+FeatureMatcherSummary MatchShard(const FeatureMatcherOptions& options, const std::string& stage,
+                                 ProgressSink& progress) {
+  StageRun run(stage, OptionsText(options));
+  Database database(options.database_path, Database::OpenMode::kReadOnly);
+  const fs::path shard_path = ShardDatabasePath(options.database_path, options.shard);
+  Database shard(shard_path, Database::OpenMode::kCreate, NewestVersionWith(database.layout()));
+  Transaction transaction = shard.BeginTransaction();
+  const FeatureMatcherSummary summary = MatchPairs(options, stage, &database, &shard, progress);
+  run.Finish(&shard, Counts(summary));
+  CancelFlag::ThrowIfRequested();
+  transaction.Commit();
+  return summary;
+}
+
+// RunFeatureMatcher on every rank of the MPI job (see the header).
+FeatureMatcherSummary RunOnRanks(const FeatureMatcherOptions& options, const std::string& stage,
+                                 ProgressSink& progress) {
+  StageRun run(stage, OptionsText(options));
+  const Shard shard = ThisRanksShard();
+  const fs::path shard_path = ShardDatabasePath(options.database_path, shard);
+  const auto remove_shard = [&] {
+    std::error_code ignored;  // nothing to do about a file that cannot go
+    fs::remove(shard_path, ignored);
+    fs::remove(shard_path.string() + "-journal", ignored);
+  };
+  FeatureMatcherSummary summary;
+  RunOnEveryRank(
+      stage,
+      [&] {
+        remove_shard();
+        FeatureMatcherOptions part = options;
+        part.shard = shard;
+        summary = MatchShard(part, stage, progress);
+      },
+      remove_shard);
+  // Every rank counted the same candidates and skipped pairs; the matched
+  // and verified ones are split.
+  summary.num_matched = MpiWorld::Sum(summary.num_matched);
+  summary.num_verified = MpiWorld::Sum(summary.num_verified);
+  RunOnEveryRank(
+      stage,
+      [&] {
+        if (shard.index != 0) return;
+        Database database(options.database_path, Database::OpenMode::kReadWrite);
+        Transaction transaction = database.BeginTransaction();
+        for (int index = 0; index < shard.count; ++index) {
+          Database part(ShardDatabasePath(options.database_path, Shard{index, shard.count}),
+                        Database::OpenMode::kReadOnly);
+          CopyPairRows(&part, &database);
+        }
+        run.Finish(&database, Counts(summary));
+        CancelFlag::ThrowIfRequested();
+        transaction.Commit();
+      },
+      remove_shard);
+  remove_shard();
+  return summary;
+}
+
+}  // namespace
+
+FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, ProgressSink& progress) {
+  options.Check();
+  const std::string stage = PairingModeName(options.mode) + "_matcher";
+  if (options.shard.Whole() && MpiWorld::Distributed()) return RunOnRanks(options, stage, progress);
+  if (!options.shard.Whole()) return MatchShard(options, stage, progress);
+  StageRun run(stage, OptionsText(options));
+  Database database(options.database_path, Database::OpenMode::kReadWrite);
+  Transaction transaction = database.BeginTransaction();
+  const FeatureMatcherSummary summary = MatchPairs(options, stage, &database, &database, progress);
+  run.Finish(&database, Counts(summary));
   CancelFlag::ThrowIfRequested();
   transaction.Commit();
   LOG(INFO) << stage << ": " << summary.num_matched << " pairs matched, " << summary.num_verified

@@ -12,6 +12,7 @@
 
 #include "colmap_ext/util/progress.h"
 #include "colmap_ext/util/types.h"
+#include "pipelines/distributed/shards.h"
 #include "pipelines/features/descriptor_matching.h"
 #include "pipelines/features/two_view_verification.h"
 
@@ -55,6 +56,10 @@ struct FeatureMatcherOptions {
   TwoViewVerificationOptions verification;
   bool overwrite = false;
   int num_threads = 2;
+  // Only this block of the pairs to match, read from the database and
+  // written into the shard database beside it (shards.h), as one rank of a
+  // distributed run.
+  Shard shard;
   void Check() const;  // throws OptionError naming the option
 };
 
@@ -75,6 +80,10 @@ std::vector<std::pair<image_t, image_t>> SequentialPairs(const std::vector<image
 std::vector<std::pair<image_t, image_t>> SpatialPairs(const std::vector<std::pair<image_t, Eigen::Vector3d>>& positions,
                                                       const SpatialPairingOptions& options);
 
+// In an MPI job (mpirun, srun: mpi_world.h) every rank matches its block of
+// the pairs into a shard database and rank 0 copies the shards' rows into
+// the database in one transaction: the same rows as one process's run.
+// Every rank calls it.
 FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, ProgressSink& progress);
 
 }  // namespace portcal
