@@ -63,6 +63,8 @@ const std::vector<Command>& Commands() {
        "incremental structure-from-motion on refracted rays"},
       {"refractive_bundle_adjuster", portcal::RefractiveBundleAdjusterCommand,
        "bundle adjustment that self-calibrates the housing (and intrinsics)"},
+      {"calibration_subset_selector", portcal::CalibrationSubsetSelectorCommand,
+       "the images of a survey to self-calibrate the housing on (an image list for the mapper)"},
       {"auto_calibrator", portcal::AutoCalibratorCommand,
        "calibrate from ArUco-marked objects without a known target: all stages"},
       {"cross_check", portcal::CrossCheckCommand,

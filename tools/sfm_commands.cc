@@ -1,7 +1,8 @@
 // Subcommands of the reconstruction back end: refractive_mapper,
-// refractive_bundle_adjuster, auto_calibrator.
+// refractive_bundle_adjuster, auto_calibrator, calibration_subset_selector.
 #include "colmap_ext/util/progress.h"
 #include "pipelines/stages/auto_calibrator.h"
+#include "pipelines/stages/calibration_subset_selector.h"
 #include "pipelines/stages/refractive_bundle_adjuster.h"
 #include "pipelines/stages/refractive_mapper.h"
 #include "tools/command_line.h"
@@ -9,6 +10,25 @@
 #include "tools/option_groups.h"
 
 namespace portcal {
+
+int CalibrationSubsetSelectorCommand(int argc, char** argv) {
+  CalibrationSubsetSelectorOptions options;
+  CommandLine cli("calibration_subset_selector",
+                  "Chooses the images of a matched survey to self-calibrate the housing on: spread evenly along "
+                  "the acquisition order (name order), each sharing a verified pair with the one before, so the "
+                  "subset maps as one model. Writes them as a list for refractive_mapper --image_list_path; map "
+                  "and refine the subset refining the housing, then map every image with it held.");
+  cli.AddRequired("database_path", &options.database_path, "matched database");
+  cli.AddRequired("output_path", &options.output_path, "the image list to write (one name per line)");
+  cli.Add("Subset.num_images", &options.subset.num_images, "images to choose (more where the pairs fall short)");
+  cli.Add("Subset.min_num_inliers", &options.subset.min_num_inliers,
+          "verified inliers that link a chosen image to the one before");
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    StderrProgress progress;
+    RunCalibrationSubsetSelector(options, progress);
+  });
+}
 
 int RefractiveMapperCommand(int argc, char** argv) {
   RefractiveMapperOptions options;
@@ -19,6 +39,8 @@ int RefractiveMapperCommand(int argc, char** argv) {
   cli.AddRequired("database_path", &options.database_path, "database with verified matches");
   cli.Add("image_path", &options.image_path, "the images (accepted for COLMAP compatibility)");
   cli.AddRequired("output_path", &options.output_path, "directory for the models");
+  cli.Add("image_list_path", &options.image_list_path,
+          "file of image names, one per line: map only these and the pairs between them");
   cli.AddHousing(&options.housing, "the housing of all cameras (default: the database's)");
   cli.AddTriState("Mapper.init_focal_from_markers", &options.init_focal_from_markers,
           "focal length from ArUco markers: -1 when the camera has no prior, 0 never, 1 always");

@@ -7,7 +7,7 @@
 
 namespace portcal {
 
-SfmInputs SfmInputs::Read(Database* database) {
+SfmInputs SfmInputs::Read(Database* database, const std::set<std::string>* only) {
   SfmInputs inputs;
   const std::map<camera_t, Housing> housings = database->ReadAllHousings();
   for (const Camera& camera : database->ReadAllCameras()) {
@@ -17,6 +17,7 @@ SfmInputs SfmInputs::Read(Database* database) {
     if (it != housings.end()) c.housing = it->second;
   }
   for (const DatabaseImage& row : database->ReadAllImages()) {
+    if (only && !only->count(row.name)) continue;
     if (!inputs.cameras.count(row.camera_id)) {
       throw InputError(database->path() + ": image '" + row.name + "' has camera " + std::to_string(row.camera_id) +
                        ", which the cameras table does not hold");
@@ -37,6 +38,7 @@ SfmInputs SfmInputs::Read(Database* database) {
     if (geometry.inlier_matches.empty()) continue;
     image_t id1, id2;
     PairIdToImagePair(pair_id, &id1, &id2);
+    if (only && (!inputs.images.count(id1) || !inputs.images.count(id2))) continue;  // outside the subset
     if (!inputs.images.count(id1) || !inputs.images.count(id2)) {
       throw InputError(database->path() + ": two_view_geometries of " + database->PairLabel(pair_id) +
                        " names an image the images table does not hold");

@@ -47,8 +47,9 @@ struct SfmInputs {
   // Pairs whose geometry is (nearly) a homography: a plane or a rotation.
   std::set<image_pair_t> planar_pairs;
   // Reads images, cameras, housings (portcal_housings), keypoints, marker
-  // detections and the inlier matches of verified pairs.
-  static SfmInputs Read(Database* database);
+  // detections and the inlier matches of verified pairs; with `only`, only
+  // the images of those names and the pairs between them.
+  static SfmInputs Read(Database* database, const std::set<std::string>* only = nullptr);
   // From a sparse model: its images' keypoints (no correspondences), its
   // cameras and housings. Marker detections are added separately.
   static SfmInputs FromSparseModel(const SparseModel& model);

@@ -1,6 +1,9 @@
 #include "pipelines/stages/refractive_mapper.h"
 
 #include <algorithm>
+#include <fstream>
+#include <set>
+#include <string>
 
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
@@ -21,14 +24,42 @@ void RefractiveMapperOptions::Check() const {
   mapper.Check();
 }
 
+namespace {
+
+// The names of --image_list_path, each checked against the database.
+std::set<std::string> ReadImageList(const std::string& path, Database* database) {
+  std::ifstream file(path);
+  if (!file) throw InputError(path + ": cannot read the image list (--image_list_path)");
+  std::set<std::string> names;
+  std::string line;
+  for (int number = 1; std::getline(file, line); ++number) {
+    const size_t begin = line.find_first_not_of(" \t\r");
+    if (begin == std::string::npos) continue;
+    const std::string name = line.substr(begin, line.find_last_not_of(" \t\r") + 1 - begin);
+    if (!database->ReadImageWithName(name)) {
+      throw InputError(path + ":" + std::to_string(number) + ": image '" + name + "' is not in " +
+                       database->path());
+    }
+    names.insert(name);
+  }
+  if (names.empty()) throw InputError(path + ": no image names (--image_list_path)");
+  return names;
+}
+
+SfmInputs ReadInputs(const RefractiveMapperOptions& options) {
+  Database database(options.database_path, Database::OpenMode::kReadOnly);
+  if (options.image_list_path.empty()) return SfmInputs::Read(&database);
+  const std::set<std::string> names = ReadImageList(options.image_list_path, &database);
+  LOG(INFO) << "refractive_mapper: " << names.size() << " images of " << options.image_list_path;
+  return SfmInputs::Read(&database, &names);
+}
+
+}  // namespace
+
 RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& options, ProgressSink& progress) {
   options.Check();
   NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
-  SfmInputs inputs;
-  {
-    Database database(options.database_path, Database::OpenMode::kReadOnly);
-    inputs = SfmInputs::Read(&database);
-  }
+  const SfmInputs inputs = ReadInputs(options);
   if (inputs.pair_inliers.empty()) {
     throw InputError(options.database_path + ": no verified image pairs; run a matcher first");
   }

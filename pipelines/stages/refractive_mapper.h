@@ -21,6 +21,9 @@ struct RefractiveMapperOptions {
   std::string database_path;
   std::string image_path;  // accepted for COLMAP compatibility
   std::string output_path;
+  // COLMAP's --image_list_path: a file of image names, one per line; only
+  // these images (and the pairs between them) are mapped. "": all.
+  std::string image_list_path;
   IncrementalMapperOptions mapper;
   std::optional<Housing> housing;  // for every camera; none: the database's
   // The focal length from the markers before mapping: always, never, or
