@@ -16,21 +16,8 @@ cd "$(dirname "$0")/.."
 n="${1:-300}"
 if [ -n "${2:-}" ]; then work="$2"; mkdir -p "$work"; else work="$(mktemp -d)"; trap 'rm -rf "$work"' EXIT; fi
 P="$PWD/build/portcal"
-timed() {
-  local name="$1" t0; shift; t0=$(date +%s%N)
-  "$@"
-  local ms=$(( ($(date +%s%N) - t0) / 1000000 ))
-  printf '%s: %d.%03d s\n' "$name" $((ms / 1000)) $((ms % 1000))
-}
-cat > "$work/survey.yaml" <<YAML
-name: survey_flat
-num_images: $n
-camera: {model: RADIAL, width: 960, height: 540, params: [700.0, 480.0, 270.0, 0.0, 0.0]}
-housing: {model: FLATPORT, params: [0.0523360, 0.0, 0.9986295, 0.02, 0.010, 1.0, 1.473, 1.334]}
-survey: {height: 2.0, speed: 0.5, frame_rate: 1.0, side_overlap: 0.6, line_length: 15.0,
-         roughness: 0.15, relief_wavelength: 2.0, navigation_sigma: 0.02}
-render: {spp: 4, noise_sigma: 1.0, white: 220, black: 30, background: 110}
-YAML
+source workflows/survey_common.sh
+survey_yaml survey_flat "$n" > "$work/survey.yaml"
 cd "$work"
 [ -f set/ground_truth.yaml ] || timed render "$P" synthesize --log_level warn --config survey.yaml --output_path set --seed 3
 rm -rf db.db sparse refined

@@ -20,6 +20,12 @@ std::filesystem::path ShardDatabasePath(const std::string& database_path, const 
   return database_path + ".shard-" + std::to_string(shard.index) + "-of-" + std::to_string(shard.count);
 }
 
+void RemoveShardDatabase(const std::filesystem::path& path) {
+  std::error_code ignored;
+  std::filesystem::remove(path, ignored);
+  std::filesystem::remove(path.string() + "-journal", ignored);
+}
+
 void RunOnEveryRank(const std::string& stage, const std::function<void()>& work,
                     const std::function<void()>& clean_up) {
   std::exception_ptr error;

@@ -33,6 +33,10 @@ Shard ThisRanksShard();
 // DB.shard-I-of-N beside the database.
 std::filesystem::path ShardDatabasePath(const std::string& database_path, const Shard& shard);
 
+// Removes a shard database and its journal (nothing to do about one that
+// cannot go).
+void RemoveShardDatabase(const std::filesystem::path& path);
+
 // Runs `work` on every rank. If it failed on any rank, every rank runs
 // `clean_up` and throws: its own error, or one saying another rank failed
 // (whose error that rank reports). Every rank must call it together.

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <map>
 #include <set>
-#include <system_error>
 #include <sstream>
 
 #include "colmap_ext/util/error.h"
@@ -112,11 +111,7 @@ FeatureExtractorSummary RunOnRanks(const FeatureExtractorOptions& options, Progr
   StageRun run("feature_extractor", OptionsText(options));
   const Shard shard = ThisRanksShard();
   const fs::path shard_path = ShardDatabasePath(options.database_path, shard);
-  const auto remove_shard = [&] {
-    std::error_code ignored;  // nothing to do about a file that cannot go
-    fs::remove(shard_path, ignored);
-    fs::remove(shard_path.string() + "-journal", ignored);
-  };
+  const auto remove_shard = [&] { RemoveShardDatabase(shard_path); };
   MergeOptions merge;
   merge.camera_sharing = SharingOf(options.reader);
   FeatureExtractorSummary mine;

@@ -4,7 +4,6 @@
 #include <map>
 #include <set>
 #include <sstream>
-#include <system_error>
 #include <unordered_set>
 
 #include "colmap_ext/util/error.h"
@@ -360,11 +359,7 @@ FeatureMatcherSummary RunOnRanks(const FeatureMatcherOptions& options, const std
   StageRun run(stage, OptionsText(options));
   const Shard shard = ThisRanksShard();
   const fs::path shard_path = ShardDatabasePath(options.database_path, shard);
-  const auto remove_shard = [&] {
-    std::error_code ignored;  // nothing to do about a file that cannot go
-    fs::remove(shard_path, ignored);
-    fs::remove(shard_path.string() + "-journal", ignored);
-  };
+  const auto remove_shard = [&] { RemoveShardDatabase(shard_path); };
   FeatureMatcherSummary summary;
   RunOnEveryRank(
       stage,

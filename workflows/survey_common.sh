@@ -1,0 +1,25 @@
+# What the survey benchmarks share (sourced by bench_survey.sh,
+# bench_survey_subset.sh, bench_mpi.sh): the rendered survey and a timer.
+
+# survey_yaml NAME NUM_IMAGES: the lawnmower survey 2 m over a rough seabed
+# behind a flat port tilted 3 deg (960 x 540, known in-air intrinsics,
+# navigation positions with 2 cm noise), as synthesize's config.
+survey_yaml() {
+  cat <<YAML
+name: $1
+num_images: $2
+camera: {model: RADIAL, width: 960, height: 540, params: [700.0, 480.0, 270.0, 0.0, 0.0]}
+housing: {model: FLATPORT, params: [0.0523360, 0.0, 0.9986295, 0.02, 0.010, 1.0, 1.473, 1.334]}
+survey: {height: 2.0, speed: 0.5, frame_rate: 1.0, side_overlap: 0.6, line_length: 15.0,
+         roughness: 0.15, relief_wavelength: 2.0, navigation_sigma: 0.02}
+render: {spp: 4, noise_sigma: 1.0, white: 220, black: 30, background: 110}
+YAML
+}
+
+# timed NAME COMMAND...: runs the command, then prints NAME and its wall time.
+timed() {
+  local name="$1" t0; shift; t0=$(date +%s%N)
+  "$@"
+  local ms=$(( ($(date +%s%N) - t0) / 1000000 ))
+  printf '%-28s %8d.%03d s\n' "$name" $((ms / 1000)) $((ms % 1000))
+}
