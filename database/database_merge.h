@@ -1,10 +1,12 @@
 // Appending one database to another, as `colmap database_merger` does:
 // the source's cameras and images get new ids after the target's (in the
 // source's id order), and every row about them follows with the new ids:
-// keypoints, descriptors, matches, two-view geometries, pose priors, and
+// keypoints, descriptors, matches, two-view geometries, pose priors (their
+// positions: a 4.x prior's covariance and gravity are not kept), and
 // portcal's housings, target observations and detection status, marker
 // detections and unmasked features. The rows are written through
-// Database, so they take the target's COLMAP layout (frames and rigs, the
+// Database, so they take the target's COLMAP layout (a frame per image in
+// its camera's rig: a rig of several sensors is not carried over; the
 // descriptors' type, where priors go).
 //
 // A shard of a distributed stage starts as a copy of the target and adds

@@ -2,7 +2,7 @@
 // database_merger` does (the same options): the first database's rows as
 // they are, then the second's cameras and images with new ids after them
 // and every row about them (database_merge.h: features, matches,
-// geometries, pose priors, and portcal's housings, target observations,
+// geometries, pose priors' positions, and portcal's housings, target observations,
 // detections, markers and unmasked features) in the first's COLMAP
 // layout. An image name in both is refused.
 #pragma once
