@@ -31,7 +31,6 @@
 #include "pipelines/stages/refractive_bundle_adjuster.h"
 #include "pipelines/stages/refractive_mapper.h"
 #include "pipelines/stages/stereo_calibrator.h"
-#include "pipelines/stages/target_extractor.h"
 #include "tests/database/colmap_fixture.h"
 #include "tests/pipelines/stages/live_test_setup.h"
 #include "tests/test_utils.h"
@@ -55,16 +54,7 @@ fs::path BoardSet(const std::string& name, const std::string& housing_and_rig, i
 }
 
 void Extract(const fs::path& images, const fs::path& database, bool per_folder, int cols) {
-  TargetExtractorOptions extract;
-  extract.database_path = database.string();
-  extract.image_path = images.string();
-  extract.reader.camera_model = "RADIAL";
-  extract.reader.single_camera = !per_folder;
-  extract.reader.single_camera_per_folder = per_folder;
-  extract.chessboard.cols = cols;
-  extract.chessboard.rows = 6;
-  extract.square_size_m = 0.025;
-  RunTargetExtractor(extract, NoProgress());
+  testing::ExtractBoard(images, database, per_folder, "RADIAL", cols, 0.025);
 }
 
 // What each calibrator found.

@@ -48,19 +48,21 @@ inline std::vector<std::pair<int, int>> TrajectoryPauses(const std::filesystem::
   return pauses;
 }
 
-// target_extractor with the board above (OPENCV cameras): one camera for
-// all images, or one per folder (a rig's cam1/ and cam2/).
+// target_extractor with the board above (OPENCV cameras; or another model
+// and a board of `cols` x 6 corners of `square_size_m`): one camera for all
+// images, or one per folder (a rig's cam1/ and cam2/).
 inline void ExtractBoard(const std::filesystem::path& images, const std::filesystem::path& database,
-                         bool camera_per_folder) {
+                         bool camera_per_folder, const std::string& camera_model = "OPENCV", int cols = 9,
+                         double square_size_m = 0.03) {
   TargetExtractorOptions extract;
   extract.database_path = database.string();
   extract.image_path = images.string();
-  extract.reader.camera_model = "OPENCV";
+  extract.reader.camera_model = camera_model;
   extract.reader.single_camera = !camera_per_folder;
   extract.reader.single_camera_per_folder = camera_per_folder;
-  extract.chessboard.cols = 9;
+  extract.chessboard.cols = cols;
   extract.chessboard.rows = 6;
-  extract.square_size_m = 0.03;
+  extract.square_size_m = square_size_m;
   RunTargetExtractor(extract, NoProgress());
 }
 
