@@ -70,6 +70,11 @@ int RefractiveBundleAdjusterCommand(int argc, char** argv) {
   cli.AddHousing(&options.housing, "replaces the model's housings (first guess)");
   Register(&cli, &options.marker_scale);
   cli.Add("BundleAdjustment.max_reproj_error", &options.max_reproj_error_px, "observations beyond are dropped");
+  cli.Add("BundleAdjustment.hold_weights", &options.hold_weights,
+          "1: the first solve, robust, decides the inliers' weights and the final solve holds them (fast); "
+          "0: both solves robust to function_tolerance");
+  cli.Add("BundleAdjustment.robust_function_tolerance", &options.robust_function_tolerance,
+          "with hold_weights: relative cost change that ends the first, robust solve");
   cli.Add("BundleAdjustment.principal_point_test_sigmas", &options.principal_point_test_sigmas,
           "with refine_principal_point: hold it at the image centre unless it lies more sigmas than this from it (0: no test)");
   Register(&cli, &options.ba);

@@ -1,5 +1,7 @@
 # What the survey benchmarks share (sourced by bench_survey.sh,
-# bench_survey_subset.sh, bench_mpi.sh): the rendered survey and a timer.
+# bench_survey_subset.sh, bench_mpi.sh, sourced from the project root): the
+# rendered survey and a timer.
+bash workflows/setup.sh --packages-only time >/dev/null  # GNU time, for the peak memory
 
 # survey_yaml NAME NUM_IMAGES: the lawnmower survey 2 m over a rough seabed
 # behind a flat port tilted 3 deg (960 x 540, known in-air intrinsics,
@@ -16,10 +18,14 @@ render: {spp: 4, noise_sigma: 1.0, white: 220, black: 30, background: 110}
 YAML
 }
 
-# timed NAME COMMAND...: runs the command, then prints NAME and its wall time.
+# timed NAME COMMAND...: runs the command, then prints NAME, its wall time
+# and its peak memory (the largest resident set of the command or any
+# process it waited for, by GNU time).
 timed() {
-  local name="$1" t0; shift; t0=$(date +%s%N)
-  "$@"
+  local name="$1" t0 rss; shift; t0=$(date +%s%N)
+  rss="$(mktemp)"
+  /usr/bin/time -q -f %M -o "$rss" "$@"
   local ms=$(( ($(date +%s%N) - t0) / 1000000 ))
-  printf '%-28s %8d.%03d s\n' "$name" $((ms / 1000)) $((ms % 1000))
+  printf '%-28s %8d.%03d s %8d MB\n' "$name" $((ms / 1000)) $((ms % 1000)) $(( $(tail -1 "$rss") / 1024 ))
+  rm -f "$rss"
 }

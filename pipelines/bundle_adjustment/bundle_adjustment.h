@@ -31,6 +31,14 @@ struct BundleAdjustmentOptions {
   bool scale_weighting = true;        // sigma grows with the keypoint's scale (above 2 px)
   double marker_sigma_px = 1.0;       // of an ArUco marker corner (edge-refined)
   double loss_scale = 1.0;            // Cauchy loss scale, in sigma; <= 0: no robust loss
+  // The robust loss's weights rho'(|r|^2), taken at the starting residuals,
+  // are held through the solve: a weighted least-squares problem, which
+  // Gauss-Newton converges quadratically. The robust solve reweights at
+  // every step and with the Cauchy loss converges only linearly (Ceres
+  // models a residual's curvature by rho' alone where rho'' < 0), which
+  // on a survey is a crawl of dozens of iterations (docs/benchmarks.md).
+  // For a final solve whose inliers a robust solve has decided.
+  bool hold_loss_weights = false;
   // > 0: in global adjustments, the registered images' position priors are
   // residuals with this standard deviation (metres) and hold the gauge
   // (align the model to them first: AlignToPositionPriors).

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <set>
 
 #include "colmap_ext/camera/camera_models.h"
@@ -97,7 +98,13 @@ class BundleProblem {
       if (camera.housing) housings_[id] = camera.housing->params;
     }
     // One loss object shared by the residuals; the problem deletes it once.
-    loss_ = options.loss_scale > 0 ? new ceres::CauchyLoss(options.loss_scale) : nullptr;
+    // With the weights held, each residual gets its own weight instead and
+    // the robust loss only computes them.
+    if (options.loss_scale > 0 && options.hold_loss_weights) {
+      weight_loss_ = std::make_unique<ceres::CauchyLoss>(options.loss_scale);
+    } else if (options.loss_scale > 0) {
+      loss_ = new ceres::CauchyLoss(options.loss_scale);
+    }
     local_ = !scope.variable_images.empty();
     // Which blocks the residuals carry: constants are captured instead (see
     // bundle_costs.h), which makes the autodiff Jets much narrower.
@@ -119,6 +126,7 @@ class BundleProblem {
   bool IsVariable(image_t id) const { return !local_ || scope_.variable_images.count(id) > 0; }
   CostBlocks BlocksOf(const HousedCamera& camera) const;
   void AddObservation(image_t image_id, const Eigen::Vector2d& pixel, double* xyz, double sigma);
+  void AddRobustResidual(ceres::CostFunction* cost, const std::vector<double*>& blocks);
   double SigmaOf(const TrackElement& e) const;
   bool FreePose(image_t id) const;
   ceres::Solver::Options SolverOptions(int* num_free_poses) const;
@@ -138,6 +146,7 @@ class BundleProblem {
   std::set<camera_t> used_cameras_;
   ceres::Problem problem_;
   ceres::LossFunction* loss_ = nullptr;
+  std::unique_ptr<ceres::LossFunction> weight_loss_;  // with hold_loss_weights: the weights' robust loss
   bool local_ = false;
   bool refine_intrinsics_ = false;
   bool refine_housing_ = false;
@@ -172,9 +181,26 @@ void BundleProblem::AddObservation(image_t image_id, const Eigen::Vector2d& pixe
   if ((kind == CostBlocks::kAll || kind == CostBlocks::kPosePointHousing) && camera.housing) {
     blocks.push_back(housings_.at(image.camera_id).data());
   }
-  problem_.AddResidualBlock(cost, loss_, blocks);
+  AddRobustResidual(cost, blocks);
   used_cameras_.insert(image.camera_id);
-  num_residuals_ += 2;
+}
+
+// An observation's residual under the robust loss, or, with the weights
+// held, under its weight rho'(|r|^2) at the current parameters (a residual
+// that cannot be evaluated there gets weight 1: the solve then fails on it
+// and says so).
+void BundleProblem::AddRobustResidual(ceres::CostFunction* cost, const std::vector<double*>& blocks) {
+  num_residuals_ += cost->num_residuals();
+  if (!weight_loss_) {
+    problem_.AddResidualBlock(cost, loss_, blocks);
+    return;
+  }
+  Eigen::VectorXd residual(cost->num_residuals());
+  double rho[3] = {0, 1, 0};
+  if (cost->Evaluate(blocks.data(), residual.data(), nullptr) && residual.allFinite()) {
+    weight_loss_->Evaluate(residual.squaredNorm(), rho);
+  }
+  problem_.AddResidualBlock(cost, new ceres::ScaledLoss(nullptr, rho[1], ceres::TAKE_OWNERSHIP), blocks);
 }
 
 // A keypoint found at a coarse scale is located less precisely: SIFT's
@@ -204,10 +230,9 @@ void BundleProblem::AddPoints() {
       const auto& ray = reconstruction_->RayOf(e.image_id, e.point2D_idx);
       if (BlocksOf(camera) == CostBlocks::kPosePoint && ray && ray->direction.z() > 1e-6) {
         // Intrinsics and housing held: the cheap fixed-ray error.
-        problem_.AddResidualBlock(CreateFixedRayCost(VirtualCenterOf(camera, *ray), ray->direction,
-                                                     camera.camera.MeanFocalLength(), sigma),
-                                  loss_, pose_blocks_.at(e.image_id).data(), xyz.data());
-        num_residuals_ += 2;
+        AddRobustResidual(
+            CreateFixedRayCost(VirtualCenterOf(camera, *ray), ray->direction, camera.camera.MeanFocalLength(), sigma),
+            {pose_blocks_.at(e.image_id).data(), xyz.data()});
         continue;
       }
       AddObservation(e.image_id, reconstruction_->inputs().images.at(e.image_id).keypoints[e.point2D_idx],

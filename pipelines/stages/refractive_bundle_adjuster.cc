@@ -35,6 +35,10 @@ void RefractiveBundleAdjusterOptions::Check() const {
   if (!(max_reproj_error_px > 0)) {
     throw OptionError("--BundleAdjustment.max_reproj_error", std::to_string(max_reproj_error_px), "> 0 px");
   }
+  if (!(robust_function_tolerance > 0 && robust_function_tolerance < 1)) {
+    throw OptionError("--BundleAdjustment.robust_function_tolerance", std::to_string(robust_function_tolerance),
+                      "in (0, 1)");
+  }
   if (!(principal_point_test_sigmas >= 0)) {
     throw OptionError("--BundleAdjustment.principal_point_test_sigmas", std::to_string(principal_point_test_sigmas),
                       ">= 0 (0: no test)");
@@ -385,13 +389,15 @@ class StagedAdjustment {
   std::vector<std::string> Calibrate(bool intrinsics_first, CalibrationStdDevs* std_devs) {
     std::vector<std::string> notes;
     warnings_.clear();
+    // The staged solves only start the next: robust, to the robust tolerance.
     if (joint_ && intrinsics_first) {
-      BundleAdjustmentOptions intrinsics = options_.ba;
+      BundleAdjustmentOptions intrinsics = Robust(options_.ba);
       intrinsics.refine_housing = false;
       AdjustBundle(&r_, intrinsics, BundleAdjustmentScope(), &markers_, options_.marker_scale);
     }
     if (joint_) {
-      AdjustBundle(&r_, options_.ba.WithIntrinsicsHeld(), BundleAdjustmentScope(), &markers_, options_.marker_scale);
+      AdjustBundle(&r_, Robust(options_.ba).WithIntrinsicsHeld(), BundleAdjustmentScope(), &markers_,
+                   options_.marker_scale);
     }
     Solve(options_.ba, std_devs);
     if (options_.ba.refine_principal_point) WarnIfPrincipalPointPoor(*std_devs);
@@ -403,9 +409,18 @@ class StagedAdjustment {
   }
 
  private:
-  // A first solve, outliers out, then the final solve with covariance.
+  // `ba` for a solve that decides the inliers: with held weights, robust to
+  // the robust tolerance.
+  BundleAdjustmentOptions Robust(const BundleAdjustmentOptions& ba) const {
+    BundleAdjustmentOptions robust = ba;
+    if (options_.hold_weights) robust.function_tolerance = options_.robust_function_tolerance;
+    return robust;
+  }
+
+  // A first solve, outliers out, then the final solve (the weights held, as
+  // the options say) with covariance.
   void Solve(const BundleAdjustmentOptions& ba, CalibrationStdDevs* std_devs) {
-    AdjustBundle(&r_, ba, BundleAdjustmentScope(), &markers_, options_.marker_scale);
+    AdjustBundle(&r_, Robust(ba), BundleAdjustmentScope(), &markers_, options_.marker_scale);
     for (const auto& [id, camera] : r_.cameras()) {
       // Garbage must not pass for a calibration.
       std::string why;
@@ -417,7 +432,9 @@ class StagedAdjustment {
       }
     }
     result_.num_filtered += FilterObservations(&r_, options_.max_reproj_error_px);
-    AdjustBundle(&r_, ba, BundleAdjustmentScope(), &markers_, options_.marker_scale, std_devs);
+    BundleAdjustmentOptions final_solve = ba;
+    final_solve.hold_loss_weights = options_.hold_weights;
+    AdjustBundle(&r_, final_solve, BundleAdjustmentScope(), &markers_, options_.marker_scale, std_devs);
   }
 
   void WarnIfPrincipalPointPoor(const CalibrationStdDevs& std_devs) {
