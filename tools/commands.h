@@ -22,6 +22,7 @@ int ExhaustiveMatcherCommand(int argc, char** argv);
 int SequentialMatcherCommand(int argc, char** argv);
 int SpatialMatcherCommand(int argc, char** argv);
 int RefractiveMapperCommand(int argc, char** argv);
+int HierarchicalMapperCommand(int argc, char** argv);
 int CalibrationSubsetSelectorCommand(int argc, char** argv);
 int RefractiveBundleAdjusterCommand(int argc, char** argv);
 int AutoCalibratorCommand(int argc, char** argv);

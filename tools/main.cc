@@ -61,6 +61,8 @@ const std::vector<Command>& Commands() {
        "match and verify images near each other by position prior"},
       {"refractive_mapper", portcal::RefractiveMapperCommand,
        "incremental structure-from-motion on refracted rays"},
+      {"hierarchical_mapper", portcal::HierarchicalMapperCommand,
+       "refractive mapping of a large survey in overlapping clusters (on MPI ranks), merged"},
       {"refractive_bundle_adjuster", portcal::RefractiveBundleAdjusterCommand,
        "bundle adjustment that self-calibrates the housing (and intrinsics)"},
       {"calibration_subset_selector", portcal::CalibrationSubsetSelectorCommand,

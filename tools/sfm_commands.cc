@@ -1,8 +1,10 @@
 // Subcommands of the reconstruction back end: refractive_mapper,
-// refractive_bundle_adjuster, auto_calibrator, calibration_subset_selector.
+// hierarchical_mapper, refractive_bundle_adjuster, auto_calibrator,
+// calibration_subset_selector.
 #include "colmap_ext/util/progress.h"
 #include "pipelines/stages/auto_calibrator.h"
 #include "pipelines/stages/calibration_subset_selector.h"
+#include "pipelines/stages/hierarchical_mapper.h"
 #include "pipelines/stages/refractive_bundle_adjuster.h"
 #include "pipelines/stages/refractive_mapper.h"
 #include "tools/command_line.h"
@@ -53,6 +55,32 @@ int RefractiveMapperCommand(int argc, char** argv) {
     if (!cli.Parse(argc, argv)) return;
     StderrProgress progress;
     RunRefractiveMapper(options, progress);
+  });
+}
+
+int HierarchicalMapperCommand(int argc, char** argv) {
+  HierarchicalMapperOptions options;
+  CommandLine cli("hierarchical_mapper",
+                  "refractive_mapper for large surveys: the scene graph cut into overlapping clusters (METIS), each "
+                  "mapped on its own (under mpirun or srun, shared out between the ranks), merged through the "
+                  "shared images and adjusted as a whole. Writes output_path/0 and each cluster's models under "
+                  "output_path/clusters/.");
+  cli.AddRequired("database_path", &options.mapper.database_path, "database with verified matches");
+  cli.Add("image_path", &options.mapper.image_path, "the images (accepted for COLMAP compatibility)");
+  cli.AddRequired("output_path", &options.mapper.output_path, "directory for the models");
+  cli.AddHousing(&options.mapper.housing, "the housing of all cameras (default: the database's)");
+  cli.Add("Hierarchical.leaf_max_num_images", &options.partition.leaf_max_num_images,
+          "images per cluster before the overlap");
+  cli.Add("Hierarchical.image_overlap", &options.partition.image_overlap,
+          "images each cluster takes from its neighbours");
+  cli.Add("Hierarchical.min_shared_points", &options.merge.min_shared_points,
+          "points a cluster's model must share with the merged ones to be merged");
+  Register(&cli, &options.mapper.radial_start);
+  Register(&cli, &options.mapper.mapper);
+  return ReportErrors([&] {
+    if (!cli.Parse(argc, argv)) return;
+    StderrProgress progress;
+    RunHierarchicalMapper(options, progress);
   });
 }
 

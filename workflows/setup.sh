@@ -20,7 +20,7 @@ packages=(
   libgtest-dev libbenchmark-dev
   libopengv-dev libyaml-cpp-dev libzip-dev
   libcpp-httplib-dev nlohmann-json3-dev
-  libopenmpi-dev openmpi-bin
+  libopenmpi-dev openmpi-bin libmetis-dev
   colmap
   "$@"
 )

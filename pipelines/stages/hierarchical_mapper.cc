@@ -1,0 +1,165 @@
+#include "pipelines/stages/hierarchical_mapper.h"
+
+#include <fstream>
+#include <optional>
+#include <set>
+
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/new_paths.h"
+#include "pipelines/distributed/mpi_world.h"
+#include "pipelines/distributed/shards.h"
+#include "pipelines/sfm/global_adjustment.h"
+
+namespace fs = std::filesystem;
+
+namespace portcal {
+
+void HierarchicalMapperOptions::Check() const {
+  if (!mapper.image_list_path.empty()) {
+    throw OptionError("--image_list_path", mapper.image_list_path, "'' (the clusters are the stage's lists)");
+  }
+  mapper.Check();
+  partition.Check();
+  merge.Check();
+}
+
+namespace {
+
+// Maps cluster `index` of `clusters` into OUTPUT/clusters/INDEX; returns
+// nothing: its models are read back from there.
+void MapCluster(const HierarchicalMapperOptions& options, const std::vector<image_t>& cluster, size_t index,
+                const SfmInputs& inputs, ProgressSink& progress) {
+  const fs::path folder = fs::path(options.mapper.output_path) / "clusters";
+  const fs::path list = folder / (std::to_string(index) + ".txt");
+  {
+    std::ofstream out(list);
+    for (image_t id : cluster) out << inputs.images.at(id).name << "\n";
+    if (!(out << std::flush)) throw InputError(list.string() + ": cannot write the cluster's image list");
+  }
+  RefractiveMapperOptions mapper = options.mapper;
+  mapper.image_list_path = list.string();
+  mapper.output_path = (folder / std::to_string(index)).string();
+  const RefractiveMapperSummary summary = RunRefractiveMapper(mapper, progress);
+  LOG(INFO) << "hierarchical_mapper: cluster " << index << " (rank " << MpiWorld::Rank()
+            << "): " << summary.num_registered << " of " << cluster.size() << " images in " << summary.num_models
+            << " model(s)";
+}
+
+// Drops observations beyond the mapper's filter error.
+void FilterObservations(Reconstruction* r, double max_error_px) {
+  std::vector<std::pair<image_t, point2D_t>> bad;
+  for (const auto& [id, point] : r->points()) {
+    for (const TrackElement& e : point.track) {
+      if (r->ReprojectionError(e.image_id, e.point2D_idx, point.xyz) > max_error_px) {
+        bad.emplace_back(e.image_id, e.point2D_idx);
+      }
+    }
+  }
+  for (const auto& [image_id, idx] : bad) r->DeleteObservation(image_id, idx);
+}
+
+// The merged model adjusted as a whole: aligned to the position priors
+// (when they give the scale), adjusted, filtered, adjusted again.
+void AdjustMerged(const IncrementalMapperOptions& mapper, Reconstruction* r) {
+  BundleAdjustmentOptions ba = GlobalAdjustmentOptions(mapper, static_cast<int>(r->poses().size()), true);
+  std::vector<MarkerCorner> markers;
+  if (mapper.marker_scale.side_length_m > 0) {
+    markers = TriangulateMarkerCorners(*r, 4 * mapper.filter_max_reproj_error_px);
+  } else if (mapper.position_prior_sigma_m > 0 && AlignToPositionPriors(r, 5 * mapper.position_prior_sigma_m)) {
+    ba.position_prior_sigma_m = mapper.position_prior_sigma_m;
+  }
+  AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, mapper.marker_scale);
+  FilterObservations(r, mapper.filter_max_reproj_error_px);
+  AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, mapper.marker_scale);
+}
+
+// Rank 0's part: the clusters' models merged, adjusted and written.
+void MergeClusters(const HierarchicalMapperOptions& options, size_t num_clusters, const SfmInputs& inputs,
+                   HierarchicalMapperSummary* summary) {
+  const fs::path folder = fs::path(options.mapper.output_path) / "clusters";
+  std::vector<SparseModel> models;
+  for (size_t c = 0; c < num_clusters; ++c) {
+    // A cluster's mapper writes its models largest first: the first is the
+    // cluster's (the others are pieces that would not join it).
+    const fs::path model = folder / std::to_string(c) / "0";
+    if (fs::exists(model)) models.push_back(ReadSparseModel(model));
+  }
+  const MergedModels merged = MergeModels(models, options.merge);
+  for (const ModelAlignment& a : merged.alignments) {
+    LOG(INFO) << "hierarchical_mapper: merged cluster " << a.model_index << ": " << a.num_shared_images
+              << " shared images, " << a.num_inliers << " of " << a.num_shared_points
+              << " shared points fit the similarity (scale " << a.merged_from_model.scale << ", RMS " << a.rms << ")";
+  }
+  if (!merged.left_out.empty()) {
+    LOG(WARNING) << "hierarchical_mapper: " << merged.left_out.size() << " cluster model(s) shared fewer than "
+                 << options.merge.min_shared_points << " points with the rest and were left out";
+  }
+  if (merged.model.images.size() < 2) {
+    throw NumericalError("hierarchical_mapper: no cluster of " + options.mapper.database_path +
+                         " could be mapped (see the clusters' messages above)");
+  }
+  Reconstruction r = Reconstruction::FromSparseModel(&inputs, merged.model);
+  // The cameras and housings the clusters were mapped with (the first
+  // cluster's estimate), not the database's.
+  for (auto& [id, camera] : r.mutable_cameras()) {
+    const auto intrinsics = merged.model.cameras.find(id);
+    if (intrinsics != merged.model.cameras.end()) camera.camera = intrinsics->second;
+    const auto housing = merged.model.housings.find(id);
+    if (housing != merged.model.housings.end()) camera.housing = housing->second;
+  }
+  r.UpdateRays();
+  AdjustMerged(options.mapper.mapper, &r);
+  WriteSparseModel(r.ToSparseModel(), fs::path(options.mapper.output_path) / "0", ModelFormat::kBinary);
+  summary->alignments = merged.alignments;
+  summary->num_left_out = static_cast<int>(merged.left_out.size());
+  summary->num_registered = static_cast<int>(r.poses().size());
+  summary->mean_reprojection_error_px = r.MeanReprojectionError();
+}
+
+}  // namespace
+
+HierarchicalMapperSummary RunHierarchicalMapper(const HierarchicalMapperOptions& options, ProgressSink& progress) {
+  options.Check();
+  const fs::path output(options.mapper.output_path);
+  // Rank 0 owns the output: a failed run on any rank leaves no folder it made.
+  std::optional<NewPaths> new_output;
+  if (MpiWorld::Rank() == 0) new_output.emplace(std::vector<fs::path>{output, output / "clusters", output / "0"});
+  MpiWorld::Barrier();  // before any rank makes a folder
+  SfmInputs inputs;
+  {
+    Database database(options.mapper.database_path, Database::OpenMode::kReadOnly);
+    inputs = SfmInputs::Read(&database);
+  }
+  if (inputs.pair_inliers.empty()) {
+    throw InputError(options.mapper.database_path + ": no verified image pairs; run a matcher first");
+  }
+  const std::vector<std::vector<image_t>> clusters = PartitionScene(inputs.pair_inliers, options.partition);
+  HierarchicalMapperSummary summary;
+  summary.num_clusters = static_cast<int>(clusters.size());
+  std::set<image_t> clustered;
+  for (const auto& cluster : clusters) clustered.insert(cluster.begin(), cluster.end());
+  summary.num_images = static_cast<int>(clustered.size());
+  LOG(INFO) << "hierarchical_mapper: " << clusters.size() << " clusters over " << MpiWorld::Size() << " rank(s)";
+  const auto clean_up = [] {};
+  RunOnEveryRank(
+      "hierarchical_mapper",
+      [&] {
+        fs::create_directories(output / "clusters");
+        for (size_t c = 0; c < clusters.size(); ++c) {
+          if (static_cast<int>(c % static_cast<size_t>(MpiWorld::Size())) != MpiWorld::Rank()) continue;
+          MapCluster(options, clusters[c], c, inputs, progress);
+        }
+      },
+      clean_up);
+  RunOnEveryRank(
+      "hierarchical_mapper",
+      [&] {
+        if (MpiWorld::Rank() == 0) MergeClusters(options, clusters.size(), inputs, &summary);
+      },
+      clean_up);
+  if (new_output) new_output->Keep();
+  return summary;
+}
+
+}  // namespace portcal
