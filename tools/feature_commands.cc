@@ -39,6 +39,8 @@ int FeatureMaskerCommand(int argc, char** argv) {
   cli.AddRequired("image_path", &options.image_path, "directory of the images");
   cli.Add("Markers.dictionary", &options.dictionary, kMarkersDictionaryHelp);
   cli.Add("Mask.enlargement_factor", &options.enlargement_factor, kMaskEnlargementHelp);
+  cli.Add("Mask.keep_all_features", &options.keep_all_features,
+          "1: store the markers and keep every feature (a survey whose markers give the scale)");
   cli.Add("num_threads", &options.num_threads, "threads");
   return ReportErrors([&] {
     if (!cli.Parse(argc, argv)) return;

@@ -59,15 +59,23 @@ void MaskImage(const FeatureMaskerOptions& options, const DatabaseImage& image,
   const image_t image_id = image.image_id;
   database->WriteMarkerDetections(image_id, markers);
   summary->num_markers += static_cast<int64_t>(markers.size());
+  summary->num_without_markers += markers.empty();
   FeatureKeypoints keypoints;
   FeatureDescriptors descriptors;
+  if (options.keep_all_features && !database->ReadUnmaskedFeatures(image_id, &keypoints, &descriptors)) {
+    // Never masked: its features are as extracted (no copy kept aside).
+    const int64_t count = static_cast<int64_t>(database->ReadKeypoints(image_id).size());
+    summary->num_features_before += count;
+    summary->num_features_kept += count;
+    return;
+  }
   const bool masked_before = FeaturesBeforeMasking(options, image, database, &keypoints, &descriptors);
   FeatureKeypoints kept_keypoints;
   std::vector<Eigen::Index> kept;
   for (size_t k = 0; k < keypoints.size(); ++k) {
     const Eigen::Vector2d xy(keypoints[k].x, keypoints[k].y);
     for (const MarkerDetection& marker : markers) {
-      if (InsideEnlargedQuad(marker.corners, options.enlargement_factor, xy)) {
+      if (options.keep_all_features || InsideEnlargedQuad(marker.corners, options.enlargement_factor, xy)) {
         kept.push_back(static_cast<Eigen::Index>(k));
         kept_keypoints.push_back(keypoints[k]);
         break;
@@ -76,8 +84,7 @@ void MaskImage(const FeatureMaskerOptions& options, const DatabaseImage& image,
   }
   summary->num_features_before += static_cast<int64_t>(keypoints.size());
   summary->num_features_kept += static_cast<int64_t>(kept.size());
-  if (markers.empty()) {
-    ++summary->num_without_markers;
+  if (markers.empty() && !options.keep_all_features) {
     LOG(WARNING) << image.name << ": no " << options.dictionary << " markers; all its features are removed";
   }
   // Unchanged (the same mask again): its matches stay valid.
@@ -117,6 +124,7 @@ std::string MaskOfTheFeatures(Database* database) {
     const std::string dictionary =
         options.count("Markers.dictionary") ? options["Markers.dictionary"] : options["Mask.dictionary"];
     mask = dictionary + ", enlargement factor " + options["Mask.enlargement_factor"];
+    if (options["Mask.keep_all_features"] == "1") mask.clear();  // detections only: the features as extracted
   }
   return mask;
 }
@@ -127,7 +135,8 @@ FeatureMaskerSummary RunFeatureMasker(const FeatureMaskerOptions& options, Progr
   options.Check();
   std::ostringstream options_text;
   options_text << "image_path=" << options.image_path << "\nMarkers.dictionary=" << options.dictionary
-               << "\nMask.enlargement_factor=" << options.enlargement_factor << "\n";
+               << "\nMask.enlargement_factor=" << options.enlargement_factor
+               << "\nMask.keep_all_features=" << options.keep_all_features << "\n";
   StageRun run("feature_masker", options_text.str());
   Database database(options.database_path, Database::OpenMode::kReadWrite);
   Transaction transaction = database.BeginTransaction();
@@ -138,6 +147,7 @@ FeatureMaskerSummary RunFeatureMasker(const FeatureMaskerOptions& options, Progr
   // cannot bring back what that mask removed.
   std::ostringstream asked;
   asked << options.dictionary << ", enlargement factor " << options.enlargement_factor;
+  if (options.keep_all_features) asked.str("every feature kept");
   const std::string mask = MaskOfTheFeatures(&database);
   if (!mask.empty() && mask != asked.str() && database.NumImagesWithUnmaskedFeatures() == 0) {
     throw InputError(options.database_path + ": its features were masked before (" + mask +

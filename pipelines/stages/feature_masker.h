@@ -25,6 +25,10 @@ struct FeatureMaskerOptions {
   std::string image_path;     // the images the database names
   std::string dictionary = "DICT_4X4_50";
   double enlargement_factor = 3.0;  // >= 1
+  // --Mask.keep_all_features: the markers are detected and stored, and
+  // every feature stays as extracted (features an earlier mask removed come
+  // back): a survey whose markers, seen in a part of it, give the scale.
+  bool keep_all_features = false;
   int num_threads = 2;
   void Check() const;  // throws OptionError naming --Mask.* or the option
 };

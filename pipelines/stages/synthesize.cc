@@ -155,7 +155,8 @@ ImageTruth TargetTruth(const Camera& camera, const Housing* housing, const Built
   return truth;
 }
 
-std::string ExtraYaml(const DatasetConfig& config, const Clutter* clutter, const SurveyPath* survey) {
+std::string ExtraYaml(const DatasetConfig& config, const Clutter* clutter, const SurveyPath* survey,
+                      const std::vector<SeabedMarker>& markers) {
   std::ostringstream out;
   out.precision(17);
   if (clutter) {
@@ -196,6 +197,17 @@ std::string ExtraYaml(const DatasetConfig& config, const Clutter* clutter, const
         << survey->footprint_width_m << "\n  roughness: " << s.roughness_m
         << "\n  relief_wavelength: " << s.relief_wavelength_m << "\n  texel: " << s.texel_m
         << "\n  seed: " << s.texture_seed << "\n";
+    if (!markers.empty()) {
+      out << "  markers:\n    dictionary: " << s.markers.dictionary << "\n    side: " << s.markers.side_m
+          << "\n    corners:  # id: TL, TR, BR, BL in the world frame\n" << std::setprecision(9);
+      for (const SeabedMarker& m : markers) {
+        out << "      " << m.id << ": [";
+        for (int k = 0; k < 4; ++k) {
+          out << (k ? ", " : "") << "[" << m.corners[k].x() << ", " << m.corners[k].y() << ", " << m.corners[k].z() << "]";
+        }
+        out << "]\n";
+      }
+    }
   } else {
     const ViewSamplingOptions& p = config.poses;
     out << "pose_generation:\n  distance: [" << p.distance_min_m << ", " << p.distance_max_m
@@ -255,6 +267,7 @@ GroundTruth TruthHeader(const DatasetConfig& config, const std::string& dir1, co
 struct Scene {
   BuiltTarget target;
   std::unique_ptr<SeabedObject> seabed;
+  SeabedMarkers seabed_markers;  // on the seabed, if the survey has any
   SurveyPath survey;
   std::optional<Clutter> clutter;
 };
@@ -271,6 +284,7 @@ Scene BuildScene(const DatasetConfig& config, const HousedCamera& camera1, Groun
     auto texture = std::make_shared<RasterTexture>(
         RandomShapesRaster(cols, rows, shapes, s.texture_seed, 2, 10), survey.area[0], survey.area[2], s.texel_m);
     scene.seabed = std::make_unique<SeabedObject>(texture, s.roughness_m, s.relief_wavelength_m, s.texture_seed + 1);
+    scene.seabed_markers = PlaceSeabedMarkers(s.markers, *scene.seabed, survey.area, config.render.levels);
     truth->target.type = "seabed";
   } else {
     scene.target = BuildTarget(config.target, config.render.levels);
@@ -333,6 +347,7 @@ struct FrameRenderer {
     objects.push_back({config.survey ? static_cast<const SceneObject*>(scene.seabed.get()) : scene.target.object.get(),
                        cam_from_target});
     if (scene.clutter) objects.push_back({scene.clutter->object.get(), scene.clutter->cam_from_clutter});
+    if (scene.seabed_markers.object) objects.push_back({scene.seabed_markers.object.get(), cam_from_target});
     std::unique_ptr<SceneObject> occluder;
     std::uniform_real_distribution<double> unit(0, 1);
     if (!config.survey && unit(*rng) < config.occlusion_probability) {
@@ -375,7 +390,7 @@ void FinishSet(const SynthesizeOptions& options, const DatasetConfig& config, co
                const GroundTruth& truth, const fs::path& staging, const fs::path& output) {
   WriteGroundTruth(truth, staging / "ground_truth.yaml",
                    ExtraYaml(config, scene.clutter ? &*scene.clutter : nullptr,
-                             config.survey ? &scene.survey : nullptr));
+                             config.survey ? &scene.survey : nullptr, scene.seabed_markers.markers));
   if (config.survey) {
     const std::string navigation = NavigationText(truth, config.survey_options.navigation_sigma_m, config.seed);
     WriteFileAtomically(staging / "navigation.txt", false, [&](std::ostream& out) { out << navigation; });

@@ -228,6 +228,13 @@ DatasetConfig ReadDatasetConfigUnguarded(const std::filesystem::path& path) {
     reader.Optional(s, "survey.", "relief_wavelength", &o.relief_wavelength_m);
     reader.Optional(s, "survey.", "texel", &o.texel_m);
     reader.Optional(s, "survey.", "navigation_sigma", &o.navigation_sigma_m);
+    if (s["markers"] && !s["markers"].IsNull()) {
+      const YAML::Node m = s["markers"];
+      reader.Optional(m, "survey.markers.", "count", &o.markers.count);
+      reader.Optional(m, "survey.markers.", "side", &o.markers.side_m);
+      reader.Optional(m, "survey.markers.", "spacing", &o.markers.spacing_m);
+      reader.Optional(m, "survey.markers.", "dictionary", &o.markers.dictionary);
+    }
     int64_t texture_seed = static_cast<int64_t>(o.texture_seed);
     reader.Optional(s, "survey.", "seed", &texture_seed);
     o.texture_seed = static_cast<uint64_t>(texture_seed);

@@ -121,6 +121,7 @@ void SurveyOptions::Check() const {
   if (!(navigation_sigma_m >= 0)) {
     throw OptionError("survey.navigation_sigma", std::to_string(navigation_sigma_m), ">= 0 m");
   }
+  markers.Check();
 }
 
 SurveyPath PlanSurvey(const Camera& camera, const Housing* housing, const SurveyOptions& options) {

@@ -10,6 +10,7 @@
 #include "colmap_ext/camera/camera.h"
 #include "colmap_ext/geometry/rigid3d.h"
 #include "colmap_ext/housing/housing.h"
+#include "pipelines/synthetic/seabed_markers.h"
 
 namespace portcal {
 
@@ -50,6 +51,7 @@ struct SurveyOptions {
   // Noise of the navigation positions written beside the images
   // (navigation.txt, per axis), metres: a DVL-aided INS over a short survey.
   double navigation_sigma_m = 0.02;
+  SeabedMarkerOptions markers;  // survey.markers: ArUco plates near the start (none by default)
   void Check() const;
 };
 

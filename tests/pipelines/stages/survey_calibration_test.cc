@@ -10,11 +10,13 @@
 // Surveys of the issue's size: workflows/bench_survey.sh.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <fstream>
 
 #include "colmap_ext/io/ground_truth.h"
 #include "pipelines/stages/feature_extractor.h"
+#include "pipelines/stages/feature_masker.h"
 #include "pipelines/stages/feature_matcher.h"
 #include "pipelines/stages/pose_prior_importer.h"
 #include "pipelines/stages/refractive_bundle_adjuster.h"
@@ -149,6 +151,112 @@ render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
   }
   std::cout << "positions: max error " << max_error * 1000 << " mm over a path of " << path << " m\n";
   EXPECT_LT(max_error, 0.005 * path);
+}
+
+// The other scale source: nine ArUco markers (15 cm) lying on the seabed
+// where the survey starts, seen by its first lines only (a third of the
+// images); feature_masker stores them and keeps every feature; mapping and
+// refinement take the scale from their side length, not the navigation
+// (which only pairs the images for matching). The similarity that best
+// maps the camera centres onto the truth must have a scale within the
+// issue's 0.5 % (the markers' corners, ~0.1 px, measure each 15 cm side to
+// ~0.2 % from one view), the port the navigation test's tolerances.
+TEST(SurveyCalibration, FlatPortFromMarkersSeenInPartOfTheSurvey) {
+  testing::TempDir dir;
+  std::ofstream(dir / "survey.yaml") << R"(name: survey
+num_images: 48
+camera: {model: RADIAL, width: 640, height: 360, params: [466.7, 320.0, 180.0, 0.0, 0.0]}
+housing: {model: FLATPORT, params: [0.0523360, 0.0, 0.9986295, 0.02, 0.010, 1.0, 1.473, 1.334]}
+survey: {height: 2.0, speed: 0.5, frame_rate: 1.0, side_overlap: 0.6, line_length: 6.0,
+         roughness: 0.15, relief_wavelength: 2.0, navigation_sigma: 0.02,
+         markers: {count: 9, side: 0.15, spacing: 1.0}}
+render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
+)";
+  NullProgress progress;
+  SynthesizeOptions synthesize;
+  synthesize.config_path = (dir / "survey.yaml").string();
+  synthesize.output_path = (dir / "set").string();
+  RunSynthesize(synthesize, progress);
+  const GroundTruth truth = ReadGroundTruth(dir / "set" / "ground_truth.yaml");
+  const std::string database = (dir / "db.db").string();
+  FeatureExtractorOptions extract;
+  extract.database_path = database;
+  extract.image_path = (dir / "set" / "images").string();
+  extract.reader.single_camera = true;
+  extract.reader.camera_model = "RADIAL";
+  extract.reader.camera_params = "466.7,320,180,0,0";
+  extract.sift.max_num_features = 1500;
+  RunFeatureExtractor(extract, progress);
+  FeatureMaskerOptions mask;
+  mask.database_path = database;
+  mask.image_path = extract.image_path;
+  mask.keep_all_features = true;
+  const FeatureMaskerSummary masked = RunFeatureMasker(mask, progress);
+  EXPECT_EQ(masked.num_features_kept, masked.num_features_before);
+  EXPECT_GE(masked.num_markers, 9);
+  EXPECT_GE(masked.num_without_markers, 24);  // markers in part of the survey only
+  PosePriorImporterOptions priors;
+  priors.database_path = database;
+  priors.input_path = (dir / "set" / "navigation.txt").string();
+  RunPosePriorImporter(priors, NoProgress());
+  FeatureMatcherOptions match;
+  match.database_path = database;
+  match.mode = PairingMode::kSpatial;
+  match.spatial.max_num_neighbors = 10;
+  RunFeatureMatcher(match, progress);
+
+  RefractiveMapperOptions map;
+  map.database_path = database;
+  map.output_path = (dir / "sparse").string();
+  map.housing = Housing::FromName("FLATPORT", {0, 0, 1, 0.01, 0.010, 1, 1.473, 1.334}, "test");
+  map.mapper.init_scene_depth_m = 2.0;
+  map.mapper.ba_refine_focal_length = false;
+  map.mapper.ba_refine_extra_params = false;
+  map.mapper.ba_refine_housing = true;
+  map.mapper.marker_scale.side_length_m = 0.15;
+  map.mapper.ba_calibration_settled_px = 1.0;  // as in the navigation test
+  map.mapper.ba_calibration_settled_min_images = 20;
+  const RefractiveMapperSummary mapped = RunRefractiveMapper(map, progress);
+  RefractiveBundleAdjusterOptions refine;
+  refine.input_path = mapped.model_paths[0].string();
+  refine.output_path = (dir / "refined").string();
+  refine.database_path = database;
+  refine.marker_scale.side_length_m = 0.15;
+  const RefractiveBundleAdjusterSummary refined = RunRefractiveBundleAdjuster(refine, NoProgress());
+  const CalibrationReport& report = refined.report;
+  EXPECT_GE(refined.num_marker_corners, 16);
+  EXPECT_GE(report.views.size(), 44u);
+
+  const std::vector<double>& h = report.housing->params;
+  const std::vector<double>& sd = report.housing_std_dev;
+  const std::vector<double>& t = truth.housing->params;
+  const Eigen::Vector3d normal(h[0], h[1], h[2]), true_normal(t[0], t[1], t[2]);
+  const double angle = std::acos(std::min(1.0, normal.normalized().dot(true_normal.normalized())));
+  const double distance_error = h[3] - t[3];
+  std::cout << "normal error " << angle / kDegree << " deg (sd " << std::hypot(sd[0], sd[1]) / kDegree
+            << "), distance error " << distance_error * 1000 << " mm (sd " << sd[3] * 1000 << ")\n";
+  EXPECT_LT(angle, 0.05 * kDegree);
+  EXPECT_LT(std::abs(distance_error), 0.006);
+  EXPECT_LT(angle, 4 * std::hypot(sd[0], sd[1]));
+  EXPECT_LT(std::abs(distance_error), 4 * sd[3]);
+  // The scale: the similarity from the model's camera centres to the true
+  // ones (the model's frame is the first image's, not the navigation's).
+  std::map<std::string, Eigen::Vector3d> true_centres;
+  for (const FrameTruth& frame : truth.images) {
+    true_centres[fs::path(frame.cam1.file).filename().string()] = frame.cam1.cam_from_target.Inverse().translation;
+  }
+  Eigen::Matrix3Xd model(3, static_cast<Eigen::Index>(report.views.size())), real(3, model.cols());
+  for (size_t k = 0; k < report.views.size(); ++k) {
+    model.col(static_cast<Eigen::Index>(k)) = report.views[k].cam_from_target.Inverse().translation;
+    real.col(static_cast<Eigen::Index>(k)) = true_centres.at(report.views[k].image_name);
+  }
+  const Eigen::Matrix4d similarity = Eigen::umeyama(model, real, true);
+  const double scale = similarity.block<3, 1>(0, 0).norm();
+  const Eigen::Matrix3Xd aligned = (similarity.block<3, 3>(0, 0) * model).colwise() + similarity.block<3, 1>(0, 3);
+  const double max_error = (aligned - real).colwise().norm().maxCoeff();
+  std::cout << "scale " << scale << "; positions after the similarity: max error " << max_error * 1000 << " mm\n";
+  EXPECT_LT(std::abs(scale - 1), 0.005);
+  EXPECT_LT(max_error, 0.005 * 23.0);  // the path is ~23 m
 }
 
 }  // namespace
