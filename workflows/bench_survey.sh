@@ -9,7 +9,13 @@
 # Prints each stage's time and the errors against the ground truth
 # (workflows/eval_survey.py). Goal (issue 5): normal <= 0.05 deg, distance
 # <= 2 mm, camera positions within 0.5 % of the path length.
-# Usage: workflows/bench_survey.sh [NUM_IMAGES=300] [WORK_DIR=temporary]
+# With SCALE=markers, 16 ArUco markers of 15 cm lie on the seabed where the
+# survey starts (its first lines see them), feature_masker stores them
+# (keeping every feature), and the mapper and the refinement take the scale
+# from their side instead of the navigation (which then only pairs images
+# for matching): compare the similarity-aligned scale and positions. A
+# markers run wants its own WORK_DIR (the renders differ).
+# Usage: [SCALE=navigation|markers] workflows/bench_survey.sh [NUM_IMAGES=300] [WORK_DIR=temporary]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ -x build/portcal ] || bash workflows/setup.sh >/dev/null
@@ -17,13 +23,23 @@ n="${1:-300}"
 if [ -n "${2:-}" ]; then work="$2"; mkdir -p "$work"; else work="$(mktemp -d)"; trap 'rm -rf "$work"' EXIT; fi
 P="$PWD/build/portcal"
 source workflows/survey_common.sh
-survey_yaml survey_flat "$n" > "$work/survey.yaml"
+scale="${SCALE:-navigation}"
+case "$scale" in
+  navigation) num_markers=0; scale_flags=(--PosePrior.position_sigma 0.02) ;;
+  markers) num_markers=16; scale_flags=(--Markers.side_length 0.15) ;;
+  *) echo "bench_survey.sh: SCALE=$scale: navigation or markers" >&2; exit 2 ;;
+esac
+survey_yaml survey_flat "$n" "$num_markers" > "$work/survey.yaml"
 cd "$work"
 [ -f set/ground_truth.yaml ] || timed render "$P" synthesize --log_level warn --config survey.yaml --output_path set --seed 3
 rm -rf db.db sparse refined
 timed extract "$P" feature_extractor --log_level warn --database_path db.db --image_path set/images \
   --ImageReader.single_camera 1 --ImageReader.camera_model RADIAL --ImageReader.camera_params 700,480,270,0,0
 "$P" pose_prior_importer --log_level warn --database_path db.db --input_path set/navigation.txt
+if [ "$scale" = markers ]; then
+  timed mask "$P" feature_masker --log_level warn --database_path db.db --image_path set/images \
+    --Mask.keep_all_features 1
+fi
 # Sequential pairs along each line, then the lines beside it by position.
 timed match_sequential "$P" sequential_matcher --log_level warn --database_path db.db \
   --SequentialMatching.overlap 5 --SequentialMatching.quadratic_overlap 0
@@ -33,8 +49,8 @@ timed match_spatial "$P" spatial_matcher --log_level warn --database_path db.db
 timed map "$P" refractive_mapper --log_level warn --database_path db.db --output_path sparse \
   --Housing.model FLATPORT --Housing.params 0,0,1,0.01,0.010,1,1.473,1.334 --Mapper.init_scene_depth 2.0 \
   --Mapper.ba_refine_focal_length 0 --Mapper.ba_refine_extra_params 0 --Mapper.ba_refine_housing 1 \
-  --PosePrior.position_sigma 0.02
+  "${scale_flags[@]}"
 timed refine "$P" refractive_bundle_adjuster --log_level warn --input_path sparse/0 --output_path refined \
-  --database_path db.db --PosePrior.position_sigma 0.02
+  --database_path db.db "${scale_flags[@]}"
 "$P" model_converter --log_level warn --input_path refined --output_path refined_txt --output_type TXT
 /usr/bin/python3 "$OLDPWD/workflows/eval_survey.py" set/ground_truth.yaml refined/calibration.yaml refined_txt/images.txt
