@@ -103,6 +103,10 @@ class Database {
   std::vector<image_pair_t> ReadMatchPairIds();
   // Pair ids that have a two_view_geometries row (verified or not).
   std::vector<image_pair_t> ReadTwoViewGeometryPairIds();
+  // Each verified pair's number of inlier matches (the rows column), for
+  // the pairs with any, without decoding the matches (COLMAP's
+  // ReadTwoViewGeometryNumInliers).
+  std::vector<std::pair<image_pair_t, int>> ReadTwoViewGeometryNumInliers();
   // Deletes matches and geometries of every pair involving the image.
   void DeleteMatchesOfImage(image_t image_id);
   // Deletes the image and every row about it (features, matches, target

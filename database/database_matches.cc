@@ -1,6 +1,7 @@
 // The matches and two_view_geometries tables of the Database.
 #include <sqlite3.h>
 
+#include <algorithm>
 #include <cstring>
 #include <functional>
 
@@ -219,6 +220,17 @@ std::vector<image_pair_t> Database::ReadTwoViewGeometryPairIds() {
   std::vector<image_pair_t> pair_ids;
   while (stmt.Step()) pair_ids.push_back(static_cast<image_pair_t>(stmt.ColumnInt64(0)));
   return pair_ids;
+}
+
+std::vector<std::pair<image_pair_t, int>> Database::ReadTwoViewGeometryNumInliers() {
+  Statement& stmt = Prepare("read_geometry_num_inliers",
+                            "SELECT pair_id, rows FROM two_view_geometries WHERE rows > 0 ORDER BY pair_id;");
+  std::vector<std::pair<image_pair_t, int>> counts;
+  while (stmt.Step()) {
+    counts.emplace_back(static_cast<image_pair_t>(stmt.ColumnInt64(0)),
+                        static_cast<int>(std::min<int64_t>(stmt.ColumnInt64(1), 1 << 30)));
+  }
+  return counts;
 }
 
 void Database::DeleteMatchesOfImage(image_t image_id) {

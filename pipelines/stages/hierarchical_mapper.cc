@@ -29,12 +29,19 @@ namespace {
 // Maps cluster `index` of `clusters` into OUTPUT/clusters/INDEX; returns
 // nothing: its models are read back from there.
 void MapCluster(const HierarchicalMapperOptions& options, const std::vector<image_t>& cluster, size_t index,
-                const SfmInputs& inputs, ProgressSink& progress) {
+                const std::map<image_t, std::string>& names, ProgressSink& progress) {
   const fs::path folder = fs::path(options.mapper.output_path) / "clusters";
   const fs::path list = folder / (std::to_string(index) + ".txt");
   {
     std::ofstream out(list);
-    for (image_t id : cluster) out << inputs.images.at(id).name << "\n";
+    for (image_t id : cluster) {
+      const auto name = names.find(id);
+      if (name == names.end()) {
+        throw InputError(options.mapper.database_path + ": a verified pair names image " + std::to_string(id) +
+                         ", which the images table does not hold");
+      }
+      out << name->second << "\n";
+    }
     if (!(out << std::flush)) throw InputError(list.string() + ": cannot write the cluster's image list");
   }
   RefractiveMapperOptions mapper = options.mapper;
@@ -75,8 +82,7 @@ void AdjustMerged(const IncrementalMapperOptions& mapper, Reconstruction* r) {
 }
 
 // Rank 0's part: the clusters' models merged, adjusted and written.
-void MergeClusters(const HierarchicalMapperOptions& options, size_t num_clusters, const SfmInputs& inputs,
-                   HierarchicalMapperSummary* summary) {
+void MergeClusters(const HierarchicalMapperOptions& options, size_t num_clusters, HierarchicalMapperSummary* summary) {
   const fs::path folder = fs::path(options.mapper.output_path) / "clusters";
   std::vector<SparseModel> models;
   for (size_t c = 0; c < num_clusters; ++c) {
@@ -98,6 +104,11 @@ void MergeClusters(const HierarchicalMapperOptions& options, size_t num_clusters
   if (merged.model.images.size() < 2) {
     throw NumericalError("hierarchical_mapper: no cluster of " + options.mapper.database_path +
                          " could be mapped (see the clusters' messages above)");
+  }
+  SfmInputs inputs;
+  {
+    Database database(options.mapper.database_path, Database::OpenMode::kReadOnly);
+    inputs = SfmInputs::Read(&database);
   }
   Reconstruction r = Reconstruction::FromSparseModel(&inputs, merged.model);
   // The cameras and housings the clusters were mapped with (the first
@@ -126,15 +137,20 @@ HierarchicalMapperSummary RunHierarchicalMapper(const HierarchicalMapperOptions&
   std::optional<NewPaths> new_output;
   if (MpiWorld::Rank() == 0) new_output.emplace(std::vector<fs::path>{output, output / "clusters", output / "0"});
   MpiWorld::Barrier();  // before any rank makes a folder
-  SfmInputs inputs;
+  // The partition needs only the pairs' inlier counts and the images'
+  // names; the keypoints and correspondences stay in the database (each
+  // cluster's mapper reads its own images', rank 0 all of them to merge).
+  std::map<image_pair_t, int> pair_inliers;
+  std::map<image_t, std::string> names;
   {
     Database database(options.mapper.database_path, Database::OpenMode::kReadOnly);
-    inputs = SfmInputs::Read(&database);
+    for (const auto& [pair_id, inliers] : database.ReadTwoViewGeometryNumInliers()) pair_inliers[pair_id] = inliers;
+    for (const DatabaseImage& image : database.ReadAllImages()) names[image.image_id] = image.name;
   }
-  if (inputs.pair_inliers.empty()) {
+  if (pair_inliers.empty()) {
     throw InputError(options.mapper.database_path + ": no verified image pairs; run a matcher first");
   }
-  const std::vector<std::vector<image_t>> clusters = PartitionScene(inputs.pair_inliers, options.partition);
+  const std::vector<std::vector<image_t>> clusters = PartitionScene(pair_inliers, options.partition);
   HierarchicalMapperSummary summary;
   summary.num_clusters = static_cast<int>(clusters.size());
   std::set<image_t> clustered;
@@ -148,14 +164,14 @@ HierarchicalMapperSummary RunHierarchicalMapper(const HierarchicalMapperOptions&
         fs::create_directories(output / "clusters");
         for (size_t c = 0; c < clusters.size(); ++c) {
           if (static_cast<int>(c % static_cast<size_t>(MpiWorld::Size())) != MpiWorld::Rank()) continue;
-          MapCluster(options, clusters[c], c, inputs, progress);
+          MapCluster(options, clusters[c], c, names, progress);
         }
       },
       clean_up);
   RunOnEveryRank(
       "hierarchical_mapper",
       [&] {
-        if (MpiWorld::Rank() == 0) MergeClusters(options, clusters.size(), inputs, &summary);
+        if (MpiWorld::Rank() == 0) MergeClusters(options, clusters.size(), &summary);
       },
       clean_up);
   if (new_output) new_output->Keep();

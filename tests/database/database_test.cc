@@ -320,6 +320,29 @@ TEST(Database, DeleteMatchesOfImageRemovesBothDirections) {
   EXPECT_FALSE(db.ReadTwoViewGeometry(2, 3).has_value());
 }
 
+// The partition's weights: each verified pair's inlier count, pairs without
+// inliers (failed verification) left out.
+TEST(Database, NumInliersOfEachVerifiedPairWithoutTheMatches) {
+  testing::TempDir dir;
+  Database db(dir / "db.db", Database::OpenMode::kCreate);
+  const camera_t camera_id = db.WriteCamera(TestCamera());
+  for (const char* name : {"a", "b", "c"}) {
+    DatabaseImage image;
+    image.name = name;
+    image.camera_id = camera_id;
+    db.WriteImage(image);
+  }
+  TwoViewGeometry geometry;
+  geometry.inlier_matches = {{0, 0}, {1, 1}, {2, 2}};
+  db.WriteTwoViewGeometry(1, 3, geometry);
+  db.WriteTwoViewGeometry(2, 3, TwoViewGeometry());
+  geometry.inlier_matches = {{4, 5}};
+  db.WriteTwoViewGeometry(2, 1, geometry);
+  const std::vector<std::pair<image_pair_t, int>> expected = {{ImagePairToPairId(1, 2), 1},
+                                                              {ImagePairToPairId(1, 3), 3}};
+  EXPECT_EQ(db.ReadTwoViewGeometryNumInliers(), expected);
+}
+
 // Another process holds the write lock for 1.5 s (here another connection,
 // on a thread): a stage waits for it, up to --Database.busy_timeout,
 // instead of failing after a second; with a shorter timeout it fails with
