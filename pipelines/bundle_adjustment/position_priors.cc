@@ -48,12 +48,7 @@ Similarity3d Fit(const std::vector<CentreAndPrior>& pairs, const std::vector<cha
     dst.col(k) = pairs[i].prior;
     ++k;
   }
-  const Eigen::Matrix4d m = Eigen::umeyama(src, dst, true);
-  Similarity3d sim;
-  sim.scale = m.block<3, 1>(0, 0).norm();
-  sim.rotation = Eigen::Quaterniond(m.block<3, 3>(0, 0) / sim.scale).normalized();
-  sim.translation = m.block<3, 1>(0, 3);
-  return sim;
+  return FitSimilarity(src, dst);
 }
 
 Eigen::Vector3d Apply(const Similarity3d& s, const Eigen::Vector3d& x) {
@@ -62,6 +57,15 @@ Eigen::Vector3d Apply(const Similarity3d& s, const Eigen::Vector3d& x) {
 
 
 }  // namespace
+
+Similarity3d FitSimilarity(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) {
+  const Eigen::Matrix4d m = Eigen::umeyama(from, to, true);
+  Similarity3d sim;
+  sim.scale = m.block<3, 1>(0, 0).norm();
+  sim.rotation = Eigen::Quaterniond(m.block<3, 3>(0, 0) / sim.scale).normalized();
+  sim.translation = m.block<3, 1>(0, 3);
+  return sim;
+}
 
 int NumUsablePositionPriors(const Reconstruction& reconstruction) {
   const std::vector<CentreAndPrior> pairs = Collect(reconstruction);

@@ -24,6 +24,10 @@ struct Similarity3d {
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
 };
 
+// The similarity that best maps the columns of `from` onto those of `to`
+// (Umeyama, least squares, with scale).
+Similarity3d FitSimilarity(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to);
+
 struct PositionPriorAlignment {
   Similarity3d new_from_old;
   int num_priors = 0;   // registered images with a prior

@@ -240,6 +240,19 @@ double Reconstruction::MeanReprojectionError() const {
   return n ? sum / n : 0.0;
 }
 
+int Reconstruction::DeleteObservationsBeyond(double max_error_px) {
+  std::vector<std::pair<image_t, point2D_t>> beyond;
+  for (const auto& [id, point] : points_) {
+    for (const TrackElement& e : point.track) {
+      if (ReprojectionError(e.image_id, e.point2D_idx, point.xyz) > max_error_px) {
+        beyond.emplace_back(e.image_id, e.point2D_idx);
+      }
+    }
+  }
+  for (const auto& [image_id, idx] : beyond) DeleteObservation(image_id, idx);
+  return static_cast<int>(beyond.size());
+}
+
 SparseModel Reconstruction::ToSparseModel() const {
   SparseModel model;
   std::map<camera_t, bool> used;

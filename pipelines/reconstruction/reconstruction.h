@@ -112,6 +112,9 @@ class Reconstruction {
   double ReprojectionError(image_t image_id, point2D_t idx, const Eigen::Vector3d& xyz) const;
   // Mean reprojection error over all observations.
   double MeanReprojectionError() const;
+  // Deletes the observations whose reprojection error exceeds the limit
+  // (and points left with < 2); returns how many.
+  int DeleteObservationsBeyond(double max_error_px);
 
   SparseModel ToSparseModel() const;
   // The model's poses and points (inputs from SfmInputs::FromSparseModel).

@@ -20,7 +20,7 @@ Eigen::Vector3d Apply(const Similarity3d& s, const Eigen::Vector3d& x) {
   return s.scale * (s.rotation * x) + s.translation;
 }
 
-Similarity3d Umeyama(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to,
+Similarity3d FitSelected(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to,
                      const std::vector<char>& use) {
   const int n = static_cast<int>(std::count(use.begin(), use.end(), 1));
   Eigen::Matrix3Xd src(3, n), dst(3, n);
@@ -29,12 +29,7 @@ Similarity3d Umeyama(const std::vector<Eigen::Vector3d>& from, const std::vector
     src.col(static_cast<Eigen::Index>(k)) = from[i];
     dst.col(static_cast<Eigen::Index>(k++)) = to[i];
   }
-  const Eigen::Matrix4d m = Eigen::umeyama(src, dst, true);
-  Similarity3d sim;
-  sim.scale = m.block<3, 1>(0, 0).norm();
-  sim.rotation = Eigen::Quaterniond(m.block<3, 3>(0, 0) / sim.scale).normalized();
-  sim.translation = m.block<3, 1>(0, 3);
-  return sim;
+  return FitSimilarity(src, dst);
 }
 
 // A fit on all, then twice on the pairs within three robust spreads
@@ -43,7 +38,7 @@ Similarity3d Umeyama(const std::vector<Eigen::Vector3d>& from, const std::vector
 void FitRobustly(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to,
                  ModelAlignment* alignment) {
   std::vector<char> use(from.size(), 1);
-  Similarity3d sim = Umeyama(from, to, use);
+  Similarity3d sim = FitSelected(from, to, use);
   for (int round = 0; round < 2; ++round) {
     std::vector<double> errors(from.size());
     for (size_t i = 0; i < from.size(); ++i) errors[i] = (Apply(sim, from[i]) - to[i]).norm();
@@ -52,7 +47,7 @@ void FitRobustly(const std::vector<Eigen::Vector3d>& from, const std::vector<Eig
     const double limit = 3.0 * 1.4826 * sorted[sorted.size() / 2];
     for (size_t i = 0; i < from.size(); ++i) use[i] = errors[i] <= limit;
     if (std::count(use.begin(), use.end(), 1) < 3) break;
-    sim = Umeyama(from, to, use);
+    sim = FitSelected(from, to, use);
   }
   double sum_sq = 0;
   int inliers = 0;

@@ -53,19 +53,6 @@ void MapCluster(const HierarchicalMapperOptions& options, const std::vector<imag
             << " model(s)";
 }
 
-// Drops observations beyond the mapper's filter error.
-void FilterObservations(Reconstruction* r, double max_error_px) {
-  std::vector<std::pair<image_t, point2D_t>> bad;
-  for (const auto& [id, point] : r->points()) {
-    for (const TrackElement& e : point.track) {
-      if (r->ReprojectionError(e.image_id, e.point2D_idx, point.xyz) > max_error_px) {
-        bad.emplace_back(e.image_id, e.point2D_idx);
-      }
-    }
-  }
-  for (const auto& [image_id, idx] : bad) r->DeleteObservation(image_id, idx);
-}
-
 // The merged model adjusted as a whole: aligned to the position priors
 // (when they give the scale), adjusted, filtered, adjusted again.
 void AdjustMerged(const IncrementalMapperOptions& mapper, Reconstruction* r) {
@@ -77,7 +64,7 @@ void AdjustMerged(const IncrementalMapperOptions& mapper, Reconstruction* r) {
     ba.position_prior_sigma_m = mapper.position_prior_sigma_m;
   }
   AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, mapper.marker_scale);
-  FilterObservations(r, mapper.filter_max_reproj_error_px);
+  r->DeleteObservationsBeyond(mapper.filter_max_reproj_error_px);
   AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, mapper.marker_scale);
 }
 

@@ -191,24 +191,6 @@ void CentrePrincipalPoints(Reconstruction* r) {
   }
 }
 
-// Drops observations whose exact reprojection error exceeds the limit.
-int FilterObservations(Reconstruction* r, double max_error_px) {
-  int removed = 0;
-  std::vector<std::pair<image_t, point2D_t>> bad;
-  for (const auto& [id, point] : r->points()) {
-    for (const TrackElement& e : point.track) {
-      if (r->ReprojectionError(e.image_id, e.point2D_idx, point.xyz) > max_error_px) {
-        bad.emplace_back(e.image_id, e.point2D_idx);
-      }
-    }
-  }
-  for (const auto& [image_id, idx] : bad) {
-    r->DeleteObservation(image_id, idx);
-    ++removed;
-  }
-  return removed;
-}
-
 // Moves the position of every housing at a bound of the adjustment (flat:
 // distance; dome: centre) to the guess's, when the guess is of the same
 // model; the rest stays.
@@ -431,7 +413,7 @@ class StagedAdjustment {
                              " px); give the intrinsics (--ImageReader.camera_params) or more views");
       }
     }
-    result_.num_filtered += FilterObservations(&r_, options_.max_reproj_error_px);
+    result_.num_filtered += r_.DeleteObservationsBeyond(options_.max_reproj_error_px);
     BundleAdjustmentOptions final_solve = ba;
     final_solve.hold_loss_weights = options_.hold_weights;
     AdjustBundle(&r_, final_solve, BundleAdjustmentScope(), &markers_, options_.marker_scale, std_devs);

@@ -297,16 +297,21 @@ TEST(Database, LockedDatabaseIsAClearError) {
   SetDatabaseBusyTimeout(60);
 }
 
-TEST(Database, DeleteMatchesOfImageRemovesBothDirections) {
-  testing::TempDir dir;
-  Database db(dir / "db.db", Database::OpenMode::kCreate);
-  const camera_t camera_id = db.WriteCamera(TestCamera());
+// Images a, b and c (ids 1, 2, 3) of one camera.
+void WriteImagesABC(Database* db) {
+  const camera_t camera_id = db->WriteCamera(TestCamera());
   for (const char* name : {"a", "b", "c"}) {
     DatabaseImage image;
     image.name = name;
     image.camera_id = camera_id;
-    db.WriteImage(image);
+    db->WriteImage(image);
   }
+}
+
+TEST(Database, DeleteMatchesOfImageRemovesBothDirections) {
+  testing::TempDir dir;
+  Database db(dir / "db.db", Database::OpenMode::kCreate);
+  WriteImagesABC(&db);
   db.WriteMatches(1, 2, {{0, 0}});
   db.WriteMatches(2, 3, {{0, 0}});
   db.WriteMatches(1, 3, {{0, 0}});
@@ -325,13 +330,7 @@ TEST(Database, DeleteMatchesOfImageRemovesBothDirections) {
 TEST(Database, NumInliersOfEachVerifiedPairWithoutTheMatches) {
   testing::TempDir dir;
   Database db(dir / "db.db", Database::OpenMode::kCreate);
-  const camera_t camera_id = db.WriteCamera(TestCamera());
-  for (const char* name : {"a", "b", "c"}) {
-    DatabaseImage image;
-    image.name = name;
-    image.camera_id = camera_id;
-    db.WriteImage(image);
-  }
+  WriteImagesABC(&db);
   TwoViewGeometry geometry;
   geometry.inlier_matches = {{0, 0}, {1, 1}, {2, 2}};
   db.WriteTwoViewGeometry(1, 3, geometry);

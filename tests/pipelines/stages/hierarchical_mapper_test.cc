@@ -1,6 +1,6 @@
 // hierarchical_mapper under `mpirun -np 2 --oversubscribe` on one machine:
-// the small rendered survey of survey_calibration_test (48 images behind a
-// flat port tilted 3 deg, navigation of 2 cm noise) cut into two
+// the small rendered survey of test_survey.h (48 images behind a flat port
+// tilted 3 deg, navigation of 2 cm noise) cut into two
 // overlapping clusters, each mapped on its own rank with the port refined
 // and the navigation as the scale, merged and adjusted as a whole; then
 // refined as refractive_mapper's model is. The merged model must give the
@@ -10,13 +10,9 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
 
-#include "colmap_ext/io/ground_truth.h"
-#include "pipelines/stages/feature_extractor.h"
-#include "pipelines/stages/feature_matcher.h"
-#include "pipelines/stages/pose_prior_importer.h"
 #include "pipelines/stages/refractive_bundle_adjuster.h"
+#include "tests/pipelines/stages/test_survey.h"
 #include "tests/test_utils.h"
 
 namespace fs = std::filesystem;
@@ -26,37 +22,6 @@ namespace {
 
 constexpr double kDegree = M_PI / 180.0;
 constexpr char kGuess[] = "0,0,1,0.01,0.010,1,1.473,1.334";
-
-// The rendered, extracted, navigated and matched survey's database.
-std::string MatchedSurvey(const testing::TempDir& dir) {
-  testing::RenderSet(dir, R"(name: survey
-num_images: 48
-camera: {model: RADIAL, width: 640, height: 360, params: [466.7, 320.0, 180.0, 0.0, 0.0]}
-housing: {model: FLATPORT, params: [0.0523360, 0.0, 0.9986295, 0.02, 0.010, 1.0, 1.473, 1.334]}
-survey: {height: 2.0, speed: 0.5, frame_rate: 1.0, side_overlap: 0.6, line_length: 6.0,
-         roughness: 0.15, relief_wavelength: 2.0, navigation_sigma: 0.02}
-render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
-)");
-  const std::string database = (dir / "db.db").string();
-  FeatureExtractorOptions extract;
-  extract.database_path = database;
-  extract.image_path = (dir / "set" / "images").string();
-  extract.reader.single_camera = true;
-  extract.reader.camera_model = "RADIAL";
-  extract.reader.camera_params = "466.7,320,180,0,0";
-  extract.sift.max_num_features = 1500;
-  RunFeatureExtractor(extract, NoProgress());
-  PosePriorImporterOptions priors;
-  priors.database_path = database;
-  priors.input_path = (dir / "set" / "navigation.txt").string();
-  RunPosePriorImporter(priors, NoProgress());
-  FeatureMatcherOptions match;
-  match.database_path = database;
-  match.mode = PairingMode::kSpatial;
-  match.spatial.max_num_neighbors = 10;
-  RunFeatureMatcher(match, NoProgress());
-  return database;
-}
 
 // The mapper's options both paths share (survey_calibration_test's).
 std::string MapperFlags() {
@@ -85,7 +50,7 @@ TEST(HierarchicalMapper, TwoClustersOnTwoRanksMergeIntoTheSequentialModel) {
     GTEST_SKIP() << "mpirun is not installed (bash workflows/test.sh installs OpenMPI)";
   }
   testing::TempDir dir;
-  const std::string database = MatchedSurvey(dir);
+  const std::string database = testing::RenderAndMatchTestSurvey(dir).database;
   const std::string portcal = testing::PortcalBinary();
   const testing::CommandResult sequential =
       testing::RunCommand(portcal + " refractive_mapper --log_level warn --database_path " + database +

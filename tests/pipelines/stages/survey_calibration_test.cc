@@ -12,16 +12,11 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <fstream>
 
-#include "colmap_ext/io/ground_truth.h"
-#include "pipelines/stages/feature_extractor.h"
 #include "pipelines/stages/feature_masker.h"
-#include "pipelines/stages/feature_matcher.h"
-#include "pipelines/stages/pose_prior_importer.h"
 #include "pipelines/stages/refractive_bundle_adjuster.h"
 #include "pipelines/stages/refractive_mapper.h"
-#include "pipelines/stages/synthesize.h"
+#include "tests/pipelines/stages/test_survey.h"
 #include "tests/test_utils.h"
 
 namespace fs = std::filesystem;
@@ -33,39 +28,11 @@ constexpr double kDegree = M_PI / 180.0;
 
 TEST(SurveyCalibration, FlatPortFromNavigationScale) {
   testing::TempDir dir;
-  std::ofstream(dir / "survey.yaml") << R"(name: survey
-num_images: 48
-camera: {model: RADIAL, width: 640, height: 360, params: [466.7, 320.0, 180.0, 0.0, 0.0]}
-housing: {model: FLATPORT, params: [0.0523360, 0.0, 0.9986295, 0.02, 0.010, 1.0, 1.473, 1.334]}
-survey: {height: 2.0, speed: 0.5, frame_rate: 1.0, side_overlap: 0.6, line_length: 6.0,
-         roughness: 0.15, relief_wavelength: 2.0, navigation_sigma: 0.02}
-render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
-)";
   NullProgress progress;
-  SynthesizeOptions synthesize;
-  synthesize.config_path = (dir / "survey.yaml").string();
-  synthesize.output_path = (dir / "set").string();
-  RunSynthesize(synthesize, progress);
-  const GroundTruth truth = ReadGroundTruth(dir / "set" / "ground_truth.yaml");
-  const std::string database = (dir / "db.db").string();
-
-  FeatureExtractorOptions extract;
-  extract.database_path = database;
-  extract.image_path = (dir / "set" / "images").string();
-  extract.reader.single_camera = true;
-  extract.reader.camera_model = "RADIAL";
-  extract.reader.camera_params = "466.7,320,180,0,0";
-  extract.sift.max_num_features = 1500;  // the strongest: a CI-sized survey
-  RunFeatureExtractor(extract, progress);
-  PosePriorImporterOptions priors;
-  priors.database_path = database;
-  priors.input_path = (dir / "set" / "navigation.txt").string();
-  ASSERT_EQ(RunPosePriorImporter(priors, NoProgress()).num_imported, 48);
-  FeatureMatcherOptions match;
-  match.database_path = database;
-  match.mode = PairingMode::kSpatial;
-  match.spatial.max_num_neighbors = 10;
-  RunFeatureMatcher(match, progress);
+  const testing::MatchedSurvey survey = testing::RenderAndMatchTestSurvey(dir);
+  ASSERT_EQ(survey.num_position_priors, 48);
+  const GroundTruth& truth = survey.truth;
+  const std::string& database = survey.database;
 
   RefractiveMapperOptions map;
   map.database_path = database;
@@ -163,47 +130,19 @@ render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
 // ~0.2 % from one view), the port the navigation test's tolerances.
 TEST(SurveyCalibration, FlatPortFromMarkersSeenInPartOfTheSurvey) {
   testing::TempDir dir;
-  std::ofstream(dir / "survey.yaml") << R"(name: survey
-num_images: 48
-camera: {model: RADIAL, width: 640, height: 360, params: [466.7, 320.0, 180.0, 0.0, 0.0]}
-housing: {model: FLATPORT, params: [0.0523360, 0.0, 0.9986295, 0.02, 0.010, 1.0, 1.473, 1.334]}
-survey: {height: 2.0, speed: 0.5, frame_rate: 1.0, side_overlap: 0.6, line_length: 6.0,
-         roughness: 0.15, relief_wavelength: 2.0, navigation_sigma: 0.02,
-         markers: {count: 9, side: 0.15, spacing: 1.0}}
-render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}
-)";
   NullProgress progress;
-  SynthesizeOptions synthesize;
-  synthesize.config_path = (dir / "survey.yaml").string();
-  synthesize.output_path = (dir / "set").string();
-  RunSynthesize(synthesize, progress);
-  const GroundTruth truth = ReadGroundTruth(dir / "set" / "ground_truth.yaml");
-  const std::string database = (dir / "db.db").string();
-  FeatureExtractorOptions extract;
-  extract.database_path = database;
-  extract.image_path = (dir / "set" / "images").string();
-  extract.reader.single_camera = true;
-  extract.reader.camera_model = "RADIAL";
-  extract.reader.camera_params = "466.7,320,180,0,0";
-  extract.sift.max_num_features = 1500;
-  RunFeatureExtractor(extract, progress);
+  const testing::MatchedSurvey survey =
+      testing::RenderAndMatchTestSurvey(dir, ",\n         markers: {count: 9, side: 0.15, spacing: 1.0}");
+  const GroundTruth& truth = survey.truth;
+  const std::string& database = survey.database;
   FeatureMaskerOptions mask;
   mask.database_path = database;
-  mask.image_path = extract.image_path;
+  mask.image_path = survey.image_path;
   mask.keep_all_features = true;
   const FeatureMaskerSummary masked = RunFeatureMasker(mask, progress);
   EXPECT_EQ(masked.num_features_kept, masked.num_features_before);
   EXPECT_GE(masked.num_markers, 9);
   EXPECT_GE(masked.num_without_markers, 24);  // markers in part of the survey only
-  PosePriorImporterOptions priors;
-  priors.database_path = database;
-  priors.input_path = (dir / "set" / "navigation.txt").string();
-  RunPosePriorImporter(priors, NoProgress());
-  FeatureMatcherOptions match;
-  match.database_path = database;
-  match.mode = PairingMode::kSpatial;
-  match.spatial.max_num_neighbors = 10;
-  RunFeatureMatcher(match, progress);
 
   RefractiveMapperOptions map;
   map.database_path = database;
