@@ -74,13 +74,14 @@ void MaskImage(const FeatureMaskerOptions& options, const DatabaseImage& image,
   std::vector<Eigen::Index> kept;
   for (size_t k = 0; k < keypoints.size(); ++k) {
     const Eigen::Vector2d xy(keypoints[k].x, keypoints[k].y);
-    for (const MarkerDetection& marker : markers) {
-      if (options.keep_all_features || InsideEnlargedQuad(marker.corners, options.enlargement_factor, xy)) {
-        kept.push_back(static_cast<Eigen::Index>(k));
-        kept_keypoints.push_back(keypoints[k]);
-        break;
-      }
+    // Kept features come back on an image without markers too.
+    bool keep = options.keep_all_features;
+    for (size_t m = 0; m < markers.size() && !keep; ++m) {
+      keep = InsideEnlargedQuad(markers[m].corners, options.enlargement_factor, xy);
     }
+    if (!keep) continue;
+    kept.push_back(static_cast<Eigen::Index>(k));
+    kept_keypoints.push_back(keypoints[k]);
   }
   summary->num_features_before += static_cast<int64_t>(keypoints.size());
   summary->num_features_kept += static_cast<int64_t>(kept.size());

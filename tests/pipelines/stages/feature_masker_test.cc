@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
 
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
@@ -92,6 +94,37 @@ TEST(FeatureMasker, AnotherMaskStartsFromTheFeaturesAsExtracted) {
   const FeatureMaskerSummary extracted_again = RunFeatureMasker(mask, progress);
   EXPECT_EQ(extracted_again.num_features_before, first.num_features_before);
   EXPECT_EQ(extracted_again.num_features_kept, first.num_features_kept);
+}
+
+// --Mask.keep_all_features after a mask: every image gets its features as
+// extracted back, the one without markers (all its features masked away)
+// too, and the markers stay stored.
+TEST(FeatureMasker, KeepingAllFeaturesAfterAMaskBringsEveryImagesBack) {
+  testing::TempDir dir;
+  FeatureExtractorOptions extract = RenderAndExtract(dir.path(), 2, 5);
+  ASSERT_TRUE(cv::imwrite((dir / "set/images/no_markers.png").string(), testing::ClutteredScene(480, 270, 9)));
+  NullProgress progress;
+  RunFeatureExtractor(extract, progress);  // the new image only
+  const auto counts = [&] {
+    Database db(dir / "db.db", Database::OpenMode::kReadOnly);
+    std::map<std::string, size_t> keypoints;
+    for (const DatabaseImage& image : db.ReadAllImages()) keypoints[image.name] = db.ReadKeypoints(image.image_id).size();
+    return keypoints;
+  };
+  const std::map<std::string, size_t> extracted = counts();
+  ASSERT_EQ(extracted.size(), 3u);
+  ASSERT_GT(extracted.at("no_markers.png"), 0u);
+  FeatureMaskerOptions mask;
+  mask.database_path = extract.database_path;
+  mask.image_path = extract.image_path;
+  const FeatureMaskerSummary masked = RunFeatureMasker(mask, progress);
+  EXPECT_EQ(masked.num_without_markers, 1);
+  EXPECT_EQ(counts().at("no_markers.png"), 0u);
+  mask.keep_all_features = true;
+  const FeatureMaskerSummary kept = RunFeatureMasker(mask, progress);
+  EXPECT_EQ(kept.num_features_kept, kept.num_features_before);
+  EXPECT_EQ(kept.num_markers, masked.num_markers);
+  EXPECT_EQ(counts(), extracted);
 }
 
 // A database masked by a portcal that did not keep the features as
