@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "colmap_ext/util/error.h"
+#include "pipelines/bundle_adjustment/point_schur.h"
 
 namespace portcal {
 
@@ -32,7 +33,7 @@ struct BlockClusters {
 
 // Dense cluster indices of every residual block (see ResidualClusters).
 std::vector<BlockClusters> AssignClusters(ceres::Problem* problem, const std::vector<ceres::ResidualBlockId>& ids,
-                                          const std::vector<double*>& points, const std::vector<double>& residuals,
+                                          const std::vector<double*>& points, const std::vector<double>& squared_norms,
                                           const ResidualClusters& clusters) {
   std::unordered_map<const double*, int> point_index;
   for (size_t p = 0; p < points.size(); ++p) point_index[points[p]] = static_cast<int>(p);
@@ -48,8 +49,8 @@ std::vector<BlockClusters> AssignClusters(ceres::Problem* problem, const std::ve
   };
   std::vector<BlockClusters> result;
   std::vector<double*> blocks;
-  size_t row = 0;
-  for (const ceres::ResidualBlockId id : ids) {
+  for (size_t k = 0; k < ids.size(); ++k) {
+    const ceres::ResidualBlockId id = ids[k];
     problem->GetParameterBlocksForResidualBlock(id, &blocks);
     BlockClusters b;
     b.image = -1;
@@ -79,15 +80,13 @@ std::vector<BlockClusters> AssignClusters(ceres::Problem* problem, const std::ve
       b.both = dense(both_index, key, &num_both);
     }
     b.rows = problem->GetCostFunctionForResidualBlock(id)->num_residuals();
-    double squared_norm = 0;
-    for (int k = 0; k < b.rows; ++k) squared_norm += residuals[row + k] * residuals[row + k];
-    double rho[3] = {squared_norm, 1, 0};
-    if (const ceres::LossFunction* loss = problem->GetLossFunctionForResidualBlock(id)) loss->Evaluate(squared_norm, rho);
+    double rho[3] = {squared_norms[k], 1, 0};
+    if (const ceres::LossFunction* loss = problem->GetLossFunctionForResidualBlock(id)) {
+      loss->Evaluate(squared_norms[k], rho);
+    }
     b.weight = rho[1];
-    row += static_cast<size_t>(b.rows);
     result.push_back(b);
   }
-  PORTCAL_CHECK_MSG(row == residuals.size(), "residual rows and blocks disagree");
   return result;
 }
 
@@ -177,71 +176,6 @@ NumericalError RankDeficient(const std::string& name, const char* measure, doubl
                         measure + " ratio " + text.str() + "); hold it fixed or add views");
 }
 
-// The Gauss-Newton system reduced over the points: S = H_cc - H_cp H_pp^+
-// H_pc, sparse (two cameras couple only through points both see), and
-// W = H_pp^+ H_pc, each point's least-squares response to the cameras.
-struct PointSchur {
-  Eigen::SparseMatrix<double> reduced;             // S, nc x nc
-  Eigen::SparseMatrix<double> point_from_cameras;  // W, 3 points x nc
-};
-
-// From the Jacobian's columns: the first `nc` are the other blocks', the
-// rest three per point. Each point's 3x3 block is pseudo-inverted.
-PointSchur ReduceOverPoints(const ceres::CRSMatrix& jacobian, int nc, size_t num_points) {
-  using RowMajor = Eigen::SparseMatrix<double, Eigen::RowMajor>;
-  const int np = static_cast<int>(3 * num_points);
-  RowMajor camera_jacobian(jacobian.num_rows, nc), point_jacobian(jacobian.num_rows, np);
-  camera_jacobian.reserve(static_cast<Eigen::Index>(jacobian.values.size()));
-  point_jacobian.reserve(static_cast<Eigen::Index>(3 * jacobian.num_rows));
-  std::vector<std::pair<int, double>> entries;
-  for (int row = 0; row < jacobian.num_rows; ++row) {
-    camera_jacobian.startVec(row);
-    point_jacobian.startVec(row);
-    entries.clear();
-    for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
-      entries.emplace_back(jacobian.cols[k], jacobian.values[k]);
-    }
-    std::sort(entries.begin(), entries.end());  // Ceres orders a row's columns by block, not index
-    int point = -1;
-    for (const auto& [col, value] : entries) {
-      if (col < nc) {
-        camera_jacobian.insertBack(row, col) = value;
-        continue;
-      }
-      PORTCAL_CHECK_MSG(point == -1 || point == (col - nc) / 3, "a residual touches two marginalised points");
-      point = (col - nc) / 3;
-      point_jacobian.insertBack(row, col - nc) = value;
-    }
-  }
-  camera_jacobian.finalize();
-  point_jacobian.finalize();
-  const Eigen::SparseMatrix<double> jc = camera_jacobian, jp = point_jacobian;
-  const Eigen::SparseMatrix<double> point_camera = jp.transpose() * jc;  // H_pc
-  const Eigen::SparseMatrix<double> point_point = jp.transpose() * jp;   // block diagonal H_pp
-  std::vector<Eigen::Triplet<double>> pinv;
-  pinv.reserve(static_cast<size_t>(3 * np));
-  for (int p = 0; p < np; p += 3) {
-    const Eigen::Matrix3d hpp = Eigen::MatrixXd(point_point.block(p, p, 3, 3));
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(hpp);
-    const Eigen::Vector3d values = eig.eigenvalues();
-    Eigen::Vector3d inverse = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 3; ++k) {
-      if (values(k) > 1e-12 * values(2)) inverse(k) = 1.0 / values(k);
-    }
-    const Eigen::Matrix3d block = eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) pinv.emplace_back(p + i, p + j, block(i, j));
-    }
-  }
-  Eigen::SparseMatrix<double> point_point_pinv(np, np);
-  point_point_pinv.setFromTriplets(pinv.begin(), pinv.end());
-  PointSchur schur;
-  schur.point_from_cameras = point_point_pinv * point_camera;
-  schur.reduced = Eigen::SparseMatrix<double>(jc.transpose() * jc) -
-                  Eigen::SparseMatrix<double>(point_camera.transpose() * schur.point_from_cameras);
-  return schur;
-}
-
 // Rows of S^-1 at `wanted` by a dense eigen-decomposition of the scaled
 // system, whose smallest eigenvector names the parameter that dominates an
 // unobservable direction.
@@ -295,36 +229,6 @@ Eigen::MatrixXd SparseInverseRows(const Eigen::SparseMatrix<double>& reduced, co
   return (d_inv_sqrt.asDiagonal() * solved).transpose();
 }
 
-// The residuals and Jacobian at the solution (without the loss function),
-// the points' columns after the `num_columns` of the other blocks.
-struct Linearisation {
-  std::vector<ceres::ResidualBlockId> residual_blocks;
-  std::map<const double*, int> offset;  // tangent column of each other block
-  int num_columns = 0;
-  ceres::CRSMatrix jacobian;
-  std::vector<double> residuals;
-};
-
-Linearisation Linearise(ceres::Problem* problem, const std::vector<double*>& points,
-                        const std::vector<double*>& others) {
-  Linearisation out;
-  ceres::Problem::EvaluateOptions evaluate;
-  evaluate.apply_loss_function = false;
-  evaluate.parameter_blocks = others;
-  evaluate.parameter_blocks.insert(evaluate.parameter_blocks.end(), points.begin(), points.end());
-  problem->GetResidualBlocks(&evaluate.residual_blocks);
-  for (double* block : others) {
-    out.offset[block] = out.num_columns;
-    out.num_columns += problem->ParameterBlockTangentSize(block);
-  }
-  if (out.num_columns == 0) throw NumericalError("covariance: no free parameters");
-  if (!problem->Evaluate(evaluate, nullptr, &out.residuals, nullptr, &out.jacobian)) {
-    throw NumericalError("covariance: the residuals cannot be evaluated at the solution");
-  }
-  out.residual_blocks = std::move(evaluate.residual_blocks);
-  return out;
-}
-
 // Jacobi scaling: rotations (radians), translations (metres), focal
 // lengths (pixels) and distortion differ by many orders of magnitude in
 // their information; the rank test and the inverse work on the scaled
@@ -375,42 +279,21 @@ WantedTangents TangentsOf(ceres::Problem* problem, const std::vector<const doubl
 // gradient w r (J_c' - H_cp H_pp^+ J_p'), w = rho' -- the points' share
 // removed as in the Schur complement. A cluster's effect S^-1 u_k is the
 // sum of its residuals' effects.
-Eigen::MatrixXd ClusteredCovariance(const Linearisation& linear, const PointSchur& schur,
-                                    const std::vector<const double*>& wanted, const WantedTangents& tangents,
-                                    const Eigen::MatrixXd& inverse_rows,
+Eigen::MatrixXd ClusteredCovariance(const PointSchurComplement& schur, const std::vector<const double*>& wanted,
+                                    const WantedTangents& tangents, const Eigen::MatrixXd& inverse_rows,
                                     const std::vector<BlockClusters>& block_clusters,
                                     const ResidualClusters& clusters, MarginalCovariance* result) {
-  const int nc = linear.num_columns;
-  Eigen::MatrixXd gain(tangents.total, nc);
+  Eigen::MatrixXd gain(tangents.total, schur.num_columns());
   for (size_t a = 0; a < wanted.size(); ++a) {
     gain.middleRows(result->offset[wanted[a]], tangents.plus[a].rows()) =
         tangents.plus[a] * inverse_rows.middleRows(tangents.first_row[a], tangents.plus[a].cols());
   }
-  // S^-1 H_cp H_pp^+ for every point coordinate (total x 3 points).
-  const Eigen::MatrixXd point_gain = gain * schur.point_from_cameras.transpose();
+  std::vector<double> weights;
+  weights.reserve(block_clusters.size());
+  for (const BlockClusters& b : block_clusters) weights.push_back(b.weight);
   ClusterEffects effects(tangents.total, block_clusters);
-  size_t block = 0;
-  int block_start = 0;
-  Eigen::VectorXd block_effect = Eigen::VectorXd::Zero(tangents.total);
-  const ceres::CRSMatrix& jacobian = linear.jacobian;
-  for (int row = 0; row < jacobian.num_rows; ++row) {
-    const double weighted_residual = block_clusters[block].weight * linear.residuals[static_cast<size_t>(row)];
-    for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
-      const int col = jacobian.cols[k];
-      const double value = jacobian.values[k] * weighted_residual;
-      if (col < nc) {
-        block_effect += gain.col(col) * value;
-      } else {
-        block_effect -= point_gain.col(col - nc) * value;
-      }
-    }
-    if (row + 1 == block_start + block_clusters[block].rows) {
-      effects.Add(block, block_effect);
-      block_start = row + 1;
-      ++block;
-      block_effect.setZero();
-    }
-  }
+  schur.VisitReducedGradients(gain, weights,
+                              [&](size_t block, const Eigen::VectorXd& effect) { effects.Add(block, effect); });
   return effects.Covariance(clusters.residuals_per_dof, &result->num_clusters, &result->num_tracks);
 }
 
@@ -437,19 +320,18 @@ MarginalCovariance ComputeMarginalCovariance(
     const std::vector<const double*>& wanted, double scale,
     const std::function<std::string(const double*, int)>& describe, const ResidualClusters* clusters,
     int max_dense_size) {
-  const Linearisation linear = Linearise(problem, points, others);
-  const int nc = linear.num_columns;
+  const PointSchurComplement schur(problem, points, others);
+  const int nc = schur.num_columns();
   // Each residual block's clusters and the weight of its gradient: the
   // loss's derivative rho'(|r|^2) (at the solution the robust gradient,
   // rho' J'r, is what balances).
   std::vector<BlockClusters> block_clusters;
   if (clusters) {
-    block_clusters = AssignClusters(problem, linear.residual_blocks, points, linear.residuals, *clusters);
+    block_clusters = AssignClusters(problem, schur.residual_blocks(), points, schur.squared_norms(), *clusters);
   }
-  const PointSchur schur = ReduceOverPoints(linear.jacobian, nc, points.size());
-  const Eigen::VectorXd d_inv_sqrt = JacobiScaling(schur.reduced, nc);
+  const Eigen::VectorXd d_inv_sqrt = JacobiScaling(schur.reduced(), nc);
   const auto name_of = [&](Eigen::Index column) {
-    for (const auto& [block, start] : linear.offset) {
+    for (const auto& [block, start] : schur.offset()) {
       const int size = problem->ParameterBlockTangentSize(block);
       if (column >= start && column < start + size) {
         return describe(block, static_cast<int>(column) - start) + " [tangent " + std::to_string(column - start) + "]";
@@ -458,11 +340,11 @@ MarginalCovariance ComputeMarginalCovariance(
     return "parameter " + std::to_string(column);
   };
   MarginalCovariance result;
-  const WantedTangents tangents = TangentsOf(problem, wanted, linear.offset, &result);
+  const WantedTangents tangents = TangentsOf(problem, wanted, schur.offset(), &result);
   // The rows of S^-1 at the wanted coordinates.
   const Eigen::MatrixXd inverse_rows = nc <= max_dense_size
-      ? DenseInverseRows(schur.reduced, d_inv_sqrt, tangents.columns, name_of)
-      : SparseInverseRows(schur.reduced, d_inv_sqrt, tangents.columns, name_of);
+      ? DenseInverseRows(schur.reduced(), d_inv_sqrt, tangents.columns, name_of)
+      : SparseInverseRows(schur.reduced(), d_inv_sqrt, tangents.columns, name_of);
 
   // Each wanted block's tangent covariance mapped to its ambient
   // coordinates: C_ab = P_a C'_ab P_b^T.
@@ -471,14 +353,14 @@ MarginalCovariance ComputeMarginalCovariance(
     for (size_t b = 0; b < wanted.size(); ++b) {
       const Eigen::MatrixXd& pa = tangents.plus[a];
       const Eigen::MatrixXd& pb = tangents.plus[b];
-      const int tb = linear.offset.at(wanted[b]);
+      const int tb = schur.offset().at(wanted[b]);
       result.covariance.block(result.offset[wanted[a]], result.offset[wanted[b]], pa.rows(), pb.rows()) =
           scale * scale * pa * inverse_rows.block(tangents.first_row[a], tb, pa.cols(), pb.cols()) * pb.transpose();
     }
   }
   if (clusters) {
     result.clustered_covariance =
-        ClusteredCovariance(linear, schur, wanted, tangents, inverse_rows, block_clusters, *clusters, &result);
+        ClusteredCovariance(schur, wanted, tangents, inverse_rows, block_clusters, *clusters, &result);
   }
   return result;
 }

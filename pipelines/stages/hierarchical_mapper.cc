@@ -47,7 +47,18 @@ void MapCluster(const HierarchicalMapperOptions& options, const std::vector<imag
   RefractiveMapperOptions mapper = options.mapper;
   mapper.image_list_path = list.string();
   mapper.output_path = (folder / std::to_string(index)).string();
-  const RefractiveMapperSummary summary = RunRefractiveMapper(mapper, progress);
+  RefractiveMapperSummary summary;
+  try {
+    summary = RunRefractiveMapper(mapper, progress);
+  } catch (const NumericalError& e) {
+    // A cluster whose images start no model (a stretch of poor overlap)
+    // is left out, as one that shares too few points is at the merge: the
+    // others still make the survey's model, and its images that other
+    // clusters hold are registered there.
+    LOG(WARNING) << "hierarchical_mapper: cluster " << index << " (" << cluster.size()
+                 << " images) could not be mapped and is left out: " << e.what();
+    return;
+  }
   LOG(INFO) << "hierarchical_mapper: cluster " << index << " (rank " << MpiWorld::Rank()
             << "): " << summary.num_registered << " of " << cluster.size() << " images in " << summary.num_models
             << " model(s)";
@@ -74,9 +85,14 @@ void MergeClusters(const HierarchicalMapperOptions& options, size_t num_clusters
   std::vector<SparseModel> models;
   for (size_t c = 0; c < num_clusters; ++c) {
     // A cluster's mapper writes its models largest first: the first is the
-    // cluster's (the others are pieces that would not join it).
+    // cluster's (the others are pieces that would not join it). A cluster
+    // that could not be mapped has none.
     const fs::path model = folder / std::to_string(c) / "0";
-    if (fs::exists(model)) models.push_back(ReadSparseModel(model));
+    if (fs::exists(model)) {
+      models.push_back(ReadSparseModel(model));
+    } else {
+      ++summary->num_unmapped;
+    }
   }
   const MergedModels merged = MergeModels(models, options.merge);
   for (const ModelAlignment& a : merged.alignments) {
@@ -113,6 +129,9 @@ void MergeClusters(const HierarchicalMapperOptions& options, size_t num_clusters
   summary->num_left_out = static_cast<int>(merged.left_out.size());
   summary->num_registered = static_cast<int>(r.poses().size());
   summary->mean_reprojection_error_px = r.MeanReprojectionError();
+  LOG(INFO) << "hierarchical_mapper: " << summary->num_registered << " images in the merged model from "
+            << models.size() << " of " << num_clusters << " clusters (" << summary->num_unmapped << " unmapped, "
+            << summary->num_left_out << " left out)";
 }
 
 }  // namespace

@@ -35,6 +35,7 @@ struct HierarchicalMapperSummary {
   int num_images = 0;      // with a verified pair
   int num_registered = 0;  // in the merged model
   std::vector<ModelAlignment> alignments;
+  int num_unmapped = 0;  // clusters whose mapping failed (left out, with a warning)
   int num_left_out = 0;  // cluster models that could not be merged
   double mean_reprojection_error_px = 0;
 };

@@ -518,12 +518,12 @@ void WriteAdjusted(const RefractiveBundleAdjusterOptions& options, const Reconst
   }();
 }
 
-}  // namespace
-
-RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options,
-                                                            ProgressSink& progress) {
-  options.Check();
-  NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
+// The input model over `inputs` (filled from it and the database), aligned
+// to its scale source. The run reads it again rather than keeping a copy
+// for its rare second attempt: a survey's model is a tenth of the
+// refinement's memory.
+Reconstruction ReadAlignedModel(const RefractiveBundleAdjusterOptions& options, bool use_priors, SfmInputs* inputs,
+                                std::vector<MarkerCorner>* markers, RefractiveBundleAdjusterSummary* result) {
   const SparseModel model = ReadSparseModel(options.input_path);
   model.Validate(options.input_path);
   if (model.images.size() < 2) {
@@ -534,12 +534,23 @@ RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBund
     // Nothing to adjust: the output would be the input, logged as refined.
     throw InputError(options.input_path + ": no 3D point; bundle adjustment needs the points the images observe");
   }
-  SfmInputs inputs = ReadAdjusterInputs(options, model);
-  Reconstruction r = Reconstruction::FromSparseModel(&inputs, model);
+  *inputs = ReadAdjusterInputs(options, model);
+  Reconstruction r = Reconstruction::FromSparseModel(inputs, model);
+  PrepareScale(options, use_priors, &r, markers, result);
+  return r;
+}
+
+}  // namespace
+
+RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options,
+                                                            ProgressSink& progress) {
+  options.Check();
+  NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
   RefractiveBundleAdjusterSummary result;
   const bool use_priors = options.ba.position_prior_sigma_m > 0;
+  SfmInputs inputs;
   std::vector<MarkerCorner> markers;
-  PrepareScale(options, use_priors, &r, &markers, &result);
+  Reconstruction r = ReadAlignedModel(options, use_priors, &inputs, &markers, &result);
   if (options.ba.refine_housing && options.marker_scale.side_length_m <= 0 && !use_priors) {
     LOG(WARNING) << "refractive_bundle_adjuster: no marker scale (--Markers.side_length): the model's scale "
                     "is arbitrary, so a flat port's distance and a dome's decentering are not in metres "
@@ -554,8 +565,6 @@ RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBund
   const bool start_at_bound =
       adjustment.joint() && adjustment.HousingAtBound() != kInvalidCameraId && options.housing_guess.has_value();
   if (start_at_bound) MoveHousingsOffBound(options.housing_guess, &r);
-  const Reconstruction start = r;
-  const std::vector<MarkerCorner> markers_start = markers;
   CalibrationStdDevs std_devs;
   std::vector<std::string> notes = adjustment.Calibrate(start_at_bound, &std_devs);
   if (adjustment.joint() && !start_at_bound && adjustment.HousingAtBound() != kInvalidCameraId) {
@@ -564,8 +573,8 @@ RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBund
     // the trade (docs/dev/auto_calibration_notes.md).
     LOG(WARNING) << "refractive_bundle_adjuster: the housing ended at a bound; adjusting again, the intrinsics "
                     "first";
-    r = start;
-    markers = markers_start;
+    markers.clear();
+    r = ReadAlignedModel(options, use_priors, &inputs, &markers, &result);
     result.num_filtered = 0;
     std_devs = CalibrationStdDevs();
     notes = adjustment.Calibrate(true, &std_devs);

@@ -94,6 +94,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   Expect([&] { db.ReadDescriptors(1); });
   Expect([&] { db.ReadAllMatches(); });
   Expect([&] { db.ReadTwoViewGeometries(); });
+  Expect([&] { db.ReadTwoViewGeometryNumInliers(); });
   Expect([&] { db.ReadAllHousings(); });
   Expect([&] {
     portcal::FeatureKeypoints keypoints;

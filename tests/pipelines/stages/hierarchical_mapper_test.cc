@@ -6,11 +6,13 @@
 // refined as refractive_mapper's model is. The merged model must give the
 // sequential one's port and camera positions within the refinement's
 // standard deviations. Surveys of 1000 images: workflows/bench_survey.sh.
+// And, in one process, clusters that cannot be mapped.
 #include "pipelines/stages/hierarchical_mapper.h"
 
 #include <gtest/gtest.h>
 
-
+#include "colmap_ext/util/error.h"
+#include "database/database.h"
 #include "pipelines/stages/refractive_bundle_adjuster.h"
 #include "tests/pipelines/stages/test_survey.h"
 #include "tests/test_utils.h"
@@ -94,6 +96,50 @@ TEST(HierarchicalMapper, TwoClustersOnTwoRanksMergeIntoTheSequentialModel) {
   }
   std::cout << "camera centres: at most " << worst * 1000 << " mm apart\n";
   EXPECT_LT(worst, 3 * 0.02 / std::sqrt(static_cast<double>(a.views.size())));
+}
+
+// Two strips of 10 images, not linked to each other, each image's 30
+// verified matches with the next too few to start a model: two clusters.
+// Each is tried and left out with a warning naming it, rather than the
+// first failure ending the job; with none mapped the job fails, saying so,
+// and leaves no output folder. One process: the clusters run in turn.
+TEST(HierarchicalMapper, ClustersThatCannotBeMappedAreLeftOutEachNamed) {
+  testing::TempDir dir;
+  const std::string database = (dir / "db.db").string();
+  {
+    Database db(database, Database::OpenMode::kCreate);
+    const camera_t camera = db.WriteCamera(Camera::FromModelName("SIMPLE_RADIAL", 700, 960, 540));
+    FeatureKeypoints keypoints;
+    for (int k = 0; k < 30; ++k) keypoints.push_back(FeatureKeypoint::FromScaleOrientation(100 + 20 * k, 270, 2, 0));
+    FeatureMatches matches;
+    for (point2D_t k = 0; k < 30; ++k) matches.push_back({k, k});
+    TwoViewGeometry geometry;
+    geometry.config = TwoViewGeometryConfig::kCalibrated;
+    geometry.inlier_matches = matches;
+    for (int i = 0; i < 20; ++i) {
+      DatabaseImage image;
+      image.name = std::to_string(i) + ".png";
+      image.camera_id = camera;
+      const image_t id = db.WriteImage(image);
+      db.WriteKeypoints(id, keypoints);
+      if (i % 10 == 0) continue;  // the first of a strip
+      db.WriteMatches(id - 1, id, matches);
+      db.WriteTwoViewGeometry(id - 1, id, geometry);
+    }
+  }
+  const fs::path output = dir / "hierarchical";
+  const testing::CommandResult run = testing::RunCommand(
+      testing::PortcalBinary() + " hierarchical_mapper --log_level info --database_path " + database +
+      " --output_path " + output.string() + " --Hierarchical.leaf_max_num_images 10 --Hierarchical.image_overlap 2");
+  EXPECT_NE(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("2 clusters"), std::string::npos) << run.output;
+  for (const std::string cluster : {"cluster 0 (", "cluster 1 ("}) {
+    const size_t at = run.output.find(cluster);
+    ASSERT_NE(at, std::string::npos) << cluster << "\n" << run.output;
+    EXPECT_NE(run.output.find("images) could not be mapped and is left out", at), std::string::npos) << run.output;
+  }
+  EXPECT_NE(run.output.find("no cluster of " + database + " could be mapped"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(output));
 }
 
 }  // namespace
