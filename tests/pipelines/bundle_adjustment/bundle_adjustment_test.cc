@@ -3,6 +3,7 @@
 // against the full one, unobservable directions named.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <functional>
 #include <random>
 
@@ -114,6 +115,97 @@ TEST(CalibrationCovariance, MarginalMatchesTheFullCovariance) {
     EXPECT_LT(vab, 0);
     EXPECT_NEAR(marginal.Correlation(&a, 0, &b, 0), vab / std::sqrt(va * vb), 1e-9);
     EXPECT_NEAR(marginal.Correlation(&b, 0, &a, 0), marginal.Correlation(&a, 0, &b, 0), 1e-12);
+  }
+}
+
+// Points seen in three frames, y = R(q) p + t, frame 0 held: the frames'
+// rotations on Ceres' quaternion manifold, a translation with one
+// coordinate held by a subset manifold, several blocks in each residual
+// in either order of the reduced system's columns. The marginal
+// covariance, assembled point by point from the residual blocks' own
+// Jacobians and the manifolds' plus Jacobians, must equal ceres::Covariance
+// on the full problem, in ambient coordinates.
+struct FramedPoint {
+  explicit FramedPoint(const Eigen::Vector3d& y) : y_(y) {}
+  template <typename T>
+  bool operator()(const T* q, const T* t, const T* p, T* r) const {
+    const Eigen::Quaternion<T> rotation(q[3], q[0], q[1], q[2]);  // Eigen's x, y, z, w storage
+    Eigen::Map<Eigen::Matrix<T, 3, 1>> residual(r);
+    residual = rotation * Eigen::Map<const Eigen::Matrix<T, 3, 1>>(p) + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t) -
+               y_.cast<T>();
+    return true;
+  }
+  Eigen::Vector3d y_;
+};
+
+TEST(CalibrationCovariance, ManifoldBlocksMatchTheFullCovariance) {
+  std::mt19937 random(7);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  std::array<Eigen::Quaterniond, 3> rotations = {
+      Eigen::Quaterniond::Identity(), Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 0).normalized())),
+      Eigen::Quaterniond(Eigen::AngleAxisd(-0.5, Eigen::Vector3d(0, 1, 1).normalized()))};
+  const std::array<Eigen::Vector3d, 3> translations = {Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 0, 0.5),
+                                                       Eigen::Vector3d(-0.5, 1, 0)};
+  std::array<Eigen::Vector4d, 3> q;  // x, y, z, w
+  std::array<Eigen::Vector3d, 3> t;
+  for (int k = 0; k < 3; ++k) {
+    q[k] = rotations[k].coeffs();
+    t[k] = translations[k] + Eigen::Vector3d(0.05, -0.02, 0.03) * k;  // a start off the truth
+  }
+  std::vector<Eigen::Vector3d> p(15);
+  ceres::Problem problem;
+  for (size_t i = 0; i < p.size(); ++i) {
+    const Eigen::Vector3d truth(std::cos(i * 0.7) * 2, std::sin(i * 1.3), 3 + 0.2 * i);
+    p[i] = truth;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d error(noise(random), noise(random), noise(random));
+      const Eigen::Vector3d y = rotations[k] * truth + translations[k] + error;
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FramedPoint, 3, 4, 3, 3>(new FramedPoint(y)), nullptr,
+                               q[k].data(), t[k].data(), p[i].data());
+    }
+  }
+  for (int k = 0; k < 3; ++k) problem.SetManifold(q[k].data(), new ceres::EigenQuaternionManifold);
+  problem.SetManifold(t[2].data(), new ceres::SubsetManifold(3, {2}));
+  problem.SetParameterBlockConstant(q[0].data());
+  problem.SetParameterBlockConstant(t[0].data());
+  ceres::Solver::Options options;
+  options.function_tolerance = 1e-14;
+  options.gradient_tolerance = 1e-14;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.BriefReport();
+
+  // The reduced system's columns in an order unlike the residuals'.
+  const std::vector<const double*> wanted = {t[1].data(), q[2].data(), q[1].data(), t[2].data()};
+  std::vector<double*> others;
+  for (const double* block : wanted) others.push_back(const_cast<double*>(block));
+  std::vector<double*> points;
+  for (Eigen::Vector3d& point : p) points.push_back(point.data());
+  ceres::Covariance::Options covariance_options;
+  ceres::Covariance covariance(covariance_options);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (const double* a : wanted) {
+    for (const double* b : wanted) pairs.emplace_back(a, b);
+  }
+  ASSERT_TRUE(covariance.Compute(pairs, &problem));
+  for (const int max_dense_size : {1200, 0}) {
+    SCOPED_TRACE(max_dense_size == 0 ? "sparse" : "dense");
+    const MarginalCovariance marginal = ComputeMarginalCovariance(
+        &problem, points, others, wanted, 1.0, [](const double*, int) { return std::string("?"); }, nullptr,
+        max_dense_size);
+    for (const double* a : wanted) {
+      for (const double* b : wanted) {
+        const int na = problem.ParameterBlockSize(a), nb = problem.ParameterBlockSize(b);
+        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> expected(na, nb);
+        covariance.GetCovarianceBlock(a, b, expected.data());
+        const Eigen::MatrixXd got = marginal.covariance.block(marginal.offset.at(a), marginal.offset.at(b), na, nb);
+        EXPECT_LT((got - expected).norm(), 1e-8 * expected.norm() + 1e-15) << "expected\n" << expected << "\ngot\n"
+                                                                        << got;
+      }
+    }
+    // The held coordinate has no variance.
+    EXPECT_EQ(marginal.StdDevs(t[2].data())[2], 0.0);
+    EXPECT_GT(marginal.StdDevs(t[2].data())[0], 0.0);
   }
 }
 
