@@ -1,6 +1,7 @@
 #include "pipelines/bundle_adjustment/point_schur.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cstdint>
 
 #include "colmap_ext/util/error.h"

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Sparse>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <unordered_map>
