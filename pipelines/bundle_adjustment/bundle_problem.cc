@@ -477,7 +477,8 @@ void BundleProblem::ComputeStdDevs(const ceres::Solver::Summary& summary, Calibr
   const auto start = std::chrono::steady_clock::now();
   const auto describe = [this](const double* block, int index) { return Describe(block, index); };
   const MarginalCovariance marginal =
-      ComputeMarginalCovariance(&problem_, points, others, wanted, scale, describe, &clusters);
+      ComputeMarginalCovariance(&problem_, points, others, wanted, scale, describe, &clusters,
+                                /*max_dense_size=*/1200, options_.num_threads);
   LOG(INFO) << "bundle adjustment: covariance of " << others.size() << " pose and calibration blocks, "
             << points.size() << " points marginalised, clustered by " << marginal.num_clusters << " images and "
             << marginal.num_tracks << " tracks: "

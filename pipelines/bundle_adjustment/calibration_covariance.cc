@@ -319,8 +319,8 @@ MarginalCovariance ComputeMarginalCovariance(
     ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others,
     const std::vector<const double*>& wanted, double scale,
     const std::function<std::string(const double*, int)>& describe, const ResidualClusters* clusters,
-    int max_dense_size) {
-  const PointSchurComplement schur(problem, points, others);
+    int max_dense_size, int num_threads) {
+  const PointSchurComplement schur(problem, points, others, num_threads);
   const int nc = schur.num_columns();
   // Each residual block's clusters and the weight of its gradient: the
   // loss's derivative rho'(|r|^2) (at the solution the robust gradient,

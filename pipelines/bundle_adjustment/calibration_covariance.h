@@ -76,11 +76,12 @@ struct ResidualClusters {
 // system is decomposed densely up to `max_dense_size` tangent parameters
 // (the rank test then finds the unobservable direction itself), beyond it
 // by a sparse LDL' factorisation (a survey of thousands of images: the
-// test names the parameter at the vanishing pivot).
+// test names the parameter at the vanishing pivot). The residuals are
+// linearised on `num_threads` threads.
 MarginalCovariance ComputeMarginalCovariance(
     ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others,
     const std::vector<const double*>& wanted, double scale,
     const std::function<std::string(const double*, int)>& describe, const ResidualClusters* clusters = nullptr,
-    int max_dense_size = 1200);
+    int max_dense_size = 1200, int num_threads = 1);
 
 }  // namespace portcal

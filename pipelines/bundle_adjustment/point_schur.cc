@@ -3,6 +3,8 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cstdint>
+#include <exception>
+#include <thread>
 
 #include "colmap_ext/util/error.h"
 
@@ -38,11 +40,44 @@ Eigen::Matrix3d PseudoInverse(const Eigen::Matrix3d& information) {
   return eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
 }
 
+// Runs work(begin, end, thread) on `num_threads` threads over contiguous
+// ranges of [0, count); the first exception is rethrown after all ended.
+void ForEachRange(size_t count, int num_threads, const std::function<void(size_t, size_t, int)>& work) {
+  const size_t threads = std::max<size_t>(1, std::min<size_t>(static_cast<size_t>(num_threads), count));
+  if (threads == 1) return work(0, count, 0);
+  std::vector<std::exception_ptr> errors(threads);
+  std::vector<std::thread> running;
+  for (size_t t = 0; t < threads; ++t) {
+    running.emplace_back([&, t] {
+      try {
+        work(count * t / threads, count * (t + 1) / threads, static_cast<int>(t));
+      } catch (...) {
+        errors[t] = std::current_exception();
+      }
+    });
+  }
+  for (std::thread& thread : running) thread.join();
+  for (const std::exception_ptr& error : errors) {
+    if (error) std::rethrow_exception(error);
+  }
+}
+
+void AddPair(int a, int b, const Eigen::MatrixXd& value, std::unordered_map<uint64_t, Eigen::MatrixXd>* pairs) {
+  if (a > b) return AddPair(b, a, value.transpose(), pairs);
+  const uint64_t key = (static_cast<uint64_t>(a) << 32) | static_cast<uint32_t>(b);
+  const auto [it, inserted] = pairs->try_emplace(key);
+  if (inserted) {
+    it->second = value;
+  } else {
+    it->second += value;
+  }
+}
+
 }  // namespace
 
 PointSchurComplement::PointSchurComplement(ceres::Problem* problem, const std::vector<double*>& points,
-                                           const std::vector<double*>& others)
-    : problem_(problem) {
+                                           const std::vector<double*>& others, int num_threads)
+    : problem_(problem), num_threads_(std::max(1, num_threads)) {
   for (size_t p = 0; p < points.size(); ++p) {
     PORTCAL_CHECK_MSG(problem->ParameterBlockTangentSize(points[p]) == 3 && !problem->GetManifold(points[p]),
                       "a marginalised point must be a plain 3-vector");
@@ -87,11 +122,22 @@ PointSchurComplement::PointSchurComplement(ceres::Problem* problem, const std::v
   std::vector<size_t> next(first_.begin(), first_.end() - 1);
   for (size_t k = 0; k < residual_blocks_.size(); ++k) by_point_[next[point_of[k]]++] = k;
 
+  // Each thread sums its points' shares of S; the sums are added after.
   squared_norms_.assign(residual_blocks_.size(), 0.0);
-  std::vector<Linearised> linearised;
-  for (size_t p = 0; p <= num_points; ++p) Reduce(static_cast<int>(p), &linearised);
+  std::vector<PairBlocks> pairs(static_cast<size_t>(num_threads_));
+  ForEachRange(num_points + 1, num_threads_, [&](size_t begin, size_t end, int thread) {
+    std::vector<Linearised> linearised;
+    for (size_t p = begin; p < end; ++p) Reduce(p, &linearised, &pairs[static_cast<size_t>(thread)]);
+  });
+  for (size_t t = 1; t < pairs.size(); ++t) {
+    for (const auto& [key, value] : pairs[t]) {
+      const auto [it, inserted] = pairs[0].try_emplace(key, value);
+      if (!inserted) it->second += value;
+    }
+    pairs[t] = {};
+  }
   std::vector<Eigen::Triplet<double>> entries;
-  for (const auto& [key, value] : pairs_) {
+  for (const auto& [key, value] : pairs[0]) {
     const int a = static_cast<int>(key >> 32), b = static_cast<int>(key & 0xffffffffu);
     for (Eigen::Index i = 0; i < value.rows(); ++i) {
       for (Eigen::Index j = 0; j < value.cols(); ++j) {
@@ -100,7 +146,7 @@ PointSchurComplement::PointSchurComplement(ceres::Problem* problem, const std::v
       }
     }
   }
-  pairs_ = {};
+  pairs = {};
   reduced_.resize(num_columns_, num_columns_);
   reduced_.setFromTriplets(entries.begin(), entries.end());
 }
@@ -143,8 +189,9 @@ void PointSchurComplement::Linearise(size_t block, Linearised* out) const {
 
 // Linearises the residual blocks of `point` (num_points: those of no point)
 // and sums the point's blocks of J'J.
-void PointSchurComplement::AccumulatePoint(int point, std::vector<Linearised>* linearised, PointBlocks* local) const {
-  const size_t begin = first_[static_cast<size_t>(point)], end = first_[static_cast<size_t>(point) + 1];
+void PointSchurComplement::AccumulatePoint(size_t point, std::vector<Linearised>* linearised,
+                                           PointBlocks* local) const {
+  const size_t begin = first_[point], end = first_[point + 1];
   linearised->resize(end - begin);
   *local = PointBlocks();
   for (size_t k = begin; k < end; ++k) {
@@ -165,29 +212,18 @@ void PointSchurComplement::AccumulatePoint(int point, std::vector<Linearised>* l
   if (!local->point_other.empty()) local->pinv = PseudoInverse(local->point_point);
 }
 
-void PointSchurComplement::AddToReduced(int a, int b, const Eigen::MatrixXd& value) {
-  if (a > b) return AddToReduced(b, a, value.transpose());
-  const uint64_t key = (static_cast<uint64_t>(a) << 32) | static_cast<uint32_t>(b);
-  const auto [it, inserted] = pairs_.try_emplace(key);
-  if (inserted) {
-    it->second = value;
-  } else {
-    it->second += value;
-  }
-}
-
 // Adds the point's share of S: its residuals' J_c'J_c, less H_cp H_pp^+ H_pc.
-void PointSchurComplement::Reduce(int point, std::vector<Linearised>* linearised) {
+void PointSchurComplement::Reduce(size_t point, std::vector<Linearised>* linearised, PairBlocks* pairs) {
   PointBlocks local;
   AccumulatePoint(point, linearised, &local);
-  const size_t begin = first_[static_cast<size_t>(point)];
+  const size_t begin = first_[point];
   for (size_t k = 0; k < linearised->size(); ++k) {
     const Linearised& block = (*linearised)[k];
     squared_norms_[by_point_[begin + k]] = block.residual.squaredNorm();
     for (size_t i = 0; i < block.others.size(); ++i) {
       for (size_t j = i; j < block.others.size(); ++j) {
-        AddToReduced(block.others[i].first, block.others[j].first,
-                     block.others[i].second.transpose() * block.others[j].second);
+        AddPair(block.others[i].first, block.others[j].first,
+                block.others[i].second.transpose() * block.others[j].second, pairs);
       }
     }
   }
@@ -196,8 +232,8 @@ void PointSchurComplement::Reduce(int point, std::vector<Linearised>* linearised
   for (size_t i = 0; i < local.point_other.size(); ++i) {
     for (size_t j = 0; j < local.point_other.size(); ++j) {
       if (local.point_other[j].first < local.point_other[i].first) continue;
-      AddToReduced(local.point_other[i].first, local.point_other[j].first,
-                   -local.point_other[i].second.transpose() * response[j]);
+      AddPair(local.point_other[i].first, local.point_other[j].first,
+              -local.point_other[i].second.transpose() * response[j], pairs);
     }
   }
 }
@@ -205,31 +241,51 @@ void PointSchurComplement::Reduce(int point, std::vector<Linearised>* linearised
 void PointSchurComplement::VisitReducedGradients(
     const Eigen::MatrixXd& gain, const std::vector<double>& weights,
     const std::function<void(size_t, const Eigen::VectorXd&)>& visit) const {
+  // In batches of points: the threads' effects wait for the visit, and a
+  // batch's are a few MB.
+  constexpr size_t kBatch = 4096;
+  const size_t count = first_.size() - 1;  // the points and the blocks of none
+  std::vector<std::vector<std::pair<size_t, Eigen::VectorXd>>> effects(static_cast<size_t>(num_threads_));
+  for (size_t batch = 0; batch < count; batch += kBatch) {
+    const size_t size = std::min(kBatch, count - batch);
+    ForEachRange(size, num_threads_, [&](size_t begin, size_t end, int thread) {
+      std::vector<std::pair<size_t, Eigen::VectorXd>>& out = effects[static_cast<size_t>(thread)];
+      out.clear();
+      for (size_t p = batch + begin; p < batch + end; ++p) ReducedGradientsOf(p, gain, weights, &out);
+    });
+    for (auto& thread : effects) {
+      for (const auto& [index, effect] : thread) visit(index, effect);
+      thread.clear();
+    }
+  }
+}
+
+void PointSchurComplement::ReducedGradientsOf(size_t point, const Eigen::MatrixXd& gain,
+                                              const std::vector<double>& weights,
+                                              std::vector<std::pair<size_t, Eigen::VectorXd>>* out) const {
   std::vector<Linearised> linearised;
   PointBlocks local;
+  AccumulatePoint(point, &linearised, &local);
   const Eigen::Index rows = gain.rows();
-  for (size_t p = 0; p + 1 < first_.size(); ++p) {
-    AccumulatePoint(static_cast<int>(p), &linearised, &local);
-    // gain H_cp H_pp^+: how the point's least-squares response carries a
-    // residual's pull on the point into the other blocks.
-    Eigen::MatrixXd point_gain = Eigen::MatrixXd::Zero(rows, 3);
-    for (const auto& [other, point_other] : local.point_other) {
-      point_gain += gain.middleCols(start_[static_cast<size_t>(other)], size_[static_cast<size_t>(other)]) *
-                    point_other.transpose();
+  // gain H_cp H_pp^+: how the point's least-squares response carries a
+  // residual's pull on the point into the other blocks.
+  Eigen::MatrixXd point_gain = Eigen::MatrixXd::Zero(rows, 3);
+  for (const auto& [other, point_other] : local.point_other) {
+    point_gain += gain.middleCols(start_[static_cast<size_t>(other)], size_[static_cast<size_t>(other)]) *
+                  point_other.transpose();
+  }
+  point_gain = point_gain * local.pinv;
+  for (size_t k = 0; k < linearised.size(); ++k) {
+    const size_t index = by_point_[first_[point] + k];
+    const Linearised& block = linearised[k];
+    const Eigen::VectorXd weighted = weights[index] * block.residual;
+    Eigen::VectorXd effect = Eigen::VectorXd::Zero(rows);
+    for (const auto& [other, jacobian] : block.others) {
+      effect.noalias() += gain.middleCols(start_[static_cast<size_t>(other)], size_[static_cast<size_t>(other)]) *
+                          (jacobian.transpose() * weighted);
     }
-    point_gain = point_gain * local.pinv;
-    for (size_t k = 0; k < linearised.size(); ++k) {
-      const size_t index = by_point_[first_[p] + k];
-      const Linearised& block = linearised[k];
-      const Eigen::VectorXd weighted = weights[index] * block.residual;
-      Eigen::VectorXd effect = Eigen::VectorXd::Zero(rows);
-      for (const auto& [other, jacobian] : block.others) {
-        effect.noalias() += gain.middleCols(start_[static_cast<size_t>(other)], size_[static_cast<size_t>(other)]) *
-                            (jacobian.transpose() * weighted);
-      }
-      if (block.point.rows() > 0) effect.noalias() -= point_gain * (block.point.transpose() * weighted);
-      visit(index, effect);
-    }
+    if (block.point.rows() > 0) effect.noalias() -= point_gain * (block.point.transpose() * weighted);
+    out->emplace_back(index, std::move(effect));
   }
 }
 

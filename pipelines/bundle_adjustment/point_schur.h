@@ -24,8 +24,10 @@ class PointSchurComplement {
   // `points`: 3-parameter blocks to marginalise (a residual block may touch
   // at most one); `others`: the other variable blocks, whose tangent
   // columns are S's, in this order. Blocks in neither list are taken as
-  // held. Throws NumericalError when a residual cannot be evaluated.
-  PointSchurComplement(ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others);
+  // held. The points are shared among `num_threads` threads. Throws
+  // NumericalError when a residual cannot be evaluated.
+  PointSchurComplement(ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others,
+                       int num_threads = 1);
 
   int num_columns() const { return num_columns_; }
   // Tangent column of each other block's first coordinate.
@@ -40,19 +42,24 @@ class PointSchurComplement {
   // For each residual block k (index into residual_blocks()): gain *
   // (J_c' - H_cp H_pp^+ J_p') weights[k] r_k, its weighted gradient with
   // the points' response removed, mapped by `gain` (rows x num_columns).
+  // Computed on the threads, visited on the caller's, in point order.
   void VisitReducedGradients(const Eigen::MatrixXd& gain, const std::vector<double>& weights,
                              const std::function<void(size_t, const Eigen::VectorXd&)>& visit) const;
 
  private:
   struct Linearised;
   struct PointBlocks;
+  // Blocks of S by pairs of other blocks (a <= b, key a << 32 | b).
+  using PairBlocks = std::unordered_map<uint64_t, Eigen::MatrixXd>;
 
   void Linearise(size_t block, Linearised* out) const;
-  void AccumulatePoint(int point, std::vector<Linearised>* linearised, PointBlocks* local) const;
-  void AddToReduced(int a, int b, const Eigen::MatrixXd& value);
-  void Reduce(int point, std::vector<Linearised>* linearised);
+  void AccumulatePoint(size_t point, std::vector<Linearised>* linearised, PointBlocks* local) const;
+  void Reduce(size_t point, std::vector<Linearised>* linearised, PairBlocks* pairs);
+  void ReducedGradientsOf(size_t point, const Eigen::MatrixXd& gain, const std::vector<double>& weights,
+                          std::vector<std::pair<size_t, Eigen::VectorXd>>* out) const;
 
   ceres::Problem* problem_;
+  int num_threads_ = 1;
   std::unordered_map<const double*, int> point_index_;
   std::unordered_map<const double*, int> other_index_;
   std::vector<int> start_, size_;      // each other block's tangent columns
@@ -64,8 +71,6 @@ class PointSchurComplement {
   // Residual blocks of point p: by_point_[first_[p] .. first_[p + 1]); the
   // blocks of no point after first_[num_points].
   std::vector<size_t> first_, by_point_;
-  // S by pairs of other blocks (a <= b), then as a sparse matrix.
-  std::unordered_map<uint64_t, Eigen::MatrixXd> pairs_;
   Eigen::SparseMatrix<double> reduced_;
 };
 

@@ -188,11 +188,11 @@ TEST(CalibrationCovariance, ManifoldBlocksMatchTheFullCovariance) {
     for (const double* b : wanted) pairs.emplace_back(a, b);
   }
   ASSERT_TRUE(covariance.Compute(pairs, &problem));
-  for (const int max_dense_size : {1200, 0}) {
-    SCOPED_TRACE(max_dense_size == 0 ? "sparse" : "dense");
+  for (const auto& [max_dense_size, threads] : {std::pair(1200, 1), std::pair(0, 1), std::pair(1200, 2)}) {
+    SCOPED_TRACE(std::string(max_dense_size == 0 ? "sparse" : "dense") + ", threads " + std::to_string(threads));
     const MarginalCovariance marginal = ComputeMarginalCovariance(
         &problem, points, others, wanted, 1.0, [](const double*, int) { return std::string("?"); }, nullptr,
-        max_dense_size);
+        max_dense_size, threads);
     for (const double* a : wanted) {
       for (const double* b : wanted) {
         const int na = problem.ParameterBlockSize(a), nb = problem.ParameterBlockSize(b);
@@ -356,12 +356,13 @@ TEST(CalibrationCovariance, ClusteredCovarianceSumsEachClustersExactEffect) {
   for (int k = 0; k < kImages; ++k) clusters.image_of_block[&offsets[k]] = k;
   clusters.residuals_per_dof = kResidualsPerDof;
   const auto describe = [](const double*, int) { return std::string("?"); };
-  for (const int max_dense_size : {1200, 0}) {
+  // Dense on one thread, sparse on two (the effects computed on both).
+  for (const auto& [max_dense_size, threads] : {std::pair(1200, 1), std::pair(0, 2)}) {
     for (const bool two : {true, false}) {
       SCOPED_TRACE(std::string(two ? "two-way" : "by image") + (max_dense_size == 0 ? ", sparse" : ", dense"));
       clusters.by_track = two;
-      const MarginalCovariance marginal =
-          ComputeMarginalCovariance(&problem, points, {&a, &b}, {&a, &b}, 1.0, describe, &clusters, max_dense_size);
+      const MarginalCovariance marginal = ComputeMarginalCovariance(&problem, points, {&a, &b}, {&a, &b}, 1.0,
+                                                                    describe, &clusters, max_dense_size, threads);
       const Eigen::Matrix2d& expected = two ? two_way : by_image;
       EXPECT_EQ(marginal.num_clusters, kImages);
       EXPECT_EQ(marginal.num_tracks, two ? kSamples : 0);
