@@ -78,17 +78,37 @@ void AddPair(int a, int b, const Eigen::MatrixXd& value, std::unordered_map<uint
 PointSchurComplement::PointSchurComplement(ceres::Problem* problem, const std::vector<double*>& points,
                                            const std::vector<double*>& others, int num_threads)
     : problem_(problem), num_threads_(std::max(1, num_threads)) {
+  IndexBlocks(points, others);
+  GroupByPoint(points.size());
+  // Each thread sums its points' shares of S; the sums are added after.
+  squared_norms_.assign(residual_blocks_.size(), 0.0);
+  std::vector<PairBlocks> pairs(static_cast<size_t>(num_threads_));
+  ForEachRange(points.size() + 1, num_threads_, [&](size_t begin, size_t end, int thread) {
+    std::vector<Linearised> linearised;
+    for (size_t p = begin; p < end; ++p) Reduce(p, &linearised, &pairs[static_cast<size_t>(thread)]);
+  });
+  for (size_t t = 1; t < pairs.size(); ++t) {
+    for (const auto& [key, value] : pairs[t]) {
+      const auto [it, inserted] = pairs[0].try_emplace(key, value);
+      if (!inserted) it->second += value;
+    }
+    pairs[t] = {};
+  }
+  Assemble(pairs[0]);
+}
+
+void PointSchurComplement::IndexBlocks(const std::vector<double*>& points, const std::vector<double*>& others) {
   for (size_t p = 0; p < points.size(); ++p) {
-    PORTCAL_CHECK_MSG(problem->ParameterBlockTangentSize(points[p]) == 3 && !problem->GetManifold(points[p]),
+    PORTCAL_CHECK_MSG(problem_->ParameterBlockTangentSize(points[p]) == 3 && !problem_->GetManifold(points[p]),
                       "a marginalised point must be a plain 3-vector");
     point_index_[points[p]] = static_cast<int>(p);
   }
   for (double* block : others) {
     other_index_[block] = static_cast<int>(start_.size());
-    const int tangent = problem->ParameterBlockTangentSize(block);
-    const int ambient = problem->ParameterBlockSize(block);
+    const int tangent = problem_->ParameterBlockTangentSize(block);
+    const int ambient = problem_->ParameterBlockSize(block);
     Eigen::MatrixXd plus;
-    if (const ceres::Manifold* manifold = problem->GetManifold(block)) {
+    if (const ceres::Manifold* manifold = problem_->GetManifold(block)) {
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> jacobian(ambient, tangent);
       manifold->PlusJacobian(block, jacobian.data());
       plus = jacobian;
@@ -100,15 +120,16 @@ PointSchurComplement::PointSchurComplement(ceres::Problem* problem, const std::v
     num_columns_ += tangent;
   }
   if (num_columns_ == 0) throw NumericalError("covariance: no free parameters");
+}
 
-  // The residual blocks by point (a counting sort), those of no point last.
-  problem->GetResidualBlocks(&residual_blocks_);
-  const size_t num_points = points.size();
+// The residual blocks by point (a counting sort), those of no point last.
+void PointSchurComplement::GroupByPoint(size_t num_points) {
+  problem_->GetResidualBlocks(&residual_blocks_);
   std::vector<size_t> point_of(residual_blocks_.size(), num_points);
   std::vector<double*> blocks;
   first_.assign(num_points + 2, 0);
   for (size_t k = 0; k < residual_blocks_.size(); ++k) {
-    problem->GetParameterBlocksForResidualBlock(residual_blocks_[k], &blocks);
+    problem_->GetParameterBlocksForResidualBlock(residual_blocks_[k], &blocks);
     for (double* block : blocks) {
       const auto it = point_index_.find(block);
       if (it == point_index_.end()) continue;
@@ -121,23 +142,12 @@ PointSchurComplement::PointSchurComplement(ceres::Problem* problem, const std::v
   by_point_.resize(residual_blocks_.size());
   std::vector<size_t> next(first_.begin(), first_.end() - 1);
   for (size_t k = 0; k < residual_blocks_.size(); ++k) by_point_[next[point_of[k]]++] = k;
+}
 
-  // Each thread sums its points' shares of S; the sums are added after.
-  squared_norms_.assign(residual_blocks_.size(), 0.0);
-  std::vector<PairBlocks> pairs(static_cast<size_t>(num_threads_));
-  ForEachRange(num_points + 1, num_threads_, [&](size_t begin, size_t end, int thread) {
-    std::vector<Linearised> linearised;
-    for (size_t p = begin; p < end; ++p) Reduce(p, &linearised, &pairs[static_cast<size_t>(thread)]);
-  });
-  for (size_t t = 1; t < pairs.size(); ++t) {
-    for (const auto& [key, value] : pairs[t]) {
-      const auto [it, inserted] = pairs[0].try_emplace(key, value);
-      if (!inserted) it->second += value;
-    }
-    pairs[t] = {};
-  }
+// S from its blocks, both triangles.
+void PointSchurComplement::Assemble(const PairBlocks& pairs) {
   std::vector<Eigen::Triplet<double>> entries;
-  for (const auto& [key, value] : pairs[0]) {
+  for (const auto& [key, value] : pairs) {
     const int a = static_cast<int>(key >> 32), b = static_cast<int>(key & 0xffffffffu);
     for (Eigen::Index i = 0; i < value.rows(); ++i) {
       for (Eigen::Index j = 0; j < value.cols(); ++j) {
@@ -146,7 +156,6 @@ PointSchurComplement::PointSchurComplement(ceres::Problem* problem, const std::v
       }
     }
   }
-  pairs = {};
   reduced_.resize(num_columns_, num_columns_);
   reduced_.setFromTriplets(entries.begin(), entries.end());
 }

@@ -52,6 +52,9 @@ class PointSchurComplement {
   // Blocks of S by pairs of other blocks (a <= b, key a << 32 | b).
   using PairBlocks = std::unordered_map<uint64_t, Eigen::MatrixXd>;
 
+  void IndexBlocks(const std::vector<double*>& points, const std::vector<double*>& others);
+  void GroupByPoint(size_t num_points);
+  void Assemble(const PairBlocks& pairs);
   void Linearise(size_t block, Linearised* out) const;
   void AccumulatePoint(size_t point, std::vector<Linearised>* linearised, PointBlocks* local) const;
   void Reduce(size_t point, std::vector<Linearised>* linearised, PairBlocks* pairs);
