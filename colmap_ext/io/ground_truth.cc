@@ -121,7 +121,8 @@ class Reader {
         for (const YAML::Node& c : m["corners_px"]) {
           if (k >= 4) Fail(where + " markers", "more than 4 corners");
           const auto v = c.as<std::vector<double>>();
-          marker.corners_px[k++] = {v.at(0), v.at(1)};
+          if (v.size() != 2) Fail(where + " markers", "expected corners of 2 numbers");
+          marker.corners_px[k++] = {v[0], v[1]};
         }
         if (k != 4) Fail(where + " markers", "expected 4 corners");
         marker.fully_inside = m["fully_inside"] ? m["fully_inside"].as<bool>() : true;
@@ -180,8 +181,9 @@ class Reader {
         if (f["extent_xy"]) {
           const auto x = f["extent_xy"][0].as<std::vector<double>>();
           const auto y = f["extent_xy"][1].as<std::vector<double>>();
-          face.extent_x = {x.at(0), x.at(1)};
-          face.extent_y = {y.at(0), y.at(1)};
+          if (x.size() != 2 || y.size() != 2) Fail("target.faces extent_xy", "expected two pairs of numbers");
+          face.extent_x = {x[0], x[1]};
+          face.extent_y = {y[0], y[1]};
         }
         face.marker_id = Get<int>(f, "marker_id");
         face.marker_side = Finite(f, "marker_side");
