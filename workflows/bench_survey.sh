@@ -15,7 +15,8 @@
 # from their side instead of the navigation (which then only pairs images
 # for matching): compare the similarity-aligned scale and positions. A
 # markers run wants its own WORK_DIR (the renders differ).
-# Usage: [SCALE=navigation|markers] workflows/bench_survey.sh [NUM_IMAGES=300] [WORK_DIR=temporary]
+# RENDER_SPP=2 renders 4 x faster (see survey_common.sh).
+# Usage: [SCALE=navigation|markers] [RENDER_SPP=4] workflows/bench_survey.sh [NUM_IMAGES=300] [WORK_DIR=temporary]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ -x build/portcal ] || bash workflows/setup.sh >/dev/null

@@ -7,7 +7,9 @@ bash workflows/setup.sh --packages-only time >/dev/null  # GNU time, for the pea
 # rough seabed behind a flat port tilted 3 deg (960 x 540, known in-air
 # intrinsics, navigation positions with 2 cm noise), as synthesize's config;
 # with MARKERS > 0, that many ArUco markers of 15 cm lie on the seabed where
-# the survey starts (a grid 1.5 m apart).
+# the survey starts (a grid 1.5 m apart). RENDER_SPP (default 4) sets the
+# renderer's samples per pixel side (spp^2 rays a pixel): the render's time
+# goes with its square, the stages after it see nearly the same images.
 survey_yaml() {
   local markers=""
   [ "${3:-0}" -gt 0 ] && markers=",
@@ -19,7 +21,7 @@ camera: {model: RADIAL, width: 960, height: 540, params: [700.0, 480.0, 270.0, 0
 housing: {model: FLATPORT, params: [0.0523360, 0.0, 0.9986295, 0.02, 0.010, 1.0, 1.473, 1.334]}
 survey: {height: 2.0, speed: 0.5, frame_rate: 1.0, side_overlap: 0.6, line_length: 15.0,
          roughness: 0.15, relief_wavelength: 2.0, navigation_sigma: 0.02$markers}
-render: {spp: 4, noise_sigma: 1.0, white: 220, black: 30, background: 110}
+render: {spp: ${RENDER_SPP:-4}, noise_sigma: 1.0, white: 220, black: 30, background: 110}
 YAML
 }
 

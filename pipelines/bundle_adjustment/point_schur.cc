@@ -260,7 +260,8 @@ void PointSchurComplement::VisitReducedGradients(
     ForEachRange(size, num_threads_, [&](size_t begin, size_t end, int thread) {
       std::vector<std::pair<size_t, Eigen::VectorXd>>& out = effects[static_cast<size_t>(thread)];
       out.clear();
-      for (size_t p = batch + begin; p < batch + end; ++p) ReducedGradientsOf(p, gain, weights, &out);
+      std::vector<Linearised> linearised;  // scratch, reused point after point
+      for (size_t p = batch + begin; p < batch + end; ++p) ReducedGradientsOf(p, gain, weights, &linearised, &out);
     });
     for (auto& thread : effects) {
       for (const auto& [index, effect] : thread) visit(index, effect);
@@ -271,10 +272,11 @@ void PointSchurComplement::VisitReducedGradients(
 
 void PointSchurComplement::ReducedGradientsOf(size_t point, const Eigen::MatrixXd& gain,
                                               const std::vector<double>& weights,
+                                              std::vector<Linearised>* linearised_scratch,
                                               std::vector<std::pair<size_t, Eigen::VectorXd>>* out) const {
-  std::vector<Linearised> linearised;
   PointBlocks local;
-  AccumulatePoint(point, &linearised, &local);
+  AccumulatePoint(point, linearised_scratch, &local);
+  const std::vector<Linearised>& linearised = *linearised_scratch;
   const Eigen::Index rows = gain.rows();
   // gain H_cp H_pp^+: how the point's least-squares response carries a
   // residual's pull on the point into the other blocks.

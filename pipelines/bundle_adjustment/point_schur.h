@@ -59,6 +59,7 @@ class PointSchurComplement {
   void AccumulatePoint(size_t point, std::vector<Linearised>* linearised, PointBlocks* local) const;
   void Reduce(size_t point, std::vector<Linearised>* linearised, PairBlocks* pairs);
   void ReducedGradientsOf(size_t point, const Eigen::MatrixXd& gain, const std::vector<double>& weights,
+                          std::vector<Linearised>* linearised_scratch,
                           std::vector<std::pair<size_t, Eigen::VectorXd>>* out) const;
 
   ceres::Problem* problem_;

@@ -106,8 +106,11 @@ struct ShadedPixel {
   float path_length = 0;
 };
 
+// t_near holds, per subframe and object, where the last ray that hit it
+// did (0: none yet); the next sample, beside it, starts its search there.
 ShadedPixel ShadePixel(const RayMap& rays, const std::vector<std::vector<PreparedObject>>& subframes,
-                       const ImageFormationOptions& options, double background, int col, int row) {
+                       const ImageFormationOptions& options, double background, int col, int row,
+                       std::vector<double>* t_near) {
   const int spp2 = options.spp * options.spp;
   double sum = 0, length_sum = 0;
   int num_lengths = 0;
@@ -117,13 +120,17 @@ ShadedPixel ShadePixel(const RayMap& rays, const std::vector<std::vector<Prepare
       sum += subframes.size() * options.levels.invalid;
       continue;
     }
+    size_t near_index = 0;
     for (const auto& prepared : subframes) {
       double t_max = 1e300;
       Hit best;
       bool found = false;
       for (const PreparedObject& p : prepared) {
         Hit hit;
-        if (p.object->Intersect(p.rotation * origin + p.translation, p.rotation * dir, t_max, &hit)) {
+        double& near = (*t_near)[near_index++];
+        if (p.object->IntersectNear(p.rotation * origin + p.translation, p.rotation * dir, t_max, near,
+                                    &hit)) {
+          near = hit.t;
           best = hit;
           t_max = hit.t;
           found = true;
@@ -183,8 +190,9 @@ cv::Mat RenderImage(const RayMap& rays, const std::vector<PlacedObject>& objects
   cv::Mat image(height, width, CV_32F), path_length(height, width, CV_32F);
   ParallelFor(static_cast<size_t>(height), options.num_threads, [&](size_t row_index) {
     const int row = static_cast<int>(row_index);
+    std::vector<double> t_near(subframes.size() * objects.size(), 0.0);
     for (int col = 0; col < width; ++col) {
-      const ShadedPixel pixel = ShadePixel(rays, subframes, options, background, col, row);
+      const ShadedPixel pixel = ShadePixel(rays, subframes, options, background, col, row, &t_near);
       image.at<float>(row, col) = pixel.value;
       path_length.at<float>(row, col) = pixel.path_length;
     }

@@ -22,6 +22,12 @@ class SceneObject {
   // Nearest hit with 0 < t < t_max of origin + t dir (object frame, dir unit).
   virtual bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                          double t_max, Hit* hit) const = 0;
+  // The same for a ray beside one that hit this object at t_near (the
+  // renderer's neighbouring sample): objects found by iteration start there.
+  virtual bool IntersectNear(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
+                             double /*t_near*/, Hit* hit) const {
+    return Intersect(origin, dir, t_max, hit);
+  }
 };
 
 // A planar face z = 0 with a texture. The print faces the side its
@@ -57,6 +63,8 @@ class SeabedObject : public SceneObject {
                double wavelength_m, uint64_t seed);
   bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
                  Hit* hit) const override;
+  bool IntersectNear(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max, double t_near,
+                     Hit* hit) const override;
   double Height(double x, double y, Eigen::Vector2d* gradient = nullptr) const;
 
  private:
@@ -66,6 +74,8 @@ class SeabedObject : public SceneObject {
     double amplitude, phase;
   };
   std::vector<Wave> waves_;
+  bool IntersectFrom(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_start, double t_max,
+                     Hit* hit) const;
 };
 
 // An object placed in the camera frame of one image.
