@@ -20,7 +20,9 @@
 # "extract map refine"; extract includes the priors, masks and matching),
 # each on what the parts before it left in WORK_DIR (the stages write in
 # transactions, so a part cut short leaves its inputs as they were).
-# Usage: [SCALE=navigation|markers] [RENDER_SPP=4] [STAGES="extract map refine"] workflows/bench_survey.sh [NUM_IMAGES=300] [WORK_DIR=temporary]
+# LOG_LEVEL=debug (default warn) logs each stage's steps and their seconds.
+# Usage: [SCALE=navigation|markers] [RENDER_SPP=4] [STAGES="extract map refine"] [LOG_LEVEL=warn]
+#        workflows/bench_survey.sh [NUM_IMAGES=300] [WORK_DIR=temporary]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ -x build/portcal ] || bash workflows/setup.sh >/dev/null
@@ -34,6 +36,7 @@ case "$scale" in
   markers) num_markers=16; scale_flags=(--Markers.side_length 0.15) ;;
   *) echo "bench_survey.sh: SCALE=$scale: navigation or markers" >&2; exit 2 ;;
 esac
+log_level="${LOG_LEVEL:-warn}"
 stages=" ${STAGES:-extract map refine} "
 for stage in $stages; do
   case "$stage" in extract|map|refine) ;; *) echo "bench_survey.sh: STAGES: $stage: extract, map or refine" >&2; exit 2 ;; esac
@@ -41,27 +44,27 @@ done
 runs() { [[ "$stages" == *" $1 "* ]]; }
 survey_yaml survey_flat "$n" "$num_markers" > "$work/survey.yaml"
 cd "$work"
-[ -f set/ground_truth.yaml ] || timed render "$P" synthesize --log_level warn --config survey.yaml --output_path set --seed 3
+[ -f set/ground_truth.yaml ] || timed render "$P" synthesize --log_level "$log_level" --config survey.yaml --output_path set --seed 3
 if runs extract; then
   rm -rf db.db sparse refined
-  timed extract "$P" feature_extractor --log_level warn --database_path db.db --image_path set/images \
+  timed extract "$P" feature_extractor --log_level "$log_level" --database_path db.db --image_path set/images \
     --ImageReader.single_camera 1 --ImageReader.camera_model RADIAL --ImageReader.camera_params 700,480,270,0,0
-  "$P" pose_prior_importer --log_level warn --database_path db.db --input_path set/navigation.txt
+  "$P" pose_prior_importer --log_level "$log_level" --database_path db.db --input_path set/navigation.txt
   if [ "$scale" = markers ]; then
-    timed mask "$P" feature_masker --log_level warn --database_path db.db --image_path set/images \
+    timed mask "$P" feature_masker --log_level "$log_level" --database_path db.db --image_path set/images \
       --Mask.keep_all_features 1
   fi
   # Sequential pairs along each line, then the lines beside it by position.
-  timed match_sequential "$P" sequential_matcher --log_level warn --database_path db.db \
+  timed match_sequential "$P" sequential_matcher --log_level "$log_level" --database_path db.db \
     --SequentialMatching.overlap 5 --SequentialMatching.quadratic_overlap 0
-  timed match_spatial "$P" spatial_matcher --log_level warn --database_path db.db
+  timed match_spatial "$P" spatial_matcher --log_level "$log_level" --database_path db.db
 fi
 if runs map; then
   [ -f db.db ] || { echo "bench_survey.sh: $work/db.db: run STAGES=extract first" >&2; exit 2; }
   rm -rf sparse refined
   # The port is refined in the mapper's global adjustments, with the
   # navigation as the scale.
-  timed map "$P" refractive_mapper --log_level warn --database_path db.db --output_path sparse \
+  timed map "$P" refractive_mapper --log_level "$log_level" --database_path db.db --output_path sparse \
     --Housing.model FLATPORT --Housing.params 0,0,1,0.01,0.010,1,1.473,1.334 --Mapper.init_scene_depth 2.0 \
     --Mapper.ba_refine_focal_length 0 --Mapper.ba_refine_extra_params 0 --Mapper.ba_refine_housing 1 \
     "${scale_flags[@]}"
@@ -69,7 +72,7 @@ fi
 runs refine || exit 0
 [ -d sparse/0 ] || { echo "bench_survey.sh: $work/sparse/0: run STAGES=map first" >&2; exit 2; }
 rm -rf refined refined_txt
-timed refine "$P" refractive_bundle_adjuster --log_level warn --input_path sparse/0 --output_path refined \
+timed refine "$P" refractive_bundle_adjuster --log_level "$log_level" --input_path sparse/0 --output_path refined \
   --database_path db.db "${scale_flags[@]}"
-"$P" model_converter --log_level warn --input_path refined --output_path refined_txt --output_type TXT
+"$P" model_converter --log_level "$log_level" --input_path refined --output_path refined_txt --output_type TXT
 /usr/bin/python3 "$OLDPWD/workflows/eval_survey.py" set/ground_truth.yaml refined/calibration.yaml refined_txt/images.txt
