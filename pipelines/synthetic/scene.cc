@@ -65,26 +65,21 @@ double SeabedObject::Height(double x, double y, Eigen::Vector2d* gradient) const
 
 bool SeabedObject::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                              double t_max, Hit* hit) const {
-  if (!(dir.z() < -1e-6)) return false;  // looking down only
-  return IntersectFrom(origin, dir, -origin.z() / dir.z(), t_max, hit);  // from the mean plane
+  return IntersectNear(origin, dir, t_max, 0.0, hit);  // from the mean plane
 }
 
 bool SeabedObject::IntersectNear(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
                                  double t_near, Hit* hit) const {
-  if (!(dir.z() < -1e-6)) return false;
-  return IntersectFrom(origin, dir, t_near > 0 ? t_near : -origin.z() / dir.z(), t_max, hit);
-}
-
-bool SeabedObject::IntersectFrom(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_start,
-                                 double t_max, Hit* hit) const {
-  // Newton on f(t) = z(t) - height(x(t), y(t)); the relief is gentle
-  // (slopes << 1), so a few iterations converge. Its convergence is
+  if (!(dir.z() < -1e-6)) return false;  // looking down only
+  // Newton on f(t) = z(t) - height(x(t), y(t)) from t_near, or from the
+  // mean plane when there is none; the relief is gentle (slopes << 1), so a
+  // few iterations converge. Its convergence is
   // quadratic: after a step s the error is about |f''| / (2 |f'|) s^2 with
   // |f''| <= sum of a k^2 (19 / m for the surveys' relief, 0.15 m over
   // 2 m; 100 times that for a relief ten times finer), so stopping after a
   // step under 1e-6 m leaves the hit within ~1e-11 m (~1e-9 m) without
   // spending one more evaluation (5 sincos) to confirm it.
-  double t = t_start;
+  double t = t_near > 0 ? t_near : -origin.z() / dir.z();
   for (int iter = 0; iter < 20; ++iter) {
     const Eigen::Vector3d p = origin + t * dir;
     Eigen::Vector2d gradient;

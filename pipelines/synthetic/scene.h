@@ -74,8 +74,6 @@ class SeabedObject : public SceneObject {
     double amplitude, phase;
   };
   std::vector<Wave> waves_;
-  bool IntersectFrom(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_start, double t_max,
-                     Hit* hit) const;
 };
 
 // An object placed in the camera frame of one image.
