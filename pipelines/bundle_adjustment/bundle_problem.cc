@@ -217,11 +217,12 @@ double BundleProblem::SigmaOf(const TrackElement& e) const {
 
 // Points: those seen by a variable image (all, in a global adjustment).
 void BundleProblem::AddPoints() {
-  for (const auto& [point_id, point] : reconstruction_->points()) {
-    bool seen_by_variable = !local_;
-    for (const TrackElement& e : point.track) seen_by_variable |= IsVariable(e.image_id);
-    if (!seen_by_variable) continue;
-    point_blocks_[point_id] = point.xyz;
+  if (local_) {
+    for (const point3D_t point_id : reconstruction_->PointsSeenBy(scope_.variable_images)) {
+      point_blocks_[point_id] = reconstruction_->points().at(point_id).xyz;
+    }
+  } else {
+    for (const auto& [point_id, point] : reconstruction_->points()) point_blocks_[point_id] = point.xyz;
   }
   for (auto& [point_id, xyz] : point_blocks_) {
     for (const TrackElement& e : reconstruction_->points().at(point_id).track) {

@@ -1,5 +1,6 @@
 #include "pipelines/reconstruction/reconstruction.h"
 
+#include <algorithm>
 #include <limits>
 
 #include "colmap_ext/util/error.h"
@@ -206,6 +207,20 @@ void Reconstruction::DeletePoint(point3D_t id) {
     UpdateVisibility(e.image_id, e.point2D_idx, -1);
   }
   points_.erase(it);
+}
+
+std::vector<point3D_t> Reconstruction::PointsSeenBy(const std::set<image_t>& image_ids) const {
+  std::vector<point3D_t> ids;
+  for (const image_t image_id : image_ids) {
+    const auto it = point_of_.find(image_id);
+    if (it == point_of_.end()) continue;
+    for (const point3D_t id : it->second) {
+      if (id != kInvalidPoint3DId) ids.push_back(id);
+    }
+  }
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  return ids;
 }
 
 int Reconstruction::NumObservations(image_t image_id) const {

@@ -89,6 +89,11 @@ class Reconstruction {
   void DeletePoint(point3D_t id);
   // Number of the image's keypoints that observe a point.
   int NumObservations(image_t image_id) const;
+  // The points that the images observe, ascending and each once: a local
+  // adjustment's points, found through the images' keypoints rather than a
+  // walk over every point of the model (which made each registration cost
+  // O(model), the mapper O(N^2)).
+  std::vector<point3D_t> PointsSeenBy(const std::set<image_t>& image_ids) const;
   // Number of the image's keypoints with a correspondence that observes a
   // point of the model: how many 2-D--3-D links registering it would find
   // (COLMAP's num_visible_points3D). Kept up to date as observations come

@@ -432,10 +432,10 @@ int Mapper::Triangulate(Reconstruction* r, image_t image_id) {
 int Mapper::Filter(Reconstruction* r, const std::set<image_t>* images) {
   int removed = 0;
   std::vector<point3D_t> ids;
-  for (const auto& [id, point] : r->points()) {
-    bool in_scope = images == nullptr;
-    for (const TrackElement& e : point.track) in_scope |= images && images->count(e.image_id) > 0;
-    if (in_scope) ids.push_back(id);
+  if (images) {
+    ids = r->PointsSeenBy(*images);
+  } else {
+    for (const auto& [id, point] : r->points()) ids.push_back(id);
   }
   for (point3D_t id : ids) {
     if (!r->points().count(id)) continue;

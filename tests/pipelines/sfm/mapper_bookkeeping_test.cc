@@ -1,11 +1,14 @@
 // The mapper's bookkeeping: the count of each image's keypoints that would
 // link to a point of the model, kept up to date as observations come and
-// go, must equal a walk over the correspondences; and the measure of how far
+// go, must equal a walk over the correspondences, and the points a set of
+// images sees (a local adjustment's) a walk over every point's track; and
+// the measure of how far
 // a refinement of the intrinsics and housing moved the image, by which the
 // mapper stops refining them.
 #include <gtest/gtest.h>
 
 #include <random>
+#include <set>
 
 #include "colmap_ext/camera/camera.h"
 #include "colmap_ext/util/error.h"
@@ -28,6 +31,17 @@ int VisiblePointsByWalk(const Reconstruction& r, image_t image_id) {
     }
   }
   return visible;
+}
+
+// What the local adjustment and filter took before PointsSeenBy.
+std::vector<point3D_t> PointsSeenByWalk(const Reconstruction& r, const std::set<image_t>& images) {
+  std::vector<point3D_t> ids;
+  for (const auto& [id, point] : r.points()) {
+    bool seen = false;
+    for (const TrackElement& e : point.track) seen |= images.count(e.image_id) > 0;
+    if (seen) ids.push_back(id);
+  }
+  return ids;
 }
 
 TEST(Reconstruction, VisiblePointCountsFollowEveryObservationChange) {
@@ -56,9 +70,20 @@ TEST(Reconstruction, VisiblePointCountsFollowEveryObservationChange) {
   }
 
   Reconstruction r(&inputs, inputs.cameras);
+  size_t points_seen = 0;
   const auto expect_counts = [&](const std::string& after) {
     for (image_t id = 1; id <= kImages; ++id) {
       ASSERT_EQ(r.NumVisiblePoints(id), VisiblePointsByWalk(r, id)) << "image " << id << " after " << after;
+    }
+    // The points of each pair of images and of a single image (an image not
+    // registered sees none).
+    for (image_t a = 1; a <= kImages; ++a) {
+      for (image_t b = a; b <= kImages; ++b) {
+        const std::set<image_t> images = {a, b};
+        const std::vector<point3D_t> seen = r.PointsSeenBy(images);
+        ASSERT_EQ(seen, PointsSeenByWalk(r, images)) << a << ", " << b << " after " << after;
+        points_seen += seen.size();
+      }
     }
   };
   expect_counts("construction");
@@ -104,6 +129,7 @@ TEST(Reconstruction, VisiblePointCountsFollowEveryObservationChange) {
   }
   EXPECT_GT(operations, 500);
   EXPECT_GT(nonzero, 2000);  // the counts were exercised, not zero throughout
+  EXPECT_GT(points_seen, 10000u);
 }
 
 HousedCamera Pinhole(double f) {
