@@ -2,9 +2,8 @@
 // link to a point of the model, kept up to date as observations come and
 // go, must equal a walk over the correspondences, and the points a set of
 // images sees (a local adjustment's) a walk over every point's track; and
-// the measure of how far
-// a refinement of the intrinsics and housing moved the image, by which the
-// mapper stops refining them.
+// the measure of how far a refinement of the intrinsics and housing moved
+// the image, by which the mapper stops refining them.
 #include <gtest/gtest.h>
 
 #include <random>
