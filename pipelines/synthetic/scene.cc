@@ -73,8 +73,8 @@ bool SeabedObject::IntersectNear(const Eigen::Vector3d& origin, const Eigen::Vec
   if (!(dir.z() < -1e-6)) return false;  // looking down only
   // Newton on f(t) = z(t) - height(x(t), y(t)) from t_near, or from the
   // mean plane when there is none; the relief is gentle (slopes << 1), so a
-  // few iterations converge. Its convergence is
-  // quadratic: after a step s the error is about |f''| / (2 |f'|) s^2 with
+  // few iterations converge. Its convergence is quadratic: after a step s
+  // the error is about |f''| / (2 |f'|) s^2 with
   // |f''| <= sum of a k^2 (19 / m for the surveys' relief, 0.15 m over
   // 2 m; 100 times that for a relief ten times finer), so stopping after a
   // step under 1e-6 m leaves the hit within ~1e-11 m (~1e-9 m) without
