@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <limits>
 
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/cost/autodiff_functor.h"
@@ -80,10 +81,71 @@ struct StereoStart {
   Rigid3d median_cam2_from_cam1;
 };
 
+// Whether two candidates for cam2_from_cam1 agree: within kAgreementDeg in
+// rotation and kAgreementDistance times the board's distance in position.
+// A board numbered from the other end gives a candidate that is off by a
+// half turn about the board's normal through its centre, so the two
+// hypotheses never come close; a single view's pose is good to a fraction
+// of a degree and a percent of the distance.
+constexpr double kAgreementDeg = 5;
+constexpr double kAgreementDistance = 0.05;
+
+// A frame's two candidates: camera 2's board as numbered and turned by 180
+// degrees about its centre, and how far the board is from camera 1.
+struct FrameCandidates {
+  Rigid3d as_is, turned;
+  double board_distance = 0;
+};
+
+// How far `candidate` is from the nearer of a frame's two candidates, in
+// units of the agreement tolerance (< 1: they agree).
+double Disagreement(const Rigid3d& candidate, const FrameCandidates& frame) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Rigid3d* other : {&frame.as_is, &frame.turned}) {
+    const double rotation = candidate.rotation.angularDistance(other->rotation) * 180 / M_PI / kAgreementDeg;
+    const double position =
+        (candidate.translation - other->translation).norm() / (kAgreementDistance * frame.board_distance);
+    best = std::min(best, std::max(rotation, position));
+  }
+  return best;
+}
+
+// The candidate most frames agree with (ties: the smallest summed
+// disagreement). The true relative pose is offered by every frame whose
+// views are right up to numbering; a candidate from a board numbered from
+// the other end differs from frame to frame (the half turn is about each
+// frame's board normal), so it gathers few. A median of all frames'
+// candidates would not do: when most frames of camera 2 are numbered from
+// the other end (a camera mounted upside down numbers every one that way),
+// the median lies among the wrong ones.
+Rigid3d ConsensusPose(const std::vector<FrameCandidates>& frames) {
+  Rigid3d best;
+  int best_support = -1;
+  double best_sum = std::numeric_limits<double>::infinity();
+  for (const FrameCandidates& frame : frames) {
+    for (const Rigid3d* candidate : {&frame.as_is, &frame.turned}) {
+      int support = 0;
+      double sum = 0;
+      for (const FrameCandidates& other : frames) {
+        const double disagreement = Disagreement(*candidate, other);
+        support += disagreement < 1;
+        sum += std::min(disagreement, 1.0);
+      }
+      if (support > best_support || (support == best_support && sum < best_sum)) {
+        best = *candidate;
+        best_support = support;
+        best_sum = sum;
+      }
+    }
+  }
+  return best;
+}
+
 // A board that looks the same rotated by 180 degrees (an even number of
 // squares) may be numbered from the other end in one camera: each frame
-// also gets camera 2's view rotated by 180 degrees about the board centre,
-// and keeps whichever agrees with the median relative pose.
+// keeps camera 2's view as numbered or turned by 180 degrees about the
+// board centre, whichever agrees with the consensus; the median of the
+// kept relative poses starts the adjustment.
 StereoStart StartStereo(const std::vector<StereoFrame>& frames, const HousedCamera& camera1,
                         const HousedCamera& camera2, int num_threads) {
   Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
@@ -96,27 +158,28 @@ StereoStart StartStereo(const std::vector<StereoFrame>& frames, const HousedCame
   const Eigen::Vector2d centre = 0.5 * (lo + hi);
   StereoStart start;
   start.used = frames;
-  std::vector<Rigid3d> relative, relative_flipped;
+  std::vector<FrameCandidates> candidates;
   std::vector<CalibrationView> flipped;
   for (const StereoFrame& frame : frames) {
     start.poses1.push_back(ToPose(EstimateViewPose(frame.cam1, camera1, num_threads)));
     const Rigid3d target_from_cam1 = FromPose(start.poses1.back()).Inverse();
-    relative.push_back(EstimateViewPose(frame.cam2, camera2, num_threads) * target_from_cam1);
     CalibrationView view = frame.cam2;
     for (auto& p : view.points_in_target) p.head<2>() = 2 * centre - p.head<2>();
-    relative_flipped.push_back(EstimateViewPose(view, camera2, num_threads) * target_from_cam1);
+    candidates.push_back({EstimateViewPose(frame.cam2, camera2, num_threads) * target_from_cam1,
+                          EstimateViewPose(view, camera2, num_threads) * target_from_cam1,
+                          std::max(target_from_cam1.translation.norm(), 1e-6)});
     flipped.push_back(std::move(view));
   }
-  const Rigid3d median = MedianPose(relative);
+  const Rigid3d consensus = ConsensusPose(candidates);
   std::vector<Rigid3d> chosen;
   for (size_t f = 0; f < frames.size(); ++f) {
-    const double as_is = median.rotation.angularDistance(relative[f].rotation);
-    const double turned = median.rotation.angularDistance(relative_flipped[f].rotation);
+    const double as_is = consensus.rotation.angularDistance(candidates[f].as_is.rotation);
+    const double turned = consensus.rotation.angularDistance(candidates[f].turned.rotation);
     if (turned < as_is) {
       start.used[f].cam2 = flipped[f];
       LOG(INFO) << frames[f].cam2.image_name << ": board numbered from the other end; turned by 180 deg";
     }
-    chosen.push_back(turned < as_is ? relative_flipped[f] : relative[f]);
+    chosen.push_back(turned < as_is ? candidates[f].turned : candidates[f].as_is);
   }
   start.median_cam2_from_cam1 = MedianPose(chosen);
   return start;

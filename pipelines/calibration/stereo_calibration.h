@@ -3,6 +3,8 @@
 // starts at a robust median of the frames' relative poses (geodesic L1
 // median of the rotations, Hartley et al., "L1 rotation averaging using the
 // Weiszfeld algorithm", CVPR 2011; geometric median of the translations),
+// each frame's board in camera 2 as numbered or turned by 180 degrees,
+// whichever agrees with the pose most frames offer,
 // then a joint adjustment of the target poses, the relative pose and,
 // optionally, the intrinsics; standard deviations from the covariance scaled
 // by the residual variance.
