@@ -1,6 +1,7 @@
 // Stereo calibration: the shared in-air stereo render against its ground
 // truth, OpenCV's stereo sample against cv::stereoCalibrate on the same
-// corners, the robust median, and a rig behind two housings.
+// corners, the robust median, a camera mounted upside down, and a rig
+// behind two housings.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -191,8 +192,8 @@ TEST(StereoCalibration, CameraUpsideDownNumbersEveryBoardFromTheOtherEnd) {
   }
   ASSERT_EQ(numbered_differently, 10);
   const StereoCalibrationResult result = CalibrateStereo(frames, housed, housed, StereoCalibrationSettings());
-  // 0.2 px of noise on 70 corners a frame: the rig to well under a mm and
-  // a tenth of a degree.
+  // 0.2 px of noise on 35 corners a view, 10 frames: the rig to well under
+  // a millimetre and a tenth of a degree.
   EXPECT_LT((result.cam2_from_cam1.translation - truth.translation).norm(), 1e-3);
   EXPECT_LT(AngleDeg(result.cam2_from_cam1.rotation, truth.rotation), 0.1);
   EXPECT_LT(result.overall_rms_px, 0.3);
