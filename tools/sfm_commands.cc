@@ -101,6 +101,11 @@ int RefractiveBundleAdjusterCommand(int argc, char** argv) {
   cli.Add("BundleAdjustment.hold_weights", &options.hold_weights,
           "1: the first solve, robust, decides the inliers' weights and the final solve holds them (fast); "
           "0: both solves robust to function_tolerance");
+  cli.Add("BundleAdjustment.robust_max_unsettled_weights", &options.robust_max_unsettled_weights,
+          "with hold_weights: the first, robust solve also ends once a step changed at most this fraction of "
+          "the weights by more than 0.01 (0: off)");
+  cli.Add("BundleAdjustment.held_trust_region_radius", &options.held_trust_region_radius,
+          "with hold_weights: the final solve's first trust region");
   cli.Add("BundleAdjustment.robust_function_tolerance", &options.robust_function_tolerance,
           "with hold_weights: relative cost change that ends the first, robust solve");
   cli.Add("BundleAdjustment.principal_point_test_sigmas", &options.principal_point_test_sigmas,

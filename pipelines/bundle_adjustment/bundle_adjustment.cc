@@ -25,6 +25,14 @@ void BundleAdjustmentOptions::Check() const {
   if (!(function_tolerance > 0)) {
     throw OptionError("--BundleAdjustment.function_tolerance", std::to_string(function_tolerance), "> 0");
   }
+  if (!(max_unsettled_weight_fraction >= 0 && max_unsettled_weight_fraction < 1)) {
+    throw OptionError("--BundleAdjustment.robust_max_unsettled_weights", std::to_string(max_unsettled_weight_fraction),
+                      "in [0, 1)");
+  }
+  if (!(initial_trust_region_radius > 0 && initial_trust_region_radius <= 1e16)) {
+    throw OptionError("--BundleAdjustment.held_trust_region_radius", std::to_string(initial_trust_region_radius),
+                      "in (0, 1e16]");
+  }
 }
 
 BundleAdjustmentOptions BundleAdjustmentOptions::WithIntrinsicsHeld() const {

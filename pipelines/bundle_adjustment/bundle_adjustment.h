@@ -39,12 +39,20 @@ struct BundleAdjustmentOptions {
   // on a survey is a crawl of dozens of iterations (docs/benchmarks.md).
   // For a final solve whose inliers a robust solve has decided.
   bool hold_loss_weights = false;
+  // > 0, with the robust loss (weights not held): the solve also ends once a
+  // step changed the weight rho'(|r|^2) of at most this fraction of the
+  // observations by more than 0.01: for a robust solve that only decides
+  // the weights a held-weights solve then uses (weights_settled.h).
+  double max_unsettled_weight_fraction = 0;
   // > 0: in global adjustments, the registered images' position priors are
   // residuals with this standard deviation (metres) and hold the gauge
   // (align the model to them first: AlignToPositionPriors).
   double position_prior_sigma_m = 0;
   int max_num_iterations = 100;
   double function_tolerance = 1e-8;  // relative cost change that ends the solve
+  // Levenberg-Marquardt's first trust region (Ceres' default 1e4): its
+  // damping is diag(J'J) / radius.
+  double initial_trust_region_radius = 1e4;
   int num_threads = 2;
   void Check() const;  // throws OptionError naming --BundleAdjustment.*
   // These options with focal length, principal point and extra parameters

@@ -20,6 +20,7 @@
 #include "pipelines/bundle_adjustment/bundle_costs_fixed.h"
 #include "pipelines/bundle_adjustment/calibration_covariance.h"
 #include "pipelines/bundle_adjustment/position_priors.h"
+#include "pipelines/bundle_adjustment/weights_settled.h"
 #include "pipelines/reconstruction/ray_geometry.h"
 
 namespace portcal {
@@ -147,6 +148,7 @@ class BundleProblem {
   ceres::Problem problem_;
   ceres::LossFunction* loss_ = nullptr;
   std::unique_ptr<ceres::LossFunction> weight_loss_;  // with hold_loss_weights: the weights' robust loss
+  std::vector<ceres::ResidualBlockId> robust_blocks_;  // under loss_, with max_unsettled_weight_fraction
   bool local_ = false;
   bool refine_intrinsics_ = false;
   bool refine_housing_ = false;
@@ -192,7 +194,8 @@ void BundleProblem::AddObservation(image_t image_id, const Eigen::Vector2d& pixe
 void BundleProblem::AddRobustResidual(ceres::CostFunction* cost, const std::vector<double*>& blocks) {
   num_residuals_ += cost->num_residuals();
   if (!weight_loss_) {
-    problem_.AddResidualBlock(cost, loss_, blocks);
+    const ceres::ResidualBlockId id = problem_.AddResidualBlock(cost, loss_, blocks);
+    if (loss_ && options_.max_unsettled_weight_fraction > 0) robust_blocks_.push_back(id);
     return;
   }
   Eigen::VectorXd residual(cost->num_residuals());
@@ -390,13 +393,21 @@ ceres::Solver::Options BundleProblem::SolverOptions(int* num_free_poses) const {
   // Per-iteration lines (cost, step, time) in the debug log.
   solver.logging_type = VLOG_IS_ON(2) ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
   solver.function_tolerance = options_.function_tolerance;
+  solver.initial_trust_region_radius = options_.initial_trust_region_radius;
   solver.parameter_tolerance = 1e-10;
   return solver;
 }
 
 ceres::Solver::Summary BundleProblem::Solve() {
   int num_free_poses = 0;
-  const ceres::Solver::Options solver = SolverOptions(&num_free_poses);
+  ceres::Solver::Options solver = SolverOptions(&num_free_poses);
+  std::unique_ptr<WeightsSettledCallback> weights_settled;
+  if (!robust_blocks_.empty()) {
+    weights_settled = std::make_unique<WeightsSettledCallback>(&problem_, std::move(robust_blocks_), loss_,
+                                                               options_.max_unsettled_weight_fraction);
+    solver.callbacks.push_back(weights_settled.get());
+    solver.update_state_every_iteration = true;
+  }
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem_, &summary);
   if (!summary.IsSolutionUsable()) throw NumericalError("bundle adjustment failed: " + summary.BriefReport());

@@ -39,6 +39,14 @@ void RefractiveBundleAdjusterOptions::Check() const {
     throw OptionError("--BundleAdjustment.robust_function_tolerance", std::to_string(robust_function_tolerance),
                       "in (0, 1)");
   }
+  if (!(robust_max_unsettled_weights >= 0 && robust_max_unsettled_weights < 1)) {
+    throw OptionError("--BundleAdjustment.robust_max_unsettled_weights", std::to_string(robust_max_unsettled_weights),
+                      "in [0, 1)");
+  }
+  if (!(held_trust_region_radius > 0 && held_trust_region_radius <= 1e16)) {
+    throw OptionError("--BundleAdjustment.held_trust_region_radius", std::to_string(held_trust_region_radius),
+                      "in (0, 1e16]");
+  }
   if (!(principal_point_test_sigmas >= 0)) {
     throw OptionError("--BundleAdjustment.principal_point_test_sigmas", std::to_string(principal_point_test_sigmas),
                       ">= 0 (0: no test)");
@@ -395,7 +403,10 @@ class StagedAdjustment {
   // the robust tolerance.
   BundleAdjustmentOptions Robust(const BundleAdjustmentOptions& ba) const {
     BundleAdjustmentOptions robust = ba;
-    if (options_.hold_weights) robust.function_tolerance = options_.robust_function_tolerance;
+    if (options_.hold_weights) {
+      robust.function_tolerance = options_.robust_function_tolerance;
+      robust.max_unsettled_weight_fraction = options_.robust_max_unsettled_weights;
+    }
     return robust;
   }
 
@@ -416,6 +427,7 @@ class StagedAdjustment {
     result_.num_filtered += r_.DeleteObservationsBeyond(options_.max_reproj_error_px);
     BundleAdjustmentOptions final_solve = ba;
     final_solve.hold_loss_weights = options_.hold_weights;
+    if (options_.hold_weights) final_solve.initial_trust_region_radius = options_.held_trust_region_radius;
     AdjustBundle(&r_, final_solve, BundleAdjustmentScope(), &markers_, options_.marker_scale, std_devs);
   }
 

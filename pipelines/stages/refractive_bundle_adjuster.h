@@ -39,15 +39,27 @@ struct RefractiveBundleAdjusterOptions {
   MarkerScale marker_scale;
   double max_reproj_error_px = 4.0;  // observations beyond are dropped before the final solve
   // The schedule of iteratively reweighted least squares: the first solve,
-  // robust, ends at this relative cost change and so decides the inliers
-  // and their weights; the final solve holds the weights
-  // (BundleAdjustmentOptions::hold_loss_weights) and runs to
-  // ba.function_tolerance. Without held weights both solves are robust to
-  // ba.function_tolerance, and on a survey the first crawls (1000 images:
-  // 43 iterations where the robust cost changes by ~1e-8 each;
-  // docs/benchmarks.md).
+  // robust, decides the inliers and their weights, and ends when they have
+  // settled (at most robust_max_unsettled_weights of the observations'
+  // weights changed by more than 0.01 in a step: weights_settled.h) or at
+  // robust_function_tolerance, the relative cost change; the final solve
+  // holds the weights (BundleAdjustmentOptions::hold_loss_weights) and runs
+  // to ba.function_tolerance. Without held weights both solves are robust
+  // to ba.function_tolerance, and on a survey the first crawls (1000
+  // images: 43 iterations where the robust cost changes by ~1e-8 each;
+  // docs/benchmarks.md). The relative cost change alone ends the robust
+  // solve later the longer the survey (4 iterations at 1000 images, 7 at
+  // 2000), the weights settle after one (docs/scale.md).
   bool hold_weights = true;
   double robust_function_tolerance = 1e-6;
+  double robust_max_unsettled_weights = 0.01;  // 0: the cost change alone
+  // The final solve's first trust region (BundleAdjustmentOptions::
+  // initial_trust_region_radius). With the weights held it is a weighted
+  // least-squares problem started near its minimum, where Gauss-Newton
+  // converges in a step; Ceres' default (1e4) damps a survey's weak modes
+  // (the long strips' bending) and the solve crawls while the region grows
+  // 3 x a step (2000 images: 4 steps of 80 s against 1; docs/scale.md).
+  double held_trust_region_radius = 1e10;
   // With ba.refine_principal_point and a value > 0: after the final solve the
   // principal point is set to the image centre and held there (the solve
   // redone) unless the refined one lies more than this many standard
