@@ -1,8 +1,11 @@
 #include "pipelines/bundle_adjustment/weights_settled.h"
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <thread>
+#include <utility>
 
 #include "colmap_ext/util/logging.h"
 
@@ -17,7 +20,7 @@ WeightsSettledCallback::WeightsSettledCallback(const ceres::Problem* problem,
       max_unsettled_fraction_(max_unsettled_fraction) {}
 
 void WeightsSettledCallback::ComputeWeights(std::vector<double>* weights) const {
-  weights->assign(residual_blocks_.size(), 0.0);
+  weights->assign(residual_blocks_.size(), std::numeric_limits<double>::quiet_NaN());
   // The cost functions themselves, on the parameters' own memory (Problem::
   // EvaluateResidualBlock sets the blocks' state: not from two threads), in
   // two halves on two threads: a survey has millions of blocks.

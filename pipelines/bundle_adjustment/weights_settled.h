@@ -35,8 +35,8 @@ class WeightsSettledCallback : public ceres::IterationCallback {
   double last_unsettled_fraction() const { return last_unsettled_fraction_; }
 
  private:
-  // The weights at the current parameters; 0 where a block cannot be
-  // evaluated (a NaN residual is then a change, never a settled weight).
+  // The weights at the current parameters; NaN where a block cannot be
+  // evaluated (its weight then never counts as settled).
   void ComputeWeights(std::vector<double>* weights) const;
 
   const ceres::Problem* problem_;
