@@ -39,19 +39,16 @@ void RefractiveBundleAdjusterOptions::Check() const {
     throw OptionError("--BundleAdjustment.robust_function_tolerance", std::to_string(robust_function_tolerance),
                       "in (0, 1)");
   }
-  if (!(robust_max_unsettled_weights >= 0 && robust_max_unsettled_weights < 1)) {
-    throw OptionError("--BundleAdjustment.robust_max_unsettled_weights", std::to_string(robust_max_unsettled_weights),
-                      "in [0, 1)");
-  }
-  if (!(held_trust_region_radius > 0 && held_trust_region_radius <= 1e16)) {
-    throw OptionError("--BundleAdjustment.held_trust_region_radius", std::to_string(held_trust_region_radius),
-                      "in (0, 1e16]");
-  }
   if (!(principal_point_test_sigmas >= 0)) {
     throw OptionError("--BundleAdjustment.principal_point_test_sigmas", std::to_string(principal_point_test_sigmas),
                       ">= 0 (0: no test)");
   }
-  ba.Check();
+  // ba as the robust and the held solves take it (their two options are
+  // checked where BundleAdjustmentOptions checks its own).
+  BundleAdjustmentOptions staged = ba;
+  staged.max_unsettled_weight_fraction = robust_max_unsettled_weights;
+  staged.initial_trust_region_radius = held_trust_region_radius;
+  staged.Check();
 }
 
 namespace {
