@@ -9,9 +9,17 @@
 # table: target, executions, seconds, coverage, result. Do not pause a run
 # (kill -STOP): libFuzzer's 1200 s timeout counts wall time, so a long pause
 # is reported as a hang (replay the timeout-* input to tell).
+# Beside a benchmark, start it niced in a session of its own (`setsid nice
+# -n 19 workflows/fuzz.sh ...`): Linux' autogroups weigh sessions against
+# each other before nice counts, so a fuzzer alone in its session would take
+# a full core from the benchmark whatever its nice (docs/scale.md); as the
+# leader of its session it gives the session's group its own nice.
 # Usage: workflows/fuzz.sh [RUNS=10000000] [TARGET...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
+if [ "$(nice)" -gt 0 ] && [ "$(ps -o sid= -p $$ | tr -d ' ')" = "$$" ] && [ -w /proc/self/autogroup ]; then
+  echo "$(nice)" > /proc/self/autogroup
+fi
 build="${PORTCAL_SANITIZE_BUILD:-build-sanitize}"  # the clang tree
 runs="${1:-10000000}"; shift || true
 targets=("$@")
