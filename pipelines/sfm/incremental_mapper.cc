@@ -66,6 +66,10 @@ void IncrementalMapperOptions::Check() const {
     throw OptionError("--Mapper.ba_global_function_tolerance", std::to_string(ba_global_function_tolerance),
                       "in (0, 1)");
   }
+  if (!(ba_global_max_unsettled_weights >= 0 && ba_global_max_unsettled_weights < 1)) {
+    throw OptionError("--Mapper.ba_global_max_unsettled_weights", std::to_string(ba_global_max_unsettled_weights),
+                      "in [0, 1)");
+  }
   if (!(ba_calibration_settled_px >= 0)) {
     throw OptionError("--Mapper.ba_calibration_settled_px", std::to_string(ba_calibration_settled_px), ">= 0");
   }
@@ -102,7 +106,9 @@ class Mapper {
   int Triangulate(Reconstruction* r, image_t image_id);
   int Filter(Reconstruction* r, const std::set<image_t>* images);
   void LocalAdjust(Reconstruction* r, image_t image_id);
-  void GlobalAdjust(Reconstruction* r, bool refine_intrinsics);
+  // `growing`: an adjustment while the model grows, not the model's first
+  // or final one (IncrementalMapperOptions::ba_global_max_unsettled_weights).
+  void GlobalAdjust(Reconstruction* r, bool refine_intrinsics, bool growing = false);
   // The housing's adjustments before the joint one (see GlobalAdjust).
   void AdjustHousingFirst(Reconstruction* r, const BundleAdjustmentOptions& ba, std::vector<MarkerCorner>* markers);
   // Records a global adjustment's refinement of the calibration and whether
@@ -241,7 +247,7 @@ void Mapper::GrowModel(Reconstruction* r, bool abandon_allowed, ProgressSink& pr
         // (IncrementalMapperOptions::ba_calibration_settled_px).
         const bool refine =
             (r->poses().size() <= 8 || r->poses().size() >= 1.33 * last_refine) && !CalibrationSettled();
-        Timed("global", [&] { GlobalAdjust(r, refine); return 0; });
+        Timed("global", [&] { GlobalAdjust(r, refine, /*growing=*/true); return 0; });
         if (refine) last_refine = r->poses().size();
         last_global = r->poses().size();
       }
@@ -489,7 +495,7 @@ void Mapper::LocalAdjust(Reconstruction* r, image_t image_id) {
   Filter(r, &scope.variable_images);
 }
 
-void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
+void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics, bool growing) {
   // Intrinsics from a handful of views are barely constrained: they are
   // refined from kMinImagesForIntrinsics images on, and a result that is
   // bogus (COLMAP's test: focal length off by more than a factor 2 from the
@@ -498,6 +504,10 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics) {
   const int num_images = static_cast<int>(r->poses().size());
   refine_intrinsics = refine_intrinsics && num_images >= kMinImagesForIntrinsics;
   BundleAdjustmentOptions ba = GlobalAdjustmentOptions(options_, num_images, refine_intrinsics);
+  // With the calibration held the adjustment only carries the model along
+  // until the next one; one that refines the calibration converges (it
+  // decides whether the port has settled).
+  if (growing && !refine_intrinsics) ba.max_unsettled_weight_fraction = options_.ba_global_max_unsettled_weights;
   if (options_.position_prior_sigma_m > 0 && options_.marker_scale.side_length_m <= 0 &&
       AlignToPositionPriors(r, 5 * options_.position_prior_sigma_m)) {
     // The model in the priors' metric frame, the priors as residuals.

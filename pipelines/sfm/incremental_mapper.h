@@ -65,6 +65,15 @@ struct IncrementalMapperOptions {
   // stage converges fully, at 1e-8), and iterating them further changed
   // nothing downstream but the time (docs/benchmarks.md).
   double ba_global_function_tolerance = 1e-5;
+  // A global adjustment while the model grows, with the calibration held,
+  // also ends once a step changed the robust loss's weight of at most this
+  // fraction of the observations by more than 0.01 (weights_settled.h): its
+  // model is intermediate, and on a long survey the robust solve otherwise
+  // crawls along the strips for more iterations the longer they are
+  // (docs/scale.md). Adjustments that refine the calibration, and the
+  // model's final ones, end by the cost change alone. 0: the cost change
+  // alone everywhere.
+  double ba_global_max_unsettled_weights = 0.01;
   // The intrinsics and housing are refined whenever the model has grown by
   // a third, until two such refinements in a row, on models of 50 images or
   // more, moved no point at the scene's median depth by this many pixels;

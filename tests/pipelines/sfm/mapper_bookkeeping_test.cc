@@ -201,6 +201,22 @@ TEST(IncrementalMapperOptions, GlobalFunctionToleranceIsAFractionAndNamedWhenBad
   }
 }
 
+TEST(IncrementalMapperOptions, GlobalUnsettledWeightsAreAFractionAndNamedWhenBad) {
+  IncrementalMapperOptions options;
+  options.ba_global_max_unsettled_weights = 0;  // the cost change alone
+  EXPECT_NO_THROW(options.Check());
+  for (const double bad : {-0.01, 1.0, std::nan("")}) {
+    options.ba_global_max_unsettled_weights = bad;
+    try {
+      options.Check();
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const OptionError& e) {
+      EXPECT_NE(std::string(e.what()).find("--Mapper.ba_global_max_unsettled_weights"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 TEST(IncrementalMapperOptions, NegativeRestartsAreNamed) {
   IncrementalMapperOptions options;
   options.init_max_restarts = 0;
