@@ -96,6 +96,9 @@ void Register(CommandLine* cli, IncrementalMapperOptions* o) {
   cli->Add("Mapper.ba_global_max_unsettled_weights", &o->ba_global_max_unsettled_weights,
            "a global adjustment while the model grows, calibration held, also ends once a step changed at most "
            "this fraction of the robust weights by more than 0.01 (0: by the cost change alone)");
+  cli->Add("Mapper.ba_final_hold_weights", &o->ba_final_hold_weights,
+           "the model's final adjustment: robust until the weights settle, then a solve with them held (0 | 1; "
+           "0: robust to the cost change)");
   cli->Add("Mapper.ba_calibration_settled_px", &o->ba_calibration_settled_px,
            "hold intrinsics and housing until the final adjustment once two refinements in a row (from "
            "--Mapper.ba_calibration_settled_min_images on) moved the image by less than this, pixels (0: refine "

@@ -86,6 +86,8 @@ void IncrementalMapperOptions::Check() const {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
+// The final held-weights solve's first trust region (see GlobalAdjust).
+constexpr double kHeldTrustRegionRadius = 1e10;
 
 class Mapper {
  public:
@@ -106,9 +108,15 @@ class Mapper {
   int Triangulate(Reconstruction* r, image_t image_id);
   int Filter(Reconstruction* r, const std::set<image_t>* images);
   void LocalAdjust(Reconstruction* r, image_t image_id);
-  // `growing`: an adjustment while the model grows, not the model's first
-  // or final one (IncrementalMapperOptions::ba_global_max_unsettled_weights).
-  void GlobalAdjust(Reconstruction* r, bool refine_intrinsics, bool growing = false);
+  // What ends a global adjustment (IncrementalMapperOptions::
+  // ba_global_max_unsettled_weights and ba_final_hold_weights).
+  enum class AdjustmentEnd {
+    kCostChange,        // the cost change alone
+    kGrowing,           // while the model grows: with the calibration held, also settled weights
+    kWeightsSettled,    // settled weights or the cost change: it decides the inliers
+    kHeldWeightsSolve,  // the weights held: the weighted least-squares solve after kWeightsSettled
+  };
+  void GlobalAdjust(Reconstruction* r, bool refine_intrinsics, AdjustmentEnd end = AdjustmentEnd::kCostChange);
   // The housing's adjustments before the joint one (see GlobalAdjust).
   void AdjustHousingFirst(Reconstruction* r, const BundleAdjustmentOptions& ba, std::vector<MarkerCorner>* markers);
   // Records a global adjustment's refinement of the calibration and whether
@@ -247,7 +255,7 @@ void Mapper::GrowModel(Reconstruction* r, bool abandon_allowed, ProgressSink& pr
         // (IncrementalMapperOptions::ba_calibration_settled_px).
         const bool refine =
             (r->poses().size() <= 8 || r->poses().size() >= 1.33 * last_refine) && !CalibrationSettled();
-        Timed("global", [&] { GlobalAdjust(r, refine, /*growing=*/true); return 0; });
+        Timed("global", [&] { GlobalAdjust(r, refine, AdjustmentEnd::kGrowing); return 0; });
         if (refine) last_refine = r->poses().size();
         last_global = r->poses().size();
       }
@@ -262,9 +270,10 @@ void Mapper::FinishModel(Reconstruction* r, size_t model_index) {
   // Rays may have moved with the intrinsics: triangulate what is left,
   // adjust once more and filter.
   for (const auto& [id, pose] : std::map<image_t, Rigid3d>(r->poses())) Triangulate(r, id);
-  GlobalAdjust(r, true);
+  const bool held = options_.ba_final_hold_weights;
+  GlobalAdjust(r, true, held ? AdjustmentEnd::kWeightsSettled : AdjustmentEnd::kCostChange);
   Filter(r, nullptr);
-  GlobalAdjust(r, true);
+  GlobalAdjust(r, true, held ? AdjustmentEnd::kHeldWeightsSolve : AdjustmentEnd::kCostChange);
   LOG(INFO) << "refractive_mapper: model " << model_index << ": " << r->poses().size() << " images, "
             << r->points().size() << " points, mean reprojection error " << r->MeanReprojectionError() << " px";
 }
@@ -495,7 +504,7 @@ void Mapper::LocalAdjust(Reconstruction* r, image_t image_id) {
   Filter(r, &scope.variable_images);
 }
 
-void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics, bool growing) {
+void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics, AdjustmentEnd end) {
   // Intrinsics from a handful of views are barely constrained: they are
   // refined from kMinImagesForIntrinsics images on, and a result that is
   // bogus (COLMAP's test: focal length off by more than a factor 2 from the
@@ -504,10 +513,19 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics, bool growin
   const int num_images = static_cast<int>(r->poses().size());
   refine_intrinsics = refine_intrinsics && num_images >= kMinImagesForIntrinsics;
   BundleAdjustmentOptions ba = GlobalAdjustmentOptions(options_, num_images, refine_intrinsics);
-  // With the calibration held the adjustment only carries the model along
-  // until the next one; one that refines the calibration converges (it
-  // decides whether the port has settled).
-  if (growing && !refine_intrinsics) ba.max_unsettled_weight_fraction = options_.ba_global_max_unsettled_weights;
+  // While growing, with the calibration held the adjustment only carries
+  // the model along until the next one; one that refines the calibration
+  // converges (it decides whether the port has settled).
+  if ((end == AdjustmentEnd::kGrowing && !refine_intrinsics) || end == AdjustmentEnd::kWeightsSettled) {
+    ba.max_unsettled_weight_fraction = options_.ba_global_max_unsettled_weights;
+  }
+  if (end == AdjustmentEnd::kHeldWeightsSolve) {
+    ba.hold_loss_weights = true;
+    // Started near its minimum, the weighted problem converges in a step
+    // undamped; Ceres' default region damps the strips' weak modes
+    // (RefractiveBundleAdjusterOptions::held_trust_region_radius).
+    ba.initial_trust_region_radius = kHeldTrustRegionRadius;
+  }
   if (options_.position_prior_sigma_m > 0 && options_.marker_scale.side_length_m <= 0 &&
       AlignToPositionPriors(r, 5 * options_.position_prior_sigma_m)) {
     // The model in the priors' metric frame, the priors as residuals.
