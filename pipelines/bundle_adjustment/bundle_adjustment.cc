@@ -41,6 +41,14 @@ BundleAdjustmentOptions BundleAdjustmentOptions::WithIntrinsicsHeld() const {
   return held;
 }
 
+BundleAdjustmentOptions BundleAdjustmentOptions::WithWeightsHeld(double first_trust_region_radius) const {
+  BundleAdjustmentOptions held = *this;
+  held.hold_loss_weights = true;
+  held.max_unsettled_weight_fraction = 0;  // the weights no longer move
+  held.initial_trust_region_radius = first_trust_region_radius;
+  return held;
+}
+
 bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::string* why) {
   std::ostringstream text;
   const double ratio = after.MeanFocalLength() / before.MeanFocalLength();

@@ -58,7 +58,17 @@ struct BundleAdjustmentOptions {
   // These options with focal length, principal point and extra parameters
   // held (a stage that adjusts the housing under the current intrinsics).
   BundleAdjustmentOptions WithIntrinsicsHeld() const;
+  // These options for the weighted least-squares solve after a robust solve
+  // has decided the weights: the weights held, the first trust region
+  // `first_trust_region_radius` (kHeldWeightsTrustRegionRadius below).
+  BundleAdjustmentOptions WithWeightsHeld(double first_trust_region_radius) const;
 };
+
+// The held-weights solve's first trust region. Started near its minimum,
+// the weighted problem converges in an undamped step; Ceres' default region
+// (1e4) damps the long strips' weak modes over many steps
+// (docs/scale.md: 2000 images, 4 steps against 1).
+constexpr double kHeldWeightsTrustRegionRadius = 1e10;
 
 // A physical marker corner: its point and where it was seen.
 struct MarkerCorner {

@@ -7,7 +7,7 @@
 namespace portcal {
 
 BundleAdjustmentOptions GlobalAdjustmentOptions(const IncrementalMapperOptions& options, int num_images,
-                                                bool refine_intrinsics) {
+                                                bool refine_intrinsics, AdjustmentEnd end) {
   BundleAdjustmentOptions ba;
   ba.refine_focal_length = refine_intrinsics && options.ba_refine_focal_length;
   ba.refine_principal_point = refine_intrinsics && options.ba_refine_principal_point;
@@ -19,6 +19,13 @@ BundleAdjustmentOptions GlobalAdjustmentOptions(const IncrementalMapperOptions& 
   ba.max_num_iterations = options.ba_max_num_iterations;
   ba.function_tolerance = options.ba_global_function_tolerance;
   ba.num_threads = options.num_threads;
+  // While growing, with the calibration held the adjustment only carries
+  // the model along until the next one; one that refines the calibration
+  // converges (it decides whether the port has settled).
+  if ((end == AdjustmentEnd::kGrowing && !refine_intrinsics) || end == AdjustmentEnd::kWeightsSettled) {
+    ba.max_unsettled_weight_fraction = options.ba_global_max_unsettled_weights;
+  }
+  if (end == AdjustmentEnd::kHeldWeightsSolve) return ba.WithWeightsHeld(kHeldWeightsTrustRegionRadius);
   return ba;
 }
 

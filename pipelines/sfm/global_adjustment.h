@@ -18,12 +18,22 @@ namespace portcal {
 // adjustment refines them from this many images on.
 constexpr int kMinImagesForIntrinsics = 5;
 
+// What ends a global adjustment (IncrementalMapperOptions::
+// ba_global_max_unsettled_weights and ba_final_hold_weights).
+enum class AdjustmentEnd {
+  kCostChange,        // the cost change alone
+  kGrowing,           // while the model grows: with the calibration held, also settled weights
+  kWeightsSettled,    // settled weights or the cost change: it decides the inliers
+  kHeldWeightsSolve,  // the weights held: the weighted least-squares solve after kWeightsSettled
+};
+
 // The options of a global adjustment of a model of `num_images` images:
 // the intrinsics and housing refined as the mapper's options say when
 // `refine_intrinsics`, only the first extra parameter below
-// ba_full_intrinsics_min_images.
+// ba_full_intrinsics_min_images; ending as `end` says.
 BundleAdjustmentOptions GlobalAdjustmentOptions(const IncrementalMapperOptions& options, int num_images,
-                                                bool refine_intrinsics);
+                                                bool refine_intrinsics,
+                                                AdjustmentEnd end = AdjustmentEnd::kCostChange);
 
 // COLMAP's bogus-camera test against the intrinsics before the adjustment,
 // and the focal length against the mapper's start, which a slow drift of

@@ -86,8 +86,6 @@ void IncrementalMapperOptions::Check() const {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
-// The final held-weights solve's first trust region (see GlobalAdjust).
-constexpr double kHeldTrustRegionRadius = 1e10;
 
 class Mapper {
  public:
@@ -108,14 +106,6 @@ class Mapper {
   int Triangulate(Reconstruction* r, image_t image_id);
   int Filter(Reconstruction* r, const std::set<image_t>* images);
   void LocalAdjust(Reconstruction* r, image_t image_id);
-  // What ends a global adjustment (IncrementalMapperOptions::
-  // ba_global_max_unsettled_weights and ba_final_hold_weights).
-  enum class AdjustmentEnd {
-    kCostChange,        // the cost change alone
-    kGrowing,           // while the model grows: with the calibration held, also settled weights
-    kWeightsSettled,    // settled weights or the cost change: it decides the inliers
-    kHeldWeightsSolve,  // the weights held: the weighted least-squares solve after kWeightsSettled
-  };
   void GlobalAdjust(Reconstruction* r, bool refine_intrinsics, AdjustmentEnd end = AdjustmentEnd::kCostChange);
   // The housing's adjustments before the joint one (see GlobalAdjust).
   void AdjustHousingFirst(Reconstruction* r, const BundleAdjustmentOptions& ba, std::vector<MarkerCorner>* markers);
@@ -512,20 +502,7 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics, AdjustmentE
   // repeated with the intrinsics held.
   const int num_images = static_cast<int>(r->poses().size());
   refine_intrinsics = refine_intrinsics && num_images >= kMinImagesForIntrinsics;
-  BundleAdjustmentOptions ba = GlobalAdjustmentOptions(options_, num_images, refine_intrinsics);
-  // While growing, with the calibration held the adjustment only carries
-  // the model along until the next one; one that refines the calibration
-  // converges (it decides whether the port has settled).
-  if ((end == AdjustmentEnd::kGrowing && !refine_intrinsics) || end == AdjustmentEnd::kWeightsSettled) {
-    ba.max_unsettled_weight_fraction = options_.ba_global_max_unsettled_weights;
-  }
-  if (end == AdjustmentEnd::kHeldWeightsSolve) {
-    ba.hold_loss_weights = true;
-    // Started near its minimum, the weighted problem converges in a step
-    // undamped; Ceres' default region damps the strips' weak modes
-    // (RefractiveBundleAdjusterOptions::held_trust_region_radius).
-    ba.initial_trust_region_radius = kHeldTrustRegionRadius;
-  }
+  BundleAdjustmentOptions ba = GlobalAdjustmentOptions(options_, num_images, refine_intrinsics, end);
   if (options_.position_prior_sigma_m > 0 && options_.marker_scale.side_length_m <= 0 &&
       AlignToPositionPriors(r, 5 * options_.position_prior_sigma_m)) {
     // The model in the priors' metric frame, the priors as residuals.

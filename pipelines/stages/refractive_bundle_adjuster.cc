@@ -422,9 +422,8 @@ class StagedAdjustment {
       }
     }
     result_.num_filtered += r_.DeleteObservationsBeyond(options_.max_reproj_error_px);
-    BundleAdjustmentOptions final_solve = ba;
-    final_solve.hold_loss_weights = options_.hold_weights;
-    if (options_.hold_weights) final_solve.initial_trust_region_radius = options_.held_trust_region_radius;
+    const BundleAdjustmentOptions final_solve =
+        options_.hold_weights ? ba.WithWeightsHeld(options_.held_trust_region_radius) : ba;
     AdjustBundle(&r_, final_solve, BundleAdjustmentScope(), &markers_, options_.marker_scale, std_devs);
   }
 

@@ -59,7 +59,7 @@ struct RefractiveBundleAdjusterOptions {
   // converges in a step; Ceres' default (1e4) damps a survey's weak modes
   // (the long strips' bending) and the solve crawls while the region grows
   // 3 x a step (2000 images: 4 steps against 1; docs/scale.md).
-  double held_trust_region_radius = 1e10;
+  double held_trust_region_radius = kHeldWeightsTrustRegionRadius;
   // With ba.refine_principal_point and a value > 0: after the final solve the
   // principal point is set to the image centre and held there (the solve
   // redone) unless the refined one lies more than this many standard
