@@ -21,6 +21,7 @@
 # each on what the parts before it left in WORK_DIR (the stages write in
 # transactions, so a part cut short leaves its inputs as they were).
 # LOG_LEVEL=debug (default warn) logs each stage's steps and their seconds.
+# MAPPER_ARGS="--Mapper.x v ..." adds options to the mapper's command line.
 # Usage: [SCALE=navigation|markers] [RENDER_SPP=4] [STAGES="extract map refine"] [LOG_LEVEL=warn]
 #        workflows/bench_survey.sh [NUM_IMAGES=300] [WORK_DIR=temporary]
 set -euo pipefail
@@ -37,6 +38,7 @@ case "$scale" in
   *) echo "bench_survey.sh: SCALE=$scale: navigation or markers" >&2; exit 2 ;;
 esac
 log_level="${LOG_LEVEL:-warn}"
+read -ra mapper_args <<< "${MAPPER_ARGS:-}"
 stages=" ${STAGES:-extract map refine} "
 for stage in $stages; do
   case "$stage" in extract|map|refine) ;; *) echo "bench_survey.sh: STAGES: $stage: extract, map or refine" >&2; exit 2 ;; esac
@@ -67,7 +69,7 @@ if runs map; then
   timed map "$P" refractive_mapper --log_level "$log_level" --database_path db.db --output_path sparse \
     --Housing.model FLATPORT --Housing.params 0,0,1,0.01,0.010,1,1.473,1.334 --Mapper.init_scene_depth 2.0 \
     --Mapper.ba_refine_focal_length 0 --Mapper.ba_refine_extra_params 0 --Mapper.ba_refine_housing 1 \
-    "${scale_flags[@]}"
+    "${scale_flags[@]}" ${mapper_args[@]+"${mapper_args[@]}"}
 fi
 runs refine || exit 0
 [ -d sparse/0 ] || { echo "bench_survey.sh: $work/sparse/0: run STAGES=map first" >&2; exit 2; }
