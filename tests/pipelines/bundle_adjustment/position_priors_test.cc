@@ -412,8 +412,8 @@ TEST(PositionPriors, RobustSolveEndsWhenTheWeightsSettle) {
   ExpectSameSolution(survey, robust, std_devs, settled);
   std::cout << "weights settled after " << decided.iterations.size() << " robust iterations (1e-6 stop: "
             << iterations_to_1e6 << "), held solve " << held.iterations.size() << " iterations; port distance "
-            << settled.cameras().at(1).housing->params[3] << " / robust " << robust.cameras().at(1).housing->params[3] << " (sd " << std_devs.housing.at(1)[3]
-            << ")\n";
+            << settled.cameras().at(1).housing->params[3] << " / robust " << robust.cameras().at(1).housing->params[3]
+            << " (sd " << std_devs.housing.at(1)[3] << ")\n";
 }
 
 // A bounded port (the distance's floor) makes Ceres run a projected line
