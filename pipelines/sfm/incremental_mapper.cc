@@ -574,8 +574,11 @@ void Mapper::NoteRefinement(const Reconstruction& r, const BundleAdjustmentOptio
   }
   num_settled_in_a_row_ = shift < options_.ba_calibration_settled_px ? num_settled_in_a_row_ + 1 : 0;
   refinements_.back().settled = CalibrationSettled();
-  VLOG(1) << "refractive_mapper: the refinement on " << r.poses().size() << " images moved the image by up to "
-          << shift << " px at the median depth " << depth << (CalibrationSettled() ? " (settled)" : "");
+  std::ostringstream moved;  // infinity: the adjustment ended before converging
+  if (std::isinf(shift)) moved << "ended before converging (image shift not measured)";
+  else moved << "moved the image by up to " << shift << " px";
+  VLOG(1) << "refractive_mapper: the refinement on " << r.poses().size() << " images " << moved.str()
+          << " at the median depth " << depth << (CalibrationSettled() ? " (settled)" : "");
 }
 
 }  // namespace
