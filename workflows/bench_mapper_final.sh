@@ -17,11 +17,8 @@ cd "$(dirname "$0")/.."
 work="${1:?usage: workflows/bench_mapper_final.sh WORK_DIR}"
 [ -f "$work/db.db" ] || { echo "bench_mapper_final.sh: $work/db.db: run bench_survey.sh STAGES=extract first" >&2; exit 2; }
 P="$PWD/build/portcal"
-case "${SCALE:-navigation}" in
-  navigation) scale_flags=(--PosePrior.position_sigma 0.02) ;;
-  markers) scale_flags=(--Markers.side_length 0.15) ;;
-  *) echo "bench_mapper_final.sh: SCALE=$SCALE: navigation or markers" >&2; exit 2 ;;
-esac
+source workflows/survey_common.sh
+survey_scale "${SCALE:-navigation}"
 eval_survey="$PWD/workflows/eval_survey.py"
 cd "$work"
 for held in 1 0; do

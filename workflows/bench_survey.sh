@@ -32,11 +32,7 @@ if [ -n "${2:-}" ]; then work="$2"; mkdir -p "$work"; else work="$(mktemp -d)"; 
 P="$PWD/build/portcal"
 source workflows/survey_common.sh
 scale="${SCALE:-navigation}"
-case "$scale" in
-  navigation) num_markers=0; scale_flags=(--PosePrior.position_sigma 0.02) ;;
-  markers) num_markers=16; scale_flags=(--Markers.side_length 0.15) ;;
-  *) echo "bench_survey.sh: SCALE=$scale: navigation or markers" >&2; exit 2 ;;
-esac
+survey_scale "$scale"
 log_level="${LOG_LEVEL:-warn}"
 read -ra mapper_args <<< "${MAPPER_ARGS:-}"
 stages=" ${STAGES:-extract map refine} "

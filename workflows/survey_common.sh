@@ -1,6 +1,6 @@
 # What the survey benchmarks share (sourced by bench_survey.sh,
-# bench_survey_subset.sh, bench_mpi.sh, sourced from the project root): the
-# rendered survey and a timer.
+# bench_survey_subset.sh, bench_mpi.sh, bench_mapper_final.sh, sourced from
+# the project root): the rendered survey, its scale source and a timer.
 bash workflows/setup.sh --packages-only time >/dev/null  # GNU time, for the peak memory
 
 # survey_yaml NAME NUM_IMAGES [MARKERS=0]: the lawnmower survey 2 m over a
@@ -23,6 +23,18 @@ survey: {height: 2.0, speed: 0.5, frame_rate: 1.0, side_overlap: 0.6, line_lengt
          roughness: 0.15, relief_wavelength: 2.0, navigation_sigma: 0.02$markers}
 render: {spp: ${RENDER_SPP:-4}, noise_sigma: 1.0, white: 220, black: 30, background: 110}
 YAML
+}
+
+# survey_scale SCALE: sets num_markers (for survey_yaml) and scale_flags
+# (the mapper's and the refinement's scale options) for SCALE=navigation
+# (the position priors, 2 cm) or markers (16 markers of 15 cm); exits 2
+# naming the script otherwise.
+survey_scale() {
+  case "$1" in
+    navigation) num_markers=0; scale_flags=(--PosePrior.position_sigma 0.02) ;;
+    markers) num_markers=16; scale_flags=(--Markers.side_length 0.15) ;;
+    *) echo "$(basename "$0"): SCALE=$1: navigation or markers" >&2; exit 2 ;;
+  esac
 }
 
 # timed NAME COMMAND...: runs the command, then prints NAME, its wall time
