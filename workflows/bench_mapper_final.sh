@@ -10,7 +10,8 @@
 # bench_survey.sh made with SCALE=markers).
 # WORK_DIR: a bench_survey.sh work folder after STAGES=extract (db.db and
 # set/); the runs write fh_0*, fh_1* in it.
-# Usage: [SCALE=navigation|markers] workflows/bench_mapper_final.sh WORK_DIR
+# HOLD="1" (default "1 0") runs the settings listed.
+# Usage: [SCALE=navigation|markers] [HOLD="1 0"] workflows/bench_mapper_final.sh WORK_DIR
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ -x build/portcal ] || bash workflows/setup.sh >/dev/null
@@ -21,7 +22,9 @@ source workflows/survey_common.sh
 survey_scale "${SCALE:-navigation}"
 eval_survey="$PWD/workflows/eval_survey.py"
 cd "$work"
-for held in 1 0; do
+read -ra settings <<< "${HOLD:-1 0}"
+for held in "${settings[@]}"; do
+  case "$held" in 0|1) ;; *) echo "bench_mapper_final.sh: HOLD: $held: 0 or 1" >&2; exit 2 ;; esac
   rm -rf "fh_$held" "fh_${held}_ref" "fh_${held}_txt"
   /usr/bin/time -f "map (held=$held): %e s, %M KB" "$P" refractive_mapper --log_level debug --database_path db.db \
     --output_path "fh_$held" --Housing.model FLATPORT --Housing.params 0,0,1,0.01,0.010,1,1.473,1.334 \
