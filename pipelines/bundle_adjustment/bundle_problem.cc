@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
-#include <limits>
 #include <memory>
 #include <set>
 
@@ -100,8 +99,8 @@ class BundleProblem {
       if (camera.housing) housings_[id] = camera.housing->params;
     }
     // One loss object shared by the residuals; the problem deletes it once.
-    // With the weights held, each residual's weight goes into its sigma
-    // instead and the robust loss only computes them.
+    // With the weights held, each residual gets its own weight instead and
+    // the robust loss only computes them.
     if (options.loss_scale > 0 && options.hold_loss_weights) {
       weight_loss_ = std::make_unique<ceres::CauchyLoss>(options.loss_scale);
     } else if (options.loss_scale > 0) {
@@ -128,8 +127,7 @@ class BundleProblem {
   bool IsVariable(image_t id) const { return !local_ || scope_.variable_images.count(id) > 0; }
   CostBlocks BlocksOf(const HousedCamera& camera) const;
   void AddObservation(image_t image_id, const Eigen::Vector2d& pixel, double* xyz, double sigma);
-  void AddRobustResidual(const std::function<ceres::CostFunction*(double)>& cost_at, double sigma,
-                         const std::vector<double*>& blocks);
+  void AddRobustResidual(ceres::CostFunction* cost, const std::vector<double*>& blocks);
   double SigmaOf(const TrackElement& e) const;
   bool FreePose(image_t id) const;
   ceres::Solver::Options SolverOptions(int* num_free_poses) const;
@@ -174,11 +172,10 @@ void BundleProblem::AddObservation(image_t image_id, const Eigen::Vector2d& pixe
   const HousedCamera& camera = cameras_.at(image.camera_id);
   const ObservationModel model = ObservationModel::Of(camera);
   const CostBlocks kind = BlocksOf(camera);
-  const bool virtual_error = options_.virtual_camera_error && camera.housing.has_value();
-  const auto cost_at = [&](double sigma_px) {
-    return virtual_error ? CreateVirtualCameraCost(camera.camera.model_id, camera.housing->model_id, pixel, sigma_px)
-                         : CreateReprojectionCost(model, kind, pixel, sigma_px);
-  };
+  ceres::CostFunction* cost =
+      options_.virtual_camera_error && camera.housing
+          ? CreateVirtualCameraCost(camera.camera.model_id, camera.housing->model_id, pixel, sigma)
+          : CreateReprojectionCost(model, kind, pixel, sigma);
   std::vector<double*> blocks = {pose_blocks_.at(image_id).data(), xyz};
   if (kind == CostBlocks::kPosePointIntrinsics || kind == CostBlocks::kAll) {
     blocks.push_back(intrinsics_.at(image.camera_id).data());
@@ -186,21 +183,15 @@ void BundleProblem::AddObservation(image_t image_id, const Eigen::Vector2d& pixe
   if ((kind == CostBlocks::kAll || kind == CostBlocks::kPosePointHousing) && camera.housing) {
     blocks.push_back(housings_.at(image.camera_id).data());
   }
-  AddRobustResidual(cost_at, sigma, blocks);
+  AddRobustResidual(cost, blocks);
   used_cameras_.insert(image.camera_id);
 }
 
 // An observation's residual under the robust loss, or, with the weights
-// held, under its weight w = rho'(|r|^2) at the current parameters (a
-// residual that cannot be evaluated there gets weight 1: the solve then
-// fails on it and says so). The weight goes into the residual's sigma,
-// sigma / sqrt(w), which gives the same cost, w |r|^2, and the same
-// Jacobian as a ScaledLoss would, without a loss object per residual (on a
-// survey of millions of observations those objects and Ceres' count of
-// their owners cost ~100 bytes each; docs/scale.md).
-void BundleProblem::AddRobustResidual(const std::function<ceres::CostFunction*(double)>& cost_at, double sigma,
-                                      const std::vector<double*>& blocks) {
-  ceres::CostFunction* cost = cost_at(sigma);
+// held, under its weight rho'(|r|^2) at the current parameters (a residual
+// that cannot be evaluated there gets weight 1: the solve then fails on it
+// and says so).
+void BundleProblem::AddRobustResidual(ceres::CostFunction* cost, const std::vector<double*>& blocks) {
   num_residuals_ += cost->num_residuals();
   if (!weight_loss_) {
     const ceres::ResidualBlockId id = problem_.AddResidualBlock(cost, loss_, blocks);
@@ -212,14 +203,7 @@ void BundleProblem::AddRobustResidual(const std::function<ceres::CostFunction*(d
   if (cost->Evaluate(blocks.data(), residual.data(), nullptr) && residual.allFinite()) {
     weight_loss_->Evaluate(residual.squaredNorm(), rho);
   }
-  if (rho[1] != 1.0) {
-    // The Cauchy weight 1 / (1 + s / c^2) underflows to 0 only for an s
-    // that overflows; such a residual keeps the least positive weight.
-    const double weight = std::max(rho[1], std::numeric_limits<double>::min());
-    delete cost;
-    cost = cost_at(sigma / std::sqrt(weight));
-  }
-  problem_.AddResidualBlock(cost, nullptr, blocks);
+  problem_.AddResidualBlock(cost, new ceres::ScaledLoss(nullptr, rho[1], ceres::TAKE_OWNERSHIP), blocks);
 }
 
 // A keypoint found at a coarse scale is located less precisely: SIFT's
@@ -250,10 +234,8 @@ void BundleProblem::AddPoints() {
       const auto& ray = reconstruction_->RayOf(e.image_id, e.point2D_idx);
       if (BlocksOf(camera) == CostBlocks::kPosePoint && ray && ray->direction.z() > 1e-6) {
         // Intrinsics and housing held: the cheap fixed-ray error.
-        const Eigen::Vector3d center = VirtualCenterOf(camera, *ray);
-        const double focal = camera.camera.MeanFocalLength();
         AddRobustResidual(
-            [&](double sigma_px) { return CreateFixedRayCost(center, ray->direction, focal, sigma_px); }, sigma,
+            CreateFixedRayCost(VirtualCenterOf(camera, *ray), ray->direction, camera.camera.MeanFocalLength(), sigma),
             {pose_blocks_.at(e.image_id).data(), xyz.data()});
         continue;
       }
