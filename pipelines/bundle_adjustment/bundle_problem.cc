@@ -4,6 +4,7 @@
 // and the write-back, each a method of BundleProblem.
 #include <algorithm>
 #include <chrono>
+#include <deque>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -80,6 +81,29 @@ std::vector<int> ConstantIntrinsics(const Camera& camera, const BundleAdjustment
   return constant;
 }
 
+// A residual's robust weight w, held: rho(s) = w s (a ScaledLoss without
+// an inner loss), kept by the problem builder in bulk.
+class HeldWeight final : public ceres::LossFunction {
+ public:
+  explicit HeldWeight(double weight) : weight_(weight) {}
+  void Evaluate(double s, double rho[3]) const override {
+    rho[0] = weight_ * s;
+    rho[1] = weight_;
+    rho[2] = 0;
+  }
+
+ private:
+  double weight_;
+};
+
+// The problem owns the cost functions; the losses are the builder's (see
+// BundleProblem's members).
+ceres::Problem::Options ProblemOptions() {
+  ceres::Problem::Options options;
+  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  return options;
+}
+
 class BundleProblem {
  public:
   BundleProblem(Reconstruction* reconstruction, const BundleAdjustmentOptions& options,
@@ -98,13 +122,13 @@ class BundleProblem {
       intrinsics_[id] = camera.camera.params;
       if (camera.housing) housings_[id] = camera.housing->params;
     }
-    // One loss object shared by the residuals; the problem deletes it once.
-    // With the weights held, each residual gets its own weight instead and
-    // the robust loss only computes them.
+    // One loss object shared by the residuals. With the weights held, each
+    // residual gets its own weight instead and the robust loss only
+    // computes them.
     if (options.loss_scale > 0 && options.hold_loss_weights) {
       weight_loss_ = std::make_unique<ceres::CauchyLoss>(options.loss_scale);
     } else if (options.loss_scale > 0) {
-      loss_ = new ceres::CauchyLoss(options.loss_scale);
+      loss_ = std::make_unique<ceres::CauchyLoss>(options.loss_scale);
     }
     local_ = !scope.variable_images.empty();
     // Which blocks the residuals carry: constants are captured instead (see
@@ -145,9 +169,15 @@ class BundleProblem {
   std::map<camera_t, std::vector<double>> intrinsics_, housings_;
   std::map<point3D_t, Eigen::Vector3d> point_blocks_;
   std::set<camera_t> used_cameras_;
-  ceres::Problem problem_;
-  ceres::LossFunction* loss_ = nullptr;
+  // The losses outlive the problem, which does not own them. A held weight
+  // is 16 bytes here; as a ScaledLoss owned by the problem it was an
+  // allocation and an entry in Ceres' table of the losses it owns, several
+  // times that per observation (docs/scale.md).
+  std::unique_ptr<ceres::LossFunction> loss_;         // the robust loss, shared
   std::unique_ptr<ceres::LossFunction> weight_loss_;  // with hold_loss_weights: the weights' robust loss
+  std::deque<HeldWeight> held_weights_;               // with hold_loss_weights: one per residual block
+  ceres::HuberLoss prior_loss_{3.0};                  // position priors' (3 sigma)
+  ceres::Problem problem_{ProblemOptions()};
   std::vector<ceres::ResidualBlockId> robust_blocks_;  // under loss_, with max_unsettled_weight_fraction
   bool local_ = false;
   bool refine_intrinsics_ = false;
@@ -194,7 +224,7 @@ void BundleProblem::AddObservation(image_t image_id, const Eigen::Vector2d& pixe
 void BundleProblem::AddRobustResidual(ceres::CostFunction* cost, const std::vector<double*>& blocks) {
   num_residuals_ += cost->num_residuals();
   if (!weight_loss_) {
-    const ceres::ResidualBlockId id = problem_.AddResidualBlock(cost, loss_, blocks);
+    const ceres::ResidualBlockId id = problem_.AddResidualBlock(cost, loss_.get(), blocks);
     if (loss_ && options_.max_unsettled_weight_fraction > 0) robust_blocks_.push_back(id);
     return;
   }
@@ -203,7 +233,8 @@ void BundleProblem::AddRobustResidual(ceres::CostFunction* cost, const std::vect
   if (cost->Evaluate(blocks.data(), residual.data(), nullptr) && residual.allFinite()) {
     weight_loss_->Evaluate(residual.squaredNorm(), rho);
   }
-  problem_.AddResidualBlock(cost, new ceres::ScaledLoss(nullptr, rho[1], ceres::TAKE_OWNERSHIP), blocks);
+  held_weights_.emplace_back(rho[1]);
+  problem_.AddResidualBlock(cost, &held_weights_.back(), blocks);
 }
 
 // A keypoint found at a coarse scale is located less precisely: SIFT's
@@ -279,7 +310,7 @@ void BundleProblem::AddPositionPriors() {
     const auto& prior = reconstruction_->inputs().images.at(id).position_prior;
     if (!prior || !problem_.HasParameterBlock(block.data())) continue;
     problem_.AddResidualBlock(CreatePositionPriorCost(*prior, options_.position_prior_sigma_m),
-                              new ceres::HuberLoss(3.0), block.data());
+                              &prior_loss_, block.data());
     num_residuals_ += 3;
   }
 }
@@ -403,7 +434,7 @@ ceres::Solver::Summary BundleProblem::Solve() {
   ceres::Solver::Options solver = SolverOptions(&num_free_poses);
   std::unique_ptr<WeightsSettledCallback> weights_settled;
   if (!robust_blocks_.empty()) {
-    weights_settled = std::make_unique<WeightsSettledCallback>(&problem_, std::move(robust_blocks_), loss_,
+    weights_settled = std::make_unique<WeightsSettledCallback>(&problem_, std::move(robust_blocks_), loss_.get(),
                                                                options_.max_unsettled_weight_fraction);
     solver.callbacks.push_back(weights_settled.get());
     solver.update_state_every_iteration = true;
