@@ -6,6 +6,7 @@
 
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/random_seed.h"
+#include "pipelines/features/relative_pose_refinement.h"
 
 namespace portcal {
 
@@ -84,7 +85,9 @@ MatchedPoints FInliersOf(const MatchedPoints& all, const cv::Mat& f_mask, std::v
   return out;
 }
 
-// Relative pose of a calibrated pair (unit baseline) from E's inliers.
+// Relative pose of a calibrated pair (unit baseline) from E's inliers: E's
+// decomposition in front of both cameras, then fitted to all the inliers
+// (relative_pose_refinement.h).
 std::optional<Rigid3d> PoseFromEssential(const cv::Mat& E, const MatchedPoints& e_points, const cv::Mat& e_mask) {
   std::vector<cv::Point2d> in1, in2;
   for (size_t k = 0; k < e_points.ray_index.size(); ++k) {
@@ -99,7 +102,13 @@ std::optional<Rigid3d> PoseFromEssential(const cv::Mat& E, const MatchedPoints& 
   Eigen::Vector3d translation;
   cv::cv2eigen(R, rotation);
   cv::cv2eigen(t, translation);
-  return Rigid3d(Eigen::Quaterniond(rotation), translation);
+  const Rigid3d from_sample(Eigen::Quaterniond(rotation), translation);
+  std::vector<Eigen::Vector2d> points1, points2;
+  for (size_t k = 0; k < in1.size(); ++k) {
+    points1.emplace_back(in1[k].x, in1[k].y);
+    points2.emplace_back(in2[k].x, in2[k].y);
+  }
+  return RefineRelativePose(points1, points2, from_sample).value_or(from_sample);
 }
 
 }  // namespace
