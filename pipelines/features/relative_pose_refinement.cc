@@ -4,6 +4,7 @@
 #include <ceres/rotation.h>
 
 #include <cmath>
+#include <memory>
 
 namespace portcal {
 
@@ -49,18 +50,23 @@ struct SampsonError {
 }  // namespace
 
 std::optional<Rigid3d> RefineRelativePose(const std::vector<Eigen::Vector2d>& points1,
-                                          const std::vector<Eigen::Vector2d>& points2, const Rigid3d& cam2_from_cam1) {
-  if (points1.size() != points2.size() || points1.size() < 5) return std::nullopt;
+                                          const std::vector<Eigen::Vector2d>& points2, const Rigid3d& cam2_from_cam1,
+                                          double loss_scale) {
+  if (points1.size() != points2.size() || points1.size() < 5 || !(loss_scale >= 0)) return std::nullopt;
   const double norm = cam2_from_cam1.translation.norm();
   if (!(norm > 0) || !std::isfinite(norm)) return std::nullopt;
   const Eigen::Quaterniond start = cam2_from_cam1.rotation.normalized();
   double q[4] = {start.x(), start.y(), start.z(), start.w()};
   Eigen::Vector3d t = cam2_from_cam1.translation / norm;
-  ceres::Problem problem;
+  // One loss for all residuals, deleted here, not by the problem.
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  const std::unique_ptr<ceres::LossFunction> loss(loss_scale > 0 ? new ceres::CauchyLoss(loss_scale) : nullptr);
   for (size_t i = 0; i < points1.size(); ++i) {
     problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<SampsonError, 1, 4, 3>(new SampsonError(points1[i], points2[i])), nullptr, q,
-        t.data());
+        new ceres::AutoDiffCostFunction<SampsonError, 1, 4, 3>(new SampsonError(points1[i], points2[i])), loss.get(),
+        q, t.data());
   }
   problem.SetManifold(q, new ceres::EigenQuaternionManifold());
   problem.SetManifold(t.data(), new ceres::SphereManifold<3>());

@@ -87,8 +87,11 @@ MatchedPoints FInliersOf(const MatchedPoints& all, const cv::Mat& f_mask, std::v
 
 // Relative pose of a calibrated pair (unit baseline) from E's inliers: E's
 // decomposition in front of both cameras, then fitted to all the inliers
-// (relative_pose_refinement.h).
-std::optional<Rigid3d> PoseFromEssential(const cv::Mat& E, const MatchedPoints& e_points, const cv::Mat& e_mask) {
+// (relative_pose_refinement.h) under a Cauchy loss of a quarter of the
+// inlier threshold (1 px at the default 4), the scale of a true match's
+// noise, not of the chance matches the threshold lets in.
+std::optional<Rigid3d> PoseFromEssential(const cv::Mat& E, const MatchedPoints& e_points, const cv::Mat& e_mask,
+                                         double threshold) {
   std::vector<cv::Point2d> in1, in2;
   for (size_t k = 0; k < e_points.ray_index.size(); ++k) {
     if (e_mask.at<uchar>(static_cast<int>(k))) {
@@ -108,7 +111,7 @@ std::optional<Rigid3d> PoseFromEssential(const cv::Mat& E, const MatchedPoints& 
     points1.emplace_back(in1[k].x, in1[k].y);
     points2.emplace_back(in2[k].x, in2[k].y);
   }
-  return RefineRelativePose(points1, points2, from_sample).value_or(from_sample);
+  return RefineRelativePose(points1, points2, from_sample, threshold / 4).value_or(from_sample);
 }
 
 }  // namespace
@@ -147,8 +150,8 @@ TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& key
   std::vector<int> f_index;  // match indices of F's inliers
   const MatchedPoints f_points = FInliersOf(points, f_mask, &f_index);
   cv::Mat E;
+  const double focal = 0.5 * (camera1.MeanFocalLength() + camera2.MeanFocalLength());
   if (static_cast<int>(f_points.rays1.size()) >= options.min_num_inliers) {
-    const double focal = 0.5 * (camera1.MeanFocalLength() + camera2.MeanFocalLength());
     cv::theRNG() = cv::RNG(GeneratorState(options.random_seed));
     E = cv::findEssentialMat(f_points.rays1, f_points.rays2, cv::Mat::eye(3, 3, CV_64F), cv::RANSAC,
                              options.confidence, options.max_error / focal, options.max_num_trials, e_mask);
@@ -169,7 +172,7 @@ TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& key
     geometry.config = nh / ne > options.max_H_inlier_ratio ? TwoViewGeometryConfig::kPlanarOrPanoramic
                                                            : TwoViewGeometryConfig::kCalibrated;
     geometry.inlier_matches = e_inliers;
-    if (const auto pose = PoseFromEssential(E, f_points, e_mask)) geometry.cam2_from_cam1 = *pose;
+    if (const auto pose = PoseFromEssential(E, f_points, e_mask, options.max_error / focal)) geometry.cam2_from_cam1 = *pose;
   } else if (nf >= min_inliers) {
     geometry.config = nh / nf > options.max_H_inlier_ratio ? TwoViewGeometryConfig::kPlanarOrPanoramic
                                                            : TwoViewGeometryConfig::kUncalibrated;

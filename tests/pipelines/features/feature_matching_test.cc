@@ -142,12 +142,13 @@ TEST(TwoViewVerification, KeepsTheTrueMatchesOfACalibratedPair) {
   // pixel falls within 4 px of its epipolar line with probability ~1 %.
   EXPECT_GE(true_kept, 0.99 * num_true);
   EXPECT_LE(false_kept, 0.03 * (900 - num_true));
-  // The pose is fitted to all ~630 inliers: 0.5 px over f = 700 is 7e-4
-  // per match, ~3e-5 rad (0.002 deg) over 630 of them; the narrow field of
-  // view (69 x 42 deg) lets rotation and translation trade, which widens
-  // that several times. A minimal sample's pose was 1.1 deg off here.
+  // The pose is fitted to the ~630 true matches: at 0.5 px their Fisher
+  // information (Sampson's distance, this pair's geometry) gives standard
+  // deviations of 0.062 deg for the rotation and 0.17 deg for the
+  // translation's direction (the narrow field of view lets the two trade).
+  // Bounds at about 3 of them; a minimal sample's pose was 1.1 deg off here.
   const double angle = geometry.cam2_from_cam1.rotation.angularDistance(pair.cam2_from_cam1.rotation);
-  EXPECT_LT(angle, 0.05 * M_PI / 180);
+  EXPECT_LT(angle, 0.2 * M_PI / 180);
   const Eigen::Vector3d t = pair.cam2_from_cam1.translation.normalized();
   EXPECT_GT(geometry.cam2_from_cam1.translation.normalized().dot(t), std::cos(0.5 * M_PI / 180));
   std::cout << "relative pose: rotation " << angle * 180 / M_PI << " deg, translation "
@@ -177,7 +178,7 @@ TEST(RelativePoseRefinement, ConvergesToTheExactPoseFromADegreeOff) {
   NormalisedMatches(truth, 100, 0.0, &rng, &points1, &points2);
   const Rigid3d start(truth.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 180, Eigen::Vector3d::UnitY())),
                       (truth.translation + Eigen::Vector3d(0, 0.05, 0.05)).normalized());
-  const auto refined = RefineRelativePose(points1, points2, start);
+  const auto refined = RefineRelativePose(points1, points2, start, 0.0);
   ASSERT_TRUE(refined);
   // Exact matches: only the solver's stop separates it from the truth.
   EXPECT_LT(refined->rotation.angularDistance(truth.rotation), 1e-8);
@@ -190,12 +191,12 @@ TEST(RelativePoseRefinement, FewerThanFiveMatchesOrNoBaselineAreNotRefined) {
   std::mt19937 rng(5);
   std::vector<Eigen::Vector2d> points1, points2;
   NormalisedMatches(truth, 4, 0.0, &rng, &points1, &points2);
-  EXPECT_FALSE(RefineRelativePose(points1, points2, truth));
+  EXPECT_FALSE(RefineRelativePose(points1, points2, truth, 0.0));
   NormalisedMatches(truth, 20, 0.0, &rng, &points1, &points2);
-  EXPECT_TRUE(RefineRelativePose(points1, points2, truth));
-  EXPECT_FALSE(RefineRelativePose(points1, points2, Rigid3d()));  // zero translation: no direction to refine
+  EXPECT_TRUE(RefineRelativePose(points1, points2, truth, 0.0));
+  EXPECT_FALSE(RefineRelativePose(points1, points2, Rigid3d(), 0.0));  // zero translation: no direction to refine
   points2.pop_back();
-  EXPECT_FALSE(RefineRelativePose(points1, points2, truth));
+  EXPECT_FALSE(RefineRelativePose(points1, points2, truth, 0.0));
 }
 
 TEST(TwoViewVerification, RejectsTheChanceMatchesOfUnrelatedImages) {
