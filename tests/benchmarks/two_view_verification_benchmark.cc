@@ -80,3 +80,4 @@ BENCHMARK(BM_RefineRelativePose)->Arg(900)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace portcal
+BENCHMARK_MAIN();
