@@ -4,8 +4,8 @@
 // and the write-back, each a method of BundleProblem.
 #include <algorithm>
 #include <chrono>
-#include <deque>
 #include <cmath>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <set>

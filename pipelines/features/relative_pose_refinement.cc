@@ -10,9 +10,8 @@ namespace portcal {
 
 namespace {
 
-// Ceres' stops for a five-parameter fit: it converges in a handful of
-// Gauss-Newton steps from RANSAC's pose, so the limit only bounds a bad
-// start.
+// From RANSAC's pose the five-parameter fit converges in a handful of
+// steps; the limit only bounds the work on a bad start.
 constexpr int kMaxNumIterations = 50;
 
 // Sampson's distance of one match from the epipolar geometry E = [t]x R,

@@ -1,10 +1,10 @@
 // The relative pose of a calibrated pair, refined on the inliers of its
 // essential matrix. RANSAC returns the pose of its best minimal sample,
-// whose five matches carry their noise into it undiluted (1.1 deg off on a
-// 900-match test pair at 0.5 px); COLMAP's LO-RANSAC ends on a fit to all
-// inliers. Here the fit is Sampson's distance over all inliers, minimised
-// by Ceres over the rotation and the translation's direction (the baseline
-// is unit: a pair does not observe its scale).
+// whose five matches carry their noise into it undiluted
+// (docs/benchmarks.md); COLMAP's LO-RANSAC ends on a fit to all inliers.
+// Here the fit is Sampson's distance over all inliers, minimised by Ceres
+// over the rotation and the translation's direction (the baseline is unit:
+// a pair does not observe its scale).
 #pragma once
 
 #include <Eigen/Core>
