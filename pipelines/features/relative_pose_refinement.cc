@@ -33,8 +33,7 @@ struct SampsonError {
     const Eigen::Matrix<T, 3, 1> p2(T(x2_.x()), T(x2_.y()), T(1));
     const Eigen::Matrix<T, 3, 1> e_p1 = E * p1;
     const Eigen::Matrix<T, 3, 1> et_p2 = E.transpose() * p2;
-    const T denominator =
-        e_p1.x() * e_p1.x() + e_p1.y() * e_p1.y() + et_p2.x() * et_p2.x() + et_p2.y() * et_p2.y();
+    const T denominator = e_p1.x() * e_p1.x() + e_p1.y() * e_p1.y() + et_p2.x() * et_p2.x() + et_p2.y() * et_p2.y();
     // A match on the epipoles' line through both centres has no epipolar
     // distance to measure: fail rather than divide by zero.
     if (!(denominator > T(0))) return false;
@@ -64,8 +63,8 @@ std::optional<Rigid3d> RefineRelativePose(const std::vector<Eigen::Vector2d>& po
   const std::unique_ptr<ceres::LossFunction> loss(loss_scale > 0 ? new ceres::CauchyLoss(loss_scale) : nullptr);
   for (size_t i = 0; i < points1.size(); ++i) {
     problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<SampsonError, 1, 4, 3>(new SampsonError(points1[i], points2[i])), loss.get(),
-        q, t.data());
+        new ceres::AutoDiffCostFunction<SampsonError, 1, 4, 3>(new SampsonError(points1[i], points2[i])), loss.get(), q,
+        t.data());
   }
   problem.SetManifold(q, new ceres::EigenQuaternionManifold());
   problem.SetManifold(t.data(), new ceres::SphereManifold<3>());
