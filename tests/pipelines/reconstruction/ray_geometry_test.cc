@@ -59,8 +59,13 @@ TEST(RayGeometry, GeneralizedAbsolutePoseRecoversThePoseBehindAPortWithOutliers)
   std::vector<char> inliers;
   const auto pose = EstimateGeneralizedAbsolutePose(rays, points, GeneralizedAbsolutePoseOptions(), &inliers);
   ASSERT_TRUE(pose);
-  EXPECT_LT((pose->translation - truth.translation).norm(), 1e-6);
-  EXPECT_LT(pose->rotation.angularDistance(truth.rotation), 1e-6);
+  // The inliers are exact, so only the solver's stop separates the pose
+  // from the truth: OpenGV's nonlinear refinement stops when a step is
+  // below 1e10 x machine epsilon (2.2e-6) of its parameters' norm (the
+  // translation and the Cayley vector, ~0.5 here), ~1e-6. The bounds
+  // allow ten such steps (1e-6 passed with gcc and failed with clang, 1.2e-6 rad).
+  EXPECT_LT((pose->translation - truth.translation).norm(), 1e-5);
+  EXPECT_LT(pose->rotation.angularDistance(truth.rotation), 1e-5);
   int correct = 0;
   for (int i = 0; i < 80; ++i) correct += inliers[i] == (i % 5 != 0);
   EXPECT_GE(correct, 78);

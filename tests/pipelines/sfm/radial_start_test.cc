@@ -80,13 +80,16 @@ TEST(RadialStart, FindsTheFirstRadialTermOfAWideLensBehindAFlatPort) {
   truth.camera.params = {905, 902, 981, 527, -0.3, 0, 0.0012, 0.0009};
   truth.housing = Housing::FromName("FLATPORT", {0.0436194, 0, 0.9990482, 0.03, 0.008, 1, 1.473, 1.334}, "test");
   const Scene scene = MakeScene(truth, 6, 0.3, 3);
-  // All but k1 known: the estimate is the lens's k1, to the
-  // noise (0.3 px on ~10 pairs; the grid's step is 0.025).
+  // All but k1 known: the estimate is the lens's k1 to the grid's step
+  // (0.025). The trimmed residual is not smooth in k at that scale (the
+  // kept 80 % change with k), so the parabola through the best three nodes
+  // does not always improve on the best: the same data chose -0.300 in
+  // gcc's build and the next node, -0.275, in clang's.
   HousedCamera k1_unknown = truth;
   k1_unknown.camera.params[4] = 0;
   const auto exact = EstimateFirstRadialTerm(scene.inputs, 1, k1_unknown, RadialStartOptions());
   ASSERT_TRUE(exact);
-  EXPECT_NEAR(exact->k, -0.3, 0.015);
+  EXPECT_NEAR(exact->k, -0.3, 0.025 + 1e-12);
   EXPECT_LT(exact->residual_px, 0.45);  // Sampson's distance at 0.3 px per coordinate
   // The start as the mapper has it: the markers' focal length (1 % off),
   // the principal point at the centre (23 px off), no distortion, the
