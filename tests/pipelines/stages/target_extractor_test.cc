@@ -285,10 +285,13 @@ TEST_P(MarkerBoards, ObservationsAndCalibration) {
   EXPECT_LT(errors.back(), charuco ? 0.3 : 0.5) << GetParam();
   const CameraCalibrationResult result = CalibrateCamera(ReadTargetViews(&db).by_camera.begin()->second,
                                                          Camera::FromModelName("RADIAL", 700, 800, 600), {});
+  std::cout << GetParam() << ": parameters off by";
   for (int i = 0; i < 5; ++i) {
+    std::cout << " " << (result.camera.params[i] - truth.camera.params[i]) / result.params_std_dev[i];
     EXPECT_LT(std::abs(result.camera.params[i] - truth.camera.params[i]), 4 * result.params_std_dev[i] + 1e-9)
         << "parameter " << i;
   }
+  std::cout << " sigma\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(Targets, MarkerBoards, ::testing::Values("aruco_grid", "charuco"));
