@@ -93,10 +93,13 @@ MatchedPoints FInliersOf(const MatchedPoints& all, const cv::Mat& f_mask, std::v
 std::optional<Rigid3d> PoseFromEssential(const cv::Mat& E, const MatchedPoints& e_points, const cv::Mat& e_mask,
                                          double threshold) {
   std::vector<cv::Point2d> in1, in2;
+  std::vector<Eigen::Vector2d> points1, points2;
   for (size_t k = 0; k < e_points.ray_index.size(); ++k) {
     if (e_mask.at<uchar>(static_cast<int>(k))) {
       in1.push_back(e_points.rays1[k]);
       in2.push_back(e_points.rays2[k]);
+      points1.emplace_back(in1.back().x, in1.back().y);
+      points2.emplace_back(in2.back().x, in2.back().y);
     }
   }
   cv::Mat R, t;
@@ -106,11 +109,6 @@ std::optional<Rigid3d> PoseFromEssential(const cv::Mat& E, const MatchedPoints& 
   cv::cv2eigen(R, rotation);
   cv::cv2eigen(t, translation);
   const Rigid3d from_sample(Eigen::Quaterniond(rotation), translation);
-  std::vector<Eigen::Vector2d> points1, points2;
-  for (size_t k = 0; k < in1.size(); ++k) {
-    points1.emplace_back(in1[k].x, in1[k].y);
-    points2.emplace_back(in2[k].x, in2[k].y);
-  }
   return RefineRelativePose(points1, points2, from_sample, threshold / 4).value_or(from_sample);
 }
 
