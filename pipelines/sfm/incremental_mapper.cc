@@ -162,7 +162,7 @@ class Mapper {
 
 std::vector<MappedModel> Mapper::Run(ProgressSink& progress) {
   std::vector<MappedModel> models;
-  std::set<image_pair_t> tried;
+  std::set<image_pair_t> tried = options_.init_excluded_pairs;
   progress.Begin("refractive_mapper: images registered", inputs_.images.size());
   // Initial pairs of the current model whose growth was abandoned because
   // the intrinsics kept coming out implausible (a wrong start, see
@@ -203,7 +203,7 @@ std::vector<MappedModel> Mapper::Run(ProgressSink& progress) {
             << seconds_["global"];
     const bool keep = static_cast<int>(r.poses().size()) >= options_.min_model_size;
     for (const auto& [id, pose] : r.poses()) used_.insert(id);
-    if (keep) models.push_back(MappedModel{std::move(r), std::move(refinements_)});
+    if (keep) models.push_back(MappedModel{std::move(r), start, std::move(refinements_)});
     if (!options_.multiple_models) break;
     if (inputs_.images.size() - used_.size() < 2) break;
   }

@@ -8,6 +8,7 @@
 // is ordinary SfM through the same code.
 #pragma once
 
+#include <set>
 #include <vector>
 
 #include "colmap_ext/util/progress.h"
@@ -34,6 +35,11 @@ struct IncrementalMapperOptions {
   // of them a factor 2 (docs/dev/auto_calibration_notes.md).
   double max_focal_ratio_to_start = 2.0;
   double init_max_error_px = 4.0;
+  // Pairs no model starts from: the auto-calibrator's next start excludes
+  // the pair the previous start's model grew from, so that it takes another
+  // path (with only another random seed, three starts grew three identical
+  // wrong models from one pair; docs/dev/auto_calibration_notes.md).
+  std::set<image_pair_t> init_excluded_pairs;
   // Scale of a model when markers do not give it: the initial pair's median
   // scene depth, metres.
   double init_scene_depth_m = 1.0;
@@ -126,6 +132,7 @@ struct CalibrationRefinement {
 
 struct MappedModel {
   Reconstruction reconstruction;
+  image_pair_t initial_pair = 0;  // the pair it grew from
   std::vector<CalibrationRefinement> calibration_refinements;  // in order; the final adjustment's last
 };
 

@@ -1,6 +1,7 @@
 #include "pipelines/stages/auto_calibrator.h"
 
 #include <chrono>
+#include <set>
 #include <iomanip>
 #include <sstream>
 
@@ -136,8 +137,10 @@ void KeepStart(const fs::path& output_path, int kept, int num_starts) {
 }
 
 RefractiveMapperOptions MapperOptions(const AutoCalibratorOptions& options, const std::string& database_path,
-                                      const fs::path& dir, int random_seed, bool refine_intrinsics) {
+                                      const fs::path& dir, int random_seed, bool refine_intrinsics,
+                                      const std::set<image_pair_t>& excluded_pairs) {
   RefractiveMapperOptions map;
+  map.mapper.init_excluded_pairs = excluded_pairs;
   map.database_path = database_path;
   map.image_path = options.image_path;
   map.output_path = (dir / "sparse").string();
@@ -190,14 +193,18 @@ RefractiveBundleAdjusterOptions RefinerOptions(const AutoCalibratorOptions& opti
   return refine;
 }
 
-// Start k: the mapper (random seed + k) and the refinement, judged; throws
-// NumericalError where either fails or the result is ruled out.
+// Start k: the mapper (random seed + k, none of `excluded_pairs` as its
+// initial pair) and the refinement, judged; throws NumericalError where
+// either fails or the result is ruled out. Adds the pair the model grew
+// from to `excluded_pairs`.
 CalibrationStart MapAndRefine(const AutoCalibratorOptions& options, const std::string& database_path, int k,
                               const std::optional<double>& markers_focal, bool refine_intrinsics,
-                              ProgressSink& progress) {
+                              std::set<image_pair_t>* excluded_pairs, ProgressSink& progress) {
   const fs::path dir = k == 0 ? fs::path(options.output_path) : fs::path(options.output_path) / StartDir(k);
   const RefractiveMapperSummary mapped = RunRefractiveMapper(
-      MapperOptions(options, database_path, dir, options.random_seed + k, refine_intrinsics), progress);
+      MapperOptions(options, database_path, dir, options.random_seed + k, refine_intrinsics, *excluded_pairs),
+      progress);
+  excluded_pairs->insert(mapped.initial_pairs.at(0));
   CalibrationStart start;
   start.index = k;
   start.num_registered = static_cast<int>(ReadSparseModel(mapped.model_paths.at(0)).images.size());
@@ -217,8 +224,8 @@ CalibrationStart MapAndRefine(const AutoCalibratorOptions& options, const std::s
 }
 
 // Several starts when one cannot be trusted (a wrong basin, or a poorly
-// determined solution): the mapper's random choices from another seed take
-// another path; the start with the fewest warnings, then the smallest
+// determined solution): another initial pair and the mapper's random
+// choices from another seed take another path; the start with the fewest warnings, then the smallest
 // residual, is kept (its files moved into the output folder). Throws the
 // first start's error when none succeeds.
 CalibrationStart BestStart(const AutoCalibratorOptions& options, const std::string& database_path,
@@ -227,9 +234,11 @@ CalibrationStart BestStart(const AutoCalibratorOptions& options, const std::stri
   const int num_starts = refine_intrinsics ? options.max_num_starts : 1;
   std::optional<CalibrationStart> best;
   std::string first_error;
+  std::set<image_pair_t> excluded_pairs;
   for (int k = 0; k < num_starts; ++k) {
     try {
-      CalibrationStart start = MapAndRefine(options, database_path, k, markers_focal, refine_intrinsics, progress);
+      CalibrationStart start =
+          MapAndRefine(options, database_path, k, markers_focal, refine_intrinsics, &excluded_pairs, progress);
       if (!best || BetterStart(start, *best)) best = std::move(start);
     } catch (const NumericalError& e) {
       if (first_error.empty()) first_error = e.what();
@@ -237,7 +246,8 @@ CalibrationStart BestStart(const AutoCalibratorOptions& options, const std::stri
     }
     if (best && NumCurableWarnings(best->refined) == 0) break;
     if (k + 1 < num_starts) {
-      LOG(WARNING) << "auto_calibrator: start " << k + 1 << " is not to be trusted; mapping again from random seed "
+      LOG(WARNING) << "auto_calibrator: start " << k + 1
+                   << " is not to be trusted; mapping again from another initial pair and random seed "
                    << options.random_seed + k + 1;
     }
   }

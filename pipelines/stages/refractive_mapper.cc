@@ -90,6 +90,7 @@ RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& optio
     const fs::path dir = fs::path(options.output_path) / std::to_string(m);
     WriteSparseModel(models[m].reconstruction.ToSparseModel(), dir, ModelFormat::kBinary);
     summary.model_paths.push_back(dir);
+    summary.initial_pairs.push_back(models[m].initial_pair);
     summary.num_registered += static_cast<int>(models[m].reconstruction.poses().size());
     const auto& refinements = models[m].calibration_refinements;
     const auto held = std::find_if(refinements.begin(), refinements.end(),

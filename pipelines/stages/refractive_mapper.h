@@ -43,6 +43,7 @@ struct RefractiveMapperSummary {
   int num_registered = 0;  // over all models
   int num_images = 0;
   std::vector<std::filesystem::path> model_paths;
+  std::vector<image_pair_t> initial_pairs;  // per model: the pair it grew from
   // Per model: its global adjustments that refined the intrinsics or housing.
   std::vector<std::vector<CalibrationRefinement>> calibration_refinements;
 };

@@ -2,7 +2,8 @@
 // images, and the pairs between them, are mapped; a list naming an image
 // the database does not hold, an empty list and a missing file are errors
 // naming the file (and line), with no output folder left. The list
-// calibration_subset_selector writes maps as one model.
+// calibration_subset_selector writes maps as one model. A pair excluded as
+// the initial pair is not started from.
 #include "pipelines/stages/refractive_mapper.h"
 
 #include <gtest/gtest.h>
@@ -65,6 +66,24 @@ TEST(RefractiveMapper, ImageListMapsOnlyTheListedImages) {
   const SparseModel model = ReadSparseModel(summary.model_paths[0]);
   EXPECT_EQ(model.images.size(), 4u);
   for (const auto& [id, image] : model.images) EXPECT_EQ(listed.count(image.name), 1u) << image.name;
+}
+
+// The auto-calibrator's next start excludes the pair the previous start's
+// model grew from (IncrementalMapperOptions::init_excluded_pairs).
+TEST(RefractiveMapper, AnExcludedPairIsNotStartedFrom) {
+  const testing::TempDir dir;
+  const fs::path database = MatchedDatabase(dir);
+  RefractiveMapperOptions options = MapperOptions(dir, database);
+  options.image_list_path.clear();
+  const RefractiveMapperSummary first = RunRefractiveMapper(options, NoProgress());
+  ASSERT_EQ(first.initial_pairs.size(), static_cast<size_t>(first.num_models));
+  ASSERT_GE(first.num_models, 1);
+  options.output_path = (dir / "sparse_again").string();
+  options.mapper.init_excluded_pairs = {first.initial_pairs[0]};
+  const RefractiveMapperSummary again = RunRefractiveMapper(options, NoProgress());
+  ASSERT_GE(again.num_models, 1);
+  for (image_pair_t pair : again.initial_pairs) EXPECT_NE(pair, first.initial_pairs[0]);
+  EXPECT_EQ(again.num_registered, 7);
 }
 
 TEST(RefractiveMapper, ABadImageListIsNamed) {
