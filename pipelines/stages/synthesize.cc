@@ -93,8 +93,11 @@ std::unique_ptr<SceneObject> MakeOccluder(const BuiltTarget& target, const Rigid
                                           double fraction, std::mt19937_64* rng, Rigid3d* cam_from_occluder) {
   std::uniform_real_distribution<double> unit(0, 1);
   const auto& points = target.outline_points;
-  const Eigen::Vector3d anchor_in_target =
-      target.center + unit(*rng) * (points[static_cast<size_t>(unit(*rng) * points.size()) % points.size()] - target.center);
+  // One draw per statement (the operands' order is the compiler's; this is
+  // gcc's): the outline point, then how far towards it from the centre.
+  const Eigen::Vector3d& toward = points[static_cast<size_t>(unit(*rng) * points.size()) % points.size()];
+  const double reach = unit(*rng);
+  const Eigen::Vector3d anchor_in_target = target.center + reach * (toward - target.center);
   double size = 0;
   for (const auto& p : points) size = std::max(size, 2 * (p - target.center).norm());
   const double along = 0.55;

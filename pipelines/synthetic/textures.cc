@@ -202,7 +202,11 @@ cv::Mat RandomShapesRaster(int cols, int rows, int num_shapes, uint64_t seed,
   std::uniform_real_distribution<double> angle(0, 180);
   cv::Mat image(rows, cols, CV_8UC1, cv::Scalar(110));
   for (int i = 0; i < num_shapes; ++i) {
-    const cv::Point center(x(rng), y(rng));
+    // y before x, one per statement (see SampleTargetView: the arguments'
+    // order is the compiler's; this is gcc's).
+    const int center_y = y(rng);
+    const int center_x = x(rng);
+    const cv::Point center(center_x, center_y);
     const int s = size(rng), g = gray(rng), k = kind(rng);
     const double a = angle(rng);
     if (k == 0) {

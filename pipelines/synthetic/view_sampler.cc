@@ -54,8 +54,14 @@ Rigid3d SampleTargetView(const Camera& camera, const Housing* housing,
   int rejected_projection = 0, rejected_angle = 0;
   for (int attempt = 0; attempt < options.max_tries; ++attempt) {
     // The target centre on the ray of a random pixel, at a random distance.
-    const Eigen::Vector2d pixel(margin + unit(*rng) * (camera.width - 2 * margin),
-                                margin + unit(*rng) * (camera.height - 2 * margin));
+    // One draw per statement: the order in which a call's arguments are
+    // evaluated is unspecified (gcc and clang differ), and a seed must make
+    // the same set whichever compiler built the renderer. Row before column:
+    // the order gcc's builds drew them in, which made the sets measured so far.
+    const double row_fraction = unit(*rng);
+    const double column_fraction = unit(*rng);
+    const Eigen::Vector2d pixel(margin + column_fraction * (camera.width - 2 * margin),
+                                margin + row_fraction * (camera.height - 2 * margin));
     const std::optional<Ray3d> ray = UnprojectPixel(camera, housing, pixel);
     if (!ray) continue;
     const double distance = options.distance_min_m +
