@@ -1,8 +1,8 @@
 #include "pipelines/stages/auto_calibrator.h"
 
 #include <chrono>
-#include <set>
 #include <iomanip>
+#include <set>
 #include <sstream>
 
 #include "colmap_ext/camera/camera_models.h"
@@ -225,9 +225,9 @@ CalibrationStart MapAndRefine(const AutoCalibratorOptions& options, const std::s
 
 // Several starts when one cannot be trusted (a wrong basin, or a poorly
 // determined solution): another initial pair and the mapper's random
-// choices from another seed take another path; the start with the fewest warnings, then the smallest
-// residual, is kept (its files moved into the output folder). Throws the
-// first start's error when none succeeds.
+// choices from another seed take another path; the start with the fewest
+// warnings, then the smallest residual, is kept (its files moved into the
+// output folder). Throws the first start's error when none succeeds.
 CalibrationStart BestStart(const AutoCalibratorOptions& options, const std::string& database_path,
                            const std::optional<double>& markers_focal, bool refine_intrinsics,
                            ProgressSink& progress) {
