@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include "colmap_ext/camera/camera_models.h"
@@ -101,6 +102,49 @@ std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconst
     result.push_back(corner);
   }
   return result;
+}
+
+std::optional<double> ScaleToMarkers(Reconstruction* reconstruction, double max_error_px, double side_length_m) {
+  std::map<int, std::map<int, Eigen::Vector3d>> corners_of;
+  for (const MarkerCorner& corner : TriangulateMarkerCorners(*reconstruction, max_error_px)) {
+    corners_of[corner.marker_id][corner.corner] = corner.xyz;
+  }
+  std::vector<double> ratios;
+  for (const auto& [id, corners] : corners_of) {
+    for (auto a = corners.begin(); a != corners.end(); ++a) {
+      for (auto b = std::next(a); b != corners.end(); ++b) {
+        const double length = (b->first - a->first == 2) ? side_length_m * std::sqrt(2.0) : side_length_m;
+        const double triangulated = (a->second - b->second).norm();
+        if (triangulated > 0) ratios.push_back(length / triangulated);
+      }
+    }
+  }
+  if (ratios.empty()) return std::nullopt;
+  std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+  const double scale = ratios[ratios.size() / 2];
+  for (auto& [id, pose] : reconstruction->mutable_poses()) pose.translation *= scale;
+  std::vector<point3D_t> ids;
+  for (const auto& [id, point] : reconstruction->points()) ids.push_back(id);
+  for (point3D_t id : ids) reconstruction->point(id).xyz *= scale;
+  return scale;
+}
+
+std::vector<MarkerCorner> UpdateMarkerCorners(const Reconstruction& reconstruction, double max_error_px,
+                                              const std::vector<MarkerCorner>& adjusted) {
+  std::map<std::pair<int, int>, Eigen::Vector3d> placed;
+  for (const MarkerCorner& corner : adjusted) placed[{corner.marker_id, corner.corner}] = corner.xyz;
+  std::vector<MarkerCorner> corners = TriangulateMarkerCorners(reconstruction, max_error_px);
+  for (MarkerCorner& corner : corners) {
+    const auto it = placed.find({corner.marker_id, corner.corner});
+    if (it == placed.end()) continue;
+    const bool agrees = std::all_of(corner.observations.begin(), corner.observations.end(), [&](const auto& seen) {
+      const auto projected =
+          reconstruction.CameraOf(seen.first).Project(reconstruction.poses().at(seen.first) * it->second);
+      return projected && (*projected - seen.second).norm() < max_error_px;
+    });
+    if (agrees) corner.xyz = it->second;
+  }
+  return corners;
 }
 
 camera_t CameraWithHousingAtBound(const std::map<camera_t, HousedCamera>& cameras) {

@@ -7,6 +7,7 @@
 
 #include <ceres/ceres.h>
 
+#include <optional>
 #include <set>
 #include <vector>
 
@@ -87,6 +88,27 @@ struct MarkerScale {
 // the current poses (corners whose rays miss each other are dropped).
 std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconstruction,
                                                    double max_error_px);
+
+// Scales the model (points, camera centres; the origin stays) so that the
+// markers' sides, triangulated from the current poses, have their known
+// length: the median of known over triangulated length, over every side and
+// diagonal of the corners TriangulateMarkerCorners finds. Returns that
+// factor, or nothing where no marker has two corners triangulated. The
+// mapper's model otherwise grows at the scale refraction prefers under the
+// housing's estimate of the moment, which the markers' few observations do
+// not overrule (docs/scale.md: 2.7-3.7 times theirs).
+std::optional<double> ScaleToMarkers(Reconstruction* reconstruction, double max_error_px, double side_length_m);
+
+// The corners for the next of a series of adjustments: triangulated afresh
+// as above (corners newly seen by two images, the observations that agree),
+// but a corner an earlier adjustment placed -- one of `adjusted` -- keeps
+// that place wherever all its observations still agree with it. A fresh
+// triangulation fits each corner to its rays alone and so undoes the
+// adjustment's fit to the markers' sides (sigma 0.1 mm): millimetres of
+// triangulation noise are tens of sigmas, which every adjustment would
+// first have to remove again.
+std::vector<MarkerCorner> UpdateMarkerCorners(const Reconstruction& reconstruction, double max_error_px,
+                                              const std::vector<MarkerCorner>& adjusted);
 
 struct BundleAdjustmentScope {
   // Images whose poses are free; all registered images when empty.

@@ -29,6 +29,10 @@ BundleAdjustmentOptions GlobalAdjustmentOptions(const IncrementalMapperOptions& 
   return ba;
 }
 
+bool EndedOnItsCriterion(const ceres::Solver::Summary& summary) {
+  return summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::USER_SUCCESS;
+}
+
 bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before, const std::map<camera_t, HousedCamera>& after,
                      const std::map<camera_t, HousedCamera>& start, double max_focal_ratio_to_start) {
   for (const auto& [id, camera] : after) {
@@ -37,6 +41,14 @@ bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before, const std::
     if (!(ratio < max_focal_ratio_to_start && 1 / ratio < max_focal_ratio_to_start)) return true;
   }
   return false;
+}
+
+double PrepareMarkerCorners(Reconstruction* r, double max_error_px, double side_length_m,
+                            std::vector<MarkerCorner>* corners) {
+  const double scale = ScaleToMarkers(r, max_error_px, side_length_m).value_or(1.0);
+  for (MarkerCorner& corner : *corners) corner.xyz *= scale;
+  *corners = UpdateMarkerCorners(*r, max_error_px, *corners);
+  return scale;
 }
 
 bool HasOrientedHousing(const Reconstruction& r) {

@@ -35,11 +35,25 @@ BundleAdjustmentOptions GlobalAdjustmentOptions(const IncrementalMapperOptions& 
                                                 bool refine_intrinsics,
                                                 AdjustmentEnd end = AdjustmentEnd::kCostChange);
 
+// An adjustment ended on its own criterion rather than its iteration
+// budget: the cost change (Ceres' CONVERGENCE) or settled robust weights
+// (WeightsSettledCallback's USER_SUCCESS). What it moved is then a result.
+bool EndedOnItsCriterion(const ceres::Solver::Summary& summary);
+
 // COLMAP's bogus-camera test against the intrinsics before the adjustment,
 // and the focal length against the mapper's start, which a slow drift of
 // many adjustments would otherwise pass.
 bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before, const std::map<camera_t, HousedCamera>& after,
                      const std::map<camera_t, HousedCamera>& start, double max_focal_ratio_to_start);
+
+// The markers' corners for a global adjustment of `r` (markers of side
+// `side_length_m`): the model scaled to them first (ScaleToMarkers), as
+// the priors' alignment puts it in their frame, then `corners` -- those an
+// earlier adjustment placed, scaled with the model -- updated
+// (UpdateMarkerCorners). Returns the scale applied (1 without two views of
+// a marker).
+double PrepareMarkerCorners(Reconstruction* r, double max_error_px, double side_length_m,
+                            std::vector<MarkerCorner>* corners);
 
 // A housing with an orientation to refine apart from its position (a flat
 // port's normal).

@@ -136,6 +136,9 @@ class Mapper {
   // A global adjustment refining the housing has converged (off its bounds)
   // in the current model.
   bool port_converged_ = false;
+  // The markers' corners as the last global adjustment left them (see
+  // UpdateMarkerCorners).
+  std::vector<MarkerCorner> marker_corners_;
   // How many global adjustments that refined the intrinsics found them
   // implausible (and held them) in a row, up to the last one.
   int num_implausible_in_a_row_ = 0;
@@ -216,6 +219,7 @@ std::vector<MappedModel> Mapper::Run(ProgressSink& progress) {
 
 void Mapper::StartModel() {
   port_converged_ = false;
+  marker_corners_.clear();
   num_implausible_in_a_row_ = 0;
   num_settled_in_a_row_ = 0;
   refinements_.clear();
@@ -293,6 +297,7 @@ bool Mapper::TryInitialPair(Reconstruction* r, image_t a, image_t b) {
   if (static_cast<int>(r->points().size()) < options_.init_min_num_inliers) {
     r->Deregister(b);
     r->Deregister(a);
+    marker_corners_.clear();
     return false;
   }
   return true;
@@ -508,10 +513,12 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics, AdjustmentE
     // The model in the priors' metric frame, the priors as residuals.
     ba.position_prior_sigma_m = options_.position_prior_sigma_m;
   }
-  std::vector<MarkerCorner> markers;
   if (options_.marker_scale.side_length_m > 0) {
-    markers = TriangulateMarkerCorners(*r, options_.filter_max_reproj_error_px * 4);
+    const double scale = PrepareMarkerCorners(r, options_.filter_max_reproj_error_px * 4,
+                                              options_.marker_scale.side_length_m, &marker_corners_);
+    VLOG(2) << "refractive_mapper: " << r->poses().size() << " images scaled by " << scale << " to the markers";
   }
+  std::vector<MarkerCorner>& markers = marker_corners_;
   const ModelSnapshot before = ModelSnapshot::Of(*r, markers);
   AdjustHousingFirst(r, ba, &markers);
   const ceres::Solver::Summary summary =
@@ -527,7 +534,7 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics, AdjustmentE
     ba.refine_housing = false;
     AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
   }
-  if (ba.refine_housing && summary.termination_type == ceres::CONVERGENCE) {
+  if (ba.refine_housing && EndedOnItsCriterion(summary)) {
     port_converged_ = CameraWithHousingAtBound(r->cameras()) == kInvalidCameraId;
   }
   NoteRefinement(*r, ba, implausible, summary, before.cameras);
@@ -566,7 +573,7 @@ void Mapper::NoteRefinement(const Reconstruction& r, const BundleAdjustmentOptio
   if (!refined || static_cast<int>(r.poses().size()) < options_.ba_calibration_settled_min_images) return;
   const double depth = MedianSceneDepth(r);
   double& shift = refinements_.back().image_shift_px;
-  if (depth > 0 && summary.termination_type == ceres::CONVERGENCE) {
+  if (depth > 0 && EndedOnItsCriterion(summary)) {
     shift = 0;
     for (const auto& [id, camera] : r.cameras()) {
       shift = std::max(shift, MaxImageShiftPx(cameras_before.at(id), camera, depth));
@@ -574,9 +581,11 @@ void Mapper::NoteRefinement(const Reconstruction& r, const BundleAdjustmentOptio
   }
   num_settled_in_a_row_ = shift < options_.ba_calibration_settled_px ? num_settled_in_a_row_ + 1 : 0;
   refinements_.back().settled = CalibrationSettled();
-  std::ostringstream moved;  // infinity: the adjustment ended before converging
-  if (std::isinf(shift)) moved << "ended before converging (image shift not measured)";
+  std::ostringstream moved;
+  if (!EndedOnItsCriterion(summary)) moved << "ended before converging (image shift not measured)";
+  else if (std::isinf(shift)) moved << "had no scene depth (image shift not measured)";
   else moved << "moved the image by up to " << shift << " px";
+  if (summary.termination_type == ceres::USER_SUCCESS) moved << " (ended once the robust weights settled)";
   VLOG(1) << "refractive_mapper: the refinement on " << r.poses().size() << " images " << moved.str()
           << " at the median depth " << depth << (CalibrationSettled() ? " (settled)" : "");
 }

@@ -64,13 +64,14 @@ void MapCluster(const HierarchicalMapperOptions& options, const std::vector<imag
             << " model(s)";
 }
 
-// The merged model adjusted as a whole: aligned to the position priors
-// (when they give the scale), adjusted, filtered, adjusted again.
+// The merged model adjusted as a whole: scaled to the markers or aligned
+// to the position priors (whichever gives the scale), adjusted, filtered,
+// adjusted again.
 void AdjustMerged(const IncrementalMapperOptions& mapper, Reconstruction* r) {
   BundleAdjustmentOptions ba = GlobalAdjustmentOptions(mapper, static_cast<int>(r->poses().size()), true);
   std::vector<MarkerCorner> markers;
   if (mapper.marker_scale.side_length_m > 0) {
-    markers = TriangulateMarkerCorners(*r, 4 * mapper.filter_max_reproj_error_px);
+    PrepareMarkerCorners(r, 4 * mapper.filter_max_reproj_error_px, mapper.marker_scale.side_length_m, &markers);
   } else if (mapper.position_prior_sigma_m > 0 && AlignToPositionPriors(r, 5 * mapper.position_prior_sigma_m)) {
     ba.position_prior_sigma_m = mapper.position_prior_sigma_m;
   }

@@ -3,7 +3,8 @@
 // calibration stop once the robust weights have settled, those that refine
 // it converge, and the model's final pair is a robust solve that decides the
 // weights followed by a weighted least-squares solve that holds them, with
-// the refinement's first trust region (docs/scale.md).
+// the refinement's first trust region (docs/scale.md); each ends on its own
+// criterion or runs out of iterations.
 #include "pipelines/sfm/global_adjustment.h"
 
 #include <gtest/gtest.h>
@@ -84,6 +85,20 @@ TEST(GlobalAdjustmentOptions, FinalPairDecidesTheWeightsThenHoldsThem) {
   EXPECT_EQ(refinement.hold_loss_weights, held.hold_loss_weights);
   EXPECT_EQ(refinement.max_unsettled_weight_fraction, held.max_unsettled_weight_fraction);
   EXPECT_EQ(refinement.initial_trust_region_radius, held.initial_trust_region_radius);
+}
+
+// The final robust solve ends once its weights settle (USER_SUCCESS, see
+// RobustSolveEndsWhenTheWeightsSettle): that is its criterion, as the cost
+// change is the others'; its refinement is measured and the port counts as
+// converged. Only the iteration budget leaves an adjustment unfinished.
+TEST(GlobalAdjustment, SettledWeightsEndAnAdjustmentAsConvergenceDoes) {
+  ceres::Solver::Summary summary;
+  summary.termination_type = ceres::CONVERGENCE;
+  EXPECT_TRUE(EndedOnItsCriterion(summary));
+  summary.termination_type = ceres::USER_SUCCESS;
+  EXPECT_TRUE(EndedOnItsCriterion(summary));
+  summary.termination_type = ceres::NO_CONVERGENCE;
+  EXPECT_FALSE(EndedOnItsCriterion(summary));
 }
 
 }  // namespace
