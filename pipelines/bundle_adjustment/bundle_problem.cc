@@ -150,8 +150,7 @@ class BundleProblem {
  private:
   bool IsVariable(image_t id) const { return !local_ || scope_.variable_images.count(id) > 0; }
   CostBlocks BlocksOf(const HousedCamera& camera) const;
-  // `robust`: under the robust loss (a feature's match may be wrong).
-  void AddObservation(image_t image_id, const Eigen::Vector2d& pixel, double* xyz, double sigma, bool robust = true);
+  void AddObservation(image_t image_id, const Eigen::Vector2d& pixel, double* xyz, double sigma);
   void AddRobustResidual(ceres::CostFunction* cost, const std::vector<double*>& blocks);
   double SigmaOf(const TrackElement& e) const;
   bool FreePose(image_t id) const;
@@ -198,8 +197,7 @@ CostBlocks BundleProblem::BlocksOf(const HousedCamera& camera) const {
   return CostBlocks::kPosePoint;
 }
 
-void BundleProblem::AddObservation(image_t image_id, const Eigen::Vector2d& pixel, double* xyz, double sigma,
-                                   bool robust) {
+void BundleProblem::AddObservation(image_t image_id, const Eigen::Vector2d& pixel, double* xyz, double sigma) {
   const SfmImage& image = reconstruction_->inputs().images.at(image_id);
   const HousedCamera& camera = cameras_.at(image.camera_id);
   const ObservationModel model = ObservationModel::Of(camera);
@@ -215,12 +213,7 @@ void BundleProblem::AddObservation(image_t image_id, const Eigen::Vector2d& pixe
   if ((kind == CostBlocks::kAll || kind == CostBlocks::kPosePointHousing) && camera.housing) {
     blocks.push_back(housings_.at(image.camera_id).data());
   }
-  if (robust) {
-    AddRobustResidual(cost, blocks);
-  } else {
-    problem_.AddResidualBlock(cost, nullptr, blocks);
-    num_residuals_ += cost->num_residuals();
-  }
+  AddRobustResidual(cost, blocks);
   used_cameras_.insert(image.camera_id);
 }
 
@@ -284,16 +277,14 @@ void BundleProblem::AddPoints() {
 }
 
 // The markers' corners, observed, and their sides of known length: the
-// scale. The corners' observations, identified and gated already, are not
-// robust: under the loss, sides (sigma 0.1 mm) pulled corners 40 px off
-// their rays at next to no cost, and held nothing (docs/scale.md).
+// scale.
 void BundleProblem::AddMarkers() {
   use_markers_ = markers_ && marker_scale_.side_length_m > 0 && !markers_->empty();
   if (!use_markers_) return;
   std::map<int, std::array<double*, 4>> corners_of;
   for (MarkerCorner& corner : *markers_) {
     for (const auto& [image_id, pixel] : corner.observations) {
-      if (poses_.count(image_id)) AddObservation(image_id, pixel, corner.xyz.data(), options_.marker_sigma_px, false);
+      if (poses_.count(image_id)) AddObservation(image_id, pixel, corner.xyz.data(), options_.marker_sigma_px);
     }
     if (!corners_of.count(corner.marker_id)) corners_of[corner.marker_id] = {nullptr, nullptr, nullptr, nullptr};
     corners_of[corner.marker_id][corner.corner] = corner.xyz.data();

@@ -45,7 +45,13 @@ bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before, const std::
 
 double PrepareMarkerCorners(Reconstruction* r, double max_error_px, double side_length_m,
                             std::vector<MarkerCorner>* corners) {
-  const double scale = ScaleToMarkers(r, max_error_px, side_length_m).value_or(1.0);
+  // In air the scale is a gauge that the refinement sets from the markers;
+  // rescaling earlier only changed which minimum the intrinsics reached from
+  // a poor start (AutoCalibrationRealCameras' in-air target: focal length
+  // 10 px, 3 sigma, off). Behind a housing refraction sets the scale.
+  const bool refracted = std::any_of(r->cameras().begin(), r->cameras().end(),
+                                     [](const auto& entry) { return entry.second.housing.has_value(); });
+  const double scale = refracted ? ScaleToMarkers(r, max_error_px, side_length_m).value_or(1.0) : 1.0;
   for (MarkerCorner& corner : *corners) corner.xyz *= scale;
   *corners = UpdateMarkerCorners(*r, max_error_px, *corners);
   return scale;

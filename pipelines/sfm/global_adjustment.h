@@ -47,8 +47,9 @@ bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before, const std::
                      const std::map<camera_t, HousedCamera>& start, double max_focal_ratio_to_start);
 
 // The markers' corners for a global adjustment of `r` (markers of side
-// `side_length_m`): the model scaled to them first (ScaleToMarkers), as
-// the priors' alignment puts it in their frame, then `corners` -- those an
+// `side_length_m`): the model scaled to them first (ScaleToMarkers) when a
+// camera has a housing, as the priors' alignment puts it in their frame,
+// then `corners` -- those an
 // earlier adjustment placed, scaled with the model -- updated
 // (UpdateMarkerCorners). Returns the scale applied (1 without two views of
 // a marker).
