@@ -95,8 +95,9 @@ std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconst
 // diagonal of the corners TriangulateMarkerCorners finds. Returns that
 // factor, or nothing where no marker has two corners triangulated. The
 // mapper's model otherwise grows at the scale refraction prefers under the
-// housing's estimate of the moment, which the markers' few observations do
-// not overrule (docs/scale.md: 2.7-3.7 times theirs).
+// housing's estimate of the moment (docs/scale.md: 2.7-3.7 times the
+// markers'), and its adjustments, rather than rescale it, pull the corners
+// off their rays, which the robust loss lets them do at little cost.
 std::optional<double> ScaleToMarkers(Reconstruction* reconstruction, double max_error_px, double side_length_m);
 
 // The corners for the next of a series of adjustments: triangulated afresh

@@ -48,11 +48,10 @@ bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before, const std::
 
 // The markers' corners for a global adjustment of `r` (markers of side
 // `side_length_m`): the model scaled to them first (ScaleToMarkers) when a
-// camera has a housing, as the priors' alignment puts it in their frame,
-// then `corners` -- those an
-// earlier adjustment placed, scaled with the model -- updated
-// (UpdateMarkerCorners). Returns the scale applied (1 without two views of
-// a marker).
+// camera has a housing, as the priors' alignment puts it in their frame;
+// then `corners` -- those an earlier adjustment placed, scaled with the
+// model -- updated (UpdateMarkerCorners). Returns the scale applied (1 in
+// air or without two views of a marker).
 double PrepareMarkerCorners(Reconstruction* r, double max_error_px, double side_length_m,
                             std::vector<MarkerCorner>* corners);
 

@@ -13,6 +13,7 @@
 #include "colmap_ext/housing/housing.h"
 #include "pipelines/bundle_adjustment/bundle_adjustment.h"
 #include "pipelines/reconstruction/reconstruction.h"
+#include "pipelines/sfm/global_adjustment.h"
 
 namespace portcal {
 namespace {
@@ -149,6 +150,29 @@ TEST(MarkerCorners, ScaleToMarkersLeavesAModelWithoutTwoViewsOfAMarker) {
   const std::map<image_t, Rigid3d> before = r.poses();
   EXPECT_FALSE(ScaleToMarkers(&r, kMaxErrorPx, kSide).has_value());
   for (const auto& [id, pose] : r.poses()) EXPECT_EQ(pose.translation, before.at(id).translation);
+}
+
+// The mapper's step before a global adjustment: behind a housing the model
+// is scaled to the markers and the corners follow; in air, where the scale
+// is a gauge, it is left as it is (docs/scale.md).
+TEST(MarkerCorners, PrepareMarkerCornersScalesOnlyBehindAHousing) {
+  for (const bool housed : {true, false}) {
+    MarkerScene scene = MakeScene(7);
+    if (!housed) scene.inputs.cameras.at(1).housing.reset();
+    Reconstruction r = Register(scene);
+    for (auto& [id, pose] : r.mutable_poses()) pose.translation *= 3.0;
+    std::vector<MarkerCorner> corners;
+    const double scale = PrepareMarkerCorners(&r, kMaxErrorPx, kSide, &corners);
+    ASSERT_EQ(corners.size(), 4u) << (housed ? "housed" : "in air");
+    const double side = (corners[0].xyz - corners[1].xyz).norm();
+    if (housed) {
+      EXPECT_NEAR(scale * 3.0, 1.0, 0.02);
+      EXPECT_NEAR(side, kSide, 0.02 * kSide);
+    } else {
+      EXPECT_EQ(scale, 1.0);
+      EXPECT_NEAR(side, 3.0 * kSide, 0.06 * kSide);
+    }
+  }
 }
 
 }  // namespace
