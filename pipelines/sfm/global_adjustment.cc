@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <sstream>
 
+#include "colmap_ext/util/logging.h"
+
 
 namespace portcal {
 
@@ -52,6 +54,7 @@ double PrepareMarkerCorners(Reconstruction* r, double max_error_px, double side_
   const bool refracted = std::any_of(r->cameras().begin(), r->cameras().end(),
                                      [](const auto& entry) { return entry.second.housing.has_value(); });
   const double scale = refracted ? ScaleToMarkers(r, max_error_px, side_length_m).value_or(1.0) : 1.0;
+  VLOG(2) << "global adjustment: " << r->poses().size() << " images scaled by " << scale << " to the markers";
   for (MarkerCorner& corner : *corners) corner.xyz *= scale;
   *corners = UpdateMarkerCorners(*r, max_error_px, *corners);
   return scale;

@@ -136,8 +136,7 @@ class Mapper {
   // A global adjustment refining the housing has converged (off its bounds)
   // in the current model.
   bool port_converged_ = false;
-  // The markers' corners as the last global adjustment left them (see
-  // UpdateMarkerCorners).
+  // The markers' corners as the last global adjustment left them.
   std::vector<MarkerCorner> marker_corners_;
   // How many global adjustments that refined the intrinsics found them
   // implausible (and held them) in a row, up to the last one.
@@ -514,11 +513,10 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics, AdjustmentE
     ba.position_prior_sigma_m = options_.position_prior_sigma_m;
   }
   if (options_.marker_scale.side_length_m > 0) {
-    const double scale = PrepareMarkerCorners(r, options_.filter_max_reproj_error_px * 4,
-                                              options_.marker_scale.side_length_m, &marker_corners_);
-    VLOG(2) << "refractive_mapper: " << r->poses().size() << " images scaled by " << scale << " to the markers";
+    PrepareMarkerCorners(r, options_.filter_max_reproj_error_px * 4, options_.marker_scale.side_length_m,
+                         &marker_corners_);
   }
-  std::vector<MarkerCorner>& markers = marker_corners_;
+  std::vector<MarkerCorner>& markers = marker_corners_;  // this adjustment's, kept for the next
   const ModelSnapshot before = ModelSnapshot::Of(*r, markers);
   AdjustHousingFirst(r, ba, &markers);
   const ceres::Solver::Summary summary =
