@@ -139,8 +139,9 @@ TEST(MarkerCorners, ScaleToMarkersBringsTheModelToTheMarkersSideLength) {
   EXPECT_NEAR((corners[0].xyz - corners[1].xyz).norm(), kSide, 0.02 * kSide);
   // Once at the markers' scale it stays there, to what refraction changes:
   // the port's offsets are metres too, so scaling the world is not quite a
-  // similarity of the refracted rays (2.5e-5 here).
-  EXPECT_NEAR(ScaleToMarkers(&r, kMaxErrorPx, kSide).value_or(0), 1.0, 1e-3);
+  // similarity of the refracted rays (2.5e-5 here; the bound allows 4 times
+  // that).
+  EXPECT_NEAR(ScaleToMarkers(&r, kMaxErrorPx, kSide).value_or(0), 1.0, 1e-4);
 }
 
 TEST(MarkerCorners, ScaleToMarkersLeavesAModelWithoutTwoViewsOfAMarker) {
