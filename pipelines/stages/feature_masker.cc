@@ -49,7 +49,11 @@ bool FeaturesBeforeMasking(const FeatureMaskerOptions& options, const DatabaseIm
 }
 
 bool SameKeypoints(const FeatureKeypoints& a, const FeatureKeypoints& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(FeatureKeypoint)) == 0;
+  // memcmp's pointers must not be null even for 0 bytes, and an empty
+  // vector's data() may be (UBSan, workflows/sanitize.sh: an image whose
+  // features the mask removed).
+  if (a.size() != b.size()) return false;
+  return a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(FeatureKeypoint)) == 0;
 }
 
 // Keeps the features of one image inside its markers' enlarged quads (and
