@@ -5,7 +5,6 @@
 
 #include "colmap_ext/util/logging.h"
 
-
 namespace portcal {
 
 BundleAdjustmentOptions GlobalAdjustmentOptions(const IncrementalMapperOptions& options, int num_images,

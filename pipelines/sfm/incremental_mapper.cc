@@ -133,8 +133,7 @@ class Mapper {
   const IncrementalMapperOptions& options_;
   std::set<image_t> used_;    // registered in an earlier model
   std::set<image_t> failed_;  // failed to register since the model last grew
-  // A global adjustment refining the housing has converged (off its bounds)
-  // in the current model.
+  // A global adjustment refining the housing has converged (off its bounds) in the current model.
   bool port_converged_ = false;
   // The markers' corners as the last global adjustment left them.
   std::vector<MarkerCorner> marker_corners_;
