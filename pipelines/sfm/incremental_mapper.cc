@@ -272,7 +272,7 @@ void Mapper::FinishModel(Reconstruction* r, size_t model_index) {
 
 bool Mapper::Initialize(Reconstruction* r, std::set<image_pair_t>* tried, image_pair_t* start) {
   int trials = 0;
-  for (const image_pair_t pair_id : RankInitialPairs(inputs_, options_, used_, *tried)) {
+  for (const image_pair_t pair_id : RankInitialPairs(inputs_, cameras_, options_, used_, *tried)) {
     if (trials++ >= options_.init_max_num_trials) break;
     tried->insert(pair_id);
     image_t a, b;

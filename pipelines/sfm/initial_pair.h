@@ -4,6 +4,7 @@
 // of them.
 #pragma once
 
+#include <map>
 #include <set>
 #include <vector>
 
@@ -14,9 +15,14 @@ namespace portcal {
 
 // Pairs of images not in `used` nor `tried` with at least
 // `options.init_min_num_inliers` verified matches, best first: most inlier
-// matches first, but pairs whose geometry is a homography last.
-std::vector<image_pair_t> RankInitialPairs(const SfmInputs& inputs, const IncrementalMapperOptions& options,
-                                           const std::set<image_t>& used, const std::set<image_pair_t>& tried);
+// matches first, but pairs whose geometry is a homography last and, when
+// markers of known side give the scale and a camera of `cameras` (the
+// mapper's start) is behind a housing, the best of the pairs that see a
+// marker in common and are not homographies (half of
+// `options.init_max_num_trials` at most) before all others.
+std::vector<image_pair_t> RankInitialPairs(const SfmInputs& inputs, const std::map<camera_t, HousedCamera>& cameras,
+                                           const IncrementalMapperOptions& options, const std::set<image_t>& used,
+                                           const std::set<image_pair_t>& tried);
 
 // Registers `a` at the origin and `b` by the relative pose of their matched
 // rays (a generalised relative pose in RANSAC), scaled to
