@@ -3,6 +3,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <map>
 #include <optional>
 
 #include "colmap_ext/camera/camera.h"
@@ -25,5 +27,12 @@ struct HousedCamera {
     return UnprojectPixel(camera, HousingOrNull(), pixel);
   }
 };
+
+// Whether any of `cameras` is behind a housing (refraction then sets the
+// model's scale, which in air is a gauge).
+inline bool AnyHoused(const std::map<camera_t, HousedCamera>& cameras) {
+  return std::any_of(cameras.begin(), cameras.end(),
+                     [](const auto& entry) { return entry.second.housing.has_value(); });
+}
 
 }  // namespace portcal

@@ -50,8 +50,7 @@ double PrepareMarkerCorners(Reconstruction* r, double max_error_px, double side_
   // rescaling earlier only changed which minimum the intrinsics reached from
   // a poor start (AutoCalibrationRealCameras' in-air target: focal length
   // 10 px, 3 sigma, off). Behind a housing refraction sets the scale.
-  const bool refracted = std::any_of(r->cameras().begin(), r->cameras().end(),
-                                     [](const auto& entry) { return entry.second.housing.has_value(); });
+  const bool refracted = AnyHoused(r->cameras());
   const double scale = refracted ? ScaleToMarkers(r, max_error_px, side_length_m).value_or(1.0) : 1.0;
   VLOG(2) << "global adjustment: " << r->poses().size() << " images scaled by " << scale << " to the markers";
   for (MarkerCorner& corner : *corners) corner.xyz *= scale;

@@ -77,11 +77,6 @@ std::optional<double> MarkerScaleFactor(const Reconstruction& r, double side_len
   return ratios[ratios.size() / 2];
 }
 
-bool AnyHoused(const std::map<camera_t, HousedCamera>& cameras) {
-  return std::any_of(cameras.begin(), cameras.end(),
-                     [](const auto& entry) { return entry.second.housing.has_value(); });
-}
-
 // Whether both images saw one marker (its dictionary and id), whose sides
 // then scale their model from the start.
 bool SeeACommonMarker(const SfmImage& a, const SfmImage& b) {
