@@ -2,7 +2,8 @@
 # The unit tests under AddressSanitizer and UndefinedBehaviorSanitizer
 # (clang; any report fails the test that made it), in build-sanitize/ (shared
 # with workflows/fuzz.sh). Not in CI: the instrumented build and run take
-# about an hour on 2 cores. Arguments go to ctest (e.g. -R Database).
+# ~2.5 hours on 2 cores (docs/benchmarks.md). Arguments go to ctest (e.g.
+# -R Database).
 # Usage: workflows/sanitize.sh [CTEST_ARGS...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
