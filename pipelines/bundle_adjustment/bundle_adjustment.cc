@@ -104,16 +104,17 @@ std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconst
   return result;
 }
 
-std::optional<double> ScaleToMarkers(Reconstruction* reconstruction, double max_error_px, double side_length_m) {
+std::optional<double> MarkerScaleRatio(const std::vector<MarkerCorner>& corners, double side_length_m,
+                                       bool with_diagonals) {
   std::map<int, std::map<int, Eigen::Vector3d>> corners_of;
-  for (const MarkerCorner& corner : TriangulateMarkerCorners(*reconstruction, max_error_px)) {
-    corners_of[corner.marker_id][corner.corner] = corner.xyz;
-  }
+  for (const MarkerCorner& corner : corners) corners_of[corner.marker_id][corner.corner] = corner.xyz;
   std::vector<double> ratios;
-  for (const auto& [id, corners] : corners_of) {
-    for (auto a = corners.begin(); a != corners.end(); ++a) {
-      for (auto b = std::next(a); b != corners.end(); ++b) {
-        const double length = (b->first - a->first == 2) ? side_length_m * std::sqrt(2.0) : side_length_m;
+  for (const auto& [id, placed] : corners_of) {
+    for (auto a = placed.begin(); a != placed.end(); ++a) {
+      for (auto b = std::next(a); b != placed.end(); ++b) {
+        const bool diagonal = b->first - a->first == 2;
+        if (diagonal && !with_diagonals) continue;
+        const double length = diagonal ? side_length_m * std::sqrt(2.0) : side_length_m;
         const double triangulated = (a->second - b->second).norm();
         if (triangulated > 0) ratios.push_back(length / triangulated);
       }
@@ -121,7 +122,14 @@ std::optional<double> ScaleToMarkers(Reconstruction* reconstruction, double max_
   }
   if (ratios.empty()) return std::nullopt;
   std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
-  const double scale = ratios[ratios.size() / 2];
+  return ratios[ratios.size() / 2];
+}
+
+std::optional<double> ScaleToMarkers(Reconstruction* reconstruction, double max_error_px, double side_length_m) {
+  const std::optional<double> ratio =
+      MarkerScaleRatio(TriangulateMarkerCorners(*reconstruction, max_error_px), side_length_m, /*with_diagonals=*/true);
+  if (!ratio) return std::nullopt;
+  const double scale = *ratio;
   for (auto& [id, pose] : reconstruction->mutable_poses()) pose.translation *= scale;
   std::vector<point3D_t> ids;
   for (const auto& [id, point] : reconstruction->points()) ids.push_back(id);

@@ -80,14 +80,21 @@ struct MarkerCorner {
 };
 
 struct MarkerScale {
-  double side_length_m = 0;   // <= 0: markers do not constrain the scale
-  double sigma_m = 0.0001;    // of each side and diagonal
+  double side_length_m = 0;  // <= 0: markers do not constrain the scale
+  double sigma_m = 0.0001;   // of each side and diagonal
 };
 
 // Marker corners seen by at least two registered images, triangulated from
 // the current poses (corners whose rays miss each other are dropped).
-std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconstruction,
-                                                   double max_error_px);
+std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconstruction, double max_error_px);
+
+// The median, over the markers' sides (0-1, 1-2, 2-3, 3-0) and with
+// `with_diagonals` their diagonals (0-2, 1-3, known length side * sqrt 2),
+// of known over triangulated length: the factor that brings `corners` to
+// the markers' size. Nothing where no two corners of a marker make a side
+// (or, with the diagonals, a diagonal).
+std::optional<double> MarkerScaleRatio(const std::vector<MarkerCorner>& corners, double side_length_m,
+                                       bool with_diagonals);
 
 // Scales the model (points, camera centres; the origin stays) so that the
 // markers' sides, triangulated from the current poses, have their known
@@ -155,7 +162,6 @@ camera_t CameraWithHousingAtBound(const std::map<camera_t, HousedCamera>& camera
 // Returns Ceres' summary; throws NumericalError if the solve fails.
 ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const BundleAdjustmentOptions& options,
                                     const BundleAdjustmentScope& scope, std::vector<MarkerCorner>* markers,
-                                    const MarkerScale& marker_scale,
-                                    CalibrationStdDevs* std_devs = nullptr);
+                                    const MarkerScale& marker_scale, CalibrationStdDevs* std_devs = nullptr);
 
 }  // namespace portcal

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <optional>
 #include <set>
 #include <tuple>
 
@@ -55,26 +54,6 @@ void TriangulatePair(const Reconstruction& r, image_t a, image_t b, const PairRa
     (*points)[i] = *x;
     angles->push_back(MaxTriangulationAngle(pair, *x));
   }
-}
-
-// The factor that makes the markers both images see as large as they are:
-// the median over their sides of known / measured length (nullopt when no
-// side is seen).
-std::optional<double> MarkerScaleFactor(const Reconstruction& r, double side_length_m) {
-  const std::vector<MarkerCorner> corners = TriangulateMarkerCorners(r, 1e9);
-  std::map<int, std::map<int, Eigen::Vector3d>> by_marker;
-  for (const MarkerCorner& c : corners) by_marker[c.marker_id][c.corner] = c.xyz;
-  std::vector<double> ratios;
-  for (const auto& [id, c] : by_marker) {
-    for (int k = 0; k < 4; ++k) {
-      if (c.count(k) && c.count((k + 1) % 4)) {
-        ratios.push_back(side_length_m / (c.at(k) - c.at((k + 1) % 4)).norm());
-      }
-    }
-  }
-  if (ratios.empty()) return std::nullopt;
-  std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
-  return ratios[ratios.size() / 2];
 }
 
 // Whether both images saw one marker (its dictionary and id), whose sides
@@ -160,8 +139,10 @@ bool StartFromPair(const IncrementalMapperOptions& options, image_t a, image_t b
   r->Register(a, Rigid3d());
   r->Register(b, pose_b);
   if (options.marker_scale.side_length_m > 0) {
-    // Markers seen by both: their measured side against the known one.
-    if (const auto factor = MarkerScaleFactor(*r, options.marker_scale.side_length_m)) {
+    // Markers seen by both: their measured sides against the known one
+    // (every corner kept: two views cannot tell a bad corner).
+    if (const auto factor = MarkerScaleRatio(TriangulateMarkerCorners(*r, 1e9), options.marker_scale.side_length_m,
+                                             /*with_diagonals=*/false)) {
       pose_b.translation *= *factor;
       r->Register(b, pose_b);
     }

@@ -7,6 +7,7 @@
 // corners' pixels with 0.3 px of noise.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "colmap_ext/camera/camera.h"
@@ -151,6 +152,33 @@ TEST(MarkerCorners, ScaleToMarkersLeavesAModelWithoutTwoViewsOfAMarker) {
   const std::map<image_t, Rigid3d> before = r.poses();
   EXPECT_FALSE(ScaleToMarkers(&r, kMaxErrorPx, kSide).has_value());
   for (const auto& [id, pose] : r.poses()) EXPECT_EQ(pose.translation, before.at(id).translation);
+}
+
+// The ratio itself, on corners placed by hand: a marker measured as a
+// rectangle 0.10 by 0.20 (sides 0.10, 0.20, 0.10, 0.20; diagonals 0.2236).
+// Sides alone: known over measured is 1.5 or 0.75, the median (the upper of
+// the four) 1.5. With the diagonals too, whose ratio is 0.9487 each, the
+// median of six (the fourth smallest) is 0.9487. A missing corner leaves its
+// sides and diagonal out; with no pair, there is no ratio.
+TEST(MarkerCorners, MarkerScaleRatioIsTheMedianOverSidesAndOptionallyDiagonals) {
+  std::vector<MarkerCorner> corners(4);
+  const std::array<Eigen::Vector3d, 4> xyz = {Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(0.1, 0, 2),
+                                              Eigen::Vector3d(0.1, 0.2, 2), Eigen::Vector3d(0, 0.2, 2)};
+  for (int c = 0; c < 4; ++c) {
+    corners[c].marker_id = 3;
+    corners[c].corner = c;
+    corners[c].xyz = xyz[c];
+  }
+  const double diagonal_ratio = kSide * std::sqrt(2.0) / std::hypot(0.1, 0.2);
+  EXPECT_NEAR(MarkerScaleRatio(corners, kSide, false).value_or(0), 1.5, 1e-12);
+  EXPECT_NEAR(MarkerScaleRatio(corners, kSide, true).value_or(0), diagonal_ratio, 1e-12);
+  // Without corner 2: sides 0-1 (1.5) and 3-0 (0.75), median 1.5; with the
+  // diagonal 1-3 (0.9487) the median of three is 0.9487.
+  corners.erase(corners.begin() + 2);
+  EXPECT_NEAR(MarkerScaleRatio(corners, kSide, false).value_or(0), 1.5, 1e-12);
+  EXPECT_NEAR(MarkerScaleRatio(corners, kSide, true).value_or(0), diagonal_ratio, 1e-12);
+  corners.resize(1);
+  EXPECT_FALSE(MarkerScaleRatio(corners, kSide, true).has_value());
 }
 
 // The mapper's step before a global adjustment: behind a housing the model
