@@ -22,14 +22,17 @@
 # transactions, so a part cut short leaves its inputs as they were).
 # LOG_LEVEL=debug (default warn) logs each stage's steps and their seconds.
 # MAPPER_ARGS="--Mapper.x v ..." adds options to the mapper's command line.
-# Usage: [SCALE=navigation|markers] [RENDER_SPP=4] [STAGES="extract map refine"] [LOG_LEVEL=warn]
+# PORTCAL=path runs another build's binary (to compare two builds' stages
+# on one work folder).
+# Usage: [SCALE=navigation|markers] [RENDER_SPP=4] [STAGES="extract map refine"] [LOG_LEVEL=warn] [PORTCAL=...]
 #        workflows/bench_survey.sh [NUM_IMAGES=300] [WORK_DIR=temporary]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-[ -x build/portcal ] || bash workflows/setup.sh >/dev/null
+if [ -z "${PORTCAL:-}" ] && [ ! -x build/portcal ]; then bash workflows/setup.sh >/dev/null; fi
 n="${1:-300}"
 if [ -n "${2:-}" ]; then work="$2"; mkdir -p "$work"; else work="$(mktemp -d)"; trap 'rm -rf "$work"' EXIT; fi
-P="$PWD/build/portcal"
+P="$(realpath "${PORTCAL:-build/portcal}")"
+[ -x "$P" ] || { echo "bench_survey.sh: PORTCAL: $P is not an executable" >&2; exit 2; }
 source workflows/survey_common.sh
 scale="${SCALE:-navigation}"
 survey_scale "$scale"

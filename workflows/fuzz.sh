@@ -33,7 +33,11 @@ CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 cmake --build "$build" -j"$(nproc)" --target "${targets[@]/%/_fuzzer}" >/dev/null
 # The targets write their input to a file each run: tmpfs, not the disk.
 export TMPDIR=/dev/shm
-export ASAN_OPTIONS=detect_leaks=0  # OpenCV's and yaml-cpp's caches live to the end
+# No leak check: OpenCV's and yaml-cpp's caches live to the end. No
+# allocation stacks: recording them at every malloc cost a fifth of the YAML
+# targets' time (docs/benchmarks.md); a report still names the bad access
+# and its stack, and replaying the saved input gives the rest.
+export ASAN_OPTIONS=detect_leaks=0:malloc_context_size=0
 printf '%-20s %12s %8s %8s  %s\n' target executions seconds coverage result
 status=0
 for target in "${targets[@]}"; do
