@@ -413,17 +413,12 @@ ceres::Solver::Options BundleProblem::SolverOptions(int* num_free_poses) const {
     solver.linear_solver_type = ceres::ITERATIVE_SCHUR;
     solver.preconditioner_type = ceres::SCHUR_JACOBI;
   }
-  // With bounds (a flat port's distance floor, a dome's decentering box)
-  // Ceres 2.1's trust region runs a projected Armijo line search on every
-  // step unless told not to. Where the full step is good it costs a cost
-  // evaluation; where the step overshoots it shortens the step yet rates it
-  // against the full step's predicted decrease, so a step that should be
-  // rejected is accepted at a ratio of ~0.002 and Levenberg-Marquardt only
-  // halves its region, at one Jacobian and one linear solve a halving
-  // (a rejection shrinks it 2, 4, 8 ... times for a linear solve each;
-  // docs/scale.md). The bounds hold without it: Ceres projects every
-  // step's end onto them.
-  solver.max_num_line_search_step_size_iterations = 0;
+  // With bounds (a flat port's distance, a dome's decentering) Ceres 2.1's
+  // trust region runs a projected Armijo line search on every step, and its
+  // default cubic interpolation evaluates the gradient -- the full Jacobian
+  // -- at the trial point: a second Jacobian per iteration. Quadratic
+  // interpolation needs the cost only (docs/benchmarks.md).
+  solver.line_search_interpolation_type = ceres::QUADRATIC;
   solver.max_num_iterations = options_.max_num_iterations;
   solver.num_threads = options_.num_threads;
   // Per-iteration lines (cost, step, time) in the debug log.

@@ -416,13 +416,11 @@ TEST(PositionPriors, RobustSolveEndsWhenTheWeightsSettle) {
             << " (sd " << std_devs.housing.at(1)[3] << ")\n";
 }
 
-// A bounded port (the distance's floor) would make Ceres run a projected
-// line search on every step: a cost evaluation at its trial point on top of
-// the candidate's (with Ceres' default cubic interpolation a second
-// Jacobian: 9 s of each 21 s iteration on a 1000-image survey), and on an
-// overshooting step an accepted crawl in place of a rejection. Off: one
-// Jacobian per accepted step, one cost evaluation per step, the bound kept.
-TEST(PositionPriors, BoundedPortAdjustmentRunsNoLineSearch) {
+// A bounded port (the distance's floor) makes Ceres run a projected line
+// search on every step; its trial points must cost a residual evaluation,
+// not a second Jacobian (with the default cubic interpolation: twice the
+// Jacobians, 9 s of each 21 s iteration on a 1000-image survey).
+TEST(PositionPriors, BoundedPortAdjustmentEvaluatesOneJacobianPerStep) {
   std::mt19937 rng(11);
   SyntheticSurvey survey(0.1, 0.02, &rng);
   Reconstruction r = survey.InArbitraryFrame(ArbitraryFrame());
@@ -435,13 +433,9 @@ TEST(PositionPriors, BoundedPortAdjustmentRunsNoLineSearch) {
   const ceres::Solver::Summary summary = AdjustBundle(&r, ba, BundleAdjustmentScope(), nullptr, MarkerScale());
   ASSERT_TRUE(summary.is_constrained);
   ASSERT_GT(summary.num_successful_steps, 3);
-  EXPECT_EQ(summary.num_line_search_steps, 0);
-  EXPECT_EQ(summary.line_search_total_time_in_seconds, 0.0);
-  // One at the start and one per step.
-  const int num_steps = summary.num_successful_steps + summary.num_unsuccessful_steps;
+  // One at the start and one per accepted step.
   EXPECT_LE(summary.num_jacobian_evaluations, summary.num_successful_steps + 1);
-  EXPECT_LE(summary.num_residual_evaluations, num_steps + 1);
-  EXPECT_GE(r.cameras().at(1).housing->params[3], 1e-4);
+  EXPECT_EQ(summary.line_search_gradient_evaluation_time_in_seconds, 0.0);
 }
 
 }  // namespace
