@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 #include <set>
+#include <sstream>
 
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/cost/distance_error.h"
@@ -21,6 +22,8 @@
 #include "pipelines/bundle_adjustment/bundle_costs_fixed.h"
 #include "pipelines/bundle_adjustment/calibration_covariance.h"
 #include "pipelines/bundle_adjustment/position_priors.h"
+#include "pipelines/bundle_adjustment/reduced_camera_system.h"
+#include "pipelines/bundle_adjustment/unevaluable_residuals.h"
 #include "pipelines/bundle_adjustment/weights_settled.h"
 #include "pipelines/reconstruction/ray_geometry.h"
 
@@ -31,40 +34,11 @@ namespace {
 // Keypoints up to this scale (pixels) get sigma_px; coarser ones more.
 constexpr double kReferenceScale = 2.0;
 
-
 // Beyond a thousand free poses the reduced camera system is factorised
 // sparsely only while it has at most this many 6x6 blocks (a survey's
 // images each see a few dozen neighbours: 5000 images x 40); more, it is
 // solved by preconditioned conjugate gradients.
 constexpr size_t kMaxSparseSchurBlocks = 200000;
-
-// The 6x6 blocks of the reduced camera system (the points eliminated): one
-// per free image and one per ordered pair of free images that see a common
-// point.
-size_t ReducedCameraSystemBlocks(const Reconstruction& reconstruction,
-                                 const std::map<point3D_t, Eigen::Vector3d>& point_blocks,
-                                 const std::function<bool(image_t)>& is_free) {
-  std::map<image_t, std::vector<image_t>> neighbours;
-  std::vector<image_t> track;
-  for (const auto& [point_id, xyz] : point_blocks) {
-    track.clear();
-    for (const TrackElement& e : reconstruction.points().at(point_id).track) {
-      if (is_free(e.image_id)) track.push_back(e.image_id);
-    }
-    for (const image_t a : track) {
-      std::vector<image_t>& of_a = neighbours[a];
-      for (const image_t b : track) {
-        if (b != a) of_a.push_back(b);
-      }
-    }
-  }
-  size_t blocks = 0;
-  for (auto& [image_id, of_image] : neighbours) {
-    std::sort(of_image.begin(), of_image.end());
-    blocks += 1 + static_cast<size_t>(std::unique(of_image.begin(), of_image.end()) - of_image.begin());
-  }
-  return blocks;
-}
 
 // The parameter indices of a camera that stay constant.
 std::vector<int> ConstantIntrinsics(const Camera& camera, const BundleAdjustmentOptions& o) {
@@ -156,6 +130,7 @@ class BundleProblem {
   bool FreePose(image_t id) const;
   ceres::Solver::Options SolverOptions(int* num_free_poses) const;
   std::string Describe(const double* block, int index) const;
+  std::string DescribeResidual(const std::vector<double*>& blocks) const;
   void StoreStdDevs(const MarginalCovariance& marginal, CalibrationStdDevs* std_devs) const;
 
   Reconstruction* reconstruction_;
@@ -413,12 +388,17 @@ ceres::Solver::Options BundleProblem::SolverOptions(int* num_free_poses) const {
     solver.linear_solver_type = ceres::ITERATIVE_SCHUR;
     solver.preconditioner_type = ceres::SCHUR_JACOBI;
   }
-  // With bounds (a flat port's distance, a dome's decentering) Ceres 2.1's
-  // trust region runs a projected Armijo line search on every step, and its
-  // default cubic interpolation evaluates the gradient -- the full Jacobian
-  // -- at the trial point: a second Jacobian per iteration. Quadratic
-  // interpolation needs the cost only (docs/benchmarks.md).
-  solver.line_search_interpolation_type = ceres::QUADRATIC;
+  // With bounds (a flat port's distance floor, a dome's decentering box)
+  // Ceres 2.1's trust region runs a projected Armijo line search on every
+  // step unless told not to. Where the full step is good it costs a cost
+  // evaluation; where the step overshoots it shortens the step yet rates it
+  // against the full step's predicted decrease, so a step that should be
+  // rejected is accepted at a ratio of ~0.002 and Levenberg-Marquardt only
+  // halves its region, at one Jacobian and one linear solve a halving
+  // (a rejection shrinks it 2, 4, 8 ... times for a linear solve each;
+  // docs/scale.md). The bounds hold without it: Ceres projects every
+  // step's end onto them.
+  solver.max_num_line_search_step_size_iterations = 0;
   solver.max_num_iterations = options_.max_num_iterations;
   solver.num_threads = options_.num_threads;
   // Per-iteration lines (cost, step, time) in the debug log.
@@ -441,7 +421,12 @@ ceres::Solver::Summary BundleProblem::Solve() {
   }
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem_, &summary);
-  if (!summary.IsSolutionUsable()) throw NumericalError("bundle adjustment failed: " + summary.BriefReport());
+  if (!summary.IsSolutionUsable()) {
+    throw NumericalError("bundle adjustment failed: " + summary.BriefReport() +
+                         DescribeUnevaluableResiduals(problem_, [this](const std::vector<double*>& blocks) {
+                           return DescribeResidual(blocks);
+                         }));
+  }
   VLOG(1) << "bundle adjustment: " << num_free_poses << " free poses, " << point_blocks_.size() << " points, "
           << num_residuals_ << " residuals, " << summary.iterations.size() << " iterations, "
           << summary.total_time_in_seconds << " s (" << summary.BriefReport() << ")";
@@ -465,6 +450,21 @@ std::string BundleProblem::Describe(const double* block, int index) const {
     if (b.data() == block) return "a housing parameter of camera " + std::to_string(id);
   }
   return "a marker corner";
+}
+
+// A residual by its parameter blocks (see AddPoints, AddMarkers and
+// AddPositionPriors for their order).
+std::string BundleProblem::DescribeResidual(const std::vector<double*>& blocks) const {
+  std::string image;
+  for (const auto& [id, block] : pose_blocks_) {
+    if (block.data() == blocks[0]) image = "image '" + reconstruction_->inputs().images.at(id).name + "'";
+  }
+  if (image.empty()) return "a marker's side";
+  if (blocks.size() == 1) return "the position prior of " + image;
+  for (const auto& [id, xyz] : point_blocks_) {
+    if (xyz.data() == blocks[1]) return "the observation of 3D point " + std::to_string(id) + " in " + image;
+  }
+  return "the observation of a marker corner in " + image;
 }
 
 void BundleProblem::ComputeStdDevs(const ceres::Solver::Summary& summary, CalibrationStdDevs* std_devs) {

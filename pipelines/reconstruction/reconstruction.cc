@@ -259,7 +259,7 @@ int Reconstruction::DeleteObservationsBeyond(double max_error_px) {
   std::vector<std::pair<image_t, point2D_t>> beyond;
   for (const auto& [id, point] : points_) {
     for (const TrackElement& e : point.track) {
-      if (ReprojectionError(e.image_id, e.point2D_idx, point.xyz) > max_error_px) {
+      if (!(ReprojectionError(e.image_id, e.point2D_idx, point.xyz) <= max_error_px)) {
         beyond.emplace_back(e.image_id, e.point2D_idx);
       }
     }

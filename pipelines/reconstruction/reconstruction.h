@@ -6,6 +6,7 @@
 // that registration and triangulation work on refracted rays.
 #pragma once
 
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -118,8 +119,13 @@ class Reconstruction {
   // Mean reprojection error over all observations.
   double MeanReprojectionError() const;
   // Deletes the observations whose reprojection error exceeds the limit
-  // (and points left with < 2); returns how many.
+  // or cannot be computed (and points left with < 2); returns how many.
   int DeleteObservationsBeyond(double max_error_px);
+  // Deletes the observations whose point no longer projects into their
+  // image (behind the camera, inside a port's outer surface, totally
+  // reflected): a model rescaled or realigned, its points moved, can hold
+  // them, and an adjustment cannot start with one. Returns how many.
+  int DeleteUnprojectableObservations() { return DeleteObservationsBeyond(std::numeric_limits<double>::max()); }
 
   SparseModel ToSparseModel() const;
   // The model's poses and points (inputs from SfmInputs::FromSparseModel).
