@@ -5,6 +5,8 @@
 
 namespace portcal {
 
+namespace {
+
 bool EvaluableResidualBlock(const ceres::Problem& problem, ceres::ResidualBlockId residual_block) {
   const ceres::CostFunction* cost = problem.GetCostFunctionForResidualBlock(residual_block);
   std::vector<double*> parameters;
@@ -22,6 +24,8 @@ bool EvaluableResidualBlock(const ceres::Problem& problem, ceres::ResidualBlockI
   }
   return true;
 }
+
+}  // namespace
 
 std::vector<ceres::ResidualBlockId> UnevaluableResidualBlocks(const ceres::Problem& problem) {
   std::vector<ceres::ResidualBlockId> blocks;
