@@ -27,11 +27,18 @@
 # Usage: [SCALE=navigation|markers] [RENDER_SPP=4] [STAGES="extract map refine"] [LOG_LEVEL=warn] [PORTCAL=...]
 #        workflows/bench_survey.sh [NUM_IMAGES=300] [WORK_DIR=temporary]
 set -euo pipefail
+# WORK_DIR and PORTCAL, if relative, are taken from where the script is
+# called; the rest from the repository root.
+caller="$PWD"
 cd "$(dirname "$0")/.."
 if [ -z "${PORTCAL:-}" ] && [ ! -x build/portcal ]; then bash workflows/setup.sh >/dev/null; fi
 n="${1:-300}"
-if [ -n "${2:-}" ]; then work="$2"; mkdir -p "$work"; else work="$(mktemp -d)"; trap 'rm -rf "$work"' EXIT; fi
-P="$(realpath "${PORTCAL:-build/portcal}")"
+if [ -n "${2:-}" ]; then
+  work="$(cd "$caller" && mkdir -p "$2" && realpath "$2")"
+else
+  work="$(mktemp -d)"; trap 'rm -rf "$work"' EXIT
+fi
+if [ -n "${PORTCAL:-}" ]; then P="$(cd "$caller" && realpath "$PORTCAL")"; else P="$(realpath build/portcal)"; fi
 [ -x "$P" ] || { echo "bench_survey.sh: PORTCAL: $P is not an executable" >&2; exit 2; }
 source workflows/survey_common.sh
 scale="${SCALE:-navigation}"

@@ -7,6 +7,7 @@
 // corners' pixels with 0.3 px of noise.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <random>
 
