@@ -1,7 +1,9 @@
 // Position priors: stored as COLMAP 3.8 stores GPS positions, imported from
 // a navigation file in one transaction, and, in the bundle adjustment, the
 // metric scale that lets a survey without markers self-calibrate a flat
-// port's distance.
+// port's distance. The same synthetic survey also serves the bounded
+// adjustment's solver (no line search) and an adjustment's start with an
+// observation that cannot be projected.
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
