@@ -134,6 +134,12 @@ std::optional<double> ScaleToMarkers(Reconstruction* reconstruction, double max_
   std::vector<point3D_t> ids;
   for (const auto& [id, point] : reconstruction->points()) ids.push_back(id);
   for (point3D_t id : ids) reconstruction->point(id).xyz *= scale;
+  // Rescaled, a point near a port may now lie inside it, and an adjustment
+  // cannot start from its observations (OwnRenderFlatPortIntrinsicsUnknown:
+  // a scale of 0.99928 put two points 1 cm inside a flat port).
+  const int unprojectable = reconstruction->DeleteUnprojectableObservations();
+  VLOG_IF(1, unprojectable > 0) << "scaled to the markers by " << scale << ": " << unprojectable
+                                << " observations that cannot be projected any more deleted";
   return scale;
 }
 

@@ -100,7 +100,9 @@ std::optional<double> MarkerScaleRatio(const std::vector<MarkerCorner>& corners,
 // markers' sides, triangulated from the current poses, have their known
 // length: the median of known over triangulated length, over every side and
 // diagonal of the corners TriangulateMarkerCorners finds. Returns that
-// factor, or nothing where no marker has two corners triangulated. The
+// factor, or nothing (and nothing changed) where no marker has two corners
+// triangulated. Observations that the rescale leaves unprojectable (a point
+// now inside a port) are deleted, as an adjustment cannot start from them. The
 // mapper's model otherwise grows at the scale refraction prefers under the
 // housing's estimate of the moment (docs/scale.md: 2.7-3.7 times the
 // markers'), and its adjustments, rather than rescale it, pull the corners

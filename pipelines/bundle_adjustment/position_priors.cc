@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "colmap_ext/cost/position_prior_error.h"
+#include "colmap_ext/util/logging.h"
 
 namespace portcal {
 
@@ -106,6 +107,10 @@ std::optional<PositionPriorAlignment> AlignToPositionPriors(Reconstruction* r, d
   std::vector<point3D_t> ids;
   for (const auto& [id, point] : r->points()) ids.push_back(id);
   for (point3D_t id : ids) r->point(id).xyz = Apply(sim, r->points().at(id).xyz);
+  alignment.num_unprojectable_deleted = r->DeleteUnprojectableObservations();
+  VLOG_IF(1, alignment.num_unprojectable_deleted > 0)
+      << "aligned to the position priors: " << alignment.num_unprojectable_deleted
+      << " observations that cannot be projected any more deleted";
   return alignment;
 }
 

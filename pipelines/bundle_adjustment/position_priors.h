@@ -33,13 +33,18 @@ struct PositionPriorAlignment {
   int num_priors = 0;   // registered images with a prior
   int num_inliers = 0;  // used in the final fit
   double rms_m = 0;     // of the inliers' centre - prior after the fit
+  // Observations the move left unprojectable, deleted (see below).
+  int num_unprojectable_deleted = 0;
 };
 
 // Aligns the reconstruction (poses and points) to its registered images'
 // position priors. A first fit on all, then again on those within
 // max(3 x the robust spread, min_inlier_distance_m) of their prior (a
-// navigation fix can jump). nullopt, and nothing changed, when fewer than
-// three images have priors or their centres are (nearly) collinear.
+// navigation fix can jump). Observations whose point no longer projects
+// into its image after the move (a point now inside a port) are deleted:
+// an adjustment cannot start from them. nullopt, and nothing changed, when
+// fewer than three images have priors or their centres are (nearly)
+// collinear.
 std::optional<PositionPriorAlignment> AlignToPositionPriors(Reconstruction* reconstruction,
                                                             double min_inlier_distance_m);
 

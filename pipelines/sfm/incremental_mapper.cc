@@ -515,8 +515,6 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics, AdjustmentE
     PrepareMarkerCorners(r, options_.filter_max_reproj_error_px * 4, options_.marker_scale.side_length_m,
                          &marker_corners_);
   }
-  const int unprojectable = r->DeleteUnprojectableObservations();  // scaled or aligned, some may lie inside a port
-  VLOG_IF(1, unprojectable > 0) << "global adjustment: " << unprojectable << " unprojectable observations deleted";
   std::vector<MarkerCorner>& markers = marker_corners_;  // this adjustment's, kept for the next
   const ModelSnapshot before = ModelSnapshot::Of(*r, markers);
   AdjustHousingFirst(r, ba, &markers);

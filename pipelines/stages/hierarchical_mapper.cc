@@ -75,7 +75,7 @@ void AdjustMerged(const IncrementalMapperOptions& mapper, Reconstruction* r) {
   } else if (mapper.position_prior_sigma_m > 0 && AlignToPositionPriors(r, 5 * mapper.position_prior_sigma_m)) {
     ba.position_prior_sigma_m = mapper.position_prior_sigma_m;
   }
-  r->DeleteUnprojectableObservations();  // moved, some may lie inside a port now (incremental_mapper.cc)
+  r->DeleteUnprojectableObservations();  // clusters merged by similarities: a point may lie inside a port
   AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, mapper.marker_scale);
   r->DeleteObservationsBeyond(mapper.filter_max_reproj_error_px);
   AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, mapper.marker_scale);

@@ -265,7 +265,8 @@ void PrepareScale(const RefractiveBundleAdjusterOptions& options, bool use_prior
     result->num_position_priors = alignment->num_inliers;
     LOG(INFO) << "refractive_bundle_adjuster: aligned to " << alignment->num_inliers << " of "
               << alignment->num_priors << " position priors (scale " << alignment->new_from_old.scale
-              << ", RMS " << alignment->rms_m << " m)";
+              << ", RMS " << alignment->rms_m << " m; " << alignment->num_unprojectable_deleted
+              << " observations no longer projectable deleted)";
   }
   if (options.marker_scale.side_length_m > 0) {
     *markers = TriangulateMarkerCorners(*r, 4 * options.max_reproj_error_px);

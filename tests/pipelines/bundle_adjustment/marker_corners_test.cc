@@ -146,6 +146,42 @@ TEST(MarkerCorners, ScaleToMarkersBringsTheModelToTheMarkersSideLength) {
   EXPECT_NEAR(ScaleToMarkers(&r, kMaxErrorPx, kSide).value_or(0), 1.0, 1e-4);
 }
 
+// Scaled down, a point near the lenses may come to lie inside a port (the
+// mapper met this with a port self-calibrated far out): its observations
+// cannot be projected any more, and an adjustment could not start from
+// them, so the rescale deletes them. Here a point 4.5 cm in front of image
+// 1 and of an image 5 mm beside it, in the model grown 3 times: 1.5 cm once
+// scaled back, inside the port's glass (outer surface at 2 cm).
+TEST(MarkerCorners, ScaleToMarkersDeletesTheObservationsItLeavesUnprojectable) {
+  MarkerScene scene = MakeScene(7);
+  constexpr double kGrownAt = 3.0;
+  Rigid3d beside = scene.poses.at(1);
+  beside.translation.x() -= 0.005;
+  scene.poses[5] = beside;
+  scene.inputs.images[5].image_id = 5;
+  scene.inputs.images[5].camera_id = 1;
+  const Eigen::Vector3d point = -kGrownAt * scene.poses.at(1).translation + Eigen::Vector3d(0, 0, 0.045);
+  for (image_t id : {1, 5}) {
+    Rigid3d grown = scene.poses.at(id);
+    grown.translation *= kGrownAt;
+    const auto pixel = scene.inputs.cameras.at(1).Project(grown * point);
+    ASSERT_TRUE(pixel.has_value()) << "image " << id;
+    scene.inputs.images.at(id).keypoints.push_back(*pixel);
+    scene.inputs.images.at(id).correspondences.resize(1);  // one per keypoint (none matched here)
+  }
+  Reconstruction r = Register(scene);
+  for (auto& [id, pose] : r.mutable_poses()) pose.translation *= kGrownAt;
+  const point3D_t id = r.AddPoint(point, {{1, 0}, {5, 0}});
+  ASSERT_LT(r.ReprojectionError(1, 0, point), 1e-6);
+  ASSERT_LT(r.ReprojectionError(5, 0, point), 1e-6);
+  const auto scale = ScaleToMarkers(&r, kMaxErrorPx, kSide);
+  ASSERT_TRUE(scale.has_value());
+  ASSERT_LT(*scale * 0.045, 0.02);
+  EXPECT_EQ(r.PointOf(1, 0), kInvalidPoint3DId);
+  EXPECT_EQ(r.PointOf(5, 0), kInvalidPoint3DId);
+  EXPECT_EQ(r.points().count(id), 0u);
+}
+
 TEST(MarkerCorners, ScaleToMarkersLeavesAModelWithoutTwoViewsOfAMarker) {
   MarkerScene scene = MakeScene(7);
   for (image_t id = 2; id <= 4; ++id) scene.inputs.images.at(id).markers.clear();

@@ -448,9 +448,10 @@ TEST(PositionPriors, BoundedPortAdjustmentRunsNoLineSearch) {
 
 // A point moved inside the port's outer surface (as rescaling a model with
 // a port self-calibrated far out does) cannot be projected: an adjustment
-// starting there fails and names the observation, and
-// DeleteUnprojectableObservations takes out just the observations that
-// cannot be projected, after which the adjustment runs.
+// starting there fails and names the observation, and aligning the model
+// to the priors again (DeleteUnprojectableObservations at its end) takes
+// out just the observations that cannot be projected, after which the
+// adjustment runs.
 TEST(PositionPriors, UnprojectableObservationIsNamedAndDeleted) {
   std::mt19937 rng(11);
   SyntheticSurvey survey(0.1, 0.02, &rng);
@@ -484,7 +485,10 @@ TEST(PositionPriors, UnprojectableObservationIsNamedAndDeleted) {
               std::string::npos)
         << e.what();
   }
-  EXPECT_EQ(r.DeleteUnprojectableObservations(), static_cast<int>(num_unprojectable));
+  const auto realigned = AlignToPositionPriors(&r, 0.1);
+  ASSERT_TRUE(realigned.has_value());
+  EXPECT_EQ(realigned->num_unprojectable_deleted, static_cast<int>(num_unprojectable));
+  EXPECT_EQ(r.DeleteUnprojectableObservations(), 0);
   EXPECT_EQ(r.PointOf(seen.image_id, seen.point2D_idx), kInvalidPoint3DId);
   size_t num_left = 0;
   for (const auto& [id, point] : r.points()) num_left += point.track.size();
