@@ -87,12 +87,14 @@ struct LiveSession::Pending {
 LiveSession::LiveSession(const LiveSessionOptions& options, KeptFrameStore* store, std::vector<KeptView> existing)
     : options_(options), store_(store), target_(ShapeOfTarget(options.detector)), kept_(std::move(existing)) {
   options.Check();
-  channels_.push_back({options.source.source, options.estimator, nullptr, StillnessTracker(options.hands_free)});
+  channels_.push_back(
+      Channel{options.source.source, options.estimator, nullptr, StillnessTracker(options.hands_free), cv::Size(), -1});
   if (options.Stereo()) {
     LiveEstimatorOptions estimator2 = options.estimator;
     estimator2.camera = options.camera2;
     estimator2.housing = options.housing2;
-    channels_.push_back({options.source2, estimator2, nullptr, StillnessTracker(options.hands_free)});
+    channels_.push_back(
+        Channel{options.source2, estimator2, nullptr, StillnessTracker(options.hands_free), cv::Size(), -1});
   }
   snapshot_.kept = kept_;
 }
@@ -252,7 +254,7 @@ bool LiveSession::TryKeep(const std::vector<Sight>& sights, bool requested) {
     Note(std::string("frame not stored (it can be captured again): ") + e.what(), true);
     return false;
   }
-  KeptView kept{name, sights[0].frame->time_s, views[0], Corners(detections[0]), Thumbnail(images)};
+  KeptView kept{name, sights[0].frame->time_s, views[0], Corners(detections[0]), Thumbnail(images), {}, {}};
   kept.view.image_name = name;
   if (sights.size() > 1) {
     kept.view2 = views[1];
