@@ -30,9 +30,15 @@ if [ "${#targets[@]}" -eq 0 ]; then
            dataset_config database_blobs calibration_file ground_truth stereo_calibration model_rigs)
 fi
 bash workflows/setup.sh --packages-only clang libclang-rt-14-dev >/dev/null
-CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DPORTCAL_SANITIZE=address,undefined -DPORTCAL_FUZZ=ON -DPORTCAL_BUILD_BENCHMARKS=OFF >/dev/null
-cmake --build "$build" -j"$(nproc)" --target "${targets[@]/%/_fuzzer}" >/dev/null
+# One configure and build at a time on the tree: two runs started together
+# (one per core) otherwise collide in CMake's try_compile folders.
+mkdir -p "$build"
+(
+  flock 9
+  CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DPORTCAL_SANITIZE=address,undefined -DPORTCAL_FUZZ=ON -DPORTCAL_BUILD_BENCHMARKS=OFF >/dev/null
+  cmake --build "$build" -j"$(nproc)" --target "${targets[@]/%/_fuzzer}" >/dev/null
+) 9> "$build/.fuzz_build.lock"
 # The targets write their input to a file each run: tmpfs, not the disk.
 export TMPDIR=/dev/shm
 # No leak check: OpenCV's and yaml-cpp's caches live to the end. No
