@@ -71,11 +71,11 @@ for target in "${targets[@]}"; do
       result="FAILED: see $work/log.txt and $work/crash-*"; status=1
     fi
     cat "$work/slice.txt" >> "$work/log.txt"
-    slice_done=$(grep -oP 'stat::number_of_executed_units:\s*\K[0-9]+' "$work/slice.txt" || echo 0)
+    slice_done=$(grep -a -oP 'stat::number_of_executed_units:\s*\K[0-9]+' "$work/slice.txt" || echo 0)
     done_runs=$(( done_runs + slice_done ))
     [ "$result" = "0 crashes, 0 sanitizer reports" ] && [ "$slice_done" -gt 0 ] || break
   done
-  coverage=$(grep -oP 'cov: \K[0-9]+' "$work/log.txt" | tail -1 || echo '?')
+  coverage=$(grep -a -oP 'cov: \K[0-9]+' "$work/log.txt" | tail -1 || echo '?')
   printf '%-20s %12s %8s %8s  %s\n' "$target" "$done_runs" $(( $(date +%s) - start )) "$coverage" "$result"
 done
 exit "$status"
