@@ -63,18 +63,21 @@ for target in "${targets[@]}"; do
   # not slowing over its 60 000; docs/benchmarks.md). Each slice appends
   # its output to the log.
   : > "$work/log.txt"
-  result="0 crashes, 0 sanitizer reports"; done_runs=0
+  done_runs=0; rc=0
   while [ "$done_runs" -lt "$runs" ]; do
     slice=$(( runs - done_runs < slice_runs ? runs - done_runs : slice_runs ))
-    if ! "$build/tests/${target}_fuzzer" -runs="$slice" -max_len="$max_len" -print_final_stats=1 \
-         -artifact_prefix="$work/" "$work/corpus" > "$work/slice.txt" 2>&1; then
-      result="FAILED: see $work/log.txt and $work/crash-*"; status=1
-    fi
+    "$build/tests/${target}_fuzzer" -runs="$slice" -max_len="$max_len" -print_final_stats=1 \
+      -artifact_prefix="$work/" "$work/corpus" > "$work/slice.txt" 2>&1 || rc=$?
     cat "$work/slice.txt" >> "$work/log.txt"
     slice_done=$(grep -a -oP 'stat::number_of_executed_units:\s*\K[0-9]+' "$work/slice.txt" || echo 0)
     done_runs=$(( done_runs + slice_done ))
-    [ "$result" = "0 crashes, 0 sanitizer reports" ] && [ "$slice_done" -gt 0 ] || break
+    [ "$rc" -eq 0 ] && [ "$slice_done" -gt 0 ] || break
   done
+  if [ "$rc" -eq 0 ]; then
+    result="0 crashes, 0 sanitizer reports"
+  else
+    result="FAILED: see $work/log.txt and $work/crash-*"; status=1
+  fi
   coverage=$(grep -a -oP 'cov: \K[0-9]+' "$work/log.txt" | tail -1 || echo '?')
   printf '%-20s %12s %8s %8s  %s\n' "$target" "$done_runs" $(( $(date +%s) - start )) "$coverage" "$result"
 done
