@@ -79,6 +79,34 @@ std::string StdDevSourcesText(const std::vector<double>& by_noise, const std::ve
   return out.str();
 }
 
+// The rows of a grid's map, one flow list each.
+std::string MapRows(const Eigen::MatrixXd& map, const std::string& indent) {
+  std::string text;
+  for (Eigen::Index r = 0; r < map.rows(); ++r) {
+    std::vector<double> row(static_cast<size_t>(map.cols()));
+    for (Eigen::Index c = 0; c < map.cols(); ++c) row[static_cast<size_t>(c)] = map(r, c);
+    text += indent + "- " + List(row) + "\n";
+  }
+  return text;
+}
+
+std::string UncertaintyYaml(const ProjectionUncertaintyGrid& grid) {
+  std::ostringstream out;
+  out << "projection_uncertainty:\n"
+      << "  definition: 'mrcal 2.2 projection_uncertainty, mean-frames, worstdirection-stdev (px); points at "
+         "depth working_distance_m and at infinity; -1: no ray'\n"
+      << "  of: " << grid.of << "\n"
+      << "  determined: " << (grid.determined ? "true" : "false") << "\n"
+      << "  working_distance_m: " << Num(grid.working_distance_m) << "\n"
+      << "  pixel_sigma_px: " << Num(grid.pixel_sigma_px) << "\n"
+      << "  x_px: " << List(grid.x_px) << "\n"
+      << "  y_px: " << List(grid.y_px) << "\n"
+      << "  at_working_distance_px:\n"
+      << MapRows(grid.at_working_distance_px, "  ") << "  at_infinity_px:\n"
+      << MapRows(grid.at_infinity_px, "  ");
+  return out.str();
+}
+
 std::string Yaml(const CalibrationReport& r) {
   std::ostringstream out;
   out << "# portcal calibration report (calibmar-compatible keys first)\n";
@@ -117,6 +145,7 @@ std::string Yaml(const CalibrationReport& r) {
     out << "notes:\n";
     for (const std::string& note : r.notes) out << "- " << SingleQuoted(note) << "\n";
   }
+  if (r.projection_uncertainty) out << UncertaintyYaml(*r.projection_uncertainty);
   out << "per_view:\n";
   for (const CalibratedView& v : r.views) {
     const Eigen::Vector4d q = QuaternionToWxyz(v.cam_from_target.rotation);
@@ -173,6 +202,12 @@ std::string Text(const CalibrationReport& r) {
         << r.board_warp_std_dev->y() * 1000 << " mm\n";
   }
   for (const std::string& note : r.notes) out << "\nNote: " << note << "\n";
+  if (r.projection_uncertainty && r.projection_uncertainty->determined) {
+    const ProjectionUncertaintyGrid& u = *r.projection_uncertainty;
+    out << std::setprecision(3) << "\nProjection uncertainty of the " << u.of << " (mrcal's mean-frames, worst "
+        << "direction, 1 sigma): mean " << u.Mean(false) << ", max " << u.Max(false) << " px at "
+        << u.working_distance_m << " m; mean " << u.Mean(true) << ", max " << u.Max(true) << " px at infinity\n";
+  }
   out << std::setprecision(4) << "\nRMS reprojection error " << r.overall_rms_px << " px over "
       << r.num_points << " points (residual sigma " << r.residual_sigma_px << " px)\n"
       << ErrorFiguresExplained(r.pose_frame == "world") << "\n"
@@ -197,6 +232,21 @@ std::string CameraBlock(const std::string& key, const Camera& camera, const std:
 }
 
 }  // namespace
+
+double ProjectionUncertaintyGrid::Mean(bool at_infinity) const {
+  const Eigen::MatrixXd& map = at_infinity ? at_infinity_px : at_working_distance_px;
+  double sum = 0;
+  int count = 0;
+  for (Eigen::Index k = 0; k < map.size(); ++k) {
+    if (map(k) >= 0) sum += map(k), ++count;
+  }
+  return count > 0 ? sum / count : -1;
+}
+
+double ProjectionUncertaintyGrid::Max(bool at_infinity) const {
+  const Eigen::MatrixXd& map = at_infinity ? at_infinity_px : at_working_distance_px;
+  return map.size() > 0 ? map.maxCoeff() : -1;
+}
 
 std::string WriteStereoCalibrationReport(const StereoCalibrationResult& r, const HousedCamera& camera1,
                                   const HousedCamera& camera2, const std::string& target_description,

@@ -16,6 +16,22 @@
 
 namespace portcal {
 
+// mrcal's projection uncertainty (pipelines/guidance/projection_uncertainty.h)
+// on a grid over the image, as data a script can compare: the
+// worst-direction standard deviation (px) at the grid's cell centres, at
+// the working distance (depth z in the camera frame) and at infinity.
+struct ProjectionUncertaintyGrid {
+  std::string of;  // "intrinsics" or "housing": what is uncertain
+  double working_distance_m = 0;
+  double pixel_sigma_px = 0;  // the corners' noise propagated (residual sigma)
+  std::vector<double> x_px, y_px;  // cell centres, COLMAP pixels: per column, per row
+  // rows x cols (y_px.size() x x_px.size()); -1 where no ray.
+  Eigen::MatrixXd at_working_distance_px, at_infinity_px;
+  bool determined = true;  // false: the views do not fix the unknowns (maps all -1)
+  double Mean(bool at_infinity) const;  // over the cells with a ray
+  double Max(bool at_infinity) const;
+};
+
 struct CalibrationReport {
   Camera camera;
   std::vector<double> parameters_std_dev;
@@ -43,6 +59,8 @@ struct CalibrationReport {
   // Reasons not to trust the result (e.g. a focal length whose standard
   // deviation is a large fraction of it): written first in both files.
   std::vector<std::string> warnings;
+  // Target calibrations: how far a projection can be trusted over the image.
+  std::optional<ProjectionUncertaintyGrid> projection_uncertainty;
 };
 
 // The report of a camera calibration (with the board warp when it was

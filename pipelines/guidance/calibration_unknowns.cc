@@ -8,6 +8,7 @@
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/cost/board_reprojection_error.h"
 #include "colmap_ext/cost/board_through_port_error.h"
+#include "colmap_ext/cost/board_warp.h"
 #include "colmap_ext/geometry/pose_block.h"
 #include "colmap_ext/housing/housing_manifold.h"
 #include "colmap_ext/housing/housing_models.h"
@@ -18,6 +19,9 @@ namespace portcal {
 void CalibrationUnknowns::Check() const {
   if (housing_calibration && !camera.housing) {
     throw InputError("next-pose guidance: a housing calibration needs the housing's model and constants");
+  }
+  if (camera.housing && board_warp) {
+    throw InputError("next-pose guidance: behind a housing the board is held flat (no board warp)");
   }
   camera.camera.Validate("next-pose guidance: camera");
   for (int index : fixed_intrinsics) {
@@ -30,7 +34,8 @@ void CalibrationUnknowns::Check() const {
 
 int CalibrationUnknowns::NumUnknowns() const {
   if (!housing_calibration) {
-    return static_cast<int>(camera.camera.params.size() - fixed_intrinsics.size());
+    return static_cast<int>(camera.camera.params.size() - fixed_intrinsics.size()) +
+           (board_warp && !camera.housing ? 2 : 0);
   }
   const HousingRefinement refinement = camera.housing->Refinement();
   return (refinement.orientation.empty() ? 0 : 2) + static_cast<int>(refinement.position.size());
@@ -38,17 +43,19 @@ int CalibrationUnknowns::NumUnknowns() const {
 
 namespace {
 
-// One problem over a pose and the unknowns, with the residuals of target
-// points that project; Evaluate gives the Jacobian in the tangent spaces.
+// One problem over a pose and the unknowns, with the residuals of points
+// that project; Evaluate gives the Jacobian in the tangent spaces.
 class PointProblem {
  public:
   PointProblem(const CalibrationUnknowns& unknowns, const Rigid3d& cam_from_target)
       : unknowns_(unknowns), pose_(ToPose(cam_from_target)), intrinsics_(unknowns.camera.camera.params) {
     if (unknowns.camera.housing) housing_ = unknowns.camera.housing->params;
+    if (unknowns.board_warp) warp_ = {unknowns.board_warp->value.x(), unknowns.board_warp->value.y()};
   }
 
-  // Adds the points that project; returns their indices.
-  std::vector<int> AddPoints(const std::vector<Eigen::Vector3d>& points) {
+  // Adds the points that project; returns their indices. Target points
+  // (`on_board`) sag with the board's warp; others do not.
+  std::vector<int> AddPoints(const std::vector<Eigen::Vector3d>& points, bool on_board) {
     std::vector<int> added;
     const Rigid3d cam_from_target = FromPose(pose_);
     VisitCameraModel(unknowns_.camera.camera.model_id, [&](auto camera_tag) {
@@ -57,8 +64,11 @@ class PointProblem {
         if (!unknowns_.camera.Project(cam_from_target * points[i])) continue;
         added.push_back(static_cast<int>(i));
         if (!unknowns_.camera.housing) {
-          problem_.AddResidualBlock(BoardReprojectionError<CameraModel>::Create(
-                                        points[i], Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()),
+          // (u, v) = (1, 1) is where the sag and its derivatives vanish.
+          const Eigen::Vector2d uv = on_board && unknowns_.board_warp
+                                         ? BoardWarpUv(points[i], unknowns_.board_warp->extent)
+                                         : Eigen::Vector2d(1, 1);
+          problem_.AddResidualBlock(BoardReprojectionError<CameraModel>::Create(points[i], uv, Eigen::Vector2d::Zero()),
                                     nullptr, pose_.data(), intrinsics_.data(), warp_.data());
           continue;
         }
@@ -72,15 +82,18 @@ class PointProblem {
     return added;
   }
 
-  // The Jacobian's columns: the pose's 6 (when `with_pose`), then the
-  // unknowns'. Empty without residuals.
-  Eigen::MatrixXd Jacobian(bool with_pose) {
+  // The Jacobian's columns: the pose's 6, then the unknowns' (the board
+  // warp's last, when `with_warp` and it is an unknown). Empty without
+  // residuals.
+  Eigen::MatrixXd Jacobian(bool with_warp) {
     if (problem_.NumResidualBlocks() == 0) return Eigen::MatrixXd();
     problem_.SetManifold(pose_.data(), PoseManifold());
     ceres::Problem::EvaluateOptions options;
-    if (with_pose) options.parameter_blocks.push_back(pose_.data());
+    options.parameter_blocks.push_back(pose_.data());
     if (double* block = UnknownBlock()) options.parameter_blocks.push_back(block);
-    if (options.parameter_blocks.empty()) return Eigen::MatrixXd();
+    if (with_warp && unknowns_.board_warp && !unknowns_.camera.housing) {
+      options.parameter_blocks.push_back(warp_.data());
+    }
     ceres::CRSMatrix crs;
     if (!problem_.Evaluate(options, nullptr, nullptr, nullptr, &crs)) {
       throw NumericalError("next-pose guidance: the Jacobian of a view could not be evaluated");
@@ -113,43 +126,43 @@ class PointProblem {
   PoseBlock pose_;
   std::vector<double> intrinsics_;
   std::vector<double> housing_;
-  std::array<double, 2> warp_ = {0, 0};  // a flat board
+  std::array<double, 2> warp_ = {0, 0};  // a flat board unless the warp is an unknown
 };
 
 }  // namespace
 
-Eigen::MatrixXd ViewInformation(const CalibrationUnknowns& unknowns,
-                                const std::vector<Eigen::Vector3d>& points_in_target,
-                                const Rigid3d& cam_from_target) {
+CalibrationInformation ViewInformation(const CalibrationUnknowns& unknowns,
+                                       const std::vector<Eigen::Vector3d>& points_in_target,
+                                       const Rigid3d& cam_from_target) {
   const int p = unknowns.NumUnknowns();
   PointProblem problem(unknowns, cam_from_target);
-  problem.AddPoints(points_in_target);
+  problem.AddPoints(points_in_target, true);
   const Eigen::MatrixXd jacobian = problem.Jacobian(true);
-  if (jacobian.rows() < 6 || p == 0) return Eigen::MatrixXd::Zero(p, p);
+  if (jacobian.rows() < 6 || p == 0) return CalibrationInformation::Zero(p);
+  PORTCAL_CHECK(jacobian.cols() == 6 + p);
   const Eigen::MatrixXd pose_columns = jacobian.leftCols(6);
   const Eigen::MatrixXd unknown_columns = jacobian.rightCols(p);
-  const Eigen::MatrixXd b = pose_columns.transpose() * pose_columns;
-  const Eigen::MatrixXd c = unknown_columns.transpose() * pose_columns;
-  const Eigen::MatrixXd a = unknown_columns.transpose() * unknown_columns;
-  // A pose that the view does not fix (three points) carries nothing.
-  const Eigen::LDLT<Eigen::MatrixXd> pose_information(b);
-  if (pose_information.info() != Eigen::Success || pose_information.vectorD().minCoeff() <= 1e-12 * b.trace()) {
-    return Eigen::MatrixXd::Zero(p, p);
-  }
-  const Eigen::MatrixXd reduced = a - c * pose_information.solve(c.transpose());
-  return 0.5 * (reduced + reduced.transpose());
+  return CalibrationInformation::OfView(pose_columns.transpose() * pose_columns,
+                                        unknown_columns.transpose() * unknown_columns,
+                                        unknown_columns.transpose() * pose_columns, cam_from_target.translation);
 }
 
-Eigen::MatrixXd ProjectionJacobian(const CalibrationUnknowns& unknowns,
-                                   const std::vector<Eigen::Vector3d>& points_in_cam) {
+ProjectionJacobians ProjectionJacobian(const CalibrationUnknowns& unknowns,
+                                       const std::vector<Eigen::Vector3d>& points_in_cam) {
   const int p = unknowns.NumUnknowns();
-  Eigen::MatrixXd result = Eigen::MatrixXd::Zero(2 * static_cast<Eigen::Index>(points_in_cam.size()), p);
+  const Eigen::Index rows = 2 * static_cast<Eigen::Index>(points_in_cam.size());
+  ProjectionJacobians result{Eigen::MatrixXd::Zero(rows, p), Eigen::MatrixXd::Zero(rows, 3)};
+  // At the identity pose, the pose's translation step moves the point
+  // itself: its columns are d pixel / d point.
   PointProblem problem(unknowns, Rigid3d());
-  const std::vector<int> added = problem.AddPoints(points_in_cam);
+  const std::vector<int> added = problem.AddPoints(points_in_cam, false);
   const Eigen::MatrixXd jacobian = problem.Jacobian(false);
   if (jacobian.size() == 0) return result;
+  const Eigen::Index unknown_columns = jacobian.cols() - 6;  // the warp's columns stay zero
   for (size_t k = 0; k < added.size(); ++k) {
-    result.middleRows(2 * added[k], 2) = jacobian.middleRows(2 * static_cast<Eigen::Index>(k), 2);
+    const Eigen::Index row = 2 * static_cast<Eigen::Index>(k), to = 2 * added[k];
+    result.point.middleRows(to, 2) = jacobian.block(row, 3, 2, 3);
+    result.unknowns.block(to, 0, 2, unknown_columns) = jacobian.block(row, 6, 2, unknown_columns);
   }
   return result;
 }

@@ -125,7 +125,7 @@ std::vector<PoseSuggestion> OpeningPoses(const CalibrationUnknowns& unknowns, co
 }
 
 std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, const TargetShape& target,
-                                         const Eigen::MatrixXd& information, int num_kept, int count,
+                                         const CalibrationInformation& information, int num_kept, int count,
                                          const NextPoseOptions& options) {
   options.Check();
   unknowns.Check();
@@ -135,7 +135,7 @@ std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, co
   const std::vector<PoseSuggestion> opening =
       num_kept < 3 ? OpeningPoses(unknowns, target, options) : std::vector<PoseSuggestion>();
   const ViewSamplingOptions sampling = SamplingOptions(options);
-  Eigen::MatrixXd current = information;
+  CalibrationInformation current = information;
   std::vector<PoseSuggestion> suggestions;
   for (int step = 0; step < count; ++step) {
     const int index = num_kept + step;
@@ -150,7 +150,7 @@ std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, co
     }
     std::mt19937_64 rng(options.seed * 1000003ULL + static_cast<uint64_t>(index));
     double best_score = std::numeric_limits<double>::infinity();
-    Eigen::MatrixXd best_information;
+    std::optional<CalibrationInformation> best_information;
     for (int c = 0; c < options.num_candidates; ++c) {
       Rigid3d pose;
       try {
@@ -159,11 +159,11 @@ std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, co
       } catch (const NumericalError&) {
         break;  // no pose fits: handled below
       }
-      const Eigen::MatrixXd added = ViewInformation(unknowns, target.points, pose);
+      const CalibrationInformation added = ViewInformation(unknowns, target.points, pose);
       const ProjectionUncertainty after = model.Evaluate(current + added);
       // Undetermined counts as infinitely uncertain; ties (all undetermined)
       // go to the view adding the most information.
-      const double score = after.determined ? after.mean_px : 1e12 / (1.0 + added.trace());
+      const double score = after.determined ? after.mean_px : 1e12 / (1.0 + added.reduced.trace());
       if (score < best_score) {
         best_score = score;
         best.cam_from_target = pose;
@@ -171,13 +171,13 @@ std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, co
         best_information = added;
       }
     }
-    if (best_information.size() == 0) {
+    if (!best_information) {
       throw NumericalError("next-pose guidance: no pose keeps the whole target in view within --Live.distance_range [" +
                            std::to_string(options.distance_min_m) + ", " + std::to_string(options.distance_max_m) +
                            "] m and --Live.max_tilt_deg " + std::to_string(options.tilt_max_deg));
     }
     best.why = "most lowers the expected projection uncertainty";
-    current += best_information;
+    current += *best_information;
     suggestions.push_back(best);
   }
   return suggestions;
@@ -217,8 +217,9 @@ double RigScore(const ProjectionUncertainty& after1, const ProjectionUncertainty
 
 }  // namespace
 
-PoseSuggestion SuggestRigPose(const RigUnknowns& rig, const TargetShape& target, const Eigen::MatrixXd& information1,
-                              const Eigen::MatrixXd& information2, int num_kept, const NextPoseOptions& options) {
+PoseSuggestion SuggestRigPose(const RigUnknowns& rig, const TargetShape& target,
+                              const CalibrationInformation& information1, const CalibrationInformation& information2,
+                              int num_kept, const NextPoseOptions& options) {
   options.Check();
   rig.camera1.Check();
   rig.camera2.Check();
@@ -250,11 +251,11 @@ PoseSuggestion SuggestRigPose(const RigUnknowns& rig, const TargetShape& target,
       break;
     }
     if (!InBothViews(rig, target, pose, options.border_margin_px)) continue;
-    const Eigen::MatrixXd added1 = ViewInformation(rig.camera1, target.points, pose);
-    const Eigen::MatrixXd added2 = ViewInformation(rig.camera2, target.points, rig.cam2_from_cam1 * pose);
+    const CalibrationInformation added1 = ViewInformation(rig.camera1, target.points, pose);
+    const CalibrationInformation added2 = ViewInformation(rig.camera2, target.points, rig.cam2_from_cam1 * pose);
     const ProjectionUncertainty after1 = model1.Evaluate(information1 + added1);
     const ProjectionUncertainty after2 = model2.Evaluate(information2 + added2);
-    const double score = RigScore(after1, after2, added1.trace() + added2.trace());
+    const double score = RigScore(after1, after2, added1.reduced.trace() + added2.reduced.trace());
     if (score < best_score) {
       best_score = score;
       best.cam_from_target = pose;

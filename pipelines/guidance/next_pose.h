@@ -1,7 +1,7 @@
 // Where the target should be held next (Calibration Wizard, Peng & Sturm,
 // ICCV 2019, with mrcal's measure): first a fixed opening sequence, then the
 // pose whose view most lowers the expected projection uncertainty once added
-// to the views kept so far (poses marginalised out), searched over poses
+// to the views kept so far (mrcal's mean-frames measure), searched over poses
 // that keep the whole target in view with a margin, within a tilt limit and
 // a reachable distance.
 #pragma once
@@ -60,10 +60,10 @@ std::vector<PoseSuggestion> OpeningPoses(const CalibrationUnknowns& unknowns, co
 // The next `count` poses: the opening poses not yet taken (`num_kept` views
 // kept), then greedily the best candidate, each added to the information
 // before the next is chosen. `information`: the kept views' (unit pixel
-// variance, NumUnknowns() square). Throws NumericalError when no pose keeps
+// variance). Throws NumericalError when no pose keeps
 // the target in view within the options.
 std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, const TargetShape& target,
-                                         const Eigen::MatrixXd& information, int num_kept, int count,
+                                         const CalibrationInformation& information, int num_kept, int count,
                                          const NextPoseOptions& options);
 
 // A stereo rig's guidance: both cameras' unknowns and the rig's relative
@@ -81,8 +81,9 @@ struct RigUnknowns {
 // larger of the two cameras' expected uncertainty. `before` and `after` are
 // the worse camera's. Throws NumericalError when no pose keeps the target
 // in both views within the options.
-PoseSuggestion SuggestRigPose(const RigUnknowns& rig, const TargetShape& target, const Eigen::MatrixXd& information1,
-                              const Eigen::MatrixXd& information2, int num_kept, const NextPoseOptions& options);
+PoseSuggestion SuggestRigPose(const RigUnknowns& rig, const TargetShape& target,
+                              const CalibrationInformation& information1, const CalibrationInformation& information2,
+                              int num_kept, const NextPoseOptions& options);
 
 // How far the target is from a suggested pose: the mean distance (px) of
 // its outline's corners in the image, the rotation (deg) between the poses

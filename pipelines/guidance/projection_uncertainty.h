@@ -1,18 +1,27 @@
 // The expected uncertainty of projection over the image: how far (px, one
-// standard deviation, worst direction) a point at a working distance may
-// land from where the calibration puts it, given the information the views
-// carry on the unknowns. It is mrcal's measure of a calibration's quality
-// in place of Calibration Wizard's trace of the intrinsics' covariance,
-// which adds pixels to unitless distortion terms; and it applies unchanged
-// to a housing's parameters. Unlike mrcal it holds the point fixed in the
-// camera frame (no compensation of the boards' reference frame): it ranks
-// views, and a person reads it as "pixels of doubt".
+// standard deviation, worst direction) a point may land from where the
+// calibration puts it, given the information the views carry on the
+// unknowns. It is mrcal's measure of a calibration's quality (mrcal 2.2's
+// projection_uncertainty, "mean-frames", worstdirection-stdev) in place of
+// Calibration Wizard's trace of the intrinsics' covariance, which adds
+// pixels to unitless distortion terms; and it applies unchanged to a
+// housing's parameters, the point then in water.
+//
+// As mrcal, the point is held fixed in the targets' frames, not in the
+// camera's: the camera frame is only defined through the views' poses, so
+// an error of the principal point that the boards' rotations absorb moves
+// no point seen through the target. The point is mapped into every view's
+// target frame with the solved pose and back with the perturbed one, the
+// results averaged (calibration_information.h has the first-order form).
+// At infinity only the rotations matter. docs/calibration.md says what is
+// propagated and how it compares with mrcal's own numbers.
 #pragma once
 
 #include <Eigen/Core>
 #include <string>
 #include <vector>
 
+#include "pipelines/guidance/calibration_information.h"
 #include "pipelines/guidance/calibration_unknowns.h"
 
 namespace portcal {
@@ -27,26 +36,43 @@ struct ProjectionUncertaintyOptions {
 
 struct ProjectionUncertainty {
   bool determined = false;  // the views fix every unknown
-  double mean_px = 0;       // over the grid points that project
+  double mean_px = 0;       // at the working distance, over the grid points that project
   double max_px = 0;
-  Eigen::MatrixXd map_px;   // grid_rows x grid_cols; -1 where no ray
+  double mean_at_infinity_px = 0;
+  double max_at_infinity_px = 0;
+  // grid_rows x grid_cols; -1 where no ray (or undetermined).
+  Eigen::MatrixXd map_px;              // at the working distance
+  Eigen::MatrixXd map_at_infinity_px;  // at infinity
 };
 
+// The grid's cell centres (COLMAP pixels): x per column, y per row.
+Eigen::VectorXd UncertaintyGridColumns(double image_width, int grid_cols);
+Eigen::VectorXd UncertaintyGridRows(double image_height, int grid_rows);
+
 // The grid's rays through the current estimate are computed once; then any
-// information matrix (the kept views', plus a candidate's) is scored.
+// information (the kept views', plus a candidate's) is scored.
 class ProjectionUncertaintyModel {
  public:
   ProjectionUncertaintyModel(const CalibrationUnknowns& unknowns, const ProjectionUncertaintyOptions& options);
 
-  // `information`: NumUnknowns() square, unit pixel variance (it is scaled
-  // by pixel_sigma_px^2 here).
-  ProjectionUncertainty Evaluate(const Eigen::MatrixXd& information) const;
+  // `information`: NumUnknowns() unknowns, unit pixel variance (it is
+  // scaled by pixel_sigma_px^2 here).
+  ProjectionUncertainty Evaluate(const CalibrationInformation& information) const;
 
  private:
+  // One depth's grid: the points and their Jacobians.
+  struct GridPoints {
+    std::vector<Eigen::Vector3d> points;
+    ProjectionJacobians jacobians;
+  };
+  // Worst-direction sigma at every grid point (-1 where none).
+  Eigen::MatrixXd Sigmas(const GridPoints& grid, const CalibrationInformation& information,
+                         const Eigen::MatrixXd& covariance) const;
+
   ProjectionUncertaintyOptions options_;
   int num_unknowns_ = 0;
-  Eigen::MatrixXd jacobian_;     // 2 per grid point
-  std::vector<bool> projects_;   // per grid point
+  std::vector<bool> projects_;  // per grid point
+  GridPoints at_distance_, at_infinity_;
 };
 
 }  // namespace portcal

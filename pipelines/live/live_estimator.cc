@@ -133,7 +133,7 @@ LiveEstimate LiveEstimator::EstimateCamera(const std::vector<CalibrationView>& v
   Solve(views, &estimate);
   const CalibrationUnknowns unknowns = Unknowns(estimate.camera);
   const int p = unknowns.NumUnknowns();
-  estimate.information = Eigen::MatrixXd::Zero(p, p);
+  estimate.information = CalibrationInformation::Zero(p);
   if (estimate.solved && estimate.view_poses.size() == views.size()) {
     for (size_t v = 0; v < views.size(); ++v) {
       estimate.information += ViewInformation(unknowns, views[v].points_in_target, estimate.view_poses[v]);
@@ -234,12 +234,12 @@ double LiveEstimator::Gain(const LiveEstimate& estimate, const CalibrationView& 
   } catch (const NumericalError&) {
     return 0;  // no pose fits this view: it would not help
   }
-  const Eigen::MatrixXd added = ViewInformation(unknowns, view.points_in_target, pose);
+  const CalibrationInformation added = ViewInformation(unknowns, view.points_in_target, pose);
   NextPoseOptions guidance = options_.guidance;
   guidance.uncertainty.pixel_sigma_px = std::max(0.02, estimate.pixel_sigma_px);
   const ProjectionUncertainty after =
       ProjectionUncertaintyModel(unknowns, guidance.Uncertainty()).Evaluate(estimate.information + added);
-  if (!estimate.uncertainty.determined) return added.trace() > 0 ? 1 : 0;
+  if (!estimate.uncertainty.determined) return added.reduced.trace() > 0 ? 1 : 0;
   if (!after.determined || !(estimate.uncertainty.mean_px > 0)) return 0;
   return std::max(0.0, 1 - after.mean_px / estimate.uncertainty.mean_px);
 }

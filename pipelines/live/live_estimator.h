@@ -55,7 +55,7 @@ struct LiveEstimate {
   double rms_px = 0;
   double pixel_sigma_px = 0;         // the residuals' (or the prior)
   std::vector<Rigid3d> view_poses;   // cam_from_target of each kept view
-  Eigen::MatrixXd information;       // the kept views', unit pixel variance
+  CalibrationInformation information;  // the kept views', unit pixel variance
   ProjectionUncertainty uncertainty;
   std::optional<PoseSuggestion> next;
   std::string suggestion_error;      // why there is no suggestion

@@ -48,7 +48,20 @@ std::vector<int> HeldParams(const CalibrationReport& report) {
   return held;
 }
 
+// A housing calibration on given intrinsics: the housing's uncertainty;
+// else (a camera, or a joint solve) the intrinsics' (seen through the
+// housing, if any).
+bool OfHousing(const CalibrationReport& report) {
+  return report.housing.has_value() && HeldParams(report).size() == report.camera.params.size();
+}
+
 }  // namespace
+
+ProjectionUncertaintyGrid ProjectionUncertaintyOf(const CalibrationReport& report,
+                                                  const std::vector<CalibrationView>& views) {
+  const ViewsAtPoses at_poses{HousedCamera{report.camera, report.housing}, views, report.views, report.board_warp};
+  return ProjectionUncertaintyOfViews(at_poses, OfHousing(report), HeldParams(report), report.residual_sigma_px);
+}
 
 HtmlReport CalibrationHtml(const CalibrationReport& report, const std::vector<CalibrationView>& views,
                            const std::string& title) {
@@ -56,18 +69,16 @@ HtmlReport CalibrationHtml(const CalibrationReport& report, const std::vector<Ca
   HtmlReport html{title, report.warnings, {}};
   ReportSection section{"The views", "", ViewPictures(at_poses, report.residual_sigma_px, "", "")};
   const bool housing = report.housing.has_value();
-  // A housing calibration on given intrinsics: the housing's uncertainty;
-  // else (a camera, or a joint solve) the intrinsics' (seen through the
-  // housing, if any).
-  const bool of_housing = housing && HeldParams(report).size() == report.camera.params.size();
+  const ProjectionUncertaintyGrid uncertainty =
+      report.projection_uncertainty ? *report.projection_uncertainty : ProjectionUncertaintyOf(report, views);
   section.pictures.push_back(
       {"uncertainty.png",
-       std::string("How far (px, one sigma) a point at the views' median distance may project from where this "
-                   "calibration puts it, from the ") +
-           (of_housing ? "housing's" : "intrinsics'") +
-           " uncertainty given these views (mrcal's measure; the line: the mean). It grows where the views "
-           "give little information.",
-       UncertaintyPicture(at_poses, of_housing, HeldParams(report), report.residual_sigma_px)});
+       std::string("How far (px, one sigma, worst direction) a point at the views' median distance may project "
+                   "from where this calibration puts it, from the ") +
+           (OfHousing(report) ? "housing's" : "intrinsics'") +
+           " uncertainty given these views: mrcal's measure (mean-frames), the point fixed to the targets, not "
+           "to the camera (the line: the mean). It grows where the views give little information.",
+       UncertaintyPicture(uncertainty, static_cast<int>(report.camera.width), static_cast<int>(report.camera.height))});
   html.sections.push_back(section);
   if (housing) {
     html.sections.push_back({"The housing", "",

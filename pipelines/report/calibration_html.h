@@ -18,6 +18,12 @@ namespace portcal {
 HtmlReport CalibrationHtml(const CalibrationReport& report, const std::vector<CalibrationView>& views,
                            const std::string& title);
 
+// The projection uncertainty of a target calibration of `views` (report's
+// camera, housing, kept views' poses, board warp, held parameters and
+// residual sigma): what calibration.yaml carries and the report draws.
+ProjectionUncertaintyGrid ProjectionUncertaintyOf(const CalibrationReport& report,
+                                                  const std::vector<CalibrationView>& views);
+
 // A stereo calibration: the rig from above, then each camera's coverage
 // and per-view RMS.
 HtmlReport StereoCalibrationHtml(const StereoCalibrationResult& result, const std::vector<CalibrationView>& views1,

@@ -133,10 +133,13 @@ cv::Mat ResidualVectorsPicture(const Camera& camera, const std::vector<PointResi
   return frame.canvas;
 }
 
-cv::Mat UncertaintyPicture(const ViewsAtPoses& in, bool housing_calibration, const std::vector<int>& fixed,
-                           double pixel_sigma_px) {
-  CalibrationUnknowns unknowns{in.camera, housing_calibration, fixed};
-  Eigen::MatrixXd information = Eigen::MatrixXd::Zero(unknowns.NumUnknowns(), unknowns.NumUnknowns());
+ProjectionUncertaintyGrid ProjectionUncertaintyOfViews(const ViewsAtPoses& in, bool housing_calibration,
+                                                       const std::vector<int>& fixed, double pixel_sigma_px) {
+  CalibrationUnknowns unknowns{in.camera, housing_calibration, fixed, std::nullopt};
+  // Behind a housing the guidance's residual holds the board flat: the
+  // warp, when fitted, is taken as known there.
+  if (in.board_warp && !in.camera.housing) unknowns.board_warp = BoardWarpUnknown{*in.board_warp, BoardExtent(in.views)};
+  CalibrationInformation information = CalibrationInformation::Zero(unknowns.NumUnknowns());
   std::vector<double> depths;
   const std::map<std::string, const CalibrationView*> by_name = ByName(in.views);
   for (const CalibratedView& view : in.calibrated) {
@@ -146,22 +149,37 @@ cv::Mat UncertaintyPicture(const ViewsAtPoses& in, bool housing_calibration, con
     depths.push_back(view.cam_from_target.translation.z());
   }
   ProjectionUncertaintyOptions options;
-  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  std::nth_element(depths.begin(), depths.begin() + static_cast<long>(depths.size() / 2), depths.end());
   options.working_distance_m = depths.empty() ? 1.0 : std::max(0.05, depths[depths.size() / 2]);
   options.grid_cols = 32;
   const Camera& camera = in.camera.camera;
   options.grid_rows = std::max(2, static_cast<int>(std::lround(32.0 * camera.height / camera.width)));
   options.pixel_sigma_px = std::max(1e-6, pixel_sigma_px);
   const ProjectionUncertainty uncertainty = ProjectionUncertaintyModel(unknowns, options).Evaluate(information);
+  ProjectionUncertaintyGrid grid;
+  grid.of = housing_calibration ? "housing" : "intrinsics";
+  grid.working_distance_m = options.working_distance_m;
+  grid.pixel_sigma_px = options.pixel_sigma_px;
+  const Eigen::VectorXd xs = UncertaintyGridColumns(static_cast<double>(camera.width), options.grid_cols);
+  const Eigen::VectorXd ys = UncertaintyGridRows(static_cast<double>(camera.height), options.grid_rows);
+  grid.x_px.assign(xs.data(), xs.data() + xs.size());
+  grid.y_px.assign(ys.data(), ys.data() + ys.size());
+  grid.determined = uncertainty.determined;
+  grid.at_working_distance_px = uncertainty.map_px;
+  grid.at_infinity_px = uncertainty.map_at_infinity_px;
+  return grid;
+}
+
+cv::Mat UncertaintyPicture(const ProjectionUncertaintyGrid& grid, int width, int height) {
   HeatMapStyle style;
   style.unit = "px";
-  style.title = std::string("Projection uncertainty of the ") + (housing_calibration ? "housing" : "intrinsics") +
-                " at " + Fixed(options.working_distance_m, 2) + " m: mean " + Fixed(uncertainty.mean_px, 3) +
-                ", max " + Fixed(uncertainty.max_px, 3) + " px" + (uncertainty.determined ? "" : " (UNDETERMINED)");
-  style.contour_levels = {uncertainty.mean_px};
-  const int width = static_cast<int>(in.camera.camera.width), height = static_cast<int>(in.camera.camera.height);
-  if (!uncertainty.determined) return HeatMapPicture(-Eigen::MatrixXd::Ones(2, 2), width, height, style);
-  return HeatMapPicture(uncertainty.map_px, width, height, style);
+  style.title = "Projection uncertainty of the " + grid.of + " at " + Fixed(grid.working_distance_m, 2) +
+                " m: mean " + Fixed(grid.Mean(false), 3) + ", max " + Fixed(grid.Max(false), 3) + " px (at infinity " +
+                Fixed(grid.Mean(true), 3) + ", " + Fixed(grid.Max(true), 3) + ")" +
+                (grid.determined ? "" : " (UNDETERMINED)");
+  style.contour_levels = {grid.Mean(false)};
+  if (!grid.determined) return HeatMapPicture(-Eigen::MatrixXd::Ones(2, 2), width, height, style);
+  return HeatMapPicture(grid.at_working_distance_px, width, height, style);
 }
 
 }  // namespace portcal

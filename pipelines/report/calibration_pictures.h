@@ -13,6 +13,7 @@
 
 #include "colmap_ext/camera/housed_camera.h"
 #include "colmap_ext/geometry/rigid3d.h"
+#include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/camera_calibration.h"
 
 namespace portcal {
@@ -47,12 +48,16 @@ cv::Mat PerViewRmsPicture(const std::vector<CalibratedView>& views, double resid
 cv::Mat ResidualVectorsPicture(const Camera& camera, const std::vector<PointResidual>& residuals, int num_views,
                                const std::string& title);
 
-// The expected projection uncertainty (px, 1 sigma) over the image at the
-// views' median distance, from the information of the kept views at
-// `pixel_sigma_px` (guidance/projection_uncertainty.h): of the intrinsics
-// not held, or with `housing_calibration` of the housing's refined
-// parameters.
-cv::Mat UncertaintyPicture(const ViewsAtPoses& views, bool housing_calibration, const std::vector<int>& fixed,
-                           double pixel_sigma_px);
+// The expected projection uncertainty (px, 1 sigma, mrcal's mean-frames
+// measure) over the image at the kept views' median depth and at infinity,
+// from the information of the kept views at `pixel_sigma_px`
+// (guidance/projection_uncertainty.h): of the intrinsics not held (and the
+// board warp, when fitted), or with `housing_calibration` of the housing's
+// refined parameters.
+ProjectionUncertaintyGrid ProjectionUncertaintyOfViews(const ViewsAtPoses& views, bool housing_calibration,
+                                                       const std::vector<int>& fixed, double pixel_sigma_px);
+
+// The grid's map at the working distance as a heat map.
+cv::Mat UncertaintyPicture(const ProjectionUncertaintyGrid& grid, int width, int height);
 
 }  // namespace portcal

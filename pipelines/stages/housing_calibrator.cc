@@ -97,7 +97,8 @@ HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& op
   const HousingCalibrationResult result =
       CalibrateHousing(views, start->camera, housing, options.calibration, in_air ? &*in_air : nullptr);
 
-  const CalibrationReport report = ReportOf(result, target_views.target);
+  CalibrationReport report = ReportOf(result, target_views.target);
+  report.projection_uncertainty = ProjectionUncertaintyOf(report, views);
   WriteCalibrationOutput(report, options.output_path, options.update_database ? &database : nullptr, camera_id, [&] {
     WriteHtml(CalibrationHtml(report, views, "Housing calibration (" + housing.ModelName() + ")"), options.output_path);
   });

@@ -77,9 +77,9 @@ void ExpectFewerViews(bool housing, double goal_px) {
   EXPECT_LT(guided, 0.67 * random);
 }
 
-TEST(ClosedLoopRendered, CameraCalibrationNeedsFewerViewsWithSuggestions) { ExpectFewerViews(false, 0.75); }
+TEST(ClosedLoopRendered, CameraCalibrationNeedsFewerViewsWithSuggestions) { ExpectFewerViews(false, 0.15); }
 
-TEST(ClosedLoopRendered, HousingCalibrationNeedsFewerViewsWithSuggestions) { ExpectFewerViews(true, 0.25); }
+TEST(ClosedLoopRendered, HousingCalibrationNeedsFewerViewsWithSuggestions) { ExpectFewerViews(true, 0.08); }
 
 }  // namespace
 }  // namespace portcal

@@ -13,6 +13,7 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "pipelines/calibration/camera_calibration.h"
+#include "pipelines/calibration/housing_calibration.h"
 #include "pipelines/live/live_estimator.h"
 #include "pipelines/synthetic/view_sampler.h"
 #include "tests/pipelines/guidance/simulated_person.h"
@@ -50,13 +51,28 @@ CalibrationUnknowns Unknowns(const Camera& camera) {
   return unknowns;
 }
 
-TEST(ProjectionUncertainty, PredictionMatchesTheSpreadOfRepeatedCalibrations) {
-  const Camera truth = TrueCamera();
+// The lenses the prediction is checked on: mrcal has the first; the other
+// two only portcal.
+Camera LensOfModel(const std::string& model) {
+  if (model == "OPENCV") return TrueCamera();
+  Camera camera = Camera::FromModelName(model, 500, 640, 480);
+  if (model == "OPENCV_FISHEYE") camera.params = {402, 398, 321.5, 242.0, 0.03, -0.012, 0.004, -0.001};
+  if (model == "RADIAL") camera.params = {502, 322.5, 238.0, -0.18, 0.05};
+  return camera;
+}
+
+// Predicted (mean-frames) against the spread of many calibrations of the
+// same views re-noised, each projection compared as mrcal's own Monte
+// Carlo test does: the point mapped into every target frame with the true
+// pose and back with the re-solved one, averaged, then projected by the
+// re-solved lens.
+void ExpectPredictionMatchesTheSpread(const std::string& model) {
+  const Camera truth = LensOfModel(model);
   const TargetShape board = Board();
   const NextPoseOptions options = Options();
   std::vector<Rigid3d> poses;
   for (const PoseSuggestion& s : OpeningPoses(Unknowns(truth), board, options)) poses.push_back(s.cam_from_target);
-  std::mt19937_64 rng(5);
+  std::mt19937_64 rng(7);
   ViewSamplingOptions sampling;
   sampling.distance_min_m = 0.3;
   sampling.distance_max_m = 0.9;
@@ -65,10 +81,11 @@ TEST(ProjectionUncertainty, PredictionMatchesTheSpreadOfRepeatedCalibrations) {
     poses.push_back(SampleTargetView(truth, nullptr, board.outline, board.center, -Eigen::Vector3d::UnitZ(),
                                      sampling, &rng));
   }
-  Eigen::MatrixXd information = Eigen::MatrixXd::Zero(8, 8);
+  const int p = static_cast<int>(truth.params.size());
+  CalibrationInformation information = CalibrationInformation::Zero(p);
   for (const Rigid3d& pose : poses) information += ViewInformation(Unknowns(truth), board.points, pose);
-  const ProjectionUncertaintyModel model(Unknowns(truth), options.Uncertainty());
-  const ProjectionUncertainty predicted = model.Evaluate(information);
+  const ProjectionUncertaintyModel uncertainty(Unknowns(truth), options.Uncertainty());
+  const ProjectionUncertainty predicted = uncertainty.Evaluate(information);
   ASSERT_TRUE(predicted.determined);
 
   // The same grid points, projected by each of many calibrations.
@@ -81,16 +98,20 @@ TEST(ProjectionUncertainty, PredictionMatchesTheSpreadOfRepeatedCalibrations) {
       points.push_back(ray * grid.working_distance_m / ray.z());
     }
   }
-  const int trials = 40;
+  const int trials = 100;
   std::vector<Eigen::Matrix2d> scatter(points.size(), Eigen::Matrix2d::Zero());
   CameraCalibrationSettings settings;
   settings.initialize_from_data = false;
   for (int t = 0; t < trials; ++t) {
     std::vector<CalibrationView> views;
     for (const Rigid3d& pose : poses) views.push_back(*Observe(truth, board, pose, 0.2, &rng));
-    const Camera calibrated = CalibrateCamera(views, truth, settings).camera;
+    const CameraCalibrationResult solved = CalibrateCamera(views, truth, settings);
     for (size_t k = 0; k < points.size(); ++k) {
-      const Eigen::Vector2d error = *calibrated.ImgFromCam(points[k]) - *truth.ImgFromCam(points[k]);
+      Eigen::Vector3d moved = Eigen::Vector3d::Zero();
+      for (size_t i = 0; i < poses.size(); ++i) {
+        moved += solved.views[i].cam_from_target * (poses[i].Inverse() * points[k]) / static_cast<double>(poses.size());
+      }
+      const Eigen::Vector2d error = *solved.camera.ImgFromCam(moved) - *truth.ImgFromCam(points[k]);
       scatter[k] += error * error.transpose() / trials;
     }
   }
@@ -99,13 +120,26 @@ TEST(ProjectionUncertainty, PredictionMatchesTheSpreadOfRepeatedCalibrations) {
     empirical += std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(s).eigenvalues().maxCoeff());
   }
   empirical /= static_cast<double>(scatter.size());
-  std::printf("projection uncertainty: predicted %.4f px, spread of %d calibrations %.4f px (ratio %.2f)\n",
-              predicted.mean_px, trials, empirical, empirical / predicted.mean_px);
-  // 40 trials give a standard deviation known to about 1/sqrt(2 * 40) =
-  // 11 %; the calibrations also refine the poses of noisy views, which the
-  // linear prediction only approximates.
-  EXPECT_GT(empirical / predicted.mean_px, 0.7) << empirical << " vs " << predicted.mean_px;
-  EXPECT_LT(empirical / predicted.mean_px, 1.4) << empirical << " vs " << predicted.mean_px;
+  std::printf("%s projection uncertainty (mean-frames): predicted %.4f px, spread of %d calibrations %.4f px "
+              "(ratio %.2f)\n",
+              model.c_str(), predicted.mean_px, trials, empirical, empirical / predicted.mean_px);
+  // 100 trials give a standard deviation known to about 1/sqrt(2 * 100)
+  // = 7 % (at one point; the grid's points are correlated, so its mean is
+  // hardly steadier); 20 %, as the issue asks, allows near three of those.
+  EXPECT_GT(empirical / predicted.mean_px, 0.8) << empirical << " vs " << predicted.mean_px;
+  EXPECT_LT(empirical / predicted.mean_px, 1.2) << empirical << " vs " << predicted.mean_px;
+}
+
+TEST(ProjectionUncertainty, PredictionMatchesTheSpreadOfRepeatedCalibrationsOpenCv) {
+  ExpectPredictionMatchesTheSpread("OPENCV");
+}
+
+TEST(ProjectionUncertainty, PredictionMatchesTheSpreadOfRepeatedCalibrationsFisheye) {
+  ExpectPredictionMatchesTheSpread("OPENCV_FISHEYE");
+}
+
+TEST(ProjectionUncertainty, PredictionMatchesTheSpreadOfRepeatedCalibrationsRadial) {
+  ExpectPredictionMatchesTheSpread("RADIAL");
 }
 
 // The corners seen through lens and port, with noise; empty when one
@@ -125,6 +159,72 @@ std::optional<CalibrationView> ObserveHoused(const HousedCamera& camera, const T
   }
   view.image_name = "view" + std::to_string(view.pixels.size()) + "_" + std::to_string((*rng)() % 100000);
   return view;
+}
+
+// Behind a flat port (the in-air lens given, as housing_calibrator does by
+// default), where mrcal has no model: the same views re-noised and the
+// port re-solved each time; a grid point in water held to the targets'
+// frames as above, projected through the re-solved port.
+TEST(ProjectionUncertainty, PredictionMatchesTheSpreadOfRepeatedHousingCalibrations) {
+  const HousedCamera truth{TrueCamera(), simulated::TruePort()};
+  CalibrationUnknowns unknowns;
+  unknowns.camera = truth;
+  unknowns.housing_calibration = true;
+  const TargetShape board = Board();
+  const NextPoseOptions options = Options();
+  std::vector<Rigid3d> poses;
+  for (const PoseSuggestion& s : OpeningPoses(unknowns, board, options)) poses.push_back(s.cam_from_target);
+  std::mt19937_64 rng(11);
+  ViewSamplingOptions sampling;
+  sampling.distance_min_m = 0.3;
+  sampling.distance_max_m = 0.9;
+  sampling.border_margin_px = 20;
+  while (poses.size() < 9) {
+    poses.push_back(SampleTargetView(truth.camera, truth.HousingOrNull(), board.outline, board.center,
+                                     -Eigen::Vector3d::UnitZ(), sampling, &rng));
+  }
+  CalibrationInformation information = CalibrationInformation::Zero(unknowns.NumUnknowns());
+  for (const Rigid3d& pose : poses) information += ViewInformation(unknowns, board.points, pose);
+  const ProjectionUncertaintyOptions grid = options.Uncertainty();
+  const ProjectionUncertainty predicted = ProjectionUncertaintyModel(unknowns, grid).Evaluate(information);
+  ASSERT_TRUE(predicted.determined);
+  std::vector<Eigen::Vector3d> points;
+  for (int r = 0; r < grid.grid_rows; ++r) {
+    for (int c = 0; c < grid.grid_cols; ++c) {
+      const Ray3d ray = *truth.Unproject(Eigen::Vector2d((c + 0.5) * 640 / grid.grid_cols,
+                                                         (r + 0.5) * 480 / grid.grid_rows));
+      points.push_back(ray.origin +
+                       (grid.working_distance_m - ray.origin.z()) / ray.direction.z() * ray.direction);
+    }
+  }
+  const int trials = 100;
+  std::vector<Eigen::Matrix2d> scatter(points.size(), Eigen::Matrix2d::Zero());
+  HousingCalibrationSettings settings;
+  settings.initialize_from_data = false;
+  for (int t = 0; t < trials; ++t) {
+    std::vector<CalibrationView> views;
+    for (const Rigid3d& pose : poses) views.push_back(*ObserveHoused(truth, board, pose, 0.2, &rng));
+    const HousingCalibrationResult solved = CalibrateHousing(views, truth.camera, *truth.housing, settings);
+    const HousedCamera camera{truth.camera, solved.housing};
+    for (size_t k = 0; k < points.size(); ++k) {
+      Eigen::Vector3d moved = Eigen::Vector3d::Zero();
+      for (size_t i = 0; i < poses.size(); ++i) {
+        moved += solved.views[i].cam_from_target * (poses[i].Inverse() * points[k]) / static_cast<double>(poses.size());
+      }
+      const Eigen::Vector2d error = *camera.Project(moved) - *truth.Project(points[k]);
+      scatter[k] += error * error.transpose() / trials;
+    }
+  }
+  double empirical = 0;
+  for (const Eigen::Matrix2d& s : scatter) {
+    empirical += std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(s).eigenvalues().maxCoeff());
+  }
+  empirical /= static_cast<double>(scatter.size());
+  std::printf("flat port projection uncertainty (mean-frames): predicted %.4f px, spread of %d calibrations %.4f px "
+              "(ratio %.2f)\n",
+              predicted.mean_px, trials, empirical, empirical / predicted.mean_px);
+  EXPECT_GT(empirical / predicted.mean_px, 0.8) << empirical << " vs " << predicted.mean_px;
+  EXPECT_LT(empirical / predicted.mean_px, 1.2) << empirical << " vs " << predicted.mean_px;
 }
 
 // Mean views to the goal over a few seeds, guided and random.
@@ -155,7 +255,7 @@ TEST(NextPose, ARangeWhereTheTargetCannotFitIsAnErrorNamingIt) {
   CalibrationUnknowns unknowns;
   unknowns.camera.camera = TrueCamera();
   try {
-    SuggestPoses(unknowns, Board(), Eigen::MatrixXd::Zero(8, 8), 0, 1, options);
+    SuggestPoses(unknowns, Board(), CalibrationInformation::Zero(8), 0, 1, options);
     ADD_FAILURE() << "a suggestion where the target cannot fit";
   } catch (const NumericalError& e) {
     EXPECT_NE(std::string(e.what()).find("--Live.distance_range"), std::string::npos) << e.what();
@@ -164,17 +264,18 @@ TEST(NextPose, ARangeWhereTheTargetCannotFitIsAnErrorNamingIt) {
 
 TEST(NextPose, SuggestionsReachTheGoalInFewerViewsThanRandomPoses) {
   // At 0.2 px corner noise, points 0.6 m away over the whole image (the
-  // corners included): random views of this range level off near 1 px.
-  const auto [guided, random] = MeanViewsToReach(false, 0.75, 30);
+  // corners included), mrcal's measure: random views of this range are
+  // still at 0.17-0.18 px after 30 views (docs/live.md).
+  const auto [guided, random] = MeanViewsToReach(false, 0.15, 30);
   // The paper's claim, and by a margin: fewer than two thirds of the views.
   EXPECT_LT(guided, 0.67 * random);
 }
 
 TEST(NextPose, SuggestionsAlsoGuideAHousingCalibration) {
   // The port's normal and distance, the in-air camera known: random views
-  // of this range stay above 0.3 px after 30 views. Past the opening
+  // of this range reach 0.08 px only after 25-30 views. Past the opening
   // sequence, so that the search is what is measured.
-  const auto [guided, random] = MeanViewsToReach(true, 0.25, 30);
+  const auto [guided, random] = MeanViewsToReach(true, 0.08, 30);
   EXPECT_LT(guided, 0.67 * random);
 }
 

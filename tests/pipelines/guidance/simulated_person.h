@@ -91,7 +91,7 @@ inline int ViewsToReach(bool housing, bool guided, double goal_px, int max_views
   sampling.border_margin_px = estimator_options.guidance.border_margin_px;
   std::shared_ptr<LiveEstimate> estimate;
   std::vector<CalibrationView> views;
-  Eigen::MatrixXd true_information = Eigen::MatrixXd::Zero(true_unknowns.NumUnknowns(), true_unknowns.NumUnknowns());
+  CalibrationInformation true_information = CalibrationInformation::Zero(true_unknowns.NumUnknowns());
   for (int n = 1; n <= max_views; ++n) {
     if (guided) estimate = std::make_shared<LiveEstimate>(estimator.Estimate(views, estimate.get()));
     std::optional<CalibrationView> view;
