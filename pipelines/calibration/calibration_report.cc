@@ -1,16 +1,10 @@
 #include "pipelines/calibration/calibration_report.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cstdio>
-#include <fstream>
 #include <iomanip>
-#include <regex>
 #include <sstream>
 
 #include "colmap_ext/camera/camera_models.h"
-#include "colmap_ext/io/mrcal_model.h"
-#include "colmap_ext/io/opencv_camera_file.h"
 #include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/string_utils.h"
@@ -79,6 +73,18 @@ std::string StdDevSourcesText(const std::vector<double>& by_noise, const std::ve
   return out.str();
 }
 
+// A covariance matrix under `key`, a flow list per row; nothing when empty.
+std::string CovarianceYaml(const std::string& key, const Eigen::MatrixXd& covariance) {
+  if (covariance.size() == 0) return "";
+  std::string text = key + ":\n";
+  for (Eigen::Index r = 0; r < covariance.rows(); ++r) {
+    std::vector<double> row(static_cast<size_t>(covariance.cols()));
+    for (Eigen::Index c = 0; c < covariance.cols(); ++c) row[static_cast<size_t>(c)] = covariance(r, c);
+    text += "- " + List(row) + "\n";
+  }
+  return text;
+}
+
 // The rows of a grid's map, one flow list each.
 std::string MapRows(const Eigen::MatrixXd& map, const std::string& indent) {
   std::string text;
@@ -128,6 +134,8 @@ std::string Yaml(const CalibrationReport& r) {
   for (const auto& [key, values] : estimates) {
     if (!values->empty()) out << key << ": " << StdDevList(*values) << "\n";
   }
+  out << CovarianceYaml("parameters_covariance", r.parameters_covariance)
+      << CovarianceYaml("non_svp_parameters_covariance", r.housing_covariance);
   out << "overall_rms: " << Num(r.overall_rms_px) << "\n"
       << "residual_sigma_px: " << Num(r.residual_sigma_px) << "\n"
       << "num_views: " << std::count_if(r.views.begin(), r.views.end(), [](const CalibratedView& v) { return !v.dropped; })
@@ -336,6 +344,7 @@ CalibrationReport ReportOf(const CameraCalibrationResult& result, bool with_boar
   CalibrationReport report;
   report.camera = result.camera;
   report.parameters_std_dev = result.params_std_dev;
+  if (!result.params_covariance.isZero(0)) report.parameters_covariance = result.params_covariance;
   report.overall_rms_px = result.overall_rms_px;
   report.residual_sigma_px = result.residual_sigma_px;
   report.num_points = result.num_points;
@@ -401,10 +410,15 @@ std::string HousingUncertaintyNote(const HousingCalibrationResult& result) {
                          [](double s) { return s != 0; })) {
     note << "intrinsics refined from the underwater views alone; the standard deviations include their "
             "uncertainty";
+  } else if (result.lens_covariance_propagated) {
+    note << "the in-air intrinsics are held; their covariance (from the calibration file) is propagated into "
+            "the housing's standard deviations to first order (how the port's estimate moves with the lens, "
+            "times the lens's covariance). The joint solve (--in_air_database_path) also lets the underwater "
+            "views refine the lens";
   } else {
-    note << "the in-air intrinsics are taken as exact: the housing's standard deviations leave out their "
-            "uncertainty and understate its error (give the in-air views, --in_air_database_path, for a joint "
-            "solve)";
+    note << "the in-air intrinsics are taken as exact (the calibration file carries no covariance): the "
+            "housing's standard deviations leave out their uncertainty and understate its error (give the "
+            "in-air views, --in_air_database_path, for a joint solve)";
   }
   return note.str();
 }
@@ -415,8 +429,10 @@ CalibrationReport ReportOf(const HousingCalibrationResult& result, const std::st
   CalibrationReport report;
   report.camera = result.camera;
   report.parameters_std_dev = result.camera_std_dev;
+  report.parameters_covariance = result.camera_covariance;
   report.housing = result.housing;
   report.housing_std_dev = result.housing_std_dev;
+  report.housing_covariance = result.housing_covariance;
   report.overall_rms_px = result.overall_rms_px;
   report.residual_sigma_px = result.residual_sigma_px;
   report.num_points = result.num_points;
@@ -447,134 +463,6 @@ void WriteCalibrationReport(const CalibrationReport& report, const fs::path& dir
   const std::string yaml = Yaml(report), text = Text(report);
   WriteFileAtomically(dir / "calibration.yaml", false, [&](std::ostream& out) { out << yaml; });
   WriteFileAtomically(dir / "calibration.txt", false, [&](std::ostream& out) { out << text; });
-}
-
-namespace {
-
-constexpr const char* kCalibrationFormats =
-    "portcal reads portcal's and calibmar's calibration.yaml (key 'model'), OpenCV's FileStorage YAML and ROS "
-    "camera_info YAML (key 'camera_matrix'), and mrcal's .cameramodel";
-
-// A camera from another tool's file: no standard deviations, views or
-// housing.
-CalibrationReport ReportOfCamera(const Camera& camera) {
-  CalibrationReport report;
-  report.camera = camera;
-  return report;
-}
-
-// calibmar writes the standard deviations, the RMS and the target as
-// comments ("# non_svp_est_std_dev: a, b, ...", "# overall_rms: x",
-// "# target: ..."), not as keys: taken where the keys are absent.
-void ReadCalibmarComments(const fs::path& path, CalibrationReport* report) {
-  std::ifstream in(path);
-  const std::regex comment(R"(^#\s*(non_svp_est_std_dev|overall_rms|target)\s*:\s*(.*\S)\s*$)");
-  std::smatch match;
-  for (std::string line; std::getline(in, line);) {
-    if (!std::regex_match(line, match, comment)) continue;
-    const std::string key = match[1], value = match[2];
-    try {
-      if (key == "target" && report->target_description.empty()) {
-        report->target_description = value;
-      } else if (key == "overall_rms" && report->overall_rms_px == 0) {
-        report->overall_rms_px = std::stod(value);
-      } else if (key == "non_svp_est_std_dev" && report->housing && report->housing_std_dev.empty()) {
-        for (const std::string& token : SplitTokens(value, ", ")) report->housing_std_dev.push_back(std::stod(token));
-        if (report->housing_std_dev.size() != report->housing->params.size()) {
-          throw InputError(path.string() + ": the comment non_svp_est_std_dev has " +
-                           std::to_string(report->housing_std_dev.size()) + " values, non_svp_parameters " +
-                           std::to_string(report->housing->params.size()));
-        }
-      }
-    } catch (const std::logic_error&) {  // std::stod: not a number
-      throw InputError(path.string() + ": the comment '" + line + "' does not hold numbers");
-    }
-  }
-}
-
-}  // namespace
-
-namespace {
-
-// The body of ReadCalibrationReport; yaml-cpp's exceptions (a key looked up in a scalar, a
-// value of the wrong type) are turned into InputError by the caller.
-CalibrationReport ReadCalibrationReportUnguarded(const fs::path& path) {
-  if (!fs::exists(path)) throw InputError(path.string() + ": no such file");
-  if (!fs::is_regular_file(path)) throw InputError(path.string() + ": not a file (" + kCalibrationFormats + ")");
-  if (path.extension() == ".cameramodel") return ReportOfCamera(ReadMrcalCameraModel(path).camera);
-  if (IsOpenCvOrRosCameraYaml(path)) return ReportOfCamera(ReadOpenCvCameraYaml(path));
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path.string());
-  } catch (const YAML::Exception& e) {
-    throw InputError(path.string() + ": " + e.what() + " (" + kCalibrationFormats + ")");
-  }
-  for (const char* key : {"model", "width", "height", "parameters"}) {
-    if (!root.IsMap() || !root[key]) {
-      throw InputError(path.string() + ": no key '" + key + "'; " + kCalibrationFormats);
-    }
-  }
-  CalibrationReport report;
-  try {
-    try {
-      report.camera.model_id = CameraModelNameToId(root["model"].as<std::string>());
-    } catch (const InputError& e) {
-      throw InputError(path.string() + ": model: " + e.what());
-    }
-    report.camera.width = root["width"].as<uint64_t>();
-    report.camera.height = root["height"].as<uint64_t>();
-    report.camera.params = root["parameters"].as<std::vector<double>>();
-    if (root["non_svp_model"] && root["non_svp_model"].as<std::string>() != "NONE") {
-      report.housing = Housing::FromName(root["non_svp_model"].as<std::string>(),
-                                         root["non_svp_parameters"].as<std::vector<double>>(),
-                                         path.string() + ": non_svp_parameters");
-      report.housing->ValidateInput(path.string() + ": non_svp_parameters");
-    }
-    // portcal's own keys (absent in calibmar's files).
-    if (root["parameters_std_dev"]) {
-      for (const YAML::Node& value : root["parameters_std_dev"]) {
-        report.parameters_std_dev.push_back(value.IsNull() ? -1.0 : value.as<double>());
-      }
-    }
-    if (root["per_view"]) {
-      for (const YAML::Node& entry : root["per_view"]) {
-        CalibratedView view;
-        view.image_name = entry["image"].as<std::string>();
-        if (entry["rms"]) view.rms_px = entry["rms"].as<double>();
-        if (entry["points"]) view.num_points = entry["points"].as<int>();
-        if (entry["outlier"]) view.outlier = entry["outlier"].as<bool>();
-        if (entry["dropped"]) view.dropped = entry["dropped"].as<bool>();
-        report.views.push_back(view);
-      }
-    }
-    if (root["board_warp"] && root["board_warp_std_dev"]) {
-      const auto warp = root["board_warp"].as<std::vector<double>>();
-      const auto warp_std_dev = root["board_warp_std_dev"].as<std::vector<double>>();
-      if (warp.size() != 2 || warp_std_dev.size() != 2) {
-        throw InputError(path.string() + ": board_warp and board_warp_std_dev need 2 values each");
-      }
-      report.board_warp = Eigen::Vector2d(warp[0], warp[1]);
-      report.board_warp_std_dev = Eigen::Vector2d(warp_std_dev[0], warp_std_dev[1]);
-    }
-    if (root["target"]) report.target_description = root["target"].as<std::string>();
-    if (root["notes"]) report.notes = root["notes"].as<std::vector<std::string>>();
-    if (root["warnings"]) report.warnings = root["warnings"].as<std::vector<std::string>>();
-  } catch (const YAML::Exception& e) {
-    throw InputError(path.string() + ": " + e.what());
-  }
-  ReadCalibmarComments(path, &report);
-  report.camera.Validate(path.string());
-  return report;
-}
-
-}  // namespace
-
-CalibrationReport ReadCalibrationReport(const fs::path& path) {
-  try {
-    return ReadCalibrationReportUnguarded(path);
-  } catch (const YAML::Exception& e) {
-    throw InputError(path.string() + ": " + e.what());
-  }
 }
 
 }  // namespace portcal

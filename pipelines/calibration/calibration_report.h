@@ -37,6 +37,11 @@ struct CalibrationReport {
   std::vector<double> parameters_std_dev;
   std::optional<Housing> housing;
   std::vector<double> housing_std_dev;
+  // Full covariances (the residual variance applied) of the camera's and
+  // the housing's parameters, in their orders; zero rows and columns for
+  // what is held; empty where not estimated or undetermined. A later stage
+  // propagates them (housing_calibrator: the lens's into the port's).
+  Eigen::MatrixXd parameters_covariance, housing_covariance;
   // Auto-calibration: the two estimates behind the std devs above, which
   // are the larger of them: by the noise model (the covariance, every
   // residual independent) and by the clusters' spread (the covariance

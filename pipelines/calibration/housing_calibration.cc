@@ -16,6 +16,7 @@
 #include "colmap_ext/housing/port_projection.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "pipelines/calibration/held_block_covariance.h"
 #include "pipelines/calibration/view_pose.h"
 #include "pipelines/calibration/zhang_initialization.h"
 
@@ -101,6 +102,7 @@ struct Inputs {
   int camera_model;
   Eigen::Vector4d board_extent;
   const HousingCalibrationSettings& settings;
+  const Eigen::MatrixXd* lens_covariance;  // null: none given
   bool RefinesIntrinsics() const { return settings.refine_intrinsics || in_air != nullptr; }
 };
 
@@ -312,12 +314,16 @@ int NumFreeParameters(const Inputs& in, const State& state) {
   return num_free;
 }
 
-std::vector<double> StdDevsOf(ceres::Covariance* covariance, const double* block, int size, double variance) {
-  std::vector<double> c(static_cast<size_t>(size * size));
+Eigen::MatrixXd CovarianceOf(ceres::Covariance* covariance, const double* block, int size, double variance) {
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> c(size, size);
   covariance->GetCovarianceBlock(block, block, c.data());
-  std::vector<double> std_dev(static_cast<size_t>(size));
-  for (int i = 0; i < size; ++i) {
-    std_dev[static_cast<size_t>(i)] = std::sqrt(std::max(0.0, c[static_cast<size_t>(i * size + i)] * variance));
+  return c * variance;
+}
+
+std::vector<double> StdDevsOf(const Eigen::MatrixXd& covariance) {
+  std::vector<double> std_dev(static_cast<size_t>(covariance.rows()));
+  for (Eigen::Index i = 0; i < covariance.rows(); ++i) {
+    std_dev[static_cast<size_t>(i)] = std::sqrt(std::max(0.0, covariance(i, i)));
   }
   return std_dev;
 }
@@ -345,11 +351,21 @@ void FillStdDevs(const Inputs& in, double variance, State* state, ceres::Problem
     if (in.RefinesIntrinsics()) std::fill(result->camera_std_dev.begin(), result->camera_std_dev.end(), -1.0);
     return;
   }
-  const std::vector<double> housing = StdDevsOf(&covariance, port, m, variance);
+  result->housing_covariance = CovarianceOf(&covariance, port, m, variance);
+  if (in.lens_covariance != nullptr && !in.RefinesIntrinsics() && !refined.empty()) {
+    // The held lens's own error, carried into the port (first order).
+    result->housing_covariance +=
+        HeldBlockCovarianceContribution(problem, state->intrinsics.data(), *in.lens_covariance, port);
+    result->lens_covariance_propagated = true;
+  }
+  const std::vector<double> housing = StdDevsOf(result->housing_covariance);
   for (int k : refined) result->housing_std_dev[static_cast<size_t>(k)] = housing[static_cast<size_t>(k)];
-  if (in.RefinesIntrinsics()) result->camera_std_dev = StdDevsOf(&covariance, state->intrinsics.data(), n, variance);
+  if (in.RefinesIntrinsics()) {
+    result->camera_covariance = CovarianceOf(&covariance, state->intrinsics.data(), n, variance);
+    result->camera_std_dev = StdDevsOf(result->camera_covariance);
+  }
   if (in.settings.estimate_board_warp) {
-    const std::vector<double> warp = StdDevsOf(&covariance, state->warp.data(), 2, variance);
+    const std::vector<double> warp = StdDevsOf(CovarianceOf(&covariance, state->warp.data(), 2, variance));
     result->board_warp_std_dev = Eigen::Vector2d(warp[0], warp[1]);
   }
 }
@@ -402,13 +418,20 @@ HousingCalibrationResult ResultOf(const Inputs& in, const Camera& camera, State*
 
 HousingCalibrationResult CalibrateHousing(const std::vector<CalibrationView>& views,
                                           const Camera& camera, const Housing& housing,
-                                          const HousingCalibrationSettings& settings, const InAirViews* in_air) {
+                                          const HousingCalibrationSettings& settings, const InAirViews* in_air,
+                                          const Eigen::MatrixXd* lens_covariance) {
   settings.Check();
   camera.Validate("camera");
   housing.Validate("housing");
+  const Eigen::Index n = static_cast<Eigen::Index>(camera.params.size());
+  if (lens_covariance != nullptr && (lens_covariance->rows() != n || lens_covariance->cols() != n ||
+                                     !lens_covariance->allFinite())) {
+    throw InputError("housing calibration: the lens covariance is not " + std::to_string(n) + " x " +
+                     std::to_string(n) + " finite numbers (" + camera.ModelName() + ")");
+  }
   if (views.size() < 2) throw NumericalError("housing calibration needs at least 2 views");
   if (in_air != nullptr && in_air->views.empty()) throw NumericalError("housing calibration: no in-air views");
-  const Inputs in{views, in_air, camera.model_id, SharedBoardExtent(views, in_air), settings};
+  const Inputs in{views, in_air, camera.model_id, SharedBoardExtent(views, in_air), settings, lens_covariance};
   State state;
   state.intrinsics = camera.params;
   state.housing = housing;

@@ -57,6 +57,12 @@ struct HousingCalibrationResult {
   std::vector<double> housing_std_dev;
   Camera camera;
   std::vector<double> camera_std_dev;
+  // The full covariances (the residual variance applied) of the housing's
+  // and, when refined, the camera's parameters; zero rows and columns for
+  // what is held, empty when undetermined. With a lens covariance given
+  // and the intrinsics held, the housing's includes what the lens's adds.
+  Eigen::MatrixXd housing_covariance, camera_covariance;
+  bool lens_covariance_propagated = false;
   Eigen::Vector3d initial_axis = Eigen::Vector3d::Zero();  // from the F matrices
   double overall_rms_px = 0;
   double residual_sigma_px = 0;
@@ -73,10 +79,14 @@ struct HousingCalibrationResult {
 
 // `housing` gives the model, the constants (thickness, radius, indices) and
 // the starting guess; `camera` the intrinsics (the start when refined).
-// Throws NumericalError when the solve fails.
+// `lens_covariance` (camera.params square, optional): the given
+// intrinsics' own covariance; when they are held, it is propagated into the
+// housing's (first order, held_block_covariance.h). Throws NumericalError
+// when the solve fails.
 HousingCalibrationResult CalibrateHousing(const std::vector<CalibrationView>& views,
                                           const Camera& camera, const Housing& housing,
                                           const HousingCalibrationSettings& settings,
-                                          const InAirViews* in_air = nullptr);
+                                          const InAirViews* in_air = nullptr,
+                                          const Eigen::MatrixXd* lens_covariance = nullptr);
 
 }  // namespace portcal

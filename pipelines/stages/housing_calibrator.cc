@@ -94,8 +94,12 @@ HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& op
   }
   LOG(INFO) << "housing_calibrator: " << housing.ModelName() << ", camera " << start->camera.ModelName() << ", "
             << views.size() << " views";
-  const HousingCalibrationResult result =
-      CalibrateHousing(views, start->camera, housing, options.calibration, in_air ? &*in_air : nullptr);
+  // Held intrinsics from a file that carries their covariance: it goes into
+  // the housing's standard deviations.
+  const Eigen::MatrixXd* lens_covariance =
+      !in_air && start->parameters_covariance.size() > 0 ? &start->parameters_covariance : nullptr;
+  const HousingCalibrationResult result = CalibrateHousing(views, start->camera, housing, options.calibration,
+                                                           in_air ? &*in_air : nullptr, lens_covariance);
 
   CalibrationReport report = ReportOf(result, target_views.target);
   report.projection_uncertainty = ProjectionUncertaintyOf(report, views);

@@ -147,6 +147,38 @@ TEST(ReadCalibrationReport, ReadsTheSharedCalibmarReport) {
   ExpectTheCalibmarReport(ReadCalibrationReport(shared / "datasets/calibmar-reports/calibration_condria.yaml"));
 }
 
+// The covariances a later stage propagates are written in full and read
+// back; one that is not a covariance is refused, naming the key.
+TEST(ReadCalibrationReport, CovariancesRoundTripAndAMalformedOneIsNamed) {
+  testing::TempDir dir;
+  CalibrationReport report;
+  report.camera = MakeCamera("RADIAL", {700, 401.3, 298.7, -0.1, 0.02});
+  report.parameters_std_dev = {1, 0.5, 0.5, 0.01, 0.02};
+  report.parameters_covariance = Eigen::MatrixXd::Identity(5, 5);
+  report.parameters_covariance(0, 3) = report.parameters_covariance(3, 0) = 1.0 / 3.0;  // not a short decimal
+  report.housing = Housing::FromName("DOMEPORT", {0.001, -0.002, 0.003, 0.05, 0.006, 1.0, 1.49, 1.334}, "test");
+  report.housing_std_dev = {1e-4, 1e-4, 2e-4, 0, 0, 0, 0, 0};
+  report.housing_covariance = Eigen::MatrixXd::Zero(8, 8);
+  report.housing_covariance.topLeftCorner<3, 3>() << 1e-8, 2e-9, 0, 2e-9, 1e-8, 0, 0, 0, 4e-8;
+  WriteCalibrationReport(report, dir.path());
+  const CalibrationReport read = ReadCalibrationReport(dir / "calibration.yaml");
+  EXPECT_EQ(read.parameters_covariance, report.parameters_covariance);
+  EXPECT_EQ(read.housing_covariance, report.housing_covariance);
+
+  std::string text = testing::ReadFileToString(dir / "calibration.yaml");
+  const size_t row = text.find("- [", text.find("parameters_covariance:"));
+  text.replace(row, 3, "- [-5, ");  // a sixth value in the first row
+  std::ofstream(dir / "broken.yaml") << text;
+  try {
+    ReadCalibrationReport(dir / "broken.yaml");
+    ADD_FAILURE() << "a 5 x 5 covariance with a row of 6 accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("broken.yaml"), std::string::npos) << what;
+    EXPECT_NE(what.find("parameters_covariance"), std::string::npos) << what;
+  }
+}
+
 TEST(ReadCalibrationReport, AFileOfNoKnownFormatNamesTheFormatsAndTheKey) {
   testing::TempDir dir;
   const fs::path file = dir / "calib.yaml";
