@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The commands of docs/quickstart.md, as written there, on the real dome set
 # of ../shared (or DATA): in-air calibration, the mrcal cross-check, the
-# dome port with the in-air intrinsics, the exports. A test checks that
+# dome port solved jointly with the in-air views, the exports. A test checks that
 # every portcal command of the page stands here.
 # Usage: workflows/quickstart.sh [DATA=../shared/datasets/real-dome] [WORK=a temporary folder]
 set -euo pipefail
@@ -25,12 +25,13 @@ echo "== 2. Second opinion: mrcal on the same corners, 3-fold cross-validation"
 "$portcal" cross_check --database_path air.db --input_calibration air/calibration.yaml \
   --output_path air/cross_check --CrossCheck.folds 3 | tail -n 1
 
-echo "== 3. Under water: the dome port, the in-air intrinsics held"
+echo "== 3. Under water: the dome port, solved jointly with the in-air views"
 "$portcal" target_extractor --database_path water.db --image_path real-dome/water \
   --ImageReader.camera_model OPENCV --ImageReader.single_camera 1 \
   --Target.cols 8 --Target.rows 6 --Target.square_size 0.03
-"$portcal" housing_calibrator --database_path water.db --input_calibration air/calibration.yaml \
-  --output_path water --Housing.model DOMEPORT --Housing.params 0,0,0,0.043552,0.00375,1.0,1.495,1.333
+"$portcal" housing_calibrator --database_path water.db --in_air_database_path air.db \
+  --input_calibration air/calibration.yaml --output_path water \
+  --Housing.model DOMEPORT --Housing.params 0,0,0,0.043552,0.00375,1.0,1.495,1.333
 sed -n '/^Housing/,/^RMS/p' water/calibration.txt
 
 echo "== 4. Hand-off: OpenCV and ROS files of the in-air camera; mrcal's uncertainty of its solve"
