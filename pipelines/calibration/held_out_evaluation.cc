@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "colmap_ext/cost/board_warp.h"
 #include "colmap_ext/util/error.h"
 #include "pipelines/calibration/view_pose.h"
 
@@ -59,6 +60,17 @@ void ResidualPattern(const std::vector<CalibrationView>& views, const HousedCame
 }
 
 }  // namespace
+
+std::vector<CalibrationView> WithBoardSag(const std::vector<CalibrationView>& views, const Eigen::Vector2d& warp) {
+  // The extent over these views: a board seen whole in any of them spans
+  // it, as it did in the calibration.
+  const Eigen::Vector4d extent = BoardExtent(views);
+  std::vector<CalibrationView> sagged = views;
+  for (CalibrationView& view : sagged) {
+    for (Eigen::Vector3d& point : view.points_in_target) point.z() += BoardSag(warp.data(), BoardWarpUv(point, extent));
+  }
+  return sagged;
+}
 
 HeldOutEvaluation EvaluateHeldOut(const std::vector<CalibrationView>& views, const HousedCamera& camera,
                                   int num_threads) {

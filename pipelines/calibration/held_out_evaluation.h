@@ -44,6 +44,12 @@ struct HeldOutEvaluation {
   double noise_floor_px = 0;  // what systematic_px would be for noise alone
 };
 
+// The views with their target points moved along the board's normal by
+// the sag `warp` (mrcal's parabolic warp, colmap_ext/cost/board_warp.h)
+// over the views' extent: a calibration that fitted its board's warp is
+// judged on the same board, warped alike, not on a flat one.
+std::vector<CalibrationView> WithBoardSag(const std::vector<CalibrationView>& views, const Eigen::Vector2d& warp);
+
 // Throws NumericalError when no view can be evaluated.
 HeldOutEvaluation EvaluateHeldOut(const std::vector<CalibrationView>& views, const HousedCamera& camera,
                                   int num_threads);

@@ -32,8 +32,8 @@ namespace {
 
 // The same kind of calibration as the one judged, on some of the views: a
 // housing from the report's in-air lens (the report's housing as the
-// start), or a lens from the report's as the start (board held flat, as
-// the evaluation takes it).
+// start), or a lens from the report's as the start (the board as the
+// evaluation takes it: the report's warp applied, not fitted again).
 CalibrationMethod MethodLike(const CalibrationReport& report, int num_threads) {
   return [report, num_threads](const std::vector<CalibrationView>& views, double* rms_px) -> HousedCamera {
     if (report.housing) {
@@ -59,7 +59,7 @@ std::string Number(double value) {
 }
 
 void WriteEvaluation(const CalibrationEvaluatorOptions& options, const CalibrationReport& report,
-                     const std::vector<CalibrationView>& views,
+                     const std::vector<CalibrationView>& views, bool sagged,
                      const CalibrationEvaluatorSummary& summary) {
   const HeldOutEvaluation& e = summary.evaluation;
   std::ostringstream yaml, text;
@@ -75,8 +75,14 @@ void WriteEvaluation(const CalibrationEvaluatorOptions& options, const Calibrati
        << " points, each view's pose alone with the calibration fixed\nresidual pattern: mean residual per cell of a "
           "16 x 9 grid, RMS "
        << e.systematic_px << " px (the cells' own scatter would give about " << e.noise_floor_px << " px)\n";
-  if (report.board_warp && report.board_warp->norm() > 0) {
-    text << "note: the calibration fitted a board warp; the evaluation takes the board flat\n";
+  if (report.board_warp && report.board_warp->norm() > 0 && !sagged) {
+    text << "note: the calibration fitted a board warp on another target ('" << report.target_description
+         << "'); these views' board is taken flat\n";
+  } else if (sagged) {
+    text << std::setprecision(3) << "note: the board sags as the calibration fitted it (x "
+         << 1000 * report.board_warp->x() << " mm, y " << 1000 * report.board_warp->y()
+         << " mm at its centre), in every view and every fold\n"
+         << std::setprecision(4);
   }
   text << "\n  view                          rms px  points\n";
   for (const ViewEvaluation& view : e.views) {
@@ -124,7 +130,12 @@ CalibrationEvaluatorSummary RunCalibrationEvaluator(const CalibrationEvaluatorOp
                      " of " + options.database_path + " is " + std::to_string(database_camera.width) + "x" +
                      std::to_string(database_camera.height));
   }
-  const std::vector<CalibrationView>& views = target_views.by_camera.at(camera_id);
+  // The board as the calibration found it, warped if it fitted a warp;
+  // another target (another board) is taken flat.
+  const std::vector<CalibrationView>& stored = target_views.by_camera.at(camera_id);
+  const bool sagged = report.board_warp && report.board_warp->norm() > 0 &&
+                      report.target_description == target_views.target;
+  const std::vector<CalibrationView> views = sagged ? WithBoardSag(stored, *report.board_warp) : stored;
   CalibrationEvaluatorSummary summary;
   // The evaluation, then each fold's calibration and evaluation.
   progress.Begin("calibration_evaluator", 1 + static_cast<size_t>(options.folds));
@@ -142,7 +153,7 @@ CalibrationEvaluatorSummary RunCalibrationEvaluator(const CalibrationEvaluatorOp
     progress.Advance(static_cast<size_t>(options.folds));
   }
   progress.End();
-  WriteEvaluation(options, report, views, summary);
+  WriteEvaluation(options, report, views, sagged, summary);
   LOG(INFO) << "calibration_evaluator: held-out RMS " << summary.evaluation.rms_px << " px over "
             << summary.evaluation.num_points << " points (pattern " << summary.evaluation.systematic_px
             << " px, the cells' scatter alone ~" << summary.evaluation.noise_floor_px << " px)"
