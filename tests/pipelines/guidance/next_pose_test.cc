@@ -61,6 +61,27 @@ Camera LensOfModel(const std::string& model) {
   return camera;
 }
 
+// A camera point held to the targets' frames, as mrcal's own Monte Carlo
+// test maps it: into every target frame with the true pose, back with the
+// re-solved one, averaged.
+Eigen::Vector3d MovedWithTheFrames(const Eigen::Vector3d& point, const std::vector<Rigid3d>& true_poses,
+                                   const std::vector<CalibratedView>& solved) {
+  Eigen::Vector3d moved = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < true_poses.size(); ++i) {
+    moved += solved[i].cam_from_target * (true_poses[i].Inverse() * point) / static_cast<double>(true_poses.size());
+  }
+  return moved;
+}
+
+// The mean over the grid of each point's worst-direction spread.
+double MeanWorstSpread(const std::vector<Eigen::Matrix2d>& scatter) {
+  double sum = 0;
+  for (const Eigen::Matrix2d& s : scatter) {
+    sum += std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(s).eigenvalues().maxCoeff());
+  }
+  return sum / static_cast<double>(scatter.size());
+}
+
 // Predicted (mean-frames) against the spread of many calibrations of the
 // same views re-noised, each projection compared as mrcal's own Monte
 // Carlo test does: the point mapped into every target frame with the true
@@ -107,19 +128,12 @@ void ExpectPredictionMatchesTheSpread(const std::string& model) {
     for (const Rigid3d& pose : poses) views.push_back(*Observe(truth, board, pose, 0.2, &rng));
     const CameraCalibrationResult solved = CalibrateCamera(views, truth, settings);
     for (size_t k = 0; k < points.size(); ++k) {
-      Eigen::Vector3d moved = Eigen::Vector3d::Zero();
-      for (size_t i = 0; i < poses.size(); ++i) {
-        moved += solved.views[i].cam_from_target * (poses[i].Inverse() * points[k]) / static_cast<double>(poses.size());
-      }
+      const Eigen::Vector3d moved = MovedWithTheFrames(points[k], poses, solved.views);
       const Eigen::Vector2d error = *solved.camera.ImgFromCam(moved) - *truth.ImgFromCam(points[k]);
       scatter[k] += error * error.transpose() / trials;
     }
   }
-  double empirical = 0;
-  for (const Eigen::Matrix2d& s : scatter) {
-    empirical += std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(s).eigenvalues().maxCoeff());
-  }
-  empirical /= static_cast<double>(scatter.size());
+  const double empirical = MeanWorstSpread(scatter);
   std::printf("%s projection uncertainty (mean-frames): predicted %.4f px, spread of %d calibrations %.4f px "
               "(ratio %.2f)\n",
               model.c_str(), predicted.mean_px, trials, empirical, empirical / predicted.mean_px);
@@ -207,19 +221,12 @@ TEST(ProjectionUncertainty, PredictionMatchesTheSpreadOfRepeatedHousingCalibrati
     const HousingCalibrationResult solved = CalibrateHousing(views, truth.camera, *truth.housing, settings);
     const HousedCamera camera{truth.camera, solved.housing};
     for (size_t k = 0; k < points.size(); ++k) {
-      Eigen::Vector3d moved = Eigen::Vector3d::Zero();
-      for (size_t i = 0; i < poses.size(); ++i) {
-        moved += solved.views[i].cam_from_target * (poses[i].Inverse() * points[k]) / static_cast<double>(poses.size());
-      }
-      const Eigen::Vector2d error = *camera.Project(moved) - *truth.Project(points[k]);
+      const Eigen::Vector2d error =
+          *camera.Project(MovedWithTheFrames(points[k], poses, solved.views)) - *truth.Project(points[k]);
       scatter[k] += error * error.transpose() / trials;
     }
   }
-  double empirical = 0;
-  for (const Eigen::Matrix2d& s : scatter) {
-    empirical += std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(s).eigenvalues().maxCoeff());
-  }
-  empirical /= static_cast<double>(scatter.size());
+  const double empirical = MeanWorstSpread(scatter);
   std::printf("flat port projection uncertainty (mean-frames): predicted %.4f px, spread of %d calibrations %.4f px "
               "(ratio %.2f)\n",
               predicted.mean_px, trials, empirical, empirical / predicted.mean_px);
