@@ -353,10 +353,15 @@ void FillStdDevs(const Inputs& in, double variance, State* state, ceres::Problem
   }
   result->housing_covariance = CovarianceOf(&covariance, port, m, variance);
   if (in.lens_covariance != nullptr && !in.RefinesIntrinsics() && !refined.empty()) {
-    // The held lens's own error, carried into the port (first order).
-    result->housing_covariance +=
-        HeldBlockCovarianceContribution(problem, state->intrinsics.data(), *in.lens_covariance, port);
-    result->lens_covariance_propagated = true;
+    // The held lens's own error, carried into the port (first order). If
+    // that cannot be done, the report says the lens was taken as exact.
+    try {
+      result->housing_covariance +=
+          HeldBlockCovarianceContribution(problem, state->intrinsics.data(), *in.lens_covariance, port);
+      result->lens_covariance_propagated = true;
+    } catch (const NumericalError& e) {
+      LOG(WARNING) << "housing calibration: the lens's covariance not propagated (" << e.what() << ")";
+    }
   }
   const std::vector<double> housing = StdDevsOf(result->housing_covariance);
   for (int k : refined) result->housing_std_dev[static_cast<size_t>(k)] = housing[static_cast<size_t>(k)];
