@@ -33,8 +33,6 @@ void RegisterLive(CommandLine* cli, LiveSessionOptions* live) {
   cli->Add("Live.hands_free", &hands_free.enabled, "keep frames when the target is held still (0 | 1)");
   cli->Add("Live.still_px", &hands_free.still_px, "held still: every corner within this many pixels ...");
   cli->Add("Live.still_seconds", &hands_free.still_seconds, "... for this long");
-  cli->Add("Live.min_sharpness", &hands_free.min_sharpness,
-           "a still frame is kept if its corners are at least this sharp, relative to the sharpest of the spell");
   cli->Add("Live.novelty", &hands_free.novelty_fraction,
            "a new view's corners must lie this far (fraction of the image diagonal, mean) from every kept view's");
   cli->Add("Live.min_gain", &hands_free.min_gain,
@@ -76,6 +74,8 @@ int LiveCalibratorCommand(int argc, char** argv) {
           "stereo behind housings: camera 2's in-air calibration.yaml (its port starts from --Housing.params too)");
   cli.AddHousing(&options.housing, "the port to calibrate (with --input_calibration)");
   cli.Add("Calibration.fixed_params", &fixed, "camera calibration: parameters to hold, comma separated");
+  cli.Add("Calibration.estimate_board_warp", &options.live.estimator.estimate_board_warp,
+          "fit the board's sag, live and at the end alike (0: a rigid board held flat)");
   RegisterLive(&cli, &options.live);
   cli.Add("Live.address", &options.page.address,
           "where the live page is served, HOST:PORT (0.0.0.0:PORT: seen from other machines; port 0: a free one)");

@@ -11,9 +11,6 @@ namespace portcal {
 void HandsFreeOptions::Check() const {
   if (!(still_px > 0)) throw OptionError("--Live.still_px", std::to_string(still_px), "> 0 px");
   if (!(still_seconds > 0)) throw OptionError("--Live.still_seconds", std::to_string(still_seconds), "> 0 s");
-  if (!(min_sharpness >= 0 && min_sharpness <= 1)) {
-    throw OptionError("--Live.min_sharpness", std::to_string(min_sharpness), "[0, 1]");
-  }
   if (!(novelty_fraction >= 0)) throw OptionError("--Live.novelty", std::to_string(novelty_fraction), ">= 0");
   if (!(min_gain >= 0 && min_gain < 1)) throw OptionError("--Live.min_gain", std::to_string(min_gain), "[0, 1)");
 }
@@ -49,10 +46,19 @@ double CornerSharpness(const cv::Mat& gray, const CornerMap& corners) {
 
 StillnessTracker::State StillnessTracker::Update(double time_s, const CornerMap& corners, double sharpness) {
   State state;
+  const double lasted = anchor_.empty() ? 0 : last_time_s_ - anchor_time_s_;
   if (corners.empty()) {
+    state.new_spell = true;
+    if (!anchor_.empty()) {
+      state.ended_held_s = lasted;
+      state.ended_motion_px = std::numeric_limits<double>::infinity();
+    }
     Reset();
     return state;
   }
+  // Against each corner's mean over the spell: a hand's tremor wanders
+  // about where the board is held, and the spell's first frame may be
+  // anywhere in that wander.
   double motion = std::numeric_limits<double>::infinity();
   if (!anchor_.empty()) {
     motion = 0;
@@ -60,29 +66,42 @@ StillnessTracker::State StillnessTracker::Update(double time_s, const CornerMap&
     for (const auto& [id, pixel] : corners) {
       const auto it = anchor_.find(id);
       if (it == anchor_.end()) continue;
-      motion = std::max(motion, (pixel - it->second).norm());
+      motion = std::max(motion, (pixel - it->second / spell_frames_).norm());
       ++shared;
     }
     // A spell is the same corners held still: most of them seen throughout.
     if (10 * shared < 9 * std::max(anchor_.size(), corners.size())) motion = std::numeric_limits<double>::infinity();
   }
+  last_time_s_ = time_s;
   if (!(motion <= options_.still_px)) {
+    if (!anchor_.empty()) {
+      state.ended_held_s = lasted;
+      state.ended_motion_px = motion;
+    }
     anchor_ = corners;
+    spell_frames_ = 1;
     anchor_time_s_ = time_s;
     best_sharpness_ = sharpness;
-    state.held_s = 0;
+    state.new_spell = true;
+    state.sharpest = true;
     return state;
   }
+  for (auto& [id, sum] : anchor_) {
+    const auto it = corners.find(id);
+    sum += it != corners.end() ? it->second : sum / spell_frames_;  // a corner not seen stays where it was
+  }
+  ++spell_frames_;
+  state.sharpest = sharpness > best_sharpness_;
   best_sharpness_ = std::max(best_sharpness_, sharpness);
   state.motion_px = motion;
   state.held_s = time_s - anchor_time_s_;
   state.still = state.held_s >= options_.still_seconds;
-  state.sharp = sharpness >= options_.min_sharpness * best_sharpness_;
   return state;
 }
 
 void StillnessTracker::Reset() {
   anchor_.clear();
+  spell_frames_ = 0;
   best_sharpness_ = 0;
 }
 

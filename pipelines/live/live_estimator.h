@@ -23,6 +23,10 @@ struct LiveEstimatorOptions {
   // Housing calibration when set: the model, its constants and a start.
   std::optional<Housing> housing;
   std::vector<std::string> fixed_params;  // camera calibration
+  // The board's sag, fitted as the final calibration (camera_calibrator,
+  // housing_calibrator) fits it, so that the answer does not jump at
+  // Finish (held flat, the real in-air views' cx moved by 31 px there).
+  bool estimate_board_warp = true;
   NextPoseOptions guidance;
   // The corners' noise before a solve has measured it, px.
   double prior_pixel_sigma_px = 0.1;

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <thread>
@@ -218,17 +219,34 @@ void LiveServer::Impl::Routes() {
     }
     response.status = 404;
   });
-  const auto command = [this](const char* path, std::function<void(const httplib::Request&)> action) {
-    server.Post(path, [action](const httplib::Request& request, httplib::Response& response) {
+  using Action = std::function<void(const httplib::Request&)>;
+  const std::map<std::string, Action> commands = {
+      {"/capture", [this](const httplib::Request&) { session->Capture(); }},
+      {"/undo", [this](const httplib::Request&) { session->Undo(); }},
+      {"/calibrate", [this](const httplib::Request&) { session->CalibrateNow(); }},
+      {"/finish", [this](const httplib::Request&) { session->Finish(); }},
+      {"/remove", [this](const httplib::Request& request) { session->Remove(request.get_param_value("name")); }},
+  };
+  for (const auto& [path, action] : commands) {
+    server.Post(path, [action = action](const httplib::Request& request, httplib::Response& response) {
       action(request);
       response.set_content("{\"ok\": true}", "application/json");
     });
-  };
-  command("/capture", [this](const httplib::Request&) { session->Capture(); });
-  command("/undo", [this](const httplib::Request&) { session->Undo(); });
-  command("/calibrate", [this](const httplib::Request&) { session->CalibrateNow(); });
-  command("/finish", [this](const httplib::Request&) { session->Finish(); });
-  command("/remove", [this](const httplib::Request& request) { session->Remove(request.get_param_value("name")); });
+  }
+  // A POST with neither Content-Length nor Transfer-Encoding has no body
+  // (RFC 9112, 6.3), but httplib 0.11 reads one until the client closes,
+  // which a client waiting for the answer never does (`curl -X POST` hung).
+  // The commands take no body: answer those before httplib reads.
+  server.set_pre_routing_handler([commands](const httplib::Request& request, httplib::Response& response) {
+    const auto it = commands.find(request.path);
+    if (request.method != "POST" || it == commands.end() || request.has_header("Content-Length") ||
+        request.has_header("Transfer-Encoding")) {
+      return httplib::Server::HandlerResponse::Unhandled;
+    }
+    it->second(request);
+    response.set_content("{\"ok\": true}", "application/json");
+    return httplib::Server::HandlerResponse::Handled;
+  });
 }
 
 LiveServer::LiveServer(LiveSession* session, const LivePageOptions& options) : impl_(std::make_unique<Impl>()) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <future>
 #include <iomanip>
 #include <opencv2/imgproc.hpp>
@@ -88,13 +89,13 @@ LiveSession::LiveSession(const LiveSessionOptions& options, KeptFrameStore* stor
     : options_(options), store_(store), target_(ShapeOfTarget(options.detector)), kept_(std::move(existing)) {
   options.Check();
   channels_.push_back(
-      Channel{options.source.source, options.estimator, nullptr, StillnessTracker(options.hands_free), cv::Size(), -1});
+      Channel{options.source.source, options.estimator, nullptr, StillnessTracker(options.hands_free), cv::Size(), -1, {}, {}, {}});
   if (options.Stereo()) {
     LiveEstimatorOptions estimator2 = options.estimator;
     estimator2.camera = options.camera2;
     estimator2.housing = options.housing2;
     channels_.push_back(
-        Channel{options.source2, estimator2, nullptr, StillnessTracker(options.hands_free), cv::Size(), -1});
+        Channel{options.source2, estimator2, nullptr, StillnessTracker(options.hands_free), cv::Size(), -1, {}, {}, {}});
   }
   snapshot_.kept = kept_;
 }
@@ -138,6 +139,7 @@ void LiveSession::Note(const std::string& message, bool warning) {
   } else {
     LOG(INFO) << "live: " << message;
   }
+  summary_.notes.push_back({frame_time_s_, message, warning});
   const std::lock_guard<std::mutex> lock(mutex_);
   snapshot_.message = message;
 }
@@ -193,19 +195,26 @@ void LiveSession::RememberRefused(const std::vector<Sight>& sights) {
 }
 
 // A view is new when some camera sees the target elsewhere than in every
-// kept (or refused) view.
-bool LiveSession::Novel(const std::vector<Sight>& sights) const {
+// kept (or refused) view. A refused view's repeat is not new either, and
+// its reason was said when it was refused.
+std::string LiveSession::NotNovel(const std::vector<Sight>& sights) const {
   const cv::Mat& image = sights[0].frame->image;
   const double novelty_px =
       options_.hands_free.novelty_fraction * std::hypot(static_cast<double>(image.cols), static_cast<double>(image.rows));
   for (const std::vector<KeptView>* seen : {&kept_, &rejected_}) {
     for (const KeptView& kept : *seen) {
-      bool same = MeanCornerShift(sights[0].corners, kept.corners) < novelty_px;
+      const double shift = MeanCornerShift(sights[0].corners, kept.corners);
+      bool same = shift < novelty_px;
       if (sights.size() > 1) same = same && MeanCornerShift(sights[1].corners, kept.corners2) < novelty_px;
-      if (same) return false;
+      if (!same) continue;
+      if (seen == &rejected_) return "refused before";
+      std::ostringstream why;
+      why << std::fixed << std::setprecision(0) << "too close to the kept view " << kept.name << " (corners " << shift
+          << " px from it on average, under " << novelty_px << " px: --Live.novelty)";
+      return why.str();
     }
   }
-  return true;
+  return "";
 }
 
 double LiveSession::Gain(const std::vector<CalibrationView>& views) const {
@@ -214,7 +223,14 @@ double LiveSession::Gain(const std::vector<CalibrationView>& views) const {
 }
 
 bool LiveSession::TryKeep(const std::vector<Sight>& sights, bool requested) {
-  if (!requested && !Novel(sights)) return false;  // the same view again
+  if (!requested) {
+    const std::string repeat = NotNovel(sights);
+    if (repeat == "refused before") return false;
+    if (!repeat.empty()) {
+      Note("held still, not kept: " + repeat + "; move the target (see the suggestion)", false);
+      return false;
+    }
+  }
   TargetDetectorOptions precise = options_.detector;
   precise.precise_fit = true;
   std::vector<TargetDetection> detections;
@@ -224,7 +240,7 @@ bool LiveSession::TryKeep(const std::vector<Sight>& sights, bool requested) {
     detections.push_back(DetectTarget(sights[c].gray, precise));
     if (!detections.back().found) {
       const std::string camera = sights.size() > 1 ? " of camera " + std::to_string(c + 1) : "";
-      Note("frame " + std::to_string(sights[c].frame->index) + camera + " not kept: the precise fit failed (" +
+      Note("held still, frame " + std::to_string(sights[c].frame->index) + camera + " not kept: the precise fit failed (" +
                detections.back().reason + ")",
            true);
       RememberRefused(sights);
@@ -237,8 +253,9 @@ bool LiveSession::TryKeep(const std::vector<Sight>& sights, bool requested) {
     const double gain = Gain(views);
     if (gain < options_.hands_free.min_gain) {
       std::ostringstream text;
-      text << "held still, but this view would lower the uncertainty by only " << std::setprecision(2)
-           << 100 * gain << " %: move the target (see the suggestion)";
+      text << "held still, not kept: this view would lower the uncertainty by only " << std::setprecision(2)
+           << 100 * gain << " % (--Live.min_gain " << 100 * options_.hands_free.min_gain
+           << " %); move the target (see the suggestion)";
       Note(text.str(), false);
       RememberRefused(sights);
       return false;
@@ -291,15 +308,8 @@ void LiveSession::Process(std::vector<Sight>& sights, double arrival_wall_s) {
     sights[1].corners = Corners(detection2);
   }
   const double time_s = sights[0].frame->time_s;
-  StillnessTracker::State hold;
-  for (size_t c = 0; c < sights.size(); ++c) {
-    const StillnessTracker::State state = channels_[c].tracker.Update(
-        time_s, sights[c].corners, CornerSharpness(sights[c].gray, sights[c].corners));
-    hold = c == 0 ? state
-                  : StillnessTracker::State{hold.still && state.still, hold.sharp && state.sharp,
-                                            std::min(hold.held_s, state.held_s),
-                                            std::max(hold.motion_px, state.motion_px)};
-  }
+  frame_time_s_ = time_s;
+  const StillnessTracker::State hold = Hold(sights, time_s, detection.found ? "" : detection.reason);
   std::optional<PoseDistance> to_suggestion;
   if (detection.found && estimate_ && estimate_->next) {
     if (const auto pose = EstimateTargetPose(detection, estimate_->camera)) {
@@ -311,10 +321,11 @@ void LiveSession::Process(std::vector<Sight>& sights, double arrival_wall_s) {
   ++summary_.frames;
   summary_.frames_with_target += seen;
   const bool requested = seen && capture_requested_.exchange(false);
-  if (requested || (options_.hands_free.enabled && seen && hold.still && hold.sharp)) {
-    if (TryKeep(sights, requested)) {
-      for (Channel& channel : channels_) channel.tracker.Reset();
-    }
+  if (requested) {
+    TryKeep(sights, true);
+  } else if (options_.hands_free.enabled && seen && hold.still && !spell_tried_) {
+    spell_tried_ = true;  // once per still spell, kept or refused with its reason
+    TryKeep(SharpestSights(), false);
   }
   const std::lock_guard<std::mutex> lock(mutex_);
   // Frames processed per second, over about the last second.
@@ -337,6 +348,55 @@ void LiveSession::Process(std::vector<Sight>& sights, double arrival_wall_s) {
   snapshot_.hold = hold;
   snapshot_.to_suggestion = to_suggestion;
   frame_processed_.notify_all();
+}
+
+StillnessTracker::State LiveSession::Hold(const std::vector<Sight>& sights, double time_s,
+                                          const std::string& lost_reason) {
+  StillnessTracker::State hold;
+  for (size_t c = 0; c < sights.size(); ++c) {
+    Channel& channel = channels_[c];
+    const StillnessTracker::State state =
+        channel.tracker.Update(time_s, sights[c].corners, CornerSharpness(sights[c].gray, sights[c].corners));
+    if (state.sharpest) {
+      channel.sharpest.image = sights[c].frame->image.clone();
+      channel.sharpest.time_s = sights[c].frame->time_s;
+      channel.sharpest.index = sights[c].frame->index;
+      channel.sharpest_gray = sights[c].gray.clone();
+      channel.sharpest_corners = sights[c].corners;
+    }
+    if (c == 0) {
+      hold = state;
+      continue;
+    }
+    hold.still = hold.still && state.still;
+    hold.new_spell = hold.new_spell || state.new_spell;
+    hold.held_s = std::min(hold.held_s, state.held_s);
+    hold.motion_px = std::max(hold.motion_px, state.motion_px);
+    hold.ended_held_s = std::max(hold.ended_held_s, state.ended_held_s);
+    hold.ended_motion_px = std::max(hold.ended_motion_px, state.ended_motion_px);
+  }
+  if (!hold.new_spell) return hold;
+  // A spell held for half the time asked, ended before it was tried: the
+  // person meant to hold this pose; say what broke it.
+  if (options_.hands_free.enabled && !spell_tried_ && hold.ended_held_s >= 0.5 * options_.hands_free.still_seconds) {
+    std::ostringstream why;
+    why << std::fixed << std::setprecision(1) << "held " << hold.ended_held_s << " s of "
+        << options_.hands_free.still_seconds << " s (--Live.still_seconds), not kept: ";
+    if (std::isinf(hold.ended_motion_px)) {
+      why << "the target was lost" << (lost_reason.empty() ? "" : " (" + lost_reason + ")");
+    } else {
+      why << "it moved by " << hold.ended_motion_px << " px (--Live.still_px " << options_.hands_free.still_px << ")";
+    }
+    Note(why.str(), false);
+  }
+  spell_tried_ = false;
+  return hold;
+}
+
+std::vector<LiveSession::Sight> LiveSession::SharpestSights() const {
+  std::vector<Sight> sights;
+  for (const Channel& channel : channels_) sights.push_back({&channel.sharpest, channel.sharpest_gray, channel.sharpest_corners});
+  return sights;
 }
 
 void LiveSession::ApplyRequests() {

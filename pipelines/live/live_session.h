@@ -86,6 +86,13 @@ struct LiveSnapshot {
   std::string final_status;  // after the session: the final calibration's progress, then its outcome
 };
 
+// What the session said (kept, refused and why), at a frame's media time.
+struct LiveNote {
+  double time_s = 0;
+  std::string text;
+  bool warning = false;
+};
+
 struct LiveSummary {
   int64_t frames = 0;             // processed
   int64_t frames_with_target = 0;
@@ -93,6 +100,7 @@ struct LiveSummary {
   double seconds = 0;
   std::string end_reason;         // "the source ended", "finish requested", ...
   std::vector<KeptView> kept_views;  // in the order kept
+  std::vector<LiveNote> notes;       // in the order said
   std::shared_ptr<const LiveEstimate> estimate;
 };
 
@@ -131,7 +139,8 @@ class LiveSession {
     cv::Mat gray;
     CornerMap corners;
   };
-  // Per camera: its estimator, its stillness, its image size.
+  // Per camera: its estimator, its stillness, its image size, the still
+  // spell's sharpest frame (what a hands-free keep stores).
   struct Channel {
     std::string source;
     LiveEstimatorOptions estimator_options;
@@ -139,13 +148,21 @@ class LiveSession {
     StillnessTracker tracker;
     cv::Size size;
     double other_size_since_s = -1;  // wall time frames of another size began
+    Frame sharpest;
+    cv::Mat sharpest_gray;
+    CornerMap sharpest_corners;
   };
 
   void Process(std::vector<Sight>& sights, double arrival_wall_s);
   // The first frame fixes the image size (and the camera's, if unknown);
   // false for a frame of another size.
   bool CheckSize(Channel* channel, const cv::Mat& gray, int64_t index);
-  bool Novel(const std::vector<Sight>& sights) const;
+  // "" when the view is new, else why not (the kept view it repeats).
+  std::string NotNovel(const std::vector<Sight>& sights) const;
+  // Hands-free: the spells' states combined; the sharpest frames kept;
+  // a pose held and not kept, said.
+  StillnessTracker::State Hold(const std::vector<Sight>& sights, double time_s, const std::string& lost_reason);
+  std::vector<Sight> SharpestSights() const;
   bool TryKeep(const std::vector<Sight>& sights, bool requested);
   double Gain(const std::vector<CalibrationView>& views) const;
   // A still view refused (no precise fit, too little gain): not tried
@@ -170,6 +187,7 @@ class LiveSession {
   LiveSnapshot snapshot_;
   std::vector<KeptView> kept_;
   std::vector<KeptView> rejected_;  // held still but refused since the last keep
+  bool spell_tried_ = false;        // the still spell was tried: not again
   std::shared_ptr<const LiveEstimate> estimate_;
   std::atomic<bool> capture_requested_{false};
   std::atomic<bool> undo_requested_{false};
@@ -179,6 +197,7 @@ class LiveSession {
   std::unique_ptr<Pending> pending_;  // the estimate being computed
   bool estimate_stale_ = false;       // views changed while it ran
   double last_status_s_ = -1e9;
+  double frame_time_s_ = 0;  // the frame being processed (the notes' time)
   LiveSummary summary_;
 };
 

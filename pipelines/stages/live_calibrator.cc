@@ -235,6 +235,7 @@ void CalibrateCameraAtEnd(const LiveCalibratorOptions& options, int camera_id, c
     housing.output_path = output_path;
     housing.housing = options.housing;
     housing.camera_id = camera_id;
+    housing.calibration.estimate_board_warp = options.live.estimator.estimate_board_warp;
     *housing_result = RunHousingCalibrator(housing, progress);
     return;
   }
@@ -243,6 +244,7 @@ void CalibrateCameraAtEnd(const LiveCalibratorOptions& options, int camera_id, c
   camera.output_path = output_path;
   camera.camera_id = camera_id;
   camera.calibration.fixed_params = options.fixed_params;
+  camera.calibration.estimate_board_warp = options.live.estimator.estimate_board_warp;
   *camera_result = RunCameraCalibrator(camera, progress);
 }
 

@@ -142,8 +142,22 @@ std::string LeftOutNote(const std::vector<CornerFailure>& failures) {
          (reasons.empty() ? "" : " (" + reasons + ")");
 }
 
+// The quick corners' window: a quarter of the median spacing of corners
+// next to each other in a row (never reaching the next corner), 2 to 10 px.
+// A fixed 5 x 5 window on a large, soft-edged board left the corners 2-5 px
+// apart from frame to frame of a board held still (docs/live.md).
+int QuickWindowHalf(const std::vector<bool>& seen, const std::vector<Eigen::Vector2d>& corners, int cols) {
+  std::vector<double> spacings;
+  for (size_t i = 0; i + 1 < corners.size(); ++i) {
+    if (static_cast<int>(i + 1) % cols != 0 && seen[i] && seen[i + 1]) spacings.push_back((corners[i + 1] - corners[i]).norm());
+  }
+  if (spacings.empty()) return 2;
+  std::nth_element(spacings.begin(), spacings.begin() + spacings.size() / 2, spacings.end());
+  return std::clamp(static_cast<int>(spacings[spacings.size() / 2] / 4), 2, 10);
+}
+
 // cv::cornerSubPix at full resolution on corners in COLMAP pixels.
-void PolishQuickly(const cv::Mat& gray, const std::vector<bool>& seen, std::vector<Eigen::Vector2d>* corners) {
+void PolishQuickly(const cv::Mat& gray, const std::vector<bool>& seen, int cols, std::vector<Eigen::Vector2d>* corners) {
   std::vector<cv::Point2f> points;
   std::vector<size_t> indices;
   for (size_t i = 0; i < corners->size(); ++i) {
@@ -151,8 +165,9 @@ void PolishQuickly(const cv::Mat& gray, const std::vector<bool>& seen, std::vect
     points.emplace_back((*corners)[i].x() - 0.5, (*corners)[i].y() - 0.5);
     indices.push_back(i);
   }
-  cv::cornerSubPix(gray, points, cv::Size(2, 2), cv::Size(-1, -1),
-                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 10, 0.01));
+  const int half = QuickWindowHalf(seen, *corners, cols);
+  cv::cornerSubPix(gray, points, cv::Size(half, half), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 20, 0.01));
   for (size_t k = 0; k < points.size(); ++k) (*corners)[indices[k]] = Eigen::Vector2d(points[k].x + 0.5, points[k].y + 0.5);
 }
 
@@ -264,7 +279,7 @@ ChessboardDetection DetectChessboard(const cv::Mat& gray, const ChessboardDetect
   if (!FindStart(gray, options, &start, &seen, &scale, &detection)) return detection;
   detection.reason.clear();
   if (!options.precise_fit) {
-    PolishQuickly(gray, seen, &start);
+    PolishQuickly(gray, seen, options.cols, &start);
     detection.corners.resize(start.size());
     for (size_t i = 0; i < start.size(); ++i) {
       if (seen[i]) detection.corners[i] = start[i];

@@ -29,6 +29,22 @@ LiveCalibratorOptions Options(const testing::TempDir& dir, const std::string& so
   return testing::LiveOptions(dir, source);
 }
 
+// The final calibration is the last live estimate: every parameter within
+// 0.1 of its standard deviation (the same views, the same model, the board
+// fitted alike; only the start differs). Constants and held values equal.
+void ExpectFinalIsTheLiveEstimate(const LiveSummary& session, const std::vector<double>& final_values,
+                                  const std::vector<double>& final_std_devs) {
+  ASSERT_TRUE(session.estimate && session.estimate->solved);
+  const std::vector<double>& live = session.estimate->values;
+  ASSERT_EQ(live.size(), final_values.size());
+  ASSERT_EQ(final_std_devs.size(), final_values.size());
+  for (size_t k = 0; k < live.size(); ++k) {
+    EXPECT_LE(std::abs(live[k] - final_values[k]), 0.1 * std::max(0.0, final_std_devs[k]) + 1e-9 * (1 + std::abs(final_values[k])))
+        << session.estimate->names[k] << ": live " << live[k] << ", final " << final_values[k] << " +- "
+        << final_std_devs[k];
+  }
+}
+
 CameraCalibrationResult Calibrate(const std::string& database, const fs::path& output) {
   CameraCalibratorOptions options;
   options.database_path = database;
@@ -58,6 +74,8 @@ TEST(LiveCalibrator, HandsFreeKeepsOneFramePerPauseAndMatchesTheBatchStages) {
     if (pause >= 0) ++kept_per_pause[static_cast<size_t>(pause)];
   }
   for (size_t p = 0; p < pauses.size(); ++p) EXPECT_EQ(kept_per_pause[p], 1) << "pause " << p;
+  ASSERT_TRUE(summary.camera);
+  ExpectFinalIsTheLiveEstimate(summary.session, summary.camera->camera.params, summary.camera->params_std_dev);
 
   // The batch stages on the kept frames: the same corners, the same camera.
   testing::ExtractBoard(dir / "kept", dir / "batch.db", false);
@@ -95,6 +113,7 @@ TEST(LiveCalibrator, AHousingIsCalibratedFromTheKeptViews) {
   EXPECT_TRUE(fs::exists(dir / "out/calibration.yaml"));
   const std::vector<double>& p = summary.housing->housing.params;
   const std::vector<double>& sigma = summary.housing->housing_std_dev;
+  ExpectFinalIsTheLiveEstimate(summary.session, p, sigma);
   ASSERT_EQ(sigma.size(), p.size());
   const std::vector<double> truth = {0.0174524, 0, 0.9998477, 0.012};
   for (int k = 0; k < 4; ++k) {
