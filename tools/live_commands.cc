@@ -29,6 +29,9 @@ void RegisterLive(CommandLine* cli, LiveSessionOptions* live) {
            "is processed (0)");
   cli->Add("Live.stall_seconds", &live->source.stall_seconds,
            "a live source without a frame this long is stalled (a warning; three in a row end the session)");
+  cli->Add("Live.target_uncertainty_px", &live->goal.target_uncertainty_px,
+           "the goal: mean expected projection uncertainty at the working distance, px (docs/live.md)");
+  cli->Add("Live.auto_finish", &live->goal.auto_finish, "finish by itself once the goal is met (0 | 1)");
   HandsFreeOptions& hands_free = live->hands_free;
   cli->Add("Live.hands_free", &hands_free.enabled, "keep frames when the target is held still (0 | 1)");
   cli->Add("Live.still_px", &hands_free.still_px, "held still: every corner within this many pixels ...");

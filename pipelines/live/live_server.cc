@@ -180,6 +180,10 @@ nlohmann::json LiveServer::Impl::State() const {
   for (const KeptView& view : snapshot.kept) kept.push_back({{"name", view.name}, {"points", view.view.pixels.size()}});
   state["kept"] = kept;
   state["coverage"] = CoverageFraction(snapshot);
+  const LiveGoal& goal = snapshot.goal;
+  state["goal"] = {{"target_px", goal.target_px}, {"determined", goal.determined}, {"mean_px", goal.mean_px},
+                   {"max_px", goal.max_px},         {"met", goal.met},               {"progress", goal.progress},
+                   {"limits", goal.limits},         {"summary", goal.Summary()}};
   state["estimate"] = snapshot.estimate ? EstimateJson(*snapshot.estimate) : nlohmann::json(nullptr);
   if (snapshot.to_suggestion) {
     state["to_suggestion"] = {{"outline_px", snapshot.to_suggestion->outline_px},

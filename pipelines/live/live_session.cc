@@ -74,6 +74,7 @@ void LiveSessionOptions::Check() const {
   detector.Check();
   hands_free.Check();
   estimator.guidance.Check();
+  goal.Check();
   if (max_views < 0) throw OptionError("--Live.max_views", std::to_string(max_views), ">= 0");
   if (!(pair_tolerance_s >= 0)) {
     throw OptionError("--Live.pair_tolerance", std::to_string(pair_tolerance_s), ">= 0 s (0: the frames' own order)");
@@ -180,10 +181,32 @@ void LiveSession::CollectEstimate(bool wait) {
     const std::lock_guard<std::mutex> lock(mutex_);
     snapshot_.estimate = estimate_;
   }
+  UpdateGoal();
   if (estimate_stale_) {
     estimate_stale_ = false;
     StartEstimate();
     if (wait) CollectEstimate(true);
+  }
+}
+
+void LiveSession::UpdateGoal() {
+  std::vector<CornerMap> corners1, corners2;
+  for (const KeptView& kept : kept_) {
+    corners1.push_back(kept.corners);
+    corners2.push_back(kept.corners2);
+  }
+  const double target = options_.goal.target_uncertainty_px;
+  LiveGoal goal = EvaluateGoal(*estimate_, corners1, channels_[0].size, target);
+  if (estimate_->camera2) {
+    goal = CombineGoals(goal, EvaluateGoal(*estimate_->camera2, corners2, channels_[1].size, target));
+  }
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    snapshot_.goal = goal;
+  }
+  if (goal.met != goal_met_) {
+    goal_met_ = goal.met;
+    if (goal.met || estimate_->num_views > 0) LOG(INFO) << "live: goal: " << goal.Summary();
   }
 }
 
@@ -443,6 +466,9 @@ void LiveSession::PrintStatus(double time_s) {
     line << "no target";
   }
   line << "; " << kept_.size() << " kept";
+  if (s.goal.determined) {
+    line << "; goal " << (s.goal.met ? "met" : std::to_string(static_cast<int>(100 * s.goal.progress)) + " %");
+  }
   if (estimate_ && estimate_->next) {
     line << "; next: " << estimate_->next->why;
     if (s.to_suggestion) line << ", " << std::setprecision(0) << s.to_suggestion->outline_px << " px away";
@@ -512,6 +538,9 @@ class LiveSession::Frames {
 std::string LiveSession::StopReason() const {
   if (CancelFlag::Requested()) return "interrupted";
   if (finish_requested_) return "finish requested";
+  if (options_.goal.auto_finish && goal_met_ && !pending_ && !estimate_stale_) {
+    return "the goal was met (--Live.auto_finish)";
+  }
   if (options_.max_views > 0 && static_cast<int>(kept_.size()) >= options_.max_views) {
     return std::to_string(options_.max_views) + " views kept (--Live.max_views)";
   }

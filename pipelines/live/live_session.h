@@ -17,6 +17,7 @@
 #include "pipelines/live/frame_source.h"
 #include "pipelines/live/hands_free.h"
 #include "pipelines/live/live_estimator.h"
+#include "pipelines/live/live_goal.h"
 
 namespace portcal {
 
@@ -36,6 +37,7 @@ struct LiveSessionOptions {
   TargetDetectorOptions detector;  // its precise_fit is set per use
   HandsFreeOptions hands_free;
   LiveEstimatorOptions estimator;
+  LiveGoalOptions goal;
   int max_views = 0;              // finish after this many kept views (0: when the source ends)
   double status_interval_s = 2;   // a status line on stderr this often (<= 0: never)
   // A stereo rig: camera 2's source (empty: one camera; the other source
@@ -82,6 +84,7 @@ struct LiveSnapshot {
   std::vector<KeptView> kept;
   std::shared_ptr<const LiveEstimate> estimate;
   std::optional<PoseDistance> to_suggestion;  // the current pose vs the suggestion
+  LiveGoal goal;             // of the newest estimate
   std::string message;       // the last warning or event, for the page
   std::string final_status;  // after the session: the final calibration's progress, then its outcome
 };
@@ -175,6 +178,7 @@ class LiveSession {
   void CollectEstimate(bool wait);
   void PrintStatus(double time_s);
   void Note(const std::string& message, bool warning);
+  void UpdateGoal();
 
   LiveSessionOptions options_;
   KeptFrameStore* store_;
@@ -192,6 +196,7 @@ class LiveSession {
   std::atomic<bool> capture_requested_{false};
   std::atomic<bool> undo_requested_{false};
   std::atomic<bool> finish_requested_{false};
+  bool goal_met_ = false;  // by the newest estimate (said once when it changes)
   std::vector<std::string> remove_requested_;
   struct Pending;
   std::unique_ptr<Pending> pending_;  // the estimate being computed

@@ -116,6 +116,26 @@ TEST(LiveHandHeld, RenderedViewsWithTremorBlurAndJpegAreKeptOrExplained) {
   ExpectEveryHoldKeptOrExplained(summary.session, video);
 }
 
+// With a goal and --Live.auto_finish the session ends by itself as soon as
+// the expected projection uncertainty is down to the goal, not before.
+TEST(LiveHandHeld, AHandsFreeSessionFinishesItselfAtTheGoal) {
+  const testing::TempDir dir;
+  const GroundTruth truth = testing::RenderSet(dir, kStillsYaml);
+  LiveCalibratorOptions options = testing::LiveOptions(dir, (dir / "video").string());
+  const std::vector<cv::Mat> stills =
+      DistinctStills(dir / "set", truth, options.live.hands_free.novelty_fraction * std::hypot(640.0, 480.0));
+  const testing::HandHeldVideo video = WriteHandHeldVideo(stills, dir / "video", testing::HandHeldVideoOptions());
+  options.live.goal.auto_finish = true;
+  options.live.goal.target_uncertainty_px = 0.12;
+  const LiveCalibratorSummary summary = RunLiveCalibrator(PlayAsFolder(options, video), NoProgress());
+  EXPECT_EQ(summary.session.end_reason, "the goal was met (--Live.auto_finish)");
+  ASSERT_TRUE(summary.session.estimate && summary.session.estimate->uncertainty.determined);
+  EXPECT_LE(summary.session.estimate->uncertainty.mean_px, 0.12);
+  EXPECT_LT(summary.session.kept, static_cast<int>(video.holds.size()));
+  std::cout << summary.session.kept << " of " << video.holds.size() << " poses kept to reach "
+            << summary.session.estimate->uncertainty.mean_px << " px\n";
+}
+
 // The shared real in-air views (1440 x 1080, an 8 x 6 board of 3 cm), each
 // held 1.5 s with 0.15 px of tremor.
 TEST(LiveHandHeld, RealViewsHeldByHandAreKeptOrExplained) {
