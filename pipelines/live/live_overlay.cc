@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "pipelines/live/pose_preview.h"
+#include "pipelines/report/picture.h"
 
 namespace portcal {
 namespace {
@@ -58,10 +59,16 @@ cv::Mat DrawOneOverlay(const LiveSnapshot& snapshot, const TargetShape& target, 
   line << "  " << snapshot.kept.size() << " kept";
   Caption(line.str(), 0, &bgr);
   if (snapshot.to_suggestion && estimate && estimate->next) {
+    // Angles and distances only once the camera is estimated: before, the
+    // pose of the frame rests on a guessed focal length, and it said "59
+    // deg, 41 cm" while the board filled the outline.
     std::ostringstream away;
     away << std::fixed << std::setprecision(0) << "to the suggested pose: " << snapshot.to_suggestion->outline_px
-         << " px, " << snapshot.to_suggestion->rotation_deg << " deg, " << 100 * snapshot.to_suggestion->translation_m
-         << " cm";
+         << " px";
+    if (estimate->solved) {
+      away << ", " << snapshot.to_suggestion->rotation_deg << " deg, " << 100 * snapshot.to_suggestion->translation_m
+           << " cm";
+    }
     Caption(away.str(), 1, &bgr);
   }
   return bgr;
@@ -121,28 +128,23 @@ cv::Mat DrawOneUncertainty(const LiveSnapshot& snapshot, int max_width) {
     Caption(estimate ? "not yet determined: " + estimate->status : "no estimate yet", 0, &bgr);
     return bgr;
   }
-  const Eigen::MatrixXd& map = estimate->uncertainty.map_px;
-  const double top = std::max(1e-9, estimate->uncertainty.max_px);
-  for (int r = 0; r < map.rows(); ++r) {
-    for (int c = 0; c < map.cols(); ++c) {
-      const cv::Rect cell(c * size.width / static_cast<int>(map.cols()), r * size.height / static_cast<int>(map.rows()),
-                          size.width / static_cast<int>(map.cols()) + 1, size.height / static_cast<int>(map.rows()) + 1);
-      if (map(r, c) < 0) continue;
-      cv::Mat level(1, 1, CV_8U, cv::Scalar(cv::saturate_cast<uint8_t>(255 * map(r, c) / top)));
-      cv::Mat color;
-      cv::applyColorMap(level, color, cv::COLORMAP_TURBO);
-      bgr(cell & cv::Rect(cv::Point(0, 0), size)).setTo(color.at<cv::Vec3b>(0, 0));
-      std::ostringstream value;
-      value << std::setprecision(2) << map(r, c);
-      cv::putText(bgr, value.str(), cell.tl() + cv::Point(3, cell.height / 2), cv::FONT_HERSHEY_SIMPLEX,
-                  std::max(0.3, cell.width / 110.0), cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-    }
+  // The report's heat map with a colour bar (numbers in 32 x 24 cells were
+  // unreadable on the page), the goal as a white iso-line.
+  HeatMapStyle style;
+  std::ostringstream title;
+  title << std::setprecision(3) << "expected projection uncertainty: mean " << estimate->uncertainty.mean_px
+        << " px, max " << estimate->uncertainty.max_px << " px";
+  style.title = title.str();
+  style.unit = "px";
+  if (snapshot.goal.target_px > 0) style.contour_levels = {snapshot.goal.target_px};
+  const int width = snapshot.frame.empty() ? size.width : snapshot.frame.cols;
+  const int height = snapshot.frame.empty() ? size.height : snapshot.frame.rows;
+  cv::Mat picture = HeatMapPicture(estimate->uncertainty.map_px, width, height, style);
+  if (picture.cols > max_width && max_width > 0) {
+    cv::resize(picture, picture, cv::Size(max_width, std::max(1, picture.rows * max_width / picture.cols)), 0, 0,
+               cv::INTER_AREA);
   }
-  std::ostringstream line;
-  line << std::setprecision(3) << "expected projection uncertainty: mean " << estimate->uncertainty.mean_px
-       << " px, max " << estimate->uncertainty.max_px << " px";
-  Caption(line.str(), 0, &bgr);
-  return bgr;
+  return picture;
 }
 
 // Camera 2 of a rig as camera 1's fields (no distance to the suggestion:

@@ -12,6 +12,7 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "database/database.h"
+#include "database/session_lock.h"
 #include "database/new_database_file.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/detection/detection_rows.h"
@@ -317,6 +318,7 @@ SessionOutcome RunSession(const LiveCalibratorOptions& options, const LiveSessio
                           const Conclusion& conclude) {
   NewDatabaseFile new_file(options.database_path);
   Database database(options.database_path, Database::OpenMode::kCreate);
+  const SessionLock one_session(options.database_path, "live_calibrator session");
   { Transaction probe = database.BeginTransaction(); }  // fails now, not at the first keep, when locked
   DatabaseFrameStore store(options, readers, &database);
   LiveSession session(live, &store, ExistingViews(&database, CameraFolders(options)));

@@ -143,6 +143,33 @@ TEST(LiveCalibrator, ASecondSessionGoesOnFromTheFirst) {
   EXPECT_EQ(database.NumCameras(), 1);
 }
 
+// Two sessions at once on one database: the second is refused at start with
+// a clear message (they would write images of the same names and stall on
+// each other's transactions); the first goes on.
+TEST(LiveCalibrator, ASecondSessionOnTheSameDatabaseAtOnceIsRefused) {
+  const testing::TempDir dir;
+  testing::RenderSet(dir, kTrajectoryYaml);
+  LiveCalibratorOptions options = Options(dir, (dir / "set/images").string());
+  options.live.source.realtime = false;
+  options.calibrate_at_end = false;
+  std::string refusal;
+  const LiveCalibratorSummary first =
+      RunLiveCalibrator(options, NoProgress(), [&](LiveSession& session, const std::string&) {
+        LiveCalibratorOptions second = options;
+        second.image_path = (dir / "kept2").string();
+        second.output_path = (dir / "out2").string();
+        try {
+          RunLiveCalibrator(second, NoProgress());
+        } catch (const DatabaseError& e) {
+          refusal = e.what();
+        }
+        session.Finish();
+      });
+  EXPECT_NE(refusal.find("another live_calibrator session is using this database"), std::string::npos) << refusal;
+  EXPECT_EQ(first.session.end_reason, "finish requested");
+  EXPECT_FALSE(fs::exists(dir / "kept2"));
+}
+
 TEST(LiveCalibrator, AMissingDeviceOrFileIsAClearError) {
   const testing::TempDir dir;
   for (const std::string& source : std::vector<std::string>{"/dev/video97", (dir / "no_such.avi").string()}) {

@@ -101,6 +101,7 @@ TEST(LivePage, ABrowserSeesTheStreamAndItsButtonsWork) {
   const testing::CommandResult dom = testing::RunCommand(Chromium(dir, "--dump-dom", url + "?selftest=1"));
   EXPECT_NE(dom.output.find("selftest: passed"), std::string::npos) << dom.output.substr(0, 4000);
   EXPECT_NE(dom.output.find("capture: "), std::string::npos);
+  EXPECT_NE(dom.output.find("layout: no text overflows its box"), std::string::npos) << dom.output.substr(0, 4000);
 
   // A screenshot, kept beside the test binary for a person to look at.
   const fs::path artefact = fs::current_path() / "artifacts/live_page.png";
