@@ -63,9 +63,6 @@ std::string CommandLine::GroupNames() const {
   return text;
 }
 
-namespace {
-
-// Levenshtein distance, for "did you mean".
 size_t EditDistance(const std::string& a, const std::string& b) {
   std::vector<size_t> row(b.size() + 1);
   for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
@@ -80,6 +77,8 @@ size_t EditDistance(const std::string& a, const std::string& b) {
   }
   return row[b.size()];
 }
+
+namespace {
 
 // The group asked for after -h / --help ("portcal camera_calibrator -h
 // Calibration"), or "" for all options; nullopt without -h.

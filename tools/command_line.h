@@ -30,6 +30,9 @@ class UsageError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Levenshtein distance, for "did you mean" (options and commands).
+size_t EditDistance(const std::string& a, const std::string& b);
+
 class CommandLine {
  public:
   CommandLine(std::string command, std::string summary);

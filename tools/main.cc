@@ -109,6 +109,21 @@ void HandleSignal(int signal) {
 
 namespace {
 
+// "; did you mean camera_calibrator?" for a command a few typing errors
+// away or that the word begins (as options get), else "".
+std::string DidYouMean(const std::string& word) {
+  std::vector<std::pair<size_t, std::string>> ranked;
+  for (const Command& command : Commands()) {
+    const std::string name = command.name;
+    const size_t distance = name.rfind(word, 0) == 0 && word.size() >= 3 ? 0 : portcal::EditDistance(word, name);
+    if (distance <= std::max<size_t>(2, word.size() / 4)) ranked.emplace_back(distance, name);
+  }
+  std::sort(ranked.begin(), ranked.end());
+  std::string text;
+  for (size_t k = 0; k < ranked.size() && k < 3; ++k) text += (k ? ", " : "; did you mean ") + ranked[k].second;
+  return text.empty() ? text : text + "?";
+}
+
 int RunCommandLine(int argc, char** argv) {
   portcal::InitializeLogging(argv[0]);
   portcal::KeepImageBuffersInTheHeap();
@@ -122,7 +137,8 @@ int RunCommandLine(int argc, char** argv) {
       if (argc >= 4) args.push_back(argv[3]);
       return command.run(static_cast<int>(args.size()), args.data());
     }
-    std::cerr << "error: unknown command '" << argv[2] << "' (portcal help lists the commands)\n";
+    std::cerr << "error: unknown command '" << argv[2] << "'" << DidYouMean(argv[2])
+              << " (portcal help lists the commands)\n";
     return portcal::kExitUsage;
   }
   if (argc < 2 || std::strcmp(argv[1], "help") == 0 ||
@@ -139,8 +155,8 @@ int RunCommandLine(int argc, char** argv) {
       return command.run(argc - 1, argv + 1);
     }
   }
-  std::cerr << "error: unknown command '" << argv[1]
-            << "' (portcal help lists the commands)\n";
+  std::cerr << "error: unknown command '" << argv[1] << "'" << DidYouMean(argv[1])
+            << " (portcal help lists the commands)\n";
   return portcal::kExitUsage;
 }
 

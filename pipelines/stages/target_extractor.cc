@@ -133,6 +133,7 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
   TargetExtractorSummary summary;
   SharedCameras shared_cameras;
   const std::string target = TargetDescriptionText(DetectorOptions(options));
+  std::string first_reason;  // of the first image without the target
   for (const ImageResult& result : results) {
     if (!result.readable) {
       LOG(WARNING) << result.name << ": " << result.skip_reason << "; skipped";
@@ -142,6 +143,7 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
                                          result.height, &shared_cameras);
     const TargetDetection& detection = result.detection;
     if (!detection.found) LOG(WARNING) << result.name << ": " << detection.reason;
+    if (!detection.found && first_reason.empty()) first_reason = result.name + ": " + detection.reason;
     if (detection.found && !detection.note.empty()) LOG(INFO) << result.name << ": " << detection.note;
     WriteTargetDetection(&database, image_id, detection, target);
     ++summary.num_images;
@@ -156,11 +158,16 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
                      " px a side)");
   }
   if (summary.num_found == 0) {
-    // Loud, not an error: each image's reason is stored for a look, and a
-    // rerun may add images that show it.
-    LOG(WARNING) << options.image_path << ": the target (" << target << ") was found in none of the "
-                 << summary.num_images << " images; check --Target.type and, for a chessboard, "
-                 << "--Target.cols/--Target.rows (inner corners, not squares)";
+    // Nothing done is not a success: the next stage would only say "run
+    // target_extractor first". The transaction rolls back, a new database
+    // file goes, an existing one is left as it was.
+    std::string cause = options.target_type == "chessboard"
+                            ? "--Target.cols and --Target.rows count inner corners, not squares (a board of 9 x 7 "
+                              "squares has 8 x 6)"
+                            : "--Target.dictionary and the marker and square sizes must be the board's";
+    throw InputError(options.image_path + ": the target (" + target + ") was found in none of the " +
+                     std::to_string(summary.num_images) + " images (" + first_reason + "); " + cause +
+                     "; --Target.type is " + options.target_type);
   }
   run.Finish(&database, {{"images", summary.num_images},
                          {"found", summary.num_found},

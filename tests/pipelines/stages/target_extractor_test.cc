@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "colmap_ext/io/ground_truth.h"
 #include "colmap_ext/util/error.h"
@@ -29,6 +30,21 @@ TargetExtractorOptions Options(const fs::path& database, const fs::path& images)
   options.reader.camera_model = "RADIAL";
   options.reader.single_camera = true;
   return options;
+}
+
+// A plain image of the default board (10 x 7 inner corners: 11 x 8 squares)
+// filling most of it, for the tests of what the reader does with files: a
+// run that finds the target in no image is an error.
+cv::Mat BoardImage(int width, int height) {
+  cv::Mat image(height, width, CV_8UC1, cv::Scalar(230));
+  const int square = std::min((width - 16) / 11, (height - 16) / 8);
+  const int x0 = (width - 11 * square) / 2, y0 = (height - 8 * square) / 2;
+  for (int r = 0; r < 8; ++r) {
+    for (int c = 0; c < 11; ++c) {
+      if ((r + c) % 2 == 0) cv::rectangle(image, cv::Rect(x0 + c * square, y0 + r * square, square, square), 20, cv::FILLED);
+    }
+  }
+  return image;
 }
 
 // Errors (px) of the stored observations against the ground truth.
@@ -118,7 +134,7 @@ TEST(TargetExtractor, ARerunWithOtherReaderOptionsSaysSoOrImportsTheCamerasAgain
   testing::TempDir dir;
   fs::create_directories(dir / "images");
   for (const char* name : {"a.png", "b.png", "c.png"}) {
-    cv::imwrite((dir / "images" / name).string(), cv::Mat(120, 160, CV_8UC1, cv::Scalar(90)));
+    cv::imwrite((dir / "images" / name).string(), BoardImage(160, 120));
   }
   NullProgress progress;
   TargetExtractorOptions first = Options(dir / "db.db", dir / "images");
@@ -171,7 +187,7 @@ TEST(TargetExtractor, SymlinkedImagesKeepTheirLinksNames) {
   testing::TempDir dir;
   fs::create_directories(dir / "elsewhere");
   fs::create_directories(dir / "images");
-  cv::imwrite((dir / "elsewhere/original.png").string(), cv::Mat(100, 200, CV_8UC1, cv::Scalar(0)));
+  cv::imwrite((dir / "elsewhere/original.png").string(), BoardImage(200, 100));
   fs::create_symlink(dir / "elsewhere/original.png", dir / "images/link.png");
   NullProgress progress;
   RunTargetExtractor(Options(dir / "db.db", dir / "images"), progress);
