@@ -41,7 +41,7 @@ echo "== 4. Hand-off: OpenCV and ROS files of the in-air camera; mrcal's uncerta
   --output_type ROS_YAML
 if command -v mrcal-show-projection-uncertainty >/dev/null; then
   mrcal-show-projection-uncertainty air/camera.cameramodel \
-    --hardcopy air/uncertainty.png --terminal 'pngcairo size 800,600'
+    --hardcopy air/mrcal_uncertainty.png --terminal 'pngcairo size 800,600'
 fi
 ls air
 echo "Results in $work"

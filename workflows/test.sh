@@ -6,4 +6,10 @@ cd "$(dirname "$0")/.."
 # chromium: the live page's browser test (tests/pipelines/stages/live_page_test.cc).
 bash workflows/setup.sh chromium
 cd build
-ctest --output-on-failure -j"$(nproc 2>/dev/null || echo 2)" --timeout 1500
+jobs="$(nproc 2>/dev/null || echo 2)"
+echo "test: ctest, $jobs at a time (about 20 minutes on 2 cores; a line per test as it ends)" >&2
+start=$SECONDS
+status=0
+ctest --output-on-failure -j"$jobs" --timeout 1500 || status=$?
+echo "test: done in $(((SECONDS - start) / 60)) min $(((SECONDS - start) % 60)) s, exit $status" >&2
+exit "$status"
