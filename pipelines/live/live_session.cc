@@ -376,19 +376,13 @@ void LiveSession::Process(std::vector<Sight>& sights, double arrival_wall_s) {
 StillnessTracker::State LiveSession::Hold(const std::vector<Sight>& sights, double time_s,
                                           const std::string& lost_reason) {
   StillnessTracker::State hold;
+  bool sharpest = false;
   for (size_t c = 0; c < sights.size(); ++c) {
-    Channel& channel = channels_[c];
-    const StillnessTracker::State state =
-        channel.tracker.Update(time_s, sights[c].corners, CornerSharpness(sights[c].gray, sights[c].corners));
-    if (state.sharpest) {
-      channel.sharpest.image = sights[c].frame->image.clone();
-      channel.sharpest.time_s = sights[c].frame->time_s;
-      channel.sharpest.index = sights[c].frame->index;
-      channel.sharpest_gray = sights[c].gray.clone();
-      channel.sharpest_corners = sights[c].corners;
-    }
+    const StillnessTracker::State state = channels_[c].tracker.Update(
+        time_s, sights[c].corners, CornerSharpness(sights[c].gray, sights[c].corners));
     if (c == 0) {
       hold = state;
+      sharpest = state.sharpest;  // a rig's pair: camera 1's sharpest moment
       continue;
     }
     hold.still = hold.still && state.still;
@@ -397,6 +391,20 @@ StillnessTracker::State LiveSession::Hold(const std::vector<Sight>& sights, doub
     hold.motion_px = std::max(hold.motion_px, state.motion_px);
     hold.ended_held_s = std::max(hold.ended_held_s, state.ended_held_s);
     hold.ended_motion_px = std::max(hold.ended_motion_px, state.ended_motion_px);
+  }
+  // Every camera's frame of one moment, so that a rig's pair stays a pair
+  // (camera 1 chooses it; a spell begun anew by either camera restarts it).
+  const bool all_seen =
+      std::all_of(sights.begin(), sights.end(), [](const Sight& sight) { return !sight.corners.empty(); });
+  if (all_seen && (sharpest || hold.new_spell)) {
+    for (size_t c = 0; c < sights.size(); ++c) {
+      Channel& channel = channels_[c];
+      channel.sharpest.image = sights[c].frame->image.clone();
+      channel.sharpest.time_s = sights[c].frame->time_s;
+      channel.sharpest.index = sights[c].frame->index;
+      channel.sharpest_gray = sights[c].gray.clone();
+      channel.sharpest_corners = sights[c].corners;
+    }
   }
   if (!hold.new_spell) return hold;
   // A spell held for half the time asked, ended before it was tried: the

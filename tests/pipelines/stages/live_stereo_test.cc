@@ -76,6 +76,19 @@ TEST(LiveStereo, TwoVideosInRealTimeKeepOnePairPerPauseAndCalibrateTheRig) {
     EXPECT_EQ(database.NumCameras(), 2);
   }
 
+  // Each camera's final calibration is its last live estimate, within 0.1σ.
+  ASSERT_TRUE(summary.session.estimate && summary.session.estimate->camera2);
+  const std::vector<std::pair<const LiveEstimate*, const CameraCalibrationResult*>> cameras = {
+      {summary.session.estimate.get(), &*summary.camera}, {summary.session.estimate->camera2.get(), &*summary.camera2}};
+  for (const auto& [estimate, final_camera] : cameras) {
+    ASSERT_TRUE(estimate->solved);
+    ASSERT_EQ(estimate->values.size(), final_camera->camera.params.size());
+    for (size_t k = 0; k < estimate->values.size(); ++k) {
+      EXPECT_LE(std::abs(estimate->values[k] - final_camera->camera.params[k]), 0.1 * final_camera->params_std_dev[k])
+          << estimate->names[k];
+    }
+  }
+
   // The batch stages on the kept frames give the same rig.
   const StereoCalibrationResult batch = BatchStereo(dir);
   const StereoCalibrationResult& live = *summary.stereo;
