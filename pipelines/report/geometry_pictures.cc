@@ -44,8 +44,11 @@ void DrawPort(DomePort, const double* port, const View2d& view, PlanCanvas* canv
   }
   cv::arrowedLine(canvas->image(), (*canvas)(view(Eigen::Vector3d::Zero())), c, kRed, 2, cv::LINE_AA, 0, 0.15);
   cv::circle(canvas->image(), c, 3, kBlue, cv::FILLED, cv::LINE_AA);
-  DrawLabel(&canvas->image(), "dome centre, offset " + FormatFixed(centre.norm() * 1000, 2) + " mm",
-            c + cv::Point(8, -8), 0.45, kRed);
+  // As a legend under the title: beside a centre a few millimetres from the
+  // camera's, the label ran over the camera's.
+  cv::circle(canvas->image(), cv::Point(14, 44), 3, kBlue, cv::FILLED, cv::LINE_AA);
+  DrawLabel(&canvas->image(), "dome centre, offset " + FormatFixed(centre.norm() * 1000, 2) + " mm (red arrow)",
+            cv::Point(22, 49), 0.45, kRed);
   DrawCameraCentre(canvas, view, DomePort::InnerRadius(port));
 }
 

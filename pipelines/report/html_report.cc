@@ -24,9 +24,11 @@ std::string Escaped(const std::string& text) {
   return out;
 }
 
+// The text reports wrap (pre-wrap): a long note line scrolled out of sight
+// at the right edge.
 constexpr const char* kStyle =
     "body{font-family:sans-serif;max-width:1100px;margin:1em auto;padding:0 1em;color:#222}"
-    "pre{background:#f4f4f4;padding:.8em;overflow-x:auto;font-size:13px}"
+    "pre{background:#f4f4f4;padding:.8em;white-space:pre-wrap;overflow-wrap:anywhere;font-size:13px}"
     "figure{display:inline-block;margin:.5em;vertical-align:top;max-width:100%}"
     "figure img{max-width:100%;border:1px solid #ccc}figcaption{font-size:13px;max-width:960px}"
     ".warning{color:#b00;font-weight:bold}";
