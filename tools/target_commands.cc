@@ -93,15 +93,17 @@ int HousingCalibratorCommand(int argc, char** argv) {
   HousingCalibratorOptions options;
   CommandLine cli("housing_calibrator",
                   "Calibrates a flat or dome port from the target observations of underwater "
-                  "views. With the same camera's in-air views (--in_air_database_path) the "
+                  "views. With the same camera's in-air views (--in_air_database_path, or an mrcal "
+                  ".cameramodel that keeps its optimization_inputs as --input_calibration) the "
                   "intrinsics are refined jointly, so the housing's standard deviations include "
                   "their uncertainty; else the in-air intrinsics are given (--input_calibration, "
-                  "portcal's or calibmar's calibration.yaml) and fixed unless refined. The port's "
+                  "portcal's or calibmar's calibration.yaml: its covariance propagated) and held. The port's "
                   "axis and magnitude are initialised from the data; thickness, radius and "
                   "indices are the constants of --Housing.params. Writes calibration.yaml/.txt and report.html.");
   cli.AddRequired("database_path", &options.database_path, "database with target observations");
   cli.Add("input_calibration", &options.input_calibration,
-          "in-air calibration.yaml (with --in_air_database_path: the start, optional)");
+          "in-air calibration.yaml, OpenCV/ROS YAML or .cameramodel (one with optimization_inputs: joint "
+          "solve with its views; with --in_air_database_path: the start, optional)");
   cli.Add("in_air_database_path", &options.in_air_database_path,
           "database with the camera's in-air target observations: joint solve");
   cli.Add("in_air_camera_id", &options.in_air_camera_id, "camera of the in-air database (-1: the only one)");

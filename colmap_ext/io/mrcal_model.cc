@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "colmap_ext/camera/camera_models.h"
+#include "colmap_ext/io/mrcal_optimization_inputs.h"
 #include "colmap_ext/io/npz_archive.h"
 #include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/error.h"
@@ -25,48 +26,6 @@ namespace {
 
 // mrcal pixel = COLMAP pixel - 0.5 (both axes).
 constexpr double kPixelShift = 0.5;
-
-// mrcal.optimize()'s keyword arguments for `solve`, as an .npz archive
-// (mrcal's own serialisation: None is stored as '').
-std::string OptimizationInputsArchive(const MrcalLens& lens, const Camera& camera, const MrcalBoardSolve& solve) {
-  const int64_t num_frames = static_cast<int64_t>(solve.frames_rt_toref.size());
-  if (static_cast<int64_t>(solve.observations.size()) != num_frames * solve.height_n * solve.width_n * 3) {
-    throw std::invalid_argument("MrcalBoardSolve: observations do not match the frames and the board");
-  }
-  NpzArchive npz;
-  npz.AddDoubles("intrinsics", {1, static_cast<int64_t>(lens.intrinsics.size())}, lens.intrinsics);
-  npz.AddDoubles("extrinsics_rt_fromref", {0, 6}, {});
-  std::vector<double> frames;
-  std::vector<int32_t> indices;
-  for (int64_t f = 0; f < num_frames; ++f) {
-    frames.insert(frames.end(), solve.frames_rt_toref[f].begin(), solve.frames_rt_toref[f].end());
-    indices.insert(indices.end(), {static_cast<int32_t>(f), 0, -1});
-  }
-  npz.AddDoubles("frames_rt_toref", {num_frames, 6}, frames);
-  npz.AddString("points", "");
-  npz.AddDoubles("observations_board", {num_frames, solve.height_n, solve.width_n, 3}, solve.observations);
-  npz.AddInt32s("indices_frame_camintrinsics_camextrinsics", {num_frames, 3}, indices);
-  npz.AddString("observations_point", "");
-  npz.AddString("indices_point_camintrinsics_camextrinsics", "");
-  npz.AddString("lensmodel", lens.lensmodel);
-  npz.AddInt32s("imagersizes", {1, 2}, {static_cast<int32_t>(camera.width), static_cast<int32_t>(camera.height)});
-  if (solve.warp_estimated) {
-    npz.AddDoubles("calobject_warp", {2}, {solve.calobject_warp.x(), solve.calobject_warp.y()});
-  } else {
-    npz.AddString("calobject_warp", "");
-  }
-  npz.AddBool("do_optimize_intrinsics_core", solve.intrinsics_core_estimated);
-  npz.AddBool("do_optimize_intrinsics_distortions", solve.intrinsics_distortions_estimated);
-  npz.AddBool("do_optimize_extrinsics", true);  // as mrcal-calibrate-cameras; no extrinsics here
-  npz.AddBool("do_optimize_frames", true);
-  npz.AddBool("do_optimize_calobject_warp", solve.warp_estimated);
-  npz.AddDouble("calibration_object_spacing", solve.spacing);
-  npz.AddBool("do_apply_outlier_rejection", false);
-  npz.AddBool("do_apply_regularization", false);
-  npz.AddBool("verbose", false);
-  if (!solve.image_paths.empty()) npz.AddStrings("imagepaths", solve.image_paths);
-  return npz.Bytes();
-}
 
 struct CameraModelDeleter {
   void operator()(mrcal_cameramodel_t* model) const { mrcal_free_cameramodel(&model); }
@@ -164,6 +123,14 @@ std::array<double, 6> RtFromRigid(const Rigid3d& b_from_a) {
   return {r[0], r[1], r[2], b_from_a.translation[0], b_from_a.translation[1], b_from_a.translation[2]};
 }
 
+Rigid3d RigidFromRt(const double* rt) {
+  const Eigen::Vector3d r(rt[0], rt[1], rt[2]);
+  const double angle = r.norm();
+  const Eigen::Quaterniond rotation =
+      angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, r / angle)) : Eigen::Quaterniond::Identity();
+  return Rigid3d(rotation, Eigen::Vector3d(rt[3], rt[4], rt[5]));
+}
+
 namespace {
 
 // Debian's libmrcal parses a .cameramodel without looking at its end: a
@@ -203,6 +170,56 @@ void CheckCompleteDictLiteral(const std::string& text, const std::string& path) 
   if (!open.empty()) fail("an unclosed bracket", text.size());
 }
 
+// Where the value of the top-level `key` starts in a complete dict literal
+// (after CheckCompleteDictLiteral), or npos: mrcal's C parser skips what it
+// does not use, so the solve and icam_intrinsics are found here.
+size_t TopLevelValue(const std::string& text, const std::string& key) {
+  int depth = 0;
+  char previous = 0;  // the last significant character outside strings
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '#') {
+      i = text.find('\n', i);
+      if (i == std::string::npos) break;
+    } else if (c == '\'' || c == '"') {
+      size_t j = i + 1;
+      while (j < text.size() && text[j] != c) j += text[j] == '\\' ? 2 : 1;
+      const bool is_key = depth == 1 && (previous == '{' || previous == ',') && text.compare(i + 1, j - i - 1, key) == 0 &&
+                          j - i - 1 == key.size();
+      i = j;
+      previous = c;
+      if (is_key) {
+        const size_t colon = text.find_first_not_of(" \t\r\n", j + 1);
+        if (colon != std::string::npos && text[colon] == ':') return text.find_first_not_of(" \t\r\n", colon + 1);
+      }
+    } else if (!std::isspace(static_cast<unsigned char>(c))) {
+      if (c == '{' || c == '[' || c == '(') ++depth;
+      if (c == '}' || c == ']' || c == ')') --depth;
+      previous = c;
+    }
+  }
+  return std::string::npos;
+}
+
+// The optimization_inputs bytes literal (b'...') and icam_intrinsics.
+void ReadSolveFields(const std::string& text, const std::string& path, MrcalCameraModelFile* file) {
+  const size_t inputs = TopLevelValue(text, "optimization_inputs");
+  if (inputs == std::string::npos) return;
+  if (inputs + 2 >= text.size() || text[inputs] != 'b' || (text[inputs + 1] != '\'' && text[inputs + 1] != '"')) {
+    throw InputError(path + ": 'optimization_inputs' is not a bytes literal (b'...')");
+  }
+  const size_t end = text.find(text[inputs + 1], inputs + 2);  // base 85 has no quotes
+  if (end == std::string::npos) throw InputError(path + ": 'optimization_inputs' is not closed");
+  file->optimization_inputs_base85 = text.substr(inputs + 2, end - inputs - 2);
+  const size_t icam = TopLevelValue(text, "icam_intrinsics");
+  char* parsed_end = nullptr;
+  const long value = icam == std::string::npos ? -1 : std::strtol(text.c_str() + icam, &parsed_end, 10);
+  if (icam == std::string::npos || parsed_end == text.c_str() + icam || value < 0 || value > 1000000) {
+    throw InputError(path + ": 'optimization_inputs' without a valid 'icam_intrinsics' (mrcal requires one)");
+  }
+  file->icam_intrinsics = static_cast<int>(value);
+}
+
 }  // namespace
 
 MrcalCameraModelFile ReadMrcalCameraModel(const std::filesystem::path& path) {
@@ -232,13 +249,8 @@ MrcalCameraModelFile ReadMrcalCameraModel(const std::filesystem::path& path) {
   MrcalCameraModelFile file;
   file.camera = CameraFromMrcalLens(lens, model->imagersize[0], model->imagersize[1],
                                     path.string());
-  const Eigen::Vector3d r(model->rt_cam_ref[0], model->rt_cam_ref[1], model->rt_cam_ref[2]);
-  const double angle = r.norm();
-  const Eigen::Quaterniond rotation =
-      angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, r / angle))
-                : Eigen::Quaterniond::Identity();
-  file.cam_from_ref = Rigid3d(rotation, Eigen::Vector3d(model->rt_cam_ref[3], model->rt_cam_ref[4],
-                                                        model->rt_cam_ref[5]));
+  file.cam_from_ref = RigidFromRt(model->rt_cam_ref);
+  ReadSolveFields(text, path.string(), &file);
   return file;
 }
 
@@ -268,7 +280,7 @@ void WriteMrcalCameraModel(const Camera& camera, const Rigid3d& cam_from_ref,
       out << "  'icam_intrinsics': 0,\n"
           << "  # mrcal.optimize()'s inputs at portcal's solution (an .npz archive in base 85,\n"
           << "  # as mrcal stores them), for mrcal's uncertainty and diagnostic tools\n"
-          << "  'optimization_inputs': b'" << EncodeBase85(OptimizationInputsArchive(lens, camera, *solve))
+          << "  'optimization_inputs': b'" << EncodeBase85(MrcalOptimizationInputsArchive(lens, camera, *solve))
           << "',\n";
     }
     out << "}\n";

@@ -76,10 +76,17 @@ struct MrcalBoardSolve {
 struct MrcalCameraModelFile {
   Camera camera;
   Rigid3d cam_from_ref;  // mrcal's "extrinsics" (rt_cam_ref)
+  // The solve the model came from, as stored (base 85 of an .npz archive;
+  // empty when the file has none), and which of its cameras this is.
+  // Decoded by ReadMrcalBoardSolve (mrcal_optimization_inputs.h) only
+  // where wanted: a damaged solve does not stop the lens being read.
+  std::string optimization_inputs_base85;
+  int icam_intrinsics = -1;
 };
 
 // mrcal's pose vector of b_from_a: Rodrigues rotation, then translation.
 std::array<double, 6> RtFromRigid(const Rigid3d& b_from_a);
+Rigid3d RigidFromRt(const double* rt);
 
 // Reads a .cameramodel with mrcal's parser. Throws InputError naming the file.
 MrcalCameraModelFile ReadMrcalCameraModel(const std::filesystem::path& path);

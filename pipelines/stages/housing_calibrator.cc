@@ -1,8 +1,10 @@
 #include "pipelines/stages/housing_calibrator.h"
 
+#include <filesystem>
 #include <optional>
 
 #include "colmap_ext/housing/housing_models.h"
+#include "colmap_ext/io/mrcal_optimization_inputs.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/string_utils.h"
@@ -11,6 +13,7 @@
 #include "pipelines/calibration/calibration_output.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
+#include "pipelines/crosscheck/mrcal_import.h"
 #include "pipelines/report/calibration_html.h"
 
 namespace portcal {
@@ -73,6 +76,27 @@ InAirViews ReadInAirViews(const HousingCalibratorOptions& options, const std::st
   return in_air;
 }
 
+// The in-air views kept in an mrcal .cameramodel's optimization_inputs
+// (mrcal-calibrate-cameras', or camera_calibrator's camera.cameramodel):
+// with them the lens is solved jointly, as with --in_air_database_path; a
+// .cameramodel carries no covariance, so holding its lens would take it
+// as exact. None when the file keeps no solve.
+std::optional<InAirViews> InAirViewsOfCameraModel(const std::string& path, const std::string& underwater_target,
+                                                  const Camera& start) {
+  if (std::filesystem::path(path).extension() != ".cameramodel") return std::nullopt;
+  const MrcalCameraModelFile file = ReadMrcalCameraModel(path);
+  if (file.optimization_inputs_base85.empty()) {
+    LOG(WARNING) << "housing_calibrator: " << path << " keeps no optimization_inputs: its intrinsics are held "
+                 << "as exact (give the in-air views, --in_air_database_path, for a joint solve)";
+    return std::nullopt;
+  }
+  InAirViews in_air = InAirViewsOfMrcalSolve(ReadMrcalBoardSolve(file, path), start, underwater_target, path);
+  LOG(INFO) << "housing_calibrator: " << in_air.views.size() << " in-air views from " << path
+            << "'s optimization_inputs" << (in_air.same_board ? " (the same board)" : " (another board)")
+            << ", intrinsics refined jointly";
+  return in_air;
+}
+
 }  // namespace
 
 HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& options, ProgressSink& progress) {
@@ -91,6 +115,8 @@ HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& op
   std::optional<InAirViews> in_air;
   if (!options.in_air_database_path.empty()) {
     in_air = ReadInAirViews(options, target_views.target, start ? start->camera : database_camera, &start);
+  } else {
+    in_air = InAirViewsOfCameraModel(options.input_calibration, target_views.target, start->camera);
   }
   LOG(INFO) << "housing_calibrator: " << housing.ModelName() << ", camera " << start->camera.ModelName() << ", "
             << views.size() << " views";
