@@ -116,6 +116,7 @@ std::string UncertaintyYaml(const ProjectionUncertaintyGrid& grid) {
 std::string Yaml(const CalibrationReport& r) {
   std::ostringstream out;
   out << "# portcal calibration report (calibmar-compatible keys first)\n";
+  if (r.verdict) out << "# VERDICT: " << r.verdict->Summary() << "\n";
   for (const std::string& warning : r.warnings) out << "# WARNING: " << warning << "\n";
   out << "model: " << r.camera.ModelName() << "\n"
       << "parameters: " << List(r.camera.params) << "\n"
@@ -153,6 +154,7 @@ std::string Yaml(const CalibrationReport& r) {
     out << "notes:\n";
     for (const std::string& note : r.notes) out << "- " << SingleQuoted(note) << "\n";
   }
+  if (r.verdict) out << VerdictYaml(*r.verdict);
   if (r.projection_uncertainty) out << UncertaintyYaml(*r.projection_uncertainty);
   out << "per_view:\n";
   for (const CalibratedView& v : r.views) {
@@ -172,6 +174,7 @@ std::string Text(const CalibrationReport& r) {
   std::ostringstream out;
   out << std::fixed;
   out << "portcal calibration\n===================\n\n";
+  if (r.verdict) out << VerdictText(*r.verdict) << "\n";
   for (const std::string& warning : r.warnings) out << "WARNING: " << warning << "\n\n";
   out
       << "Camera model " << r.camera.ModelName() << ", " << r.camera.width << " x " << r.camera.height

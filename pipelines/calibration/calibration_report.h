@@ -10,6 +10,7 @@
 
 #include "colmap_ext/camera/camera.h"
 #include "colmap_ext/housing/housing.h"
+#include "pipelines/calibration/calibration_verdict.h"
 #include "pipelines/calibration/camera_calibration.h"
 #include "pipelines/calibration/housing_calibration.h"
 #include "pipelines/calibration/stereo_calibration.h"
@@ -66,6 +67,8 @@ struct CalibrationReport {
   std::vector<std::string> warnings;
   // Target calibrations: how far a projection can be trusted over the image.
   std::optional<ProjectionUncertaintyGrid> projection_uncertainty;
+  // Whether to keep it (JudgeCalibration), written first when set.
+  std::optional<CalibrationVerdict> verdict;
 };
 
 // The report of a camera calibration (with the board warp when it was

@@ -63,10 +63,17 @@ ProjectionUncertaintyGrid ProjectionUncertaintyOf(const CalibrationReport& repor
   return ProjectionUncertaintyOfViews(at_poses, OfHousing(report), HeldParams(report), report.residual_sigma_px);
 }
 
+HtmlVerdict HtmlVerdictOf(const CalibrationVerdict& verdict) {
+  HtmlVerdict html{VerdictStatusName(verdict.status), {}};
+  for (const VerdictLine& line : verdict.lines) html.lines.push_back({VerdictStatusName(line.status), line.rule, line.text});
+  return html;
+}
+
 HtmlReport CalibrationHtml(const CalibrationReport& report, const std::vector<CalibrationView>& views,
                            const std::string& title) {
   ViewsAtPoses at_poses{HousedCamera{report.camera, report.housing}, views, report.views, report.board_warp};
-  HtmlReport html{title, report.warnings, {}};
+  HtmlReport html{title, report.warnings, {}, {}};
+  if (report.verdict) html.verdict = HtmlVerdictOf(*report.verdict);
   ReportSection section{"The views", "", ViewPictures(at_poses, report.residual_sigma_px, "", "")};
   const bool housing = report.housing.has_value();
   const ProjectionUncertaintyGrid uncertainty =
@@ -91,7 +98,7 @@ HtmlReport CalibrationHtml(const CalibrationReport& report, const std::vector<Ca
 
 HtmlReport StereoCalibrationHtml(const StereoCalibrationResult& result, const std::vector<CalibrationView>& views1,
                                  const std::vector<CalibrationView>& views2, const std::string& report_text) {
-  HtmlReport html{"Stereo calibration", {}, {}};
+  HtmlReport html{"Stereo calibration", {}, {}, {}};
   std::vector<Rigid3d> cam1_from_target;
   for (const CalibratedView& view : result.views1) cam1_from_target.push_back(view.cam_from_target);
   html.sections.push_back({"The rig", "",
@@ -125,7 +132,7 @@ HtmlReport EvaluationHtml(const HeldOutEvaluation& evaluation, const std::vector
     calibrated.push_back(out);
   }
   const ViewsAtPoses at_poses{camera, views, calibrated, std::nullopt};
-  HtmlReport html{"Held-out evaluation", {}, {}};
+  HtmlReport html{"Held-out evaluation", {}, {}, {}};
   ReportSection section{"The held-out views", "", ViewPictures(at_poses, 0, "", ", held out")};
   const Eigen::MatrixXd length =
       (evaluation.mean_residual_x.array().square() + evaluation.mean_residual_y.array().square()).sqrt();
@@ -145,7 +152,8 @@ HtmlReport EvaluationHtml(const HeldOutEvaluation& evaluation, const std::vector
 }
 
 HtmlReport SelfCalibrationHtml(const CalibrationReport& report, const SparseModel& model, const std::string& title) {
-  HtmlReport html{title, report.warnings, {}};
+  HtmlReport html{title, report.warnings, {}, {}};
+  if (report.verdict) html.verdict = HtmlVerdictOf(*report.verdict);
   std::vector<Eigen::Vector3d> points;
   for (const auto& [id, point] : model.points3D) points.push_back(point.xyz);
   std::vector<Rigid3d> poses;

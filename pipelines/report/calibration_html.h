@@ -45,6 +45,9 @@ HtmlReport SelfCalibrationHtml(const CalibrationReport& report, const SparseMode
 HtmlReport CrossCheckHtml(const CalibrationReport& portcal, const std::vector<CalibrationView>& views,
                           const std::vector<ReportPicture>& difference_maps, const std::string& report_text);
 
+// The page's form of a verdict.
+HtmlVerdict HtmlVerdictOf(const CalibrationVerdict& verdict);
+
 // Writes `html` into `dir` (created). Throws InputError.
 void WriteHtml(const HtmlReport& html, const std::filesystem::path& dir);
 

@@ -66,15 +66,11 @@ std::vector<PointResidual> ResidualsAtPoses(const ViewsAtPoses& in) {
 }
 
 cv::Mat CoveragePicture(const Camera& camera, const std::vector<Eigen::Vector2d>& pixels, const std::string& what) {
-  // Cells of ~1/16 of the image width: fine enough to show a bare corner,
-  // coarse enough that one board's points fill several.
-  const int cols = 16, rows = std::max(2, static_cast<int>(std::lround(16.0 * camera.height / camera.width)));
-  Eigen::MatrixXd counts = Eigen::MatrixXd::Zero(rows, cols);
-  for (const Eigen::Vector2d& p : pixels) {
-    const int c = std::clamp(static_cast<int>(p.x() / camera.width * cols), 0, cols - 1);
-    const int r = std::clamp(static_cast<int>(p.y() / camera.height * rows), 0, rows - 1);
-    counts(r, c) += 1;
-  }
+  // The verdict's cells (calibration_verdict.h), so that the picture and
+  // the verdict count the same empty cells.
+  const Eigen::MatrixXd counts =
+      CoverageCounts(static_cast<int>(camera.width), static_cast<int>(camera.height), pixels).cast<double>();
+  const int rows = static_cast<int>(counts.rows()), cols = static_cast<int>(counts.cols());
   const int empty = static_cast<int>((counts.array() == 0).count());
   HeatMapStyle style;
   style.title = "Coverage: " + std::to_string(pixels.size()) + " " + what + ", " + std::to_string(empty) + " of " +

@@ -22,10 +22,21 @@ struct ReportSection {
   std::vector<ReportPicture> pictures;
 };
 
+// The verdict the page opens with (calibration_verdict.h's, as text).
+struct HtmlVerdictLine {
+  std::string status;  // "OK", "CHECK", "FAIL"
+  std::string rule, text;
+};
+struct HtmlVerdict {
+  std::string status;  // empty: the page has none
+  std::vector<HtmlVerdictLine> lines;
+};
+
 struct HtmlReport {
   std::string title;
-  std::vector<std::string> warnings;  // shown first, in red
+  std::vector<std::string> warnings;  // shown first, in red (after the verdict)
   std::vector<ReportSection> sections;
+  HtmlVerdict verdict;
 };
 
 // Writes the pictures, then report.html, into `dir` (which exists).

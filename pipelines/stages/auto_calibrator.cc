@@ -325,11 +325,13 @@ AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   lap("refractive_mapper + refractive_bundle_adjuster");
   std::optional<Database> database;
   if (options.update_database) database.emplace(database_path, Database::OpenMode::kReadWrite);
+  const SparseModel refined = ReadSparseModel(fs::path(options.output_path) / "refined");
+  // Judged again: the report gained this stage's own warnings.
+  result.refined.report.verdict =
+      JudgeCalibration(result.refined.report, refined, refined.cameras.empty() ? 0 : refined.cameras.begin()->first);
   WriteCalibrationOutput(result.refined.report, options.output_path, database ? &*database : nullptr,
                          database ? OnlyCameraId(&*database, database_path) : kInvalidCameraId, [&] {
-                           WriteHtml(SelfCalibrationHtml(result.refined.report,
-                                                         ReadSparseModel(fs::path(options.output_path) / "refined"),
-                                                         "Auto-calibration"),
+                           WriteHtml(SelfCalibrationHtml(result.refined.report, refined, "Auto-calibration"),
                                      options.output_path);
                          });
   std::string times;

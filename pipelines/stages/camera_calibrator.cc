@@ -47,6 +47,7 @@ CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& optio
     report.notes.push_back(BoardWarpNote(result, CalibrateCamera(views, camera, flat)));
   }
   report.projection_uncertainty = ProjectionUncertaintyOf(report, views);
+  report.verdict = JudgeCalibration(report, views);
   WriteCalibrationOutput(report, options.output_path, options.update_database ? &database : nullptr, camera_id,
                          [&] {
                            WriteCalibrationCameraModel(views, result, options.calibration, options.output_path);

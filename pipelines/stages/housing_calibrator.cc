@@ -129,6 +129,7 @@ HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& op
 
   CalibrationReport report = ReportOf(result, target_views.target);
   report.projection_uncertainty = ProjectionUncertaintyOf(report, views);
+  report.verdict = JudgeCalibration(report, views);
   WriteCalibrationOutput(report, options.output_path, options.update_database ? &database : nullptr, camera_id, [&] {
     WriteHtml(CalibrationHtml(report, views, "Housing calibration (" + housing.ModelName() + ")"), options.output_path);
   });

@@ -513,6 +513,7 @@ void WriteAdjusted(const RefractiveBundleAdjusterOptions& options, const Reconst
   report.notes = std::move(notes);
   report.warnings = std::move(warnings);
   const SparseModel model = r.ToSparseModel();
+  report.verdict = JudgeCalibration(report, model, camera_id);
   WriteSparseModel(model, options.output_path, ModelFormat::kBinary);
   WriteCalibrationReport(report, options.output_path);
   WriteHtml(SelfCalibrationHtml(report, model, "Refractive bundle adjustment"), options.output_path);

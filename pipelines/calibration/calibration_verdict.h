@@ -1,0 +1,81 @@
+// The verdict a report opens with: OK, CHECK or FAIL, and each rule's
+// finding, so that a person who reads one line knows whether to keep the
+// calibration and, if not, what to do. The rules and the figures behind
+// their thresholds: docs/calibration.md, "The verdict".
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "colmap_ext/io/sparse_model.h"
+
+namespace portcal {
+
+struct CalibrationReport;
+struct CalibrationView;
+
+enum class VerdictStatus { kOk = 0, kCheck = 1, kFail = 2 };
+std::string VerdictStatusName(VerdictStatus status);  // "OK", "CHECK", "FAIL"
+
+struct VerdictLine {
+  VerdictStatus status = VerdictStatus::kOk;
+  std::string rule;  // e.g. "residuals", "coverage"
+  std::string text;  // the finding, with its figures and, when not OK, what to do
+};
+
+struct CalibrationVerdict {
+  VerdictStatus status = VerdictStatus::kOk;  // the worst line's
+  std::vector<VerdictLine> lines;             // worst first, then in the rules' order
+
+  void Add(VerdictStatus line_status, const std::string& rule, const std::string& text);
+  // "CHECK (coverage: ...; views: ...)": the status and the lines not OK.
+  std::string Summary() const;
+};
+
+struct VerdictRules {
+  // The RMS reprojection error (px) above which the corners or the model
+  // are suspect, and above which the calibration is not usable.
+  double rms_check_px = 1.0;
+  double rms_fail_px = 3.0;
+  // Fewer kept views than this: CHECK (too few to separate the lens from
+  // the poses reliably, and to tell a bad view from a good one).
+  int min_views = 10;
+  // The fraction of the coverage grid's cells (coverage.png: 16 across)
+  // that must hold a corner, and how many of the image's corners (of a
+  // 3 x 3 split) may hold none.
+  double min_covered_fraction = 0.5;
+  int max_empty_image_corners = 1;
+  // mrcal's projection uncertainty, the worst cell (px): at the working
+  // distance (CHECK, FAIL) and at infinity (CHECK).
+  double uncertainty_check_px = 1.0;
+  double uncertainty_fail_px = 3.0;
+  double uncertainty_at_infinity_check_px = 2.0;
+  void Check() const;  // throws OptionError
+};
+
+// Coverage counts over the image: cols x rows cells (cols 16, rows in
+// proportion), as coverage.png draws them.
+Eigen::MatrixXi CoverageCounts(int width, int height, const std::vector<Eigen::Vector2d>& pixels);
+
+// Judges a target or self-calibration: its warnings (undetermined
+// parameters: FAIL; others: CHECK), RMS, outlier views, number of views,
+// coverage of `pixels` (the observations, COLMAP pixels), the projection
+// uncertainty when computed, and a housing whose lens was taken as exact.
+CalibrationVerdict JudgeCalibration(const CalibrationReport& report, const std::vector<Eigen::Vector2d>& pixels,
+                                    const VerdictRules& rules = VerdictRules());
+// The same, the pixels those of a target calibration's `views`.
+CalibrationVerdict JudgeCalibration(const CalibrationReport& report, const std::vector<CalibrationView>& views,
+                                    const VerdictRules& rules = VerdictRules());
+
+// The same, the pixels those of camera `camera_id`'s observations of the
+// model's points (a self-calibration's).
+CalibrationVerdict JudgeCalibration(const CalibrationReport& report, const SparseModel& model, camera_t camera_id,
+                                    const VerdictRules& rules = VerdictRules());
+
+// calibration.txt's verdict block and calibration.yaml's `verdict:` key
+// (status, reasons: the lines not OK, findings: every line).
+std::string VerdictText(const CalibrationVerdict& verdict);
+std::string VerdictYaml(const CalibrationVerdict& verdict);
+
+}  // namespace portcal
