@@ -261,7 +261,7 @@ double ProjectionUncertaintyGrid::Max(bool at_infinity) const {
 
 std::string WriteStereoCalibrationReport(const StereoCalibrationResult& r, const HousedCamera& camera1,
                                   const HousedCamera& camera2, const std::string& target_description,
-                                  const fs::path& dir) {
+                                  const fs::path& dir, const CalibrationVerdict* verdict) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (!fs::is_directory(dir)) throw InputError(dir.string() + ": cannot create output directory");
@@ -292,7 +292,9 @@ std::string WriteStereoCalibrationReport(const StereoCalibrationResult& r, const
          << "\n  image2: '" << r.views2[f].image_name << "'\n  rms2: " << Num(r.views2[f].rms_px) << "\n";
   }
   std::ostringstream text;
-  text << std::fixed << "portcal stereo calibration\n==========================\n\nTarget: "
+  if (verdict) yaml << VerdictYaml(*verdict);
+  text << "portcal stereo calibration\n==========================\n\n" << (verdict ? VerdictText(*verdict) + "\n" : "");
+  text << std::fixed << "Target: "
        << target_description << "\n\ncam2_from_cam1 (camera 2 from camera 1)\n" << std::setprecision(6)
        << "  rotation (w, x, y, z)   " << q[0] << " " << q[1] << " " << q[2] << " " << q[3]
        << "\n  translation (m)         " << r.cam2_from_cam1.translation.transpose()

@@ -91,11 +91,11 @@ void WriteCalibrationReport(const CalibrationReport& report, const std::filesyst
 
 // Stereo: calibmar's cam_to_world_rotation_rowmajor / cam_to_world_translation
 // (camera 2 in the camera-1 frame), cam2_from_cam1 (rotation_wxyz,
-// translation) with standard deviations, and a block per camera. Returns
-// calibration.txt's text.
+// translation) with standard deviations, and a block per camera; the
+// verdict first when given. Returns calibration.txt's text.
 std::string WriteStereoCalibrationReport(const StereoCalibrationResult& result, const HousedCamera& camera1,
                                   const HousedCamera& camera2, const std::string& target_description,
-                                  const std::filesystem::path& dir);
+                                  const std::filesystem::path& dir, const CalibrationVerdict* verdict = nullptr);
 
 // Reads the camera (and housing) of a calibration.yaml written by portcal or
 // calibmar, and portcal's standard deviations, board warp, target, notes and per-view table

@@ -134,6 +134,9 @@ CalibrationReport ReadCalibrationReportUnguarded(const fs::path& path) {
       report.housing_covariance =
           ReadCovariance(root, "non_svp_parameters_covariance", report.housing->params.size(), path);
     }
+    if (root["overall_rms"]) report.overall_rms_px = root["overall_rms"].as<double>();
+    if (root["residual_sigma_px"]) report.residual_sigma_px = root["residual_sigma_px"].as<double>();
+    if (root["num_points"]) report.num_points = root["num_points"].as<int>();
     if (root["per_view"]) {
       for (const YAML::Node& entry : root["per_view"]) {
         CalibratedView view;

@@ -7,6 +7,8 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/string_utils.h"
 #include "pipelines/calibration/calibration_report.h"
+#include "pipelines/calibration/held_out_evaluation.h"
+#include "pipelines/calibration/stereo_calibration.h"
 
 namespace portcal {
 
@@ -39,6 +41,9 @@ void VerdictRules::Check() const {
   if (!(min_covered_fraction >= 0 && min_covered_fraction <= 1)) {
     throw OptionError("verdict min_covered_fraction", FormatShortest(min_covered_fraction), "in [0, 1]");
   }
+  if (!(held_out_ratio_check > 1 && pattern_ratio_check > 1)) {
+    throw OptionError("verdict held-out ratios", FormatShortest(held_out_ratio_check), "> 1");
+  }
   if (!(uncertainty_check_px > 0 && uncertainty_fail_px >= uncertainty_check_px && uncertainty_at_infinity_check_px > 0)) {
     throw OptionError("verdict uncertainty thresholds", FormatShortest(uncertainty_check_px), "0 < check <= fail");
   }
@@ -60,16 +65,21 @@ Eigen::MatrixXi CoverageCounts(int width, int height, const std::vector<Eigen::V
 
 namespace {
 
+std::vector<Eigen::Vector2d> PixelsOf(const std::vector<CalibrationView>& views) {
+  std::vector<Eigen::Vector2d> pixels;
+  for (const CalibrationView& view : views) pixels.insert(pixels.end(), view.pixels.begin(), view.pixels.end());
+  return pixels;
+}
+
 std::string Joined(const std::vector<std::string>& words) {
   std::string text;
   for (size_t i = 0; i < words.size(); ++i) text += (i == 0 ? "" : i + 1 == words.size() ? " and " : ", ") + words[i];
   return text;
 }
 
-void JudgeResiduals(const CalibrationReport& report, const VerdictRules& rules, CalibrationVerdict* verdict) {
-  const double rms = report.overall_rms_px;
+void JudgeRms(double rms, int num_points, const VerdictRules& rules, CalibrationVerdict* verdict) {
   std::ostringstream text;
-  text << "RMS " << FormatFixed(rms, 3) << " px over " << report.num_points << " points";
+  text << "RMS " << FormatFixed(rms, 3) << " px over " << num_points << " points";
   if (!std::isfinite(rms)) {
     verdict->Add(VerdictStatus::kFail, "residuals", "the RMS is not a number: the solve failed");
   } else if (rms > rules.rms_fail_px) {
@@ -85,10 +95,10 @@ void JudgeResiduals(const CalibrationReport& report, const VerdictRules& rules, 
   }
 }
 
-void JudgeViews(const CalibrationReport& report, const VerdictRules& rules, CalibrationVerdict* verdict) {
+void JudgeViews(const std::vector<CalibratedView>& views, const VerdictRules& rules, CalibrationVerdict* verdict) {
   int kept = 0;
   std::vector<std::string> outliers;
-  for (const CalibratedView& view : report.views) {
+  for (const CalibratedView& view : views) {
     if (view.dropped) continue;
     ++kept;
     if (view.outlier) outliers.push_back(view.image_name);
@@ -109,9 +119,9 @@ void JudgeViews(const CalibrationReport& report, const VerdictRules& rules, Cali
   }
 }
 
-void JudgeCoverage(const CalibrationReport& report, const std::vector<Eigen::Vector2d>& pixels,
-                   const VerdictRules& rules, CalibrationVerdict* verdict) {
-  const int width = static_cast<int>(report.camera.width), height = static_cast<int>(report.camera.height);
+void JudgeCoverage(const Camera& camera, const std::vector<Eigen::Vector2d>& pixels, const VerdictRules& rules,
+                   const std::string& rule, CalibrationVerdict* verdict) {
+  const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
   const Eigen::MatrixXi counts = CoverageCounts(width, height, pixels);
   const int cells = static_cast<int>(counts.size()), empty = static_cast<int>((counts.array() == 0).count());
   const double covered = cells > 0 ? 1.0 - static_cast<double>(empty) / cells : 0;
@@ -137,9 +147,9 @@ void JudgeCoverage(const CalibrationReport& report, const std::vector<Eigen::Vec
   // set's bottom-left): the uncertainty rule judges what it costs there.
   if (covered < rules.min_covered_fraction || static_cast<int>(empty_corners.size()) > rules.max_empty_image_corners) {
     text << ": the lens is extrapolated over the dark cells of coverage.png; add views that fill them";
-    verdict->Add(VerdictStatus::kCheck, "coverage", text.str());
+    verdict->Add(VerdictStatus::kCheck, rule, text.str());
   } else {
-    verdict->Add(VerdictStatus::kOk, "coverage", text.str());
+    verdict->Add(VerdictStatus::kOk, rule, text.str());
   }
 }
 
@@ -180,9 +190,9 @@ CalibrationVerdict JudgeCalibration(const CalibrationReport& report, const std::
     const bool undetermined = warning.rfind("the views do not determine", 0) == 0;
     verdict.Add(undetermined ? VerdictStatus::kFail : VerdictStatus::kCheck, "warning", warning);
   }
-  JudgeResiduals(report, rules, &verdict);
-  JudgeViews(report, rules, &verdict);
-  JudgeCoverage(report, pixels, rules, &verdict);
+  JudgeRms(report.overall_rms_px, report.num_points, rules, &verdict);
+  JudgeViews(report.views, rules, &verdict);
+  JudgeCoverage(report.camera, pixels, rules, "coverage", &verdict);
   if (report.projection_uncertainty) JudgeUncertainty(*report.projection_uncertainty, rules, &verdict);
   for (const std::string& note : report.notes) {
     if (note.find("taken as exact") != std::string::npos) {
@@ -196,9 +206,7 @@ CalibrationVerdict JudgeCalibration(const CalibrationReport& report, const std::
 
 CalibrationVerdict JudgeCalibration(const CalibrationReport& report, const std::vector<CalibrationView>& views,
                                     const VerdictRules& rules) {
-  std::vector<Eigen::Vector2d> pixels;
-  for (const CalibrationView& view : views) pixels.insert(pixels.end(), view.pixels.begin(), view.pixels.end());
-  return JudgeCalibration(report, pixels, rules);
+  return JudgeCalibration(report, PixelsOf(views), rules);
 }
 
 CalibrationVerdict JudgeCalibration(const CalibrationReport& report, const SparseModel& model, camera_t camera_id,
@@ -211,6 +219,83 @@ CalibrationVerdict JudgeCalibration(const CalibrationReport& report, const Spars
     }
   }
   return JudgeCalibration(report, pixels, rules);
+}
+
+CalibrationVerdict JudgeStereo(const StereoCalibrationResult& result, const std::vector<CalibrationView>& views1,
+                               const std::vector<CalibrationView>& views2, const VerdictRules& rules) {
+  rules.Check();
+  CalibrationVerdict verdict;
+  JudgeRms(result.overall_rms_px, result.num_points, rules, &verdict);
+  // A frame is an outlier where either camera's view is.
+  std::vector<CalibratedView> frames = result.views1;
+  for (size_t f = 0; f < frames.size() && f < result.views2.size(); ++f) {
+    if (result.views2[f].outlier) {
+      frames[f].outlier = true;
+      frames[f].image_name += " / " + result.views2[f].image_name;
+    }
+  }
+  JudgeViews(frames, rules, &verdict);
+  JudgeCoverage(result.camera1, PixelsOf(views1), rules, "coverage, camera 1", &verdict);
+  JudgeCoverage(result.camera2, PixelsOf(views2), rules, "coverage, camera 2", &verdict);
+  const double baseline = result.cam2_from_cam1.translation.norm();
+  const double baseline_sigma = result.translation_std_dev.norm();
+  std::ostringstream text;
+  text << "baseline " << FormatFixed(1000 * baseline, 2) << " +- " << FormatFixed(1000 * baseline_sigma, 2) << " mm";
+  if (!std::isfinite(baseline_sigma) || (result.translation_std_dev.array() < 0).any()) {
+    verdict.Add(VerdictStatus::kFail, "rig", text.str() + ": the frames do not determine the rig");
+  } else {
+    verdict.Add(VerdictStatus::kOk, "rig", text.str());
+  }
+  return verdict;
+}
+
+CalibrationVerdict JudgeHeldOut(const HeldOutEvaluation& evaluation, const CalibrationReport& input,
+                                const std::vector<FoldEvaluation>& folds, double cross_validation_rms_px,
+                                const VerdictRules& rules) {
+  rules.Check();
+  CalibrationVerdict verdict;
+  JudgeRms(evaluation.rms_px, evaluation.num_points, rules, &verdict);
+  if (input.overall_rms_px > 0 && evaluation.rms_px > rules.held_out_ratio_check * input.overall_rms_px) {
+    verdict.Add(VerdictStatus::kCheck, "held out",
+                "these views' RMS " + FormatFixed(evaluation.rms_px, 3) + " px is " +
+                    FormatFixed(evaluation.rms_px / input.overall_rms_px, 2) + "x the calibration's own (" +
+                    FormatFixed(input.overall_rms_px, 3) +
+                    " px): it does not carry to them (another focus, housing or camera?)");
+  }
+  std::ostringstream pattern;
+  pattern << "residual pattern " << FormatFixed(evaluation.systematic_px, 3) << " px, the cells' own scatter "
+          << FormatFixed(evaluation.noise_floor_px, 3) << " px";
+  if (evaluation.noise_floor_px > 0 && evaluation.systematic_px > rules.pattern_ratio_check * evaluation.noise_floor_px) {
+    pattern << " (> " << FormatShortest(rules.pattern_ratio_check)
+            << "x): the model misses something over part of the image (pattern.png shows where)";
+    verdict.Add(VerdictStatus::kCheck, "pattern", pattern.str());
+  } else {
+    verdict.Add(VerdictStatus::kOk, "pattern", pattern.str());
+  }
+  std::vector<std::string> skipped;
+  for (const ViewEvaluation& view : evaluation.views) {
+    if (!view.evaluated) skipped.push_back(view.image_name + " (" + view.why + ")");
+  }
+  if (!skipped.empty()) {
+    std::vector<std::string> named(skipped.begin(), skipped.begin() + std::min<size_t>(skipped.size(), 3));
+    if (skipped.size() > 3) named.push_back(std::to_string(skipped.size() - 3) + " more");
+    verdict.Add(VerdictStatus::kCheck, "views", std::to_string(skipped.size()) + " view(s) not evaluated: " + Joined(named));
+  }
+  if (!folds.empty()) {
+    double train = 0;
+    for (const FoldEvaluation& fold : folds) train += fold.train_rms_px / folds.size();
+    std::ostringstream text;
+    text << folds.size() << "-fold cross-validation: held-out RMS " << FormatFixed(cross_validation_rms_px, 3)
+         << " px, training " << FormatFixed(train, 3) << " px";
+    if (train > 0 && cross_validation_rms_px > rules.held_out_ratio_check * train) {
+      text << " (> " << FormatShortest(rules.held_out_ratio_check)
+           << "x): the model fits its own views better than new ones (too many parameters for the views?)";
+      verdict.Add(VerdictStatus::kCheck, "cross-validation", text.str());
+    } else {
+      verdict.Add(VerdictStatus::kOk, "cross-validation", text.str());
+    }
+  }
+  return verdict;
 }
 
 std::string VerdictText(const CalibrationVerdict& verdict) {

@@ -14,6 +14,9 @@ namespace portcal {
 
 struct CalibrationReport;
 struct CalibrationView;
+struct FoldEvaluation;
+struct StereoCalibrationResult;
+struct HeldOutEvaluation;
 
 enum class VerdictStatus { kOk = 0, kCheck = 1, kFail = 2 };
 std::string VerdictStatusName(VerdictStatus status);  // "OK", "CHECK", "FAIL"
@@ -51,6 +54,11 @@ struct VerdictRules {
   double uncertainty_check_px = 1.0;
   double uncertainty_fail_px = 3.0;
   double uncertainty_at_infinity_check_px = 2.0;
+  // Held out: views fitted this much worse than the calibration's own
+  // (or its folds' training) RMS; a residual pattern this many times the
+  // cells' own scatter (held_out_evaluation.h).
+  double held_out_ratio_check = 1.25;
+  double pattern_ratio_check = 3.0;
   void Check() const;  // throws OptionError
 };
 
@@ -72,6 +80,19 @@ CalibrationVerdict JudgeCalibration(const CalibrationReport& report, const std::
 // model's points (a self-calibration's).
 CalibrationVerdict JudgeCalibration(const CalibrationReport& report, const SparseModel& model, camera_t camera_id,
                                     const VerdictRules& rules = VerdictRules());
+
+// Judges a stereo calibration of the frames' views: RMS, frames and their
+// outliers, each camera's coverage, and whether the rig is determined.
+CalibrationVerdict JudgeStereo(const StereoCalibrationResult& result, const std::vector<CalibrationView>& views1,
+                               const std::vector<CalibrationView>& views2, const VerdictRules& rules = VerdictRules());
+
+// Judges a held-out evaluation of `input` (its RMS, when it has one, is
+// the fit's own): the held-out RMS against the thresholds and against the
+// fit's, the residual pattern, the views not evaluated, and with `folds`
+// the cross-validation's held-out against training RMS.
+CalibrationVerdict JudgeHeldOut(const HeldOutEvaluation& evaluation, const CalibrationReport& input,
+                                const std::vector<FoldEvaluation>& folds, double cross_validation_rms_px,
+                                const VerdictRules& rules = VerdictRules());
 
 // calibration.txt's verdict block and calibration.yaml's `verdict:` key
 // (status, reasons: the lines not OK, findings: every line).

@@ -79,9 +79,35 @@ std::string CrossCheckResult::Verdict() const {
   return line;
 }
 
+void AddCrossCheckFindings(const CrossCheckResult& r, CalibrationVerdict* verdict) {
+  const std::string diff = "portcal vs mrcal p95 " + FormatFixed(r.diff.p95_px, 3) + " px";
+  if (r.pass) {
+    verdict->Add(VerdictStatus::kOk, "mrcal", diff + " <= " + FormatFixed(r.max_diff_px, 3) + " px: they agree");
+  } else {
+    std::string text = diff + " > " + FormatFixed(r.max_diff_px, 3) + " px: they disagree";
+    if (!r.causes.empty()) text += "; likely cause: " + r.causes.front();
+    if (r.rerun_diff) {
+      text += r.rerun_diff->p95_px <= r.max_diff_px
+                  ? "; " + r.rerun_description + " agrees (p95 " + FormatFixed(r.rerun_diff->p95_px, 3) +
+                        " px): calibrate so"
+                  : "; " + r.rerun_description + " still disagrees";
+    }
+    verdict->Add(VerdictStatus::kCheck, "mrcal", text);
+  }
+  for (const CrossValidation& cv : r.cross_validations) {
+    // consistent / NOT consistent: CrossValidate's threshold (2x the
+    // predicted spread).
+    const bool consistent = cv.verdict.rfind("NOT", 0) != 0;
+    verdict->Add(consistent ? VerdictStatus::kOk : VerdictStatus::kCheck, "folds",
+                 cv.settings + ": " + cv.verdict);
+  }
+}
+
 std::string CrossCheckText(const CrossCheckResult& r) {
   std::ostringstream out;
-  out << "portcal cross_check\n===================\n\n"
+  out << "portcal cross_check\n===================\n\n";
+  if (r.verdict) out << VerdictText(*r.verdict) << "\n";
+  out
       << "Camera model " << r.camera_model << " (mrcal: " << r.mrcal_lensmodel << "), " << r.num_views
       << " views, " << r.num_points << " corners\n"
       << "RMS reprojection error: portcal " << FormatFixed(r.portcal_rms_px, 4) << " px, mrcal "
@@ -166,6 +192,7 @@ std::string WriteCrossCheckReport(const CrossCheckResult& r, const std::filesyst
            << ", predicted_p95_px: " << f.predicted_p95_px << "}\n";
     }
   }
+  if (r.verdict) yaml << VerdictYaml(*r.verdict);
   const std::string text = CrossCheckText(r);
   WriteFileAtomically(dir / "cross_check.yaml", false, [&](std::ostream& out) { out << yaml.str(); });
   WriteFileAtomically(dir / "cross_check.txt", false, [&](std::ostream& out) { out << text; });

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "pipelines/calibration/calibration_verdict.h"
 #include "pipelines/crosscheck/projection_diff.h"
 
 namespace portcal {
@@ -56,8 +57,18 @@ struct CrossCheckResult {
   // With --CrossCheck.folds: the input's settings, then the re-run's.
   std::vector<CrossValidation> cross_validations;
 
+  // What the report opens with: portcal's calibration of the views judged
+  // (JudgeCalibration), then this comparison's findings
+  // (AddCrossCheckFindings).
+  std::optional<CalibrationVerdict> verdict;
+
   std::string Verdict() const;  // the last line: "PASS ..." / "FAIL ..."
 };
+
+// mrcal's agreement (CHECK when it disagrees, naming the likely cause and
+// whether the re-run agrees) and each cross-validation's consistency
+// (CHECK when NOT consistent), added to `verdict`.
+void AddCrossCheckFindings(const CrossCheckResult& result, CalibrationVerdict* verdict);
 
 std::string CrossCheckText(const CrossCheckResult& result);
 // Writes cross_check.txt and cross_check.yaml into `dir`, atomically.

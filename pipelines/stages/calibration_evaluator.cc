@@ -69,6 +69,9 @@ void WriteEvaluation(const CalibrationEvaluatorOptions& options, const Calibrati
        << "\nrms_px: " << Number(e.rms_px) << "\nnum_points: " << e.num_points
        << "\nsystematic_px: " << Number(e.systematic_px) << "\nnoise_floor_px: " << Number(e.noise_floor_px)
        << "\nviews:\n";
+  const CalibrationVerdict verdict =
+      JudgeHeldOut(e, report, summary.folds, summary.cross_validation_rms_px);
+  text << VerdictText(verdict) << "\n";
   text << "Held-out evaluation: " << options.input_calibration << " (" << report.camera.ModelName()
        << (report.housing ? " + " + report.housing->ModelName() : std::string()) << ") on " << options.database_path
        << "\n\n" << std::fixed << std::setprecision(4) << "RMS " << e.rms_px << " px over " << e.num_points
@@ -108,9 +111,11 @@ void WriteEvaluation(const CalibrationEvaluatorOptions& options, const Calibrati
   fs::create_directories(dir, error);
   if (!fs::is_directory(dir)) throw InputError(dir.string() + ": cannot create the output folder");
   const std::string yaml_text = yaml.str(), text_text = text.str();
-  WriteFileAtomically(dir / "evaluation.yaml", false, [&](std::ostream& out) { out << yaml_text; });
+  WriteFileAtomically(dir / "evaluation.yaml", false, [&](std::ostream& out) { out << yaml_text << VerdictYaml(verdict); });
   WriteFileAtomically(dir / "evaluation.txt", false, [&](std::ostream& out) { out << text_text; });
-  WriteHtml(EvaluationHtml(summary.evaluation, views, {report.camera, report.housing}, text_text), dir);
+  HtmlReport html = EvaluationHtml(summary.evaluation, views, {report.camera, report.housing}, text_text);
+  html.verdict = HtmlVerdictOf(verdict);
+  WriteHtml(html, dir);
 }
 
 }  // namespace

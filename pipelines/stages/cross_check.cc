@@ -377,10 +377,13 @@ CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& 
                                                        dir / "cross_validation_diff_rerun.png"));
     }
   }
+  CalibrationReport portcal_report = ReportOf(portcal, settings.estimate_board_warp, input.target_description);
+  portcal_report.projection_uncertainty = ProjectionUncertaintyOf(portcal_report, views);
+  result.verdict = JudgeCalibration(portcal_report, views);
+  AddCrossCheckFindings(result, &*result.verdict);
+  portcal_report.verdict = result.verdict;
   const std::string text = WriteCrossCheckReport(result, dir);
-  WriteHtml(CrossCheckHtml(ReportOf(portcal, settings.estimate_board_warp, input.target_description), views,
-                           DifferenceMaps(result, options), text),
-            dir);
+  WriteHtml(CrossCheckHtml(portcal_report, views, DifferenceMaps(result, options), text), dir);
   LOG(INFO) << "cross_check: " << result.Verdict();
   new_output.Keep();
   return result;

@@ -103,14 +103,17 @@ StereoCalibratorSummary RunStereoCalibrator(const StereoCalibratorOptions& optio
   const HousedCamera camera2 = CameraFor(options.input_calibration2, *database.ReadCamera(id2), views2,
                                       options.stereo.num_threads);
   const StereoCalibrationResult result = CalibrateStereo(frames, camera1, camera2, options.stereo);
-  const std::string text =
-      WriteStereoCalibrationReport(result, camera1, camera2, target_views.target, options.output_path);
   std::vector<CalibrationView> used1, used2;
   for (const StereoFrame& frame : frames) {
     used1.push_back(frame.cam1);
     used2.push_back(frame.cam2);
   }
-  WriteHtml(StereoCalibrationHtml(result, used1, used2, text), options.output_path);
+  const CalibrationVerdict verdict = JudgeStereo(result, used1, used2);
+  const std::string text =
+      WriteStereoCalibrationReport(result, camera1, camera2, target_views.target, options.output_path, &verdict);
+  HtmlReport html = StereoCalibrationHtml(result, used1, used2, text);
+  html.verdict = HtmlVerdictOf(verdict);
+  WriteHtml(html, options.output_path);
   LOG(INFO) << "stereo_calibrator: baseline " << result.cam2_from_cam1.translation.norm() << " m, RMS "
             << result.overall_rms_px << " px -> " << options.output_path;
   new_output.Keep();

@@ -4,7 +4,7 @@
 # in a temporary folder (the doc works in ~/portcal-quickstart); then every
 # figure its outputs show with a standard deviation (the lens's fx ... k1,
 # the dome's centre) must be within one standard deviation of today's, and
-# its point counts equal. Skipped (77) without ../shared's real dome set.
+# its point counts and verdicts equal. Skipped (77) without ../shared's real dome set.
 # Usage: quickstart_doc_test.sh CHECKOUT BUILD_DIR
 set -euo pipefail
 checkout="$(realpath "$1")"
@@ -55,6 +55,15 @@ for shown_count, now_count in zip(doc_counts, now_counts):
     ok = shown_count == now_count
     failures += not ok
     print(f'points: doc {shown_count}, today {now_count}: {"ok" if ok else "DRIFTED"}')
+verdict = re.compile(r'^Verdict: (OK|CHECK|FAIL)$', re.M)
+doc_verdicts, now_verdicts = verdict.findall(doc), verdict.findall(air + water)
+for shown_verdict, now_verdict in zip(doc_verdicts, now_verdicts):
+    ok = shown_verdict == now_verdict
+    failures += not ok
+    print(f'verdict: doc {shown_verdict}, today {now_verdict}: {"ok" if ok else "DRIFTED"}')
+if len(doc_verdicts) != 2 or len(now_verdicts) != 2:
+    print(f'quickstart_doc_test: {len(doc_verdicts)} verdicts in the doc, {len(now_verdicts)} today; expected 2')
+    failures += 1
 if len(shown) < 8 or len(doc_counts) < 2:
     print(f'quickstart_doc_test: the doc shows {len(shown)} figures and {len(doc_counts)} point counts; expected >= 8 and 2')
     failures += 1

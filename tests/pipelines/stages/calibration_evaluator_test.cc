@@ -6,6 +6,7 @@
 #include "pipelines/stages/calibration_evaluator.h"
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include "colmap_ext/io/ground_truth.h"
 #include "colmap_ext/util/error.h"
@@ -39,11 +40,13 @@ struct Fixture {
     options.output_path = (dir / "evaluation").string();
   }
 
-  // The truth, with k1 moved by `dk1`, as a calibration.yaml.
-  std::string Calibration(const std::string& name, double dk1) const {
+  // The truth, with k1 moved by `dk1`, as a calibration.yaml whose own
+  // RMS (of the views it was fitted to) is `own_rms_px` (0: none).
+  std::string Calibration(const std::string& name, double dk1, double own_rms_px = 0) const {
     CalibrationReport report;
     report.camera = truth.camera;
     report.camera.params[4] += dk1;
+    report.overall_rms_px = own_rms_px;
     WriteCalibrationReport(report, dir / name);
     return (dir / name / "calibration.yaml").string();
   }
@@ -51,10 +54,15 @@ struct Fixture {
 
 TEST(CalibrationEvaluator, AWrongLensShowsInTheRmsAndInThePattern) {
   Fixture f;
-  f.options.input_calibration = f.Calibration("truth", 0);
+  // Each as if fitted to views like these: its own RMS the corners' noise
+  // (the truth's held-out RMS below, 0.030 px).
+  f.options.input_calibration = f.Calibration("truth", 0, 0.03);
   const HeldOutEvaluation right = RunCalibrationEvaluator(f.options, NoProgress()).evaluation;
-  f.options.input_calibration = f.Calibration("wrong", 0.02);
+  const std::string right_status =
+      YAML::LoadFile(f.options.output_path + "/evaluation.yaml")["verdict"]["status"].as<std::string>();
+  f.options.input_calibration = f.Calibration("wrong", 0.02, 0.03);
   const HeldOutEvaluation wrong = RunCalibrationEvaluator(f.options, NoProgress()).evaluation;
+  const YAML::Node wrong_verdict = YAML::LoadFile(f.options.output_path + "/evaluation.yaml")["verdict"];
   std::printf("held out: true lens %.4f px (pattern %.4f, noise alone %.4f); k1 + 0.02: %.4f px (pattern %.4f)\n",
               right.rms_px, right.systematic_px, right.noise_floor_px, wrong.rms_px, wrong.systematic_px);
   EXPECT_EQ(right.views.size(), 12u);
@@ -73,6 +81,14 @@ TEST(CalibrationEvaluator, AWrongLensShowsInTheRmsAndInThePattern) {
   EXPECT_GT(wrong.systematic_px, 4 * right.systematic_px);
   EXPECT_TRUE(fs::exists(fs::path(f.options.output_path) / "evaluation.yaml"));
   EXPECT_TRUE(fs::exists(fs::path(f.options.output_path) / "evaluation.txt"));
+  // The verdict: the truth OK; the wrong lens CHECK, these views fitted
+  // far worse than the calibration's own (its pattern against its own
+  // cells' scatter stays below the rule's 3x, as said above).
+  EXPECT_EQ(right_status, "OK");
+  EXPECT_EQ(wrong_verdict["status"].as<std::string>(), "CHECK");
+  ASSERT_GE(wrong_verdict["reasons"].size(), 1u);
+  EXPECT_EQ(wrong_verdict["reasons"][0].as<std::string>().rfind("held out: ", 0), 0u) << YAML::Dump(wrong_verdict);
+  EXPECT_EQ(testing::ReadFileToString(fs::path(f.options.output_path) / "evaluation.txt").rfind("Verdict: CHECK", 0), 0u);
 }
 
 TEST(CalibrationEvaluator, CrossValidationHoldsEachViewOutOnce) {

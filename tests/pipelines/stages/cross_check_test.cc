@@ -426,6 +426,14 @@ TEST(CrossCheck, RealInAirSetBlamesTheBoardWarp) {
   EXPECT_EQ(result.causes.front().rfind("board warp", 0), 0u) << result.causes.front();
   ASSERT_TRUE(result.rerun_diff.has_value());
   EXPECT_LT(result.rerun_diff->p95_px, result.max_diff_px);
+  // The verdict: CHECK, for mrcal's disagreement, naming the re-run that
+  // agrees; first in cross_check.txt.
+  ASSERT_TRUE(result.verdict.has_value());
+  EXPECT_EQ(result.verdict->status, VerdictStatus::kCheck) << result.verdict->Summary();
+  EXPECT_EQ(result.verdict->lines.front().rule, "mrcal");
+  EXPECT_NE(result.verdict->lines.front().text.find("agrees"), std::string::npos) << result.verdict->lines.front().text;
+  EXPECT_EQ(testing::ReadFileToString(dir / "check/cross_check.txt").find("Verdict: CHECK"),
+            testing::ReadFileToString(dir / "check/cross_check.txt").find("Verdict:"));
 }
 
 }  // namespace
