@@ -6,6 +6,7 @@
 #include "colmap_ext/util/string_utils.h"
 #include "pipelines/report/calibration_pictures.h"
 #include "pipelines/report/geometry_pictures.h"
+#include "pipelines/report/lens_pictures.h"
 #include "pipelines/report/picture.h"
 
 namespace portcal {
@@ -18,12 +19,24 @@ std::vector<Eigen::Vector2d> AllPixels(const std::vector<CalibrationView>& views
   return pixels;
 }
 
-// Coverage, per-view RMS and residual vectors of views at their poses,
-// file names prefixed by `prefix`.
+// Coverage, per-view RMS, residual vectors and the residuals' histogram of
+// views at their poses, file names prefixed by `prefix`. The histogram's
+// Gaussian has the fit's residual sigma, or where there is none (held-out
+// views) the residuals' own RMS per axis.
 std::vector<ReportPicture> ViewPictures(const ViewsAtPoses& at_poses, double residual_sigma_px,
                                         const std::string& prefix, const std::string& what) {
   const Camera& camera = at_poses.camera.camera;
   const int num_views = static_cast<int>(at_poses.calibrated.size());
+  const std::vector<PointResidual> residuals = ResidualsAtPoses(at_poses);
+  std::vector<Eigen::Vector2d> kept;
+  double sum_squares = 0;
+  for (const PointResidual& r : residuals) {
+    if (r.dropped) continue;
+    kept.push_back(r.residual);
+    sum_squares += r.residual.squaredNorm();
+  }
+  const double sigma = residual_sigma_px > 0 ? residual_sigma_px
+                                             : std::sqrt(sum_squares / std::max<size_t>(1, 2 * kept.size()));
   return {
       {prefix + "coverage.png",
        "Where the corners lie over the image" + what +
@@ -36,7 +49,11 @@ std::vector<ReportPicture> ViewPictures(const ViewsAtPoses& at_poses, double res
       {prefix + "residuals.png",
        "Residual vectors (observed - predicted), magnified, one colour per view. Noise points every way; arrows "
        "that line up or swirl over a region mean the model does not fit there.",
-       ResidualVectorsPicture(camera, ResidualsAtPoses(at_poses), num_views, "Residuals" + what)},
+       ResidualVectorsPicture(camera, residuals, num_views, "Residuals" + what)},
+      {prefix + "residual_histogram.png",
+       "The residuals' x and y components against the Gaussian of the fitted noise (red). Noise follows the "
+       "curve; a heavier tail, or a peak off zero, is outliers or a model error.",
+       ResidualHistogramPicture(kept, sigma, "Residuals" + what)},
   };
 }
 
@@ -86,7 +103,34 @@ HtmlReport CalibrationHtml(const CalibrationReport& report, const std::vector<Ca
            " uncertainty given these views: mrcal's measure (mean-frames), the point fixed to the targets, not "
            "to the camera (the line: the mean). It grows where the views give little information.",
        UncertaintyPicture(uncertainty, static_cast<int>(report.camera.width), static_cast<int>(report.camera.height))});
+  section.pictures.push_back(
+      {"uncertainty_infinity.png",
+       "The same at infinity: how far a distant point's projection may be off (it grows where the views were all "
+       "near, and with what the lens's far field was not seen).",
+       UncertaintyPicture(uncertainty, static_cast<int>(report.camera.width), static_cast<int>(report.camera.height),
+                          true)});
   html.sections.push_back(section);
+  std::vector<ReportPicture> lens{
+      {"distortion.png",
+       "How far each pixel's ray lands from where a pinhole of the same focal lengths and principal point puts it "
+       "(iso-lines at 1, 10 and 100 px). The white outline is where corners were seen: outside it the model is "
+       "extrapolated.",
+       DistortionPicture(report.camera, AllPixels(views))}};
+  const bool lens_estimated = report.parameters_covariance.size() > 0 && report.parameters_covariance.diagonal().maxCoeff() > 0;
+  const cv::Mat correlation =
+      lens_estimated ? CorrelationPicture(report.parameters_covariance, SplitTokens(report.camera.ParamsInfo(), ", "),
+                                          "Correlation of the intrinsics")
+      : report.housing && report.housing_covariance.size() > 0
+          ? CorrelationPicture(report.housing_covariance, SplitTokens(report.housing->ParamsInfo(), ", "),
+                               "Correlation of the housing's parameters")
+          : cv::Mat();
+  if (!correlation.empty()) {
+    lens.push_back({"correlation.png",
+                    "The estimated parameters' correlations (held ones left out): near +-1, the views could not tell "
+                    "the two apart, and their values trade against each other (e.g. fx with a dome's axial offset).",
+                    correlation});
+  }
+  html.sections.push_back({"The lens", "", lens});
   if (housing) {
     html.sections.push_back({"The housing", "",
                              {{"housing.png", "The housing to scale, from above and from the side.",

@@ -166,16 +166,16 @@ ProjectionUncertaintyGrid ProjectionUncertaintyOfViews(const ViewsAtPoses& in, b
   return grid;
 }
 
-cv::Mat UncertaintyPicture(const ProjectionUncertaintyGrid& grid, int width, int height) {
+cv::Mat UncertaintyPicture(const ProjectionUncertaintyGrid& grid, int width, int height, bool at_infinity) {
   HeatMapStyle style;
   style.unit = "px";
-  style.title = "Projection uncertainty of the " + grid.of + " at " + Fixed(grid.working_distance_m, 2) +
-                " m: mean " + Fixed(grid.Mean(false), 3) + ", max " + Fixed(grid.Max(false), 3) + " px (at infinity " +
-                Fixed(grid.Mean(true), 3) + ", " + Fixed(grid.Max(true), 3) + ")" +
+  style.title = "Projection uncertainty of the " + grid.of + " at " +
+                (at_infinity ? std::string("infinity") : Fixed(grid.working_distance_m, 2) + " m") + ": mean " +
+                Fixed(grid.Mean(at_infinity), 3) + ", max " + Fixed(grid.Max(at_infinity), 3) + " px" +
                 (grid.determined ? "" : " (UNDETERMINED)");
-  style.contour_levels = {grid.Mean(false)};
+  style.contour_levels = {grid.Mean(at_infinity)};
   if (!grid.determined) return HeatMapPicture(-Eigen::MatrixXd::Ones(2, 2), width, height, style);
-  return HeatMapPicture(grid.at_working_distance_px, width, height, style);
+  return HeatMapPicture(at_infinity ? grid.at_infinity_px : grid.at_working_distance_px, width, height, style);
 }
 
 }  // namespace portcal

@@ -57,7 +57,7 @@ cv::Mat ResidualVectorsPicture(const Camera& camera, const std::vector<PointResi
 ProjectionUncertaintyGrid ProjectionUncertaintyOfViews(const ViewsAtPoses& views, bool housing_calibration,
                                                        const std::vector<int>& fixed, double pixel_sigma_px);
 
-// The grid's map at the working distance as a heat map.
-cv::Mat UncertaintyPicture(const ProjectionUncertaintyGrid& grid, int width, int height);
+// The grid's map at the working distance (or at infinity) as a heat map.
+cv::Mat UncertaintyPicture(const ProjectionUncertaintyGrid& grid, int width, int height, bool at_infinity = false);
 
 }  // namespace portcal

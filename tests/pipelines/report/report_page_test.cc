@@ -61,6 +61,10 @@ fs::path RenderAndExtract(const testing::TempDir& dir, const std::string& name, 
 
 struct PageLoad {
   int loaded = -1, total = -1;
+  int overflows = -1, overlaps = -1;
+  std::string layout;   // the first few offenders
+  std::string verdict;  // "Verdict: OK", ... or "none"
+  bool verdict_first = false;  // before the first section heading
 };
 
 // The page in `report_dir` as chromium loads it: how many of its images
@@ -71,7 +75,28 @@ PageLoad LoadInChromium(const testing::TempDir& dir, const fs::path& report_dir,
       "<script>window.addEventListener('load', () => { const images = [...document.images]; "
       "const ok = images.filter(i => i.complete && i.naturalWidth > 0).length; "
       "const d = document.createElement('div'); d.id = 'image-check'; "
-      "d.textContent = 'loaded ' + ok + ' of ' + images.length; document.body.appendChild(d); });</script>";
+      "d.textContent = 'loaded ' + ok + ' of ' + images.length; "
+      // Layout: text that overflows its box or the page, and boxes of text
+      // or pictures that overlap (neither inside the other).
+      "const items = [...document.querySelectorAll('h1,h2,p,li,figcaption,pre,img')]; const bad = []; "
+      "const width = document.documentElement.clientWidth; "
+      "for (const e of items) { const r = e.getBoundingClientRect(); "
+      "  if ((e.tagName !== 'IMG' && e.scrollWidth > e.clientWidth + 1) || r.right > width + 1) "
+      "    bad.push('overflow ' + e.tagName + ' ' + (e.textContent || e.src).slice(0, 60)); } "
+      "let overlaps = 0; "
+      "for (let i = 0; i < items.length; ++i) for (let j = i + 1; j < items.length; ++j) { "
+      "  const a = items[i], b = items[j]; if (a.contains(b) || b.contains(a)) continue; "
+      "  const p = a.getBoundingClientRect(), q = b.getBoundingClientRect(); "
+      "  const w = Math.min(p.right, q.right) - Math.max(p.left, q.left), "
+      "        h = Math.min(p.bottom, q.bottom) - Math.max(p.top, q.top); "
+      "  if (w > 1 && h > 1) { ++overlaps; bad.push('overlap ' + a.tagName + '/' + b.tagName + ' ' + "
+      "    (a.textContent || a.src).slice(0, 40)); } } "
+      "d.textContent += '; layout ' + (bad.length - overlaps) + ' overflows ' + overlaps + ' overlaps: ' + "
+      "  bad.slice(0, 5).join(' | '); "
+      "const v = document.getElementById('verdict'); "
+      "d.textContent += '; verdict ' + (v ? v.querySelector('p').textContent : 'none') + ' first ' + "
+      "  (v !== null && v.compareDocumentPosition(document.querySelector('h2')) === 4); "
+      "document.body.appendChild(d); });</script>";
   page.insert(page.rfind("</body>"), check);
   std::ofstream(report_dir / "report_check.html") << page;
   const std::string chromium =
@@ -91,6 +116,14 @@ PageLoad LoadInChromium(const testing::TempDir& dir, const fs::path& report_dir,
     load.loaded = std::stoi(match[1]);
     load.total = std::stoi(match[2]);
   }
+  if (std::regex_search(dom.output, match,
+                        std::regex("layout ([0-9]+) overflows ([0-9]+) overlaps: ([^;]*); verdict ([^<]*?) first (true|false)"))) {
+    load.overflows = std::stoi(match[1]);
+    load.overlaps = std::stoi(match[2]);
+    load.layout = match[3];
+    load.verdict = match[4];
+    load.verdict_first = match[5] == "true";
+  }
   return load;
 }
 
@@ -99,6 +132,10 @@ void ExpectAllLoaded(const testing::TempDir& dir, const fs::path& report_dir, in
   const PageLoad load = LoadInChromium(dir, report_dir, screenshot);
   EXPECT_EQ(load.total, num_pictures) << report_dir;
   EXPECT_EQ(load.loaded, load.total) << report_dir;
+  EXPECT_EQ(load.overflows, 0) << report_dir << ": " << load.layout;
+  EXPECT_EQ(load.overlaps, 0) << report_dir << ": " << load.layout;
+  EXPECT_EQ(load.verdict.rfind("Verdict: ", 0), 0u) << report_dir << ": no verdict";
+  EXPECT_TRUE(load.verdict_first) << report_dir << ": the verdict does not open the page";
 }
 
 // A self-calibration's model from target views at their poses: the board's
@@ -144,7 +181,9 @@ TEST(ReportPage, EveryCalibratorsPageLoadsEveryPicture) {
   camera.database_path = air.string();
   camera.output_path = (dir / "out/air").string();
   RunCameraCalibrator(camera, NoProgress());
-  ExpectAllLoaded(dir, dir / "out/air", 4);  // coverage, per-view RMS, residuals, uncertainty
+  // coverage, per-view RMS, residuals, their histogram, uncertainty near and
+  // at infinity, distortion, correlation
+  ExpectAllLoaded(dir, dir / "out/air", 8);
 
   HousingCalibratorOptions housing;
   housing.database_path = dome.string();
@@ -152,34 +191,36 @@ TEST(ReportPage, EveryCalibratorsPageLoadsEveryPicture) {
   housing.output_path = (dir / "out/dome").string();
   housing.housing = Housing::FromName("DOMEPORT", {0, 0, 0, 0.05, 0.006, 1.0, 1.473, 1.334}, "test");
   const HousingCalibrationResult housing_result = RunHousingCalibrator(housing, NoProgress());
-  ExpectAllLoaded(dir, dir / "out/dome", 5, fs::current_path() / "artifacts/report_housing.png");  // + the housing
+  ExpectAllLoaded(dir, dir / "out/dome", 9, fs::current_path() / "artifacts/report_housing.png");  // + the housing
 
   CalibrationEvaluatorOptions evaluator;
   evaluator.database_path = dome.string();
   evaluator.input_calibration = (dir / "out/dome/calibration.yaml").string();
   evaluator.output_path = (dir / "out/evaluation").string();
   RunCalibrationEvaluator(evaluator, NoProgress());
-  ExpectAllLoaded(dir, dir / "out/evaluation", 4);  // coverage, RMS, residuals, pattern
+  ExpectAllLoaded(dir, dir / "out/evaluation", 5);  // coverage, RMS, residuals, histogram, pattern
 
   CrossCheckOptions cross_check;
   cross_check.database_path = air.string();
   cross_check.input_calibration = (dir / "out/air/calibration.yaml").string();
   cross_check.output_path = (dir / "out/cross_check").string();
   RunCrossCheck(cross_check, NoProgress());
-  ExpectAllLoaded(dir, dir / "out/cross_check", 5);  // the difference map + portcal's four
+  ExpectAllLoaded(dir, dir / "out/cross_check", 9);  // the difference map + portcal's eight
 
   StereoCalibratorOptions rig;
   rig.database_path = stereo.string();
   rig.output_path = (dir / "out/stereo").string();
   RunStereoCalibrator(rig, NoProgress());
-  // The rig, and three per camera.
-  ExpectAllLoaded(dir, dir / "out/stereo", 7, fs::current_path() / "artifacts/report_stereo.png");
+  // The rig, and four per camera.
+  ExpectAllLoaded(dir, dir / "out/stereo", 9, fs::current_path() / "artifacts/report_stereo.png");
 
   Database database(dome, Database::OpenMode::kReadOnly);
   const std::vector<CalibrationView> views = ReadTargetViews(&database).by_camera.begin()->second;
   CalibrationReport report = ReportOf(housing_result, "chessboard");
   report.pose_frame = "world";
-  WriteHtml(SelfCalibrationHtml(report, ModelOfViews(views, housing_result), "Auto-calibration"), dir / "out/self");
+  const SparseModel self_model = ModelOfViews(views, housing_result);
+  report.verdict = JudgeCalibration(report, self_model, 1);  // as the self-calibrating stages judge
+  WriteHtml(SelfCalibrationHtml(report, self_model, "Auto-calibration"), dir / "out/self");
   ExpectAllLoaded(dir, dir / "out/self", 5);  // scene, coverage, RMS, residuals, housing
 }
 
