@@ -46,6 +46,8 @@ int CameraCalibratorCommand(int argc, char** argv) {
   cli.AddRequired("database_path", &options.database_path, "database with target observations");
   cli.AddRequired("output_path", &options.output_path, "directory for the reports");
   cli.Add("camera_id", &options.camera_id, "camera to calibrate (-1: the only one)");
+  cli.Add("image_path", &options.image_path,
+          "the images' folder (target_extractor's), optional: the report draws the worst views and thumbnails on them");
   cli.Add("Calibration.camera_model", &options.camera_model, "model to fit (default: the database's)");
   cli.Add("Calibration.fixed_params", &fixed,
           "parameters to hold, comma separated: names (k2, p1, ...), focal, principal_point, extra");
@@ -108,6 +110,8 @@ int HousingCalibratorCommand(int argc, char** argv) {
           "database with the camera's in-air target observations: joint solve");
   cli.Add("in_air_camera_id", &options.in_air_camera_id, "camera of the in-air database (-1: the only one)");
   cli.AddRequired("output_path", &options.output_path, "directory for the reports");
+  cli.Add("image_path", &options.image_path,
+          "the underwater images' folder, optional: the report draws the worst views and thumbnails on them");
   cli.AddHousing(&options.housing, "the port to calibrate (required; the parameters: its constants and a "
                                    "guess for what is estimated)");
   cli.Add("camera_id", &options.camera_id, "camera (-1: the only one)");

@@ -7,6 +7,7 @@
 #include "pipelines/report/calibration_pictures.h"
 #include "pipelines/report/geometry_pictures.h"
 #include "pipelines/report/lens_pictures.h"
+#include "pipelines/report/view_pictures.h"
 #include "pipelines/report/picture.h"
 
 namespace portcal {
@@ -87,11 +88,23 @@ HtmlVerdict HtmlVerdictOf(const CalibrationVerdict& verdict) {
 }
 
 HtmlReport CalibrationHtml(const CalibrationReport& report, const std::vector<CalibrationView>& views,
-                           const std::string& title) {
+                           const std::string& title, const std::filesystem::path& image_root) {
   ViewsAtPoses at_poses{HousedCamera{report.camera, report.housing}, views, report.views, report.board_warp};
   HtmlReport html{title, report.warnings, {}, {}};
   if (report.verdict) html.verdict = HtmlVerdictOf(*report.verdict);
   ReportSection section{"The views", "", ViewPictures(at_poses, report.residual_sigma_px, "", "")};
+  section.pictures.push_back(
+      {"worst_views.png",
+       std::string("The views of highest RMS") + (image_root.empty() ? " (give --image_path to see their images)" : "") +
+           ", their residuals magnified: a single wild arrow is a misdetected corner; arrows all one way, a moved "
+           "or blurred board.",
+       WorstViewsPicture(at_poses, image_root)});
+  const cv::Mat thumbnails = ThumbnailsPicture(at_poses, image_root);
+  if (!thumbnails.empty()) {
+    section.pictures.push_back({"views.png", "Every view with its detected corners: check that each board was found "
+                                             "whole and where it is.",
+                                thumbnails});
+  }
   const bool housing = report.housing.has_value();
   const ProjectionUncertaintyGrid uncertainty =
       report.projection_uncertainty ? *report.projection_uncertainty : ProjectionUncertaintyOf(report, views);

@@ -14,9 +14,12 @@
 namespace portcal {
 
 // A target calibration (camera or housing) of `views`: coverage, per-view
-// RMS, residual vectors, projection uncertainty, the housing to scale.
+// RMS, residual vectors and their histogram, the worst views, projection
+// uncertainty, the lens's distortion and correlations, the housing to
+// scale; with `image_root` (the images' folder) the worst views on their
+// images and every view's thumbnail with its corners.
 HtmlReport CalibrationHtml(const CalibrationReport& report, const std::vector<CalibrationView>& views,
-                           const std::string& title);
+                           const std::string& title, const std::filesystem::path& image_root = {});
 
 // The projection uncertainty of a target calibration of `views` (report's
 // camera, housing, kept views' poses, board warp, held parameters and

@@ -51,7 +51,8 @@ CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& optio
   WriteCalibrationOutput(report, options.output_path, options.update_database ? &database : nullptr, camera_id,
                          [&] {
                            WriteCalibrationCameraModel(views, result, options.calibration, options.output_path);
-                           WriteHtml(CalibrationHtml(report, views, "Camera calibration"), options.output_path);
+                           WriteHtml(CalibrationHtml(report, views, "Camera calibration", options.image_path),
+                                     options.output_path);
                          });
   LOG(INFO) << "camera_calibrator: RMS " << result.overall_rms_px << " px over " << result.num_points
             << " points -> " << options.output_path;

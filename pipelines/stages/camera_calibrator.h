@@ -21,6 +21,9 @@ struct CameraCalibratorOptions {
   // with the optimization_inputs of the solve where mrcal can express it).
   std::string output_path;
   int camera_id = -1;        // -1: the only camera with observations
+  // The images' folder (target_extractor's --image_path), optional: the
+  // report then draws the worst views and every view's thumbnail on them.
+  std::string image_path;
   std::string camera_model;  // "" = the database camera's model
   // The board's sag is fitted by default, as mrcal does: printed boards
   // bend, and held flat the sag goes into the intrinsics (the real in-air

@@ -131,7 +131,8 @@ HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& op
   report.projection_uncertainty = ProjectionUncertaintyOf(report, views);
   report.verdict = JudgeCalibration(report, views);
   WriteCalibrationOutput(report, options.output_path, options.update_database ? &database : nullptr, camera_id, [&] {
-    WriteHtml(CalibrationHtml(report, views, "Housing calibration (" + housing.ModelName() + ")"), options.output_path);
+    WriteHtml(CalibrationHtml(report, views, "Housing calibration (" + housing.ModelName() + ")", options.image_path),
+              options.output_path);
   });
   LOG(INFO) << "housing_calibrator: RMS " << result.overall_rms_px << " px -> " << options.output_path;
   new_output.Keep();

@@ -31,6 +31,9 @@ struct HousingCalibratorOptions {
   std::string in_air_database_path;
   int in_air_camera_id = -1;
   std::string output_path;
+  // The underwater images' folder, optional: the report draws the worst
+  // views and every view's thumbnail on them.
+  std::string image_path;
   std::optional<Housing> housing;  // required: the constants and a guess
   int camera_id = -1;
   // The board's sag fitted, as camera_calibrator does (one board, in air

@@ -180,10 +180,11 @@ TEST(ReportPage, EveryCalibratorsPageLoadsEveryPicture) {
   CameraCalibratorOptions camera;
   camera.database_path = air.string();
   camera.output_path = (dir / "out/air").string();
+  camera.image_path = (dir / "air/images").string();
   RunCameraCalibrator(camera, NoProgress());
-  // coverage, per-view RMS, residuals, their histogram, uncertainty near and
-  // at infinity, distortion, correlation
-  ExpectAllLoaded(dir, dir / "out/air", 8);
+  // coverage, per-view RMS, residuals, their histogram, the worst views, the
+  // thumbnails, uncertainty near and at infinity, distortion, correlation
+  ExpectAllLoaded(dir, dir / "out/air", 10);
 
   HousingCalibratorOptions housing;
   housing.database_path = dome.string();
@@ -191,7 +192,7 @@ TEST(ReportPage, EveryCalibratorsPageLoadsEveryPicture) {
   housing.output_path = (dir / "out/dome").string();
   housing.housing = Housing::FromName("DOMEPORT", {0, 0, 0, 0.05, 0.006, 1.0, 1.473, 1.334}, "test");
   const HousingCalibrationResult housing_result = RunHousingCalibrator(housing, NoProgress());
-  ExpectAllLoaded(dir, dir / "out/dome", 9, fs::current_path() / "artifacts/report_housing.png");  // + the housing
+  ExpectAllLoaded(dir, dir / "out/dome", 10, fs::current_path() / "artifacts/report_housing.png");  // no thumbnails, + the housing
 
   CalibrationEvaluatorOptions evaluator;
   evaluator.database_path = dome.string();
@@ -205,7 +206,7 @@ TEST(ReportPage, EveryCalibratorsPageLoadsEveryPicture) {
   cross_check.input_calibration = (dir / "out/air/calibration.yaml").string();
   cross_check.output_path = (dir / "out/cross_check").string();
   RunCrossCheck(cross_check, NoProgress());
-  ExpectAllLoaded(dir, dir / "out/cross_check", 9);  // the difference map + portcal's eight
+  ExpectAllLoaded(dir, dir / "out/cross_check", 10);  // the difference map + portcal's nine
 
   StereoCalibratorOptions rig;
   rig.database_path = stereo.string();
