@@ -48,7 +48,8 @@ echo "== 2. In air: target_extractor, camera_calibrator (RADIAL)"
   --image_path "$work/air/images" --ImageReader.camera_model RADIAL \
   --ImageReader.single_camera 1 --Target.cols 10 --Target.rows 7 --Target.square_size 0.02
 "$portcal" camera_calibrator --log_level warn --database_path "$work/air.db" \
-  --output_path "$work/air_calibration"
+  --output_path "$work/air_calibration" --image_path "$work/air/images"
+sed -n '/^Verdict/,/^$/p' "$work/air_calibration/calibration.txt"
 sed -n '/^  parameter /,/^RMS/p' "$work/air_calibration/calibration.txt"
 echo "-- truth: f 648.68, cx 480, cy 270, k1 -0.08, k2 0.01"
 
@@ -60,8 +61,9 @@ echo "      jointly with the in-air views"
   --ImageReader.single_camera 1 --Target.cols 10 --Target.rows 7 --Target.square_size 0.02
 "$portcal" housing_calibrator --log_level warn --database_path "$work/dome.db" \
   --input_calibration "$work/air_calibration/calibration.yaml" --in_air_database_path "$work/air.db" \
-  --output_path "$work/dome_calibration" \
+  --output_path "$work/dome_calibration" --image_path "$work/dome/images" \
   --Housing.model DOMEPORT --Housing.params 0,0,0,0.05,0.006,1.0,1.473,1.334
+sed -n '/^Verdict/,/^$/p' "$work/dome_calibration/calibration.txt"
 sed -n '/^Housing/,/^RMS/p' "$work/dome_calibration/calibration.txt"
 echo "-- truth: Cx 0.004, Cy -0.002, Cz 0.006 m"
 
@@ -74,6 +76,6 @@ echo "  images and truth: air/, dome/ (ground_truth.yaml); databases: air.db, do
 echo "  reports (calibration.txt to read, calibration.yaml with calibmar's keys and standard deviations):"
 echo "    $output/air_calibration/calibration.txt"
 echo "    $output/dome_calibration/calibration.txt"
-echo "  pages with pictures (coverage, per-view RMS, residuals, uncertainty, the dome to scale), open in a browser:"
+echo "  pages (the verdict first, then coverage, residuals, the worst views, uncertainty, distortion, the dome to scale), open in a browser:"
 echo "    $output/air_calibration/report.html"
 echo "    $output/dome_calibration/report.html"

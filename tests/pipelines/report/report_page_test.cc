@@ -184,7 +184,7 @@ TEST(ReportPage, EveryCalibratorsPageLoadsEveryPicture) {
   RunCameraCalibrator(camera, NoProgress());
   // coverage, per-view RMS, residuals, their histogram, the worst views, the
   // thumbnails, uncertainty near and at infinity, distortion, correlation
-  ExpectAllLoaded(dir, dir / "out/air", 10);
+  ExpectAllLoaded(dir, dir / "out/air", 10, fs::current_path() / "artifacts/report_camera.png");
 
   HousingCalibratorOptions housing;
   housing.database_path = dome.string();
