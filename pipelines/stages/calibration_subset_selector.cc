@@ -5,6 +5,7 @@
 #include <fstream>
 #include <map>
 
+#include "colmap_ext/util/confined_path.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "database/database.h"
@@ -20,6 +21,7 @@ void CalibrationSubsetSelectorOptions::Check() const {
   if (!folder.empty() && !fs::is_directory(folder)) {
     throw OptionError("--output_path", output_path, "a file in an existing folder");
   }
+  CheckOutputFile("--output_path", output_path, {database_path});
   subset.Check();
 }
 

@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "colmap_ext/io/sparse_model.h"
+#include "colmap_ext/util/confined_path.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/new_paths.h"
@@ -86,6 +87,12 @@ UndistortionInput ReadInput(const ImageUndistorterOptions& options) {
     for (const std::string& name : ListImages(options.image_path)) input.images.push_back({name, 1});
   }
   if (input.images.empty() && input.has_poses) throw InputError(options.input_path + ": the model has no images");
+  // Names come from the model: each must stay inside --image_path when read
+  // and inside the output's images/ when written, before any work.
+  for (const ImageToUndistort& image : input.images) {
+    ConfinedPath(options.image_path, image.name, "image name in " + options.input_path);
+    ConfinedPath(fs::path(options.output_path) / "images", image.name, "image name in " + options.input_path);
+  }
   size_t missing = 0;
   std::string first_missing;
   for (const ImageToUndistort& image : input.images) {

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <thread>
 
+#include "colmap_ext/util/confined_path.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "database/database.h"
@@ -97,6 +98,8 @@ class DatabaseFrameStore : public KeptFrameStore {
   void Remove(const std::string& name) override {
     Transaction transaction = database_->BeginTransaction();
     for (size_t c = 0; c < folders_.size(); ++c) {
+      // The file renamed below must be one inside --image_path.
+      ConfinedPath(options_.image_path, ImageName(c, name), "image name in " + options_.database_path);
       const std::optional<DatabaseImage> image = database_->ReadImageWithName(ImageName(c, name));
       if (!image) throw InputError(ImageName(c, name) + ": not in " + options_.database_path);
       database_->DeleteImage(image->image_id);

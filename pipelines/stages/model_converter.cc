@@ -5,6 +5,7 @@
 #include "colmap_ext/io/mrcal_model.h"
 #include "colmap_ext/io/opencv_camera_file.h"
 #include "colmap_ext/io/sparse_model.h"
+#include "colmap_ext/util/confined_path.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/new_paths.h"
@@ -66,7 +67,11 @@ void ModelConverterOptions::Check() const {
       output_type != "ROS_YAML") {
     throw OptionError("--output_type", output_type, "BIN, TXT, CAMERAMODEL, OPENCV_YAML or ROS_YAML");
   }
-  if (IsModelType(output_type)) CheckOutputFolder("--output_path", output_path);
+  if (IsModelType(output_type)) {
+    CheckOutputFolder("--output_path", output_path);
+  } else {
+    CheckOutputFile("--output_path", output_path, {input_path});
+  }
 }
 
 ModelConverterSummary RunModelConverter(const ModelConverterOptions& options, ProgressSink& progress) {
