@@ -82,6 +82,9 @@ int LiveCalibratorCommand(int argc, char** argv) {
   RegisterLive(&cli, &options.live);
   cli.Add("Live.address", &options.page.address,
           "where the live page is served, HOST:PORT (0.0.0.0:PORT: seen from other machines; port 0: a free one)");
+  cli.Add("Live.token", &options.page.token,
+          "a password every request must carry (16-128 of A-Z a-z 0-9 _ -): the printed address holds it, the "
+          "page keeps it in a cookie; set it with 0.0.0.0 on a shared network");
   cli.Add("Live.headless", &options.page.headless, "no page: state and suggestions on stderr only (0 | 1)");
   cli.Add("Live.max_width", &options.page.max_width, "frames on the page scaled down to this width, pixels");
   cli.Add("calibrate_at_end", &options.calibrate_at_end, "write the final reports when the session ends (0 | 1)");

@@ -6,11 +6,13 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <random>
 #include <thread>
 
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "pipelines/live/live_overlay.h"
+#include "pipelines/live/request_guard.h"
 
 // Last: <resolv.h>, which it includes, defines _res, a name inside Eigen.
 #include <httplib.h>
@@ -81,7 +83,15 @@ void LivePageOptions::Check() const {
       address.find_first_not_of("0123456789", colon + 1) != std::string::npos) {
     throw OptionError("--Live.address", address, "HOST:PORT, e.g. 127.0.0.1:8080 or 0.0.0.0:8080");
   }
-  if (max_width < 64) throw OptionError("--Live.max_width", std::to_string(max_width), ">= 64");
+  if (address.size() - colon - 1 > 5 || std::stoi(address.substr(colon + 1)) > 65535) {
+    throw OptionError("--Live.address", address, "a port in [0, 65535]");
+  }
+  if (max_width < 64 || max_width > 8192) {
+    throw OptionError("--Live.max_width", std::to_string(max_width), "in [64, 8192]");
+  }
+  if (!token.empty() && !IsValidLiveToken(token)) {
+    throw OptionError("--Live.token", "(hidden)", "16-128 characters of A-Z, a-z, 0-9, _ and -");
+  }
   if (jpeg_quality < 10 || jpeg_quality > 100) {
     throw OptionError("--Live.jpeg_quality", std::to_string(jpeg_quality), "[10, 100]");
   }
@@ -92,8 +102,44 @@ std::vector<uint8_t> EncodeOverlayJpeg(const LiveSnapshot& snapshot, const Targe
   return Jpeg(DrawLiveOverlay(snapshot, target, options.max_width), options.jpeg_quality);
 }
 
+// The page with a fresh nonce on its one script and its one style, named
+// by the Content-Security-Policy sent with it: those run, no other inline
+// script does (what an injected name would need).
+std::string PageWithNonce(const std::string& page, const std::string& nonce) {
+  std::string html = page;
+  for (const std::string tag : {"<script>", "<style>"}) {
+    const size_t at = html.find(tag);
+    PORTCAL_CHECK(at != std::string::npos);
+    html.insert(at + tag.size() - 1, " nonce=\"" + nonce + "\"");
+  }
+  return html;
+}
+
+std::string NewNonce() {
+  static std::mutex mutex;
+  static std::random_device device;
+  const std::lock_guard<std::mutex> lock(mutex);
+  std::string nonce;
+  for (int i = 0; i < 4; ++i) {
+    char part[9];
+    std::snprintf(part, sizeof(part), "%08x", static_cast<unsigned>(device()));
+    nonce += part;
+  }
+  return nonce;
+}
+
+std::string ContentSecurityPolicy(const std::string& nonce) {
+  const std::string inline_allowed = nonce.empty() ? "" : " 'nonce-" + nonce + "'";
+  return "default-src 'none'; script-src 'self'" + inline_allowed + "; style-src 'self'" + inline_allowed +
+         "; img-src 'self'; connect-src 'self'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
+}
+
+// Viewers of the stream at once: each holds a server thread.
+constexpr int kMaxStreamClients = 4;
+
 struct LiveServer::Impl {
   LiveSession* session;
+  std::atomic<int> stream_clients{0};
   LivePageOptions options;
   httplib::Server server;
   std::string host;
@@ -194,8 +240,13 @@ nlohmann::json LiveServer::Impl::State() const {
 }
 
 void LiveServer::Impl::Routes() {
-  server.Get("/", [](const httplib::Request&, httplib::Response& response) {
-    response.set_content(LivePageHtml(), "text/html; charset=utf-8");
+  server.Get("/", [this](const httplib::Request& request, httplib::Response& response) {
+    if (!options.token.empty() && request.get_param_value("token") == options.token) {
+      response.set_header("Set-Cookie", LiveTokenCookie(options.token));
+    }
+    const std::string nonce = NewNonce();
+    response.set_header("Content-Security-Policy", ContentSecurityPolicy(nonce));
+    response.set_content(PageWithNonce(LivePageHtml(), nonce), "text/html; charset=utf-8");
   });
   server.Get("/state.json", [this](const httplib::Request&, httplib::Response& response) {
     response.set_header("Cache-Control", "no-store");
@@ -203,12 +254,18 @@ void LiveServer::Impl::Routes() {
   });
   server.Get("/stream.mjpg", [this](const httplib::Request&, httplib::Response& response) {
     response.set_header("Cache-Control", "no-store");
+    if (++stream_clients > kMaxStreamClients) {
+      --stream_clients;
+      response.status = 503;
+      response.set_content("too many viewers of the stream (" + std::to_string(kMaxStreamClients) + ")", "text/plain");
+      return;
+    }
     last_viewer_s = WallSeconds();
     auto sent = std::make_shared<int64_t>(0);
-    response.set_chunked_content_provider("multipart/x-mixed-replace; boundary=frame",
-                                          [this, sent](size_t, httplib::DataSink& sink) {
-                                            return StreamPart(sent.get(), sink);
-                                          });
+    response.set_chunked_content_provider(
+        "multipart/x-mixed-replace; boundary=frame",
+        [this, sent](size_t, httplib::DataSink& sink) { return StreamPart(sent.get(), sink); },
+        [this](bool) { --stream_clients; });
   });
   server.Get("/coverage.jpg", [this](const httplib::Request&, httplib::Response& response) {
     Reply(&response, Jpeg(DrawCoverage(session->Snapshot(), options.max_width / 2), 85), "image/jpeg");
@@ -241,7 +298,18 @@ void LiveServer::Impl::Routes() {
   // (RFC 9112, 6.3), but httplib 0.11 reads one until the client closes,
   // which a client waiting for the answer never does (`curl -X POST` hung).
   // The commands take no body: answer those before httplib reads.
-  server.set_pre_routing_handler([commands](const httplib::Request& request, httplib::Response& response) {
+  server.set_pre_routing_handler([this, commands](const httplib::Request& request, httplib::Response& response) {
+    const std::optional<std::string> refused = RefuseLiveRequest(
+        {request.method, request.get_header_value("Host"), request.get_header_value("Origin"),
+         request.get_header_value("Sec-Fetch-Site"), request.get_header_value("Cookie"),
+         request.get_param_value("token")},
+        port, options.token);
+    if (refused) {
+      LOG(WARNING) << "live: refused " << request.method << " " << request.path << ": " << *refused;
+      response.status = 403;
+      response.set_content("refused: " + *refused + "\n", "text/plain");
+      return httplib::Server::HandlerResponse::Handled;
+    }
     const auto it = commands.find(request.path);
     if (request.method != "POST" || it == commands.end() || request.has_header("Content-Length") ||
         request.has_header("Transfer-Encoding")) {
@@ -261,6 +329,21 @@ LiveServer::LiveServer(LiveSession* session, const LivePageOptions& options) : i
   impl_->host = options.address.substr(0, colon);
   const int port = std::stoi(options.address.substr(colon + 1));
   impl_->Routes();
+  // Nothing but the page's own documents and images; no framing.
+  impl_->server.set_post_routing_handler([](const httplib::Request&, httplib::Response& response) {
+    if (!response.has_header("Content-Security-Policy")) {
+      response.set_header("Content-Security-Policy", ContentSecurityPolicy(""));
+    }
+    response.set_header("X-Content-Type-Options", "nosniff");
+    response.set_header("Referrer-Policy", "no-referrer");
+  });
+  // Idle or slow clients give their thread back within seconds; the pool
+  // outnumbers the stream's cap, so the page stays answered.
+  impl_->server.new_task_queue = [] { return new httplib::ThreadPool(4 * kMaxStreamClients + 8); };
+  impl_->server.set_read_timeout(2);
+  impl_->server.set_write_timeout(3);
+  impl_->server.set_keep_alive_timeout(2);
+  impl_->server.set_payload_max_length(1 << 16);
   // SO_REUSEADDR (a restart need not wait out TIME_WAIT) but not httplib's
   // default SO_REUSEPORT, with which a second session would share the port
   // silently, each answering half of the requests.
@@ -282,6 +365,10 @@ LiveServer::LiveServer(LiveSession* session, const LivePageOptions& options) : i
   }
   impl_->encoder = std::thread([impl = impl_.get()] { impl->EncodeLoop(); });
   LOG(INFO) << "live: the page is at " << url();
+  if (impl_->host == "0.0.0.0" && options.token.empty()) {
+    LOG(WARNING) << "live: serving on every network of this machine without a password: anyone who reaches "
+                 << "port " << impl_->port << " can end the session or remove views (set --Live.token)";
+  }
 }
 
 LiveServer::~LiveServer() {
@@ -294,7 +381,8 @@ LiveServer::~LiveServer() {
 
 std::string LiveServer::url() const {
   const std::string host = impl_->host == "0.0.0.0" ? "127.0.0.1" : impl_->host;
-  return "http://" + host + ":" + std::to_string(impl_->port) + "/";
+  return "http://" + host + ":" + std::to_string(impl_->port) + "/" +
+         (impl_->options.token.empty() ? "" : "?token=" + impl_->options.token);
 }
 
 int LiveServer::port() const { return impl_->port; }

@@ -10,6 +10,11 @@
 //   GET  /uncertainty.jpg   the expected projection uncertainty over the image
 //   GET  /thumbnail?name=N  a kept view
 //   POST /capture /undo /calibrate /finish, /remove?name=N
+//
+// Guarded as a local web UI (request_guard.h): its own Host and Origin
+// only, an optional token, a Content-Security-Policy allowing the page's
+// own script, style and images only, bounded threads and timeouts, and a
+// cap on the stream's viewers.
 #pragma once
 
 #include <memory>
@@ -27,6 +32,11 @@ struct LivePageOptions {
   int max_width = 1280;    // frames on the page are scaled down to this width
   int jpeg_quality = 80;   // [10, 100]
   std::string output_path; // shown on the page when the session ends
+  // Required of every request when set (16-128 of [A-Za-z0-9_-]): the page
+  // has no other password, which matters on a vehicle's shared network
+  // (0.0.0.0). The printed address carries it; the page keeps it in a
+  // cookie.
+  std::string token;
   void Check() const;      // throws OptionError naming the --Live. option
 };
 
@@ -44,7 +54,7 @@ class LiveServer {
   LiveServer(const LiveServer&) = delete;
   LiveServer& operator=(const LiveServer&) = delete;
 
-  std::string url() const;  // http://host:port/
+  std::string url() const;  // http://host:port/ (with ?token= when set)
   int port() const;
   // Mean time from a frame's arrival to its overlay being encoded, ms (the
   // page's latency, less the network).

@@ -137,6 +137,31 @@ TEST(LivePage, ABrowserSeesTheStreamAndItsButtonsWork) {
     EXPECT_NE(std::string(e.what()).find("--Live.address"), std::string::npos) << e.what();
   }
 
+  // The guard. A command from another origin, a foreign Host (DNS
+  // rebinding), a page another site serves: refused, the session goes on.
+  const int live_port = std::stoi(port[1]);
+  EXPECT_EQ(RawRequestStatus(live_port, "POST /finish HTTP/1.1\r\nHost: 127.0.0.1:" + std::string(port[1]) +
+                                            "\r\nOrigin: http://evil.example\r\n\r\n"),
+            "HTTP/1.1 403 Forbidden");
+  EXPECT_EQ(RawRequestStatus(live_port, "GET /state.json HTTP/1.1\r\nHost: evil.example:" + std::string(port[1]) +
+                                            "\r\n\r\n"),
+            "HTTP/1.1 403 Forbidden");
+  const fs::path evil = dir / "evil.html";
+  std::ofstream(evil) << "<!DOCTYPE html><html><body><p id=r>sent</p><script>fetch('http://127.0.0.1:" << port[1]
+                      << "/finish', {method: 'POST', mode: 'no-cors'}).catch(() => {});"
+                         "fetch('http://127.0.0.1:" << port[1] << "/remove?name=live_0001.png', {method: 'POST', "
+                         "mode: 'no-cors'}).catch(() => {});</script></body></html>";
+  testing::RunCommand(Chromium(dir, "--dump-dom", "file://" + evil.string()));
+  const auto after = client.Get("/state.json");
+  ASSERT_TRUE(after && after->status == 200);
+  EXPECT_EQ(nlohmann::json::parse(after->body)["final"], "") << "another page ended the session";
+  // The page: a Content-Security-Policy naming the page's own nonce, and
+  // no name ever parsed as HTML.
+  const auto page = client.Get("/");
+  ASSERT_TRUE(page && page->status == 200);
+  EXPECT_NE(page->get_header_value("Content-Security-Policy").find("script-src 'self' 'nonce-"), std::string::npos);
+  EXPECT_EQ(page->body.find("innerHTML"), std::string::npos);
+
   // As `curl -X POST URL/finish` sends it: answered at once, and done.
   EXPECT_EQ(RawRequestStatus(std::stoi(port[1]), "POST /finish HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n"),
             "HTTP/1.1 200 OK");
