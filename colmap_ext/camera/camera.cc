@@ -30,6 +30,13 @@ void Camera::Validate(const std::string& context) const {
     throw InputError(context + ": unknown camera model id " +
                      std::to_string(model_id));
   }
+  // No camera has a side beyond 65 535 px; a corrupted or hostile file that
+  // claims one would make the stages allocate or loop over it for minutes.
+  constexpr uint64_t kMaxImageSide = 65535;
+  if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide) {
+    throw InputError(context + ": image size " + std::to_string(width) + " x " + std::to_string(height) +
+                     " px outside [1, " + std::to_string(kMaxImageSide) + "] per side");
+  }
   const int expected = CameraModelNumParams(model_id);
   if (static_cast<int>(params.size()) != expected) {
     throw InputError(context + ": camera model " + ModelName() + " takes " +

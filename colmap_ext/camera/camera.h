@@ -28,8 +28,9 @@ struct Camera {
   std::string ModelName() const;
   std::string ParamsInfo() const;
   // Throws InputError (prefixed by `context`, e.g. a file name) if the model
-  // is unknown, the parameter count is wrong, a parameter is not finite or a
-  // focal length is not positive.
+  // is unknown, the parameter count is wrong, a parameter is not finite, a
+  // focal length is not positive or a side of the image is not in
+  // [1, 65535] px.
   void Validate(const std::string& context) const;
 
   double MeanFocalLength() const;

@@ -2,6 +2,7 @@
 
 #include <zip.h>
 
+#include <algorithm>
 #include <cstring>
 #include <memory>
 #include <stdexcept>
@@ -27,17 +28,33 @@ std::string RawBytes(const std::vector<T>& values) {
   return std::string(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
 }
 
+// The code points of UTF-8 `text`; a byte that starts no valid sequence
+// (a Latin-1 file name) becomes U+FFFD, as Python's errors='replace'.
+std::vector<uint32_t> CodePoints(const std::string& text) {
+  std::vector<uint32_t> points;
+  for (size_t i = 0; i < text.size();) {
+    const unsigned char lead = static_cast<unsigned char>(text[i]);
+    const int length = lead < 0x80 ? 1 : (lead >> 5) == 0x6 ? 2 : (lead >> 4) == 0xe ? 3 : (lead >> 3) == 0x1e ? 4 : 0;
+    uint32_t point = length == 1 ? lead : length == 2 ? lead & 0x1f : length == 3 ? lead & 0x0f : lead & 0x07;
+    bool valid = length > 0 && i + length <= text.size();
+    for (int k = 1; valid && k < length; ++k) {
+      const unsigned char next = static_cast<unsigned char>(text[i + k]);
+      valid = (next & 0xc0) == 0x80;
+      point = (point << 6) | (next & 0x3f);
+    }
+    valid = valid && point <= 0x10ffff && !(point >= 0xd800 && point <= 0xdfff) &&
+            !(length == 2 && point < 0x80) && !(length == 3 && point < 0x800) && !(length == 4 && point < 0x10000);
+    points.push_back(valid ? point : 0xfffd);
+    i += valid ? length : 1;
+  }
+  return points;
+}
+
 // NumPy's '<U<width>': each string as `width` UTF-32LE code units, padded
 // with zeros.
-std::string Utf32Strings(const std::vector<std::string>& values, size_t width) {
+std::string Utf32Strings(const std::vector<std::vector<uint32_t>>& values, size_t width) {
   std::vector<uint32_t> units(values.size() * width, 0);
-  for (size_t i = 0; i < values.size(); ++i) {
-    for (size_t c = 0; c < values[i].size(); ++c) {
-      const unsigned char ch = static_cast<unsigned char>(values[i][c]);
-      if (ch >= 0x80) throw std::runtime_error("npz: non-ASCII string '" + values[i] + "'");
-      units[i * width + c] = ch;
-    }
-  }
+  for (size_t i = 0; i < values.size(); ++i) std::copy(values[i].begin(), values[i].end(), units.begin() + i * width);
   return RawBytes(units);
 }
 
@@ -88,14 +105,19 @@ void NpzArchive::AddBool(const std::string& name, bool value) {
 }
 
 void NpzArchive::AddString(const std::string& name, const std::string& value) {
-  const size_t width = std::max<size_t>(1, value.size());
-  Add(name, "<U" + std::to_string(width), {}, Utf32Strings({value}, width));
+  const std::vector<uint32_t> points = CodePoints(value);
+  const size_t width = std::max<size_t>(1, points.size());
+  Add(name, "<U" + std::to_string(width), {}, Utf32Strings({points}, width));
 }
 
 void NpzArchive::AddStrings(const std::string& name, const std::vector<std::string>& values) {
+  std::vector<std::vector<uint32_t>> points;
   size_t width = 1;
-  for (const std::string& value : values) width = std::max(width, value.size());
-  Add(name, "<U" + std::to_string(width), {static_cast<int64_t>(values.size())}, Utf32Strings(values, width));
+  for (const std::string& value : values) {
+    points.push_back(CodePoints(value));
+    width = std::max(width, points.back().size());
+  }
+  Add(name, "<U" + std::to_string(width), {static_cast<int64_t>(values.size())}, Utf32Strings(points, width));
 }
 
 std::string NpzArchive::Bytes() const {

@@ -19,7 +19,7 @@ class NpzArchive {
   void AddDouble(const std::string& name, double value) { AddDoubles(name, {}, {value}); }
   void AddBool(const std::string& name, bool value);
   // A scalar string, or a 1-D array of them (NumPy's '<U' strings: UTF-32,
-  // so ASCII only here).
+  // from UTF-8; invalid bytes become U+FFFD).
   void AddString(const std::string& name, const std::string& value);
   void AddStrings(const std::string& name, const std::vector<std::string>& values);
 

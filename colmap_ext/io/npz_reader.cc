@@ -236,8 +236,23 @@ std::vector<std::string> NpyArray::Strings(const std::string& context) const {
     for (size_t k = 0; k < item; k += 4) {
       const uint32_t unit = LoadAt<uint32_t>(data, (at + k) / 4);
       if (unit == 0) break;
-      if (unit >= 0x80) throw InputError(context + ": a non-ASCII string");
-      text += static_cast<char>(unit);
+      if (unit > 0x10ffff || (unit >= 0xd800 && unit <= 0xdfff)) throw InputError(context + ": not a Unicode string");
+      // UTF-8.
+      if (unit < 0x80) {
+        text += static_cast<char>(unit);
+      } else if (unit < 0x800) {
+        text += static_cast<char>(0xc0 | (unit >> 6));
+        text += static_cast<char>(0x80 | (unit & 0x3f));
+      } else if (unit < 0x10000) {
+        text += static_cast<char>(0xe0 | (unit >> 12));
+        text += static_cast<char>(0x80 | ((unit >> 6) & 0x3f));
+        text += static_cast<char>(0x80 | (unit & 0x3f));
+      } else {
+        text += static_cast<char>(0xf0 | (unit >> 18));
+        text += static_cast<char>(0x80 | ((unit >> 12) & 0x3f));
+        text += static_cast<char>(0x80 | ((unit >> 6) & 0x3f));
+        text += static_cast<char>(0x80 | (unit & 0x3f));
+      }
     }
     strings.push_back(text);
   }

@@ -25,7 +25,8 @@ struct NpyArray {
   // `context` and the type otherwise.
   std::vector<double> Doubles(const std::string& context) const;
   std::vector<int64_t> Integers(const std::string& context) const;
-  // The strings of a '<U' array (ASCII only; others throw InputError).
+  // The strings of a '<U' array, as UTF-8 (code points that are not
+  // Unicode throw InputError).
   std::vector<std::string> Strings(const std::string& context) const;
   // mrcal's None: a scalar empty string.
   bool IsNone() const;

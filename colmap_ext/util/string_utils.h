@@ -23,5 +23,9 @@ std::string FormatFixed(double value, int digits);
 // The shortest text that reads back as exactly `value` ("0.04", where
 // lexical_cast gives "0.040000000000000001"), for help texts and defaults.
 std::string FormatShortest(double value);
+// `text` as a YAML double-quoted scalar that reads back byte for byte
+// (quotes, backslashes and control characters escaped; UTF-8 kept): the
+// one form for names (image names may hold any of them) in portcal's YAML.
+std::string YamlQuoted(const std::string& text);
 
 }  // namespace portcal

@@ -159,7 +159,7 @@ std::string Yaml(const CalibrationReport& r) {
   out << "per_view:\n";
   for (const CalibratedView& v : r.views) {
     const Eigen::Vector4d q = QuaternionToWxyz(v.cam_from_target.rotation);
-    out << "- image: '" << v.image_name << "'\n  rms: " << Num(v.rms_px) << "\n  points: " << v.num_points
+    out << "- image: " << YamlQuoted(v.image_name) << "\n  rms: " << Num(v.rms_px) << "\n  points: " << v.num_points
         << "\n  outlier: " << (v.outlier ? "true" : "false") << "\n  dropped: " << (v.dropped ? "true" : "false")
         << "\n  cam_from_" << r.pose_frame << ":\n    rotation_wxyz: " << List({q[0], q[1], q[2], q[3]})
         << "\n    translation: "
@@ -288,8 +288,8 @@ std::string WriteStereoCalibrationReport(const StereoCalibrationResult& r, const
        << "\nnum_views: " << r.views1.size() << "\nnum_points: " << r.num_points << "\ntarget: '"
        << target_description << "'\nper_view:\n";
   for (size_t f = 0; f < r.views1.size(); ++f) {
-    yaml << "- image1: '" << r.views1[f].image_name << "'\n  rms1: " << Num(r.views1[f].rms_px)
-         << "\n  image2: '" << r.views2[f].image_name << "'\n  rms2: " << Num(r.views2[f].rms_px) << "\n";
+    yaml << "- image1: " << YamlQuoted(r.views1[f].image_name) << "\n  rms1: " << Num(r.views1[f].rms_px)
+         << "\n  image2: " << YamlQuoted(r.views2[f].image_name) << "\n  rms2: " << Num(r.views2[f].rms_px) << "\n";
   }
   std::ostringstream text;
   if (verdict) yaml << VerdictYaml(*verdict);

@@ -68,7 +68,11 @@ void NextPoseOptions::Check() const {
     throw OptionError("--Live.max_roll_deg", std::to_string(roll_max_deg), "[0, 180]");
   }
   if (!(border_margin_px >= 0)) throw OptionError("--Live.margin_px", std::to_string(border_margin_px), ">= 0");
-  if (num_candidates < 1) throw OptionError("--Live.num_candidates", std::to_string(num_candidates), ">= 1");
+  // Each candidate is a covariance evaluation (milliseconds): 10^5 already
+  // takes minutes per suggestion.
+  if (num_candidates < 1 || num_candidates > 100000) {
+    throw OptionError("--Live.num_candidates", std::to_string(num_candidates), "in [1, 100000]");
+  }
   Uncertainty().Check();
 }
 

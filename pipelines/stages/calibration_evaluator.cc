@@ -9,6 +9,7 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/new_paths.h"
+#include "colmap_ext/util/string_utils.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/housing_calibration.h"
@@ -89,7 +90,7 @@ void WriteEvaluation(const CalibrationEvaluatorOptions& options, const Calibrati
   }
   text << "\n  view                          rms px  points\n";
   for (const ViewEvaluation& view : e.views) {
-    yaml << "  - {image: '" << view.image_name << "', evaluated: " << (view.evaluated ? "true" : "false")
+    yaml << "  - {image: " << YamlQuoted(view.image_name) << ", evaluated: " << (view.evaluated ? "true" : "false")
          << ", rms_px: " << Number(view.evaluated ? view.rms_px : NAN) << ", points: " << view.num_points << "}\n";
     text << "  " << std::left << std::setw(28) << view.image_name << std::right << std::setw(8)
          << (view.evaluated ? Number(view.rms_px) : "-") << std::setw(8) << view.num_points

@@ -124,8 +124,10 @@ void FieldOfViewOptions::Check() const {
     throw OptionError("--Undistort.blank_pixels", std::to_string(blank_pixels), "a value in [0, 1]");
   }
   if (!(min_scale > 0)) throw OptionError("--Undistort.min_scale", std::to_string(min_scale), "> 0");
-  if (!(max_scale >= min_scale)) {
-    throw OptionError("--Undistort.max_scale", std::to_string(max_scale), ">= --Undistort.min_scale");
+  // Beyond 10x the input's side the output is all interpolation, and its
+  // remap tables grow with the square.
+  if (!(max_scale >= min_scale && max_scale <= 10)) {
+    throw OptionError("--Undistort.max_scale", std::to_string(max_scale), "in [--Undistort.min_scale, 10]");
   }
 }
 

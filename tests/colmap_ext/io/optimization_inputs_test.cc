@@ -242,3 +242,19 @@ TEST(MrcalOptimizationInputs, MissingOrDamagedSolveNamesTheFile) {
 
 }  // namespace
 }  // namespace portcal
+
+namespace portcal {
+namespace {
+
+// Image names in any script survive the archive (NumPy's '<U' is UTF-32):
+// a name that is not UTF-8 (Latin-1 bytes) is kept with U+FFFD, as
+// Python's errors='replace'.
+TEST(NpzReader, NamesInAnyScriptRoundTrip) {
+  NpzArchive npz;
+  npz.AddStrings("names", {"café.png", "水中/カメラ 01.png", "plain.png", "lat\xe9in.png"});
+  const std::vector<std::string> back = ReadNpz(npz.Bytes(), "t").at("names").Strings("t");
+  EXPECT_EQ(back, (std::vector<std::string>{"café.png", "水中/カメラ 01.png", "plain.png", "lat\xef\xbf\xbdin.png"}));
+}
+
+}  // namespace
+}  // namespace portcal

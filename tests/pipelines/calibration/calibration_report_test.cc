@@ -259,3 +259,28 @@ TEST(BoardWarpNote, SaysTheSagItsSignificanceAndWhatFlatWouldChange) {
 
 }  // namespace
 }  // namespace portcal
+
+namespace portcal {
+namespace {
+
+// Image names with quotes, backslashes, newlines, tabs and other scripts
+// are written so that calibration.yaml reads back with the same names.
+TEST(ReadCalibrationReport, ImageNamesOfAnyKindReadBack) {
+  CalibrationReport report;
+  report.camera = Camera::FromModelName("OPENCV", 500, 640, 480);
+  const std::vector<std::string> names = {"it's.png", "say \"cheese\".png", "back\\slash.png", "two\nlines.png",
+                                          "tab\there.png", "sous l'eau/é.png", "水中.png", "- dash: colon.png"};
+  for (const std::string& name : names) {
+    CalibratedView view;
+    view.image_name = name;
+    report.views.push_back(view);
+  }
+  testing::TempDir dir;
+  WriteCalibrationReport(report, dir.path());
+  const CalibrationReport back = ReadCalibrationReport(dir / "calibration.yaml");
+  ASSERT_EQ(back.views.size(), names.size());
+  for (size_t i = 0; i < names.size(); ++i) EXPECT_EQ(back.views[i].image_name, names[i]);
+}
+
+}  // namespace
+}  // namespace portcal
