@@ -324,7 +324,7 @@ std::string VerdictYaml(const CalibrationVerdict& verdict) {
   }
   out << (reasons == 0 ? " []\n" : "\n") << "  findings:\n";
   for (const VerdictLine& line : verdict.lines) {
-    out << "  - {status: " << VerdictStatusName(line.status) << ", rule: " << line.rule
+    out << "  - {status: " << VerdictStatusName(line.status) << ", rule: " << quoted(line.rule)
         << ", text: " << quoted(line.text) << "}\n";
   }
   return out.str();

@@ -3,6 +3,7 @@
 // corners, the robust median, a camera mounted upside down, and a rig
 // behind two housings.
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <fstream>
@@ -88,6 +89,13 @@ TEST(StereoCalibration, OpenCVStereoSampleAgreesWithStereoCalibrate) {
   EXPECT_EQ(testing::ReadFileToString(dir / "out/calibration.txt").find("Verdict: OK\n"),
             testing::ReadFileToString(dir / "out/calibration.txt").find("Verdict:"));
   EXPECT_NE(testing::ReadFileToString(dir / "out/calibration.txt").find("Verdict:"), std::string::npos);
+  const YAML::Node verdict = YAML::LoadFile((dir / "out/calibration.yaml").string())["verdict"];
+  EXPECT_EQ(verdict["status"].as<std::string>(), "OK");
+  bool camera2_coverage = false;
+  for (const YAML::Node& finding : verdict["findings"]) {
+    camera2_coverage = camera2_coverage || finding["rule"].as<std::string>() == "coverage, camera 2";
+  }
+  EXPECT_TRUE(camera2_coverage) << "the rule names with commas read back";
 
   // OpenCV on exactly the same corners and frames.
   Database db(dir / "db.db", Database::OpenMode::kReadOnly);
