@@ -18,7 +18,8 @@ echo "== 1. In air: corners, intrinsics (OPENCV), the report"
 "$portcal" target_extractor --database_path air.db --image_path real-dome/air \
   --ImageReader.camera_model OPENCV --ImageReader.single_camera 1 \
   --Target.cols 8 --Target.rows 6 --Target.square_size 0.03
-"$portcal" camera_calibrator --database_path air.db --output_path air
+"$portcal" camera_calibrator --database_path air.db --output_path air --image_path real-dome/air
+sed -n '/^Verdict/,/^$/p' air/calibration.txt
 sed -n '/^  parameter /,/^RMS/p' air/calibration.txt
 
 echo "== 2. Second opinion: mrcal on the same corners, 3-fold cross-validation"
@@ -30,8 +31,9 @@ echo "== 3. Under water: the dome port, solved jointly with the in-air views"
   --ImageReader.camera_model OPENCV --ImageReader.single_camera 1 \
   --Target.cols 8 --Target.rows 6 --Target.square_size 0.03
 "$portcal" housing_calibrator --database_path water.db --in_air_database_path air.db \
-  --input_calibration air/calibration.yaml --output_path water \
+  --input_calibration air/calibration.yaml --output_path water --image_path real-dome/water \
   --Housing.model DOMEPORT --Housing.params 0,0,0,0.043552,0.00375,1.0,1.495,1.333
+sed -n '/^Verdict/,/^$/p' water/calibration.txt
 sed -n '/^Housing/,/^RMS/p' water/calibration.txt
 
 echo "== 4. Hand-off: OpenCV and ROS files of the in-air camera; mrcal's uncertainty of its solve"
