@@ -73,3 +73,13 @@ if [ "$status" -ne 0 ]; then
   exit "$status"
 fi
 say "build: done, build/portcal"
+# On the PATH, as `cmake --install` would put it, so that the docs' commands
+# run as pasted: a link to this checkout's build (the last set-up wins).
+link=/usr/local/bin/portcal
+if [ -w /usr/local/bin ]; then
+  ln -sfn "$PWD/build/portcal" "$link" && say "PATH: $link -> $PWD/build/portcal"
+elif command -v sudo > /dev/null && sudo -n true 2> /dev/null; then
+  sudo ln -sfn "$PWD/build/portcal" "$link" && say "PATH: $link -> $PWD/build/portcal"
+else
+  say "PATH: /usr/local/bin is not writable; run: export PATH=\"$PWD/build:\$PATH\""
+fi
