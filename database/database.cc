@@ -2,9 +2,11 @@
 
 #include <sqlite3.h>
 
+#include <cmath>
 #include <cstring>
 
 #include "colmap_ext/util/error.h"
+#include "colmap_ext/util/string_utils.h"
 #include "database/lock_wait.h"
 #include "database/schema.h"
 
@@ -13,11 +15,30 @@ namespace fs = std::filesystem;
 namespace portcal {
 namespace {
 
+// Pixel coordinates beyond any image (sides are at most 65 535 px) by a
+// wide margin: keypoints a little outside the image are COLMAP's habit.
+constexpr float kMaxKeypointCoordinate = 1 << 20;
+
 template <typename T>
 std::vector<T> BlobAs(const std::vector<uint8_t>& blob) {
   std::vector<T> values(blob.size() / sizeof(T));
   if (!values.empty()) std::memcpy(values.data(), blob.data(), values.size() * sizeof(T));
   return values;
+}
+
+// Every image's camera is in the file. SQLite enforces the foreign key only
+// on writes with foreign_keys on, so a file edited without it (or damaged)
+// can hold an image of a camera that is not there; every stage reads
+// cameras by their id. Costs one index look-up per image.
+void CheckImagesHaveCameras(sqlite3* db, const std::string& path) {
+  Statement stmt(db, path,
+                 "SELECT image_id, name, camera_id FROM images WHERE camera_id NOT IN "
+                 "(SELECT camera_id FROM cameras) ORDER BY image_id LIMIT 1;");
+  if (!stmt.Step()) return;
+  throw InputError(path + ": image " + std::to_string(stmt.ColumnInt64(0)) + " (" + stmt.ColumnText(1) +
+                   ") refers to camera " + std::to_string(stmt.ColumnInt64(2)) +
+                   ", which the database does not hold (a damaged or hand-edited file; `sqlite3 " + path +
+                   " 'PRAGMA foreign_key_check'` lists such rows)");
 }
 
 }  // namespace
@@ -54,6 +75,7 @@ Database::Database(const fs::path& path, OpenMode mode, ColmapVersion version_if
       CreateSchema(version_if_created);
     }
     CheckSchema();
+    CheckImagesHaveCameras(db_, path_);
   } catch (...) {
     statements_.clear();
     sqlite3_close(db_);
@@ -163,6 +185,16 @@ FeatureKeypoints Database::ReadKeypoints(image_t image_id) {
     throw DatabaseError(path_ + ": keypoints of " + ImageLabel(image_id) + " have an invalid blob (" +
                         std::to_string(rows) + " x " + std::to_string(cols) + ", " + std::to_string(data.size()) +
                         " floats)");
+  }
+  // A damaged or edited blob: NaN, inf or 3e38 would pass the matchers,
+  // the masker and the mapper as if they were points.
+  for (size_t i = 0; i < data.size(); ++i) {
+    const bool coordinate = i % cols < 2;
+    if (!std::isfinite(data[i]) || (coordinate && std::abs(data[i]) > kMaxKeypointCoordinate)) {
+      throw InputError(path_ + ": keypoint " + std::to_string(i / cols) + " of " + ImageLabel(image_id) + " holds " +
+                       FormatShortest(data[i]) + (coordinate ? " as a coordinate" : " in its shape") +
+                       " (a damaged or edited database: extract this image's features again)");
+    }
   }
   keypoints.resize(rows);
   for (int64_t i = 0; i < rows; ++i) {

@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "colmap_ext/util/error.h"
+#include "colmap_ext/util/image_name.h"
 #include "database/database.h"
 
 namespace portcal {
@@ -91,10 +92,12 @@ Camera CameraFromRow(const Statement& stmt, const std::string& path) {
 
 // An images row: image_id, name, camera_id, then the prior: prior_qw..tz
 // (legacy) or the pose_priors row's position blob (3.10 on).
-DatabaseImage ImageFromRow(const Statement& stmt, bool legacy_priors) {
+DatabaseImage ImageFromRow(const Statement& stmt, bool legacy_priors, const std::string& path) {
   DatabaseImage image;
   image.image_id = static_cast<image_t>(stmt.ColumnInt64(0));
   image.name = stmt.ColumnText(1);
+  // A name no model file could hold (colmap_ext/util/image_name.h).
+  CheckImageName(image.name, path + ": image " + std::to_string(image.image_id));
   image.camera_id = static_cast<camera_t>(stmt.ColumnInt64(2));
   if (!legacy_priors) {
     const std::vector<double> position = DoublesOf(stmt.ColumnBlob(3));
@@ -237,20 +240,20 @@ std::optional<DatabaseImage> Database::ReadImage(image_t image_id) {
   Statement& stmt = Prepare("read_image", SelectImages(layout_) + " WHERE images.image_id=?;");
   stmt.Bind(1, static_cast<int64_t>(image_id));
   if (!stmt.Step()) return std::nullopt;
-  return ImageFromRow(stmt, layout_.pose_priors == ColmapLayout::PosePriors::kNone);
+  return ImageFromRow(stmt, layout_.pose_priors == ColmapLayout::PosePriors::kNone, path_);
 }
 
 std::optional<DatabaseImage> Database::ReadImageWithName(const std::string& name) {
   Statement& stmt = Prepare("read_image_name", SelectImages(layout_) + " WHERE name=?;");
   stmt.Bind(1, name);
   if (!stmt.Step()) return std::nullopt;
-  return ImageFromRow(stmt, layout_.pose_priors == ColmapLayout::PosePriors::kNone);
+  return ImageFromRow(stmt, layout_.pose_priors == ColmapLayout::PosePriors::kNone, path_);
 }
 
 std::vector<DatabaseImage> Database::ReadAllImages() {
   Statement& stmt = Prepare("read_images", SelectImages(layout_) + " ORDER BY images.image_id;");
   std::vector<DatabaseImage> images;
-  while (stmt.Step()) images.push_back(ImageFromRow(stmt, layout_.pose_priors == ColmapLayout::PosePriors::kNone));
+  while (stmt.Step()) images.push_back(ImageFromRow(stmt, layout_.pose_priors == ColmapLayout::PosePriors::kNone, path_));
   return images;
 }
 

@@ -2,6 +2,7 @@
 #include <sqlite3.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <functional>
 
@@ -78,6 +79,14 @@ TwoViewGeometry GeometryFromRow(const Statement& stmt, const Where& where) {
   geometry.H = MatrixFromBlob(stmt.ColumnBlob(7));
   const std::vector<double> qvec = DoublesFromBlob(stmt.ColumnBlob(8));
   const std::vector<double> tvec = DoublesFromBlob(stmt.ColumnBlob(9));
+  const auto finite = [](const std::vector<double>& values) {
+    return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+  };
+  if (!finite(qvec) || !finite(tvec) || !geometry.F.allFinite() || !geometry.E.allFinite() ||
+      !geometry.H.allFinite()) {
+    throw InputError(where() + ": the relative pose or F, E or H holds NaN or inf (a damaged or edited database: "
+                               "match these images again)");
+  }
   if (qvec.size() == 4 && tvec.size() == 3) {
     geometry.cam2_from_cam1 = Rigid3d(
         QuaternionFromWxyz(Eigen::Vector4d(qvec[0], qvec[1], qvec[2], qvec[3])),

@@ -6,18 +6,43 @@
 #include <cstring>
 
 #include "colmap_ext/util/error.h"
+#include "colmap_ext/util/logging.h"
 
 namespace portcal {
 
 namespace {
 
+// SQLite's message with what it means for the user where SQLite's own words
+// do not say it (a damaged file, a full disk, a dangling reference).
 std::string Describe(sqlite3* db, int code) {
   std::string message = sqlite3_errmsg(db);
-  if ((code & 0xFF) == SQLITE_BUSY || (code & 0xFF) == SQLITE_LOCKED) {
-    message += " (another process held the database past --Database.busy_timeout; wait for it to finish, or "
-               "give a longer timeout)";
+  const int extended = sqlite3_extended_errcode(db);
+  switch (code & 0xFF) {
+    case SQLITE_BUSY:
+    case SQLITE_LOCKED:
+      return message + " (another process held the database past --Database.busy_timeout; wait for it to finish, "
+                       "or give a longer timeout)";
+    case SQLITE_CORRUPT:
+      return "the database file is damaged (SQLite: " + message +
+             "); restore it from a copy, or re-run the stages that made it";
+    case SQLITE_NOTADB:
+      return "not an SQLite database (SQLite: " + message + ")";
+    case SQLITE_FULL:
+      return "the disk is full (SQLite: " + message + "); free some space and run again";
+    case SQLITE_READONLY:
+      return "the file (or its folder, for the journal) cannot be written (SQLite: " + message + ")";
+    case SQLITE_IOERR:
+      return "the file could not be read or written (SQLite: " + message + "; a failing disk, a removed drive or "
+             "a network folder that went away)";
+    case SQLITE_CONSTRAINT:
+      if (extended == SQLITE_CONSTRAINT_FOREIGNKEY) {
+        return "a row would refer to a camera or image the database does not hold (SQLite: " + message +
+               "); the database is inconsistent";
+      }
+      return message;
+    default:
+      return message;
   }
-  return message;
 }
 
 }  // namespace
@@ -31,8 +56,11 @@ Statement::Statement(sqlite3* db, const std::string& path,
 
 Statement::~Statement() { sqlite3_finalize(stmt_); }
 
+// The statement goes to the debug log, not the message: it helps a
+// developer, and a user reads what failed and why.
 void Statement::Fail(const std::string& what) const {
-  throw DatabaseError(path_ + ": " + what + " [SQL: " + sql_ + "]");
+  VLOG(1) << path_ << ": failed SQL: " << sql_;
+  throw DatabaseError(path_ + ": " + what);
 }
 
 Statement& Statement::Bind(int index, int64_t value) {
@@ -123,10 +151,13 @@ void ExecuteSql(sqlite3* db, const std::string& path, const std::string& sql) {
   char* error = nullptr;
   const int code = sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error);
   if (code != SQLITE_OK) {
+    // sqlite3_exec's own text is the more precise for plain failures (the
+    // statement's error); Describe's where it adds what the code means.
     std::string message = error ? error : Describe(db, code);
-    if ((code & 0xFF) == SQLITE_BUSY) message = Describe(db, code);
+    if ((code & 0xFF) != SQLITE_ERROR) message = Describe(db, code);
     sqlite3_free(error);
-    throw DatabaseError(path + ": " + message + " [SQL: " + sql + "]");
+    VLOG(1) << path << ": failed SQL: " << sql;
+    throw DatabaseError(path + ": " + message);
   }
 }
 

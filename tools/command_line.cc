@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <new>
+#include <opencv2/core.hpp>
 #include <sstream>
 
 #include "colmap_ext/housing/housing_models.h"
@@ -242,6 +244,18 @@ int ReportErrors(const std::function<void()>& body) {
   } catch (const Cancelled& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitCancelled;
+  } catch (const std::bad_alloc&) {
+    // Sizes are bounded before work starts; what is left is an input too
+    // large for this machine's memory as a whole.
+    std::cerr << "error: out of memory: the input (its images, features or sizes) needs more memory than this "
+                 "machine has; use smaller or fewer images, or a machine with more memory\n";
+    return kExitFailure;
+  } catch (const cv::Exception& e) {
+    // OpenCV's assertion text names its own source, not the input: say
+    // that it was OpenCV and keep its reason.
+    std::cerr << "error: OpenCV refused the input (" << e.err << " in " << e.func
+              << "); an image or a size portcal did not check; please report it with the command\n";
+    return kExitFailure;
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitFailure;

@@ -1,9 +1,11 @@
 #include "colmap_ext/io/sparse_model.h"
 
 #include <fstream>
+#include <map>
 #include <set>
 
 #include "colmap_ext/util/error.h"
+#include "colmap_ext/util/image_name.h"
 
 namespace fs = std::filesystem;
 
@@ -17,8 +19,15 @@ void SparseModel::Validate(const std::string& context, const std::string& extens
   for (const auto& [camera_id, camera] : cameras) {
     camera.Validate(in("cameras") + ": camera " + std::to_string(camera_id));
   }
+  std::map<std::string, image_t> image_of_name;
   for (const auto& [image_id, image] : images) {
+    CheckImageName(image.name, in("images") + ": image " + std::to_string(image_id));
     const std::string where = in("images") + ": image " + std::to_string(image_id) + " (" + image.name + ")";
+    const auto [other, inserted] = image_of_name.emplace(image.name, image_id);
+    if (!inserted) {
+      throw InputError(where + " has the name of image " + std::to_string(other->second) +
+                       " (names identify images in databases and image folders)");
+    }
     if (cameras.count(image.camera_id) == 0) {
       throw InputError(where + " refers to unknown camera " + std::to_string(image.camera_id));
     }
@@ -130,6 +139,22 @@ void WriteFileAtomically(const fs::path& path, bool binary,
   }
 }
 
+namespace {
+
+// images.txt holds a name as the rest of its line, and COLMAP 3.8 reads it
+// up to the first space: such a name would come back cut (see
+// colmap_ext/util/image_name.h).
+void CheckNamesFitText(const SparseModel& model) {
+  for (const auto& [image_id, image] : model.images) {
+    if (image.name.find(' ') == std::string::npos) continue;
+    throw InputError("image " + std::to_string(image_id) + " (" + image.name +
+                     "): a name with a space cannot be written to images.txt (COLMAP reads names there up to the "
+                     "first space); write the model as BIN, which keeps any name");
+  }
+}
+
+}  // namespace
+
 void WriteSparseModel(const SparseModel& model, const fs::path& dir,
                       ModelFormat format) {
   model.Validate("model to write to " + dir.string());
@@ -139,6 +164,7 @@ void WriteSparseModel(const SparseModel& model, const fs::path& dir,
     throw InputError(dir.string() + ": cannot create output directory");
   }
   const bool binary = format == ModelFormat::kBinary;
+  if (!binary) CheckNamesFitText(model);
   const std::string ext = binary ? ".bin" : ".txt";
   WriteFileAtomically(dir / ("cameras" + ext), binary, [&](std::ostream& out) {
     binary ? WriteCamerasBinary(model, out) : WriteCamerasText(model, out);

@@ -30,7 +30,7 @@ std::map<camera_t, Camera> ReadCamerasBinary(const fs::path& path) {
     camera.params.resize(CameraModelNumParams(camera.model_id));
     for (double& param : camera.params) param = reader.ReadFinite("camera parameter");
     camera.Validate(where);
-    cameras[camera.camera_id] = camera;
+    if (!cameras.emplace(camera.camera_id, camera).second) throw InputError(where + ": a second camera of this id");
   }
   return cameras;
 }
@@ -57,7 +57,10 @@ std::map<image_t, Image> ReadImagesBinary(const fs::path& path) {
       point2D.xy.y() = reader.ReadFinite("2D point y");
       point2D.point3D_id = reader.Read<uint64_t>("3D point id");
     }
-    images[image.image_id] = std::move(image);
+    const image_t image_id = image.image_id;
+    if (!images.emplace(image_id, std::move(image)).second) {
+      throw InputError(path.string() + ": image " + std::to_string(image_id) + ": a second image of this id");
+    }
   }
   return images;
 }
@@ -78,7 +81,9 @@ std::map<point3D_t, Point3D> ReadPoints3DBinary(const fs::path& path) {
       element.image_id = reader.Read<uint32_t>("track image id");
       element.point2D_idx = reader.Read<uint32_t>("track point index");
     }
-    points3D[id] = std::move(point);
+    if (!points3D.emplace(id, std::move(point)).second) {
+      throw InputError(path.string() + ": 3D point " + std::to_string(id) + ": a second point of this id");
+    }
   }
   return points3D;
 }

@@ -1,9 +1,18 @@
 #include "pipelines/calibration/calibration_output.h"
 
+#include "colmap_ext/util/error.h"
+#include "colmap_ext/util/progress.h"
+
 namespace portcal {
 
 void WriteCalibrationOutput(const CalibrationReport& report, const std::filesystem::path& dir, Database* database,
                             camera_t camera_id, const std::function<void()>& write_beside) {
+  // The last moment to honour a stop: a SIGINT during the report's pictures
+  // would otherwise end in a complete output and exit 0.
+  if (CancelFlag::Requested()) {
+    throw Cancelled("nothing was written (" + dir.string() + (database ? " and the database are" : " is") +
+                    " as it was)");
+  }
   if (database == nullptr) {
     WriteCalibrationReport(report, dir);
     if (write_beside) write_beside();

@@ -15,6 +15,14 @@ bool NearTheImage(const Eigen::Vector2d& xy, const Camera& camera) {
 }  // namespace
 
 TargetViews ReadTargetViews(Database* database) {
+  TargetViews views = ReadTargetViewsIfAny(database);
+  if (views.by_camera.empty()) {
+    throw InputError(database->path() + ": no target observations; run target_extractor first");
+  }
+  return views;
+}
+
+TargetViews ReadTargetViewsIfAny(Database* database) {
   TargetViews views;
   for (const DatabaseImage& image : database->ReadAllImages()) {
     const auto status = database->ReadTargetDetectionStatus(image.image_id);
@@ -38,9 +46,6 @@ TargetViews ReadTargetViews(Database* database) {
       view.pixels.push_back(o.xy);
     }
     views.by_camera[image.camera_id].push_back(std::move(view));
-  }
-  if (views.by_camera.empty()) {
-    throw InputError(database->path() + ": no target observations; run target_extractor first");
   }
   return views;
 }

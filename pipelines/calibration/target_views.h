@@ -16,8 +16,12 @@ struct TargetViews {
   std::string target;  // target_extractor's description, e.g. "chessboard 8x6"
 };
 
-// Throws InputError naming the database when it holds no observations.
+// Throws InputError naming the database when it holds no observations,
+// or an observation no detector writes (non-finite, far off the image).
 TargetViews ReadTargetViews(Database* database);
+// The same, empty where the database holds no observations yet (a plan
+// before the first view); a damaged observation is still an error.
+TargetViews ReadTargetViewsIfAny(Database* database);
 
 // The camera to calibrate: `camera_id` if >= 0 (must have views), else the
 // only camera with views. Throws InputError naming the database and

@@ -5,6 +5,8 @@
 
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
+#include "colmap_ext/util/image_name.h"
+#include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/string_utils.h"
 
 namespace fs = std::filesystem;
@@ -47,7 +49,13 @@ std::vector<std::string> ListImages(const fs::path& dir) {
         ext == ".bmp") {
       // Lexically: a symlinked image keeps its link's name (fs::relative would
       // resolve the link and name the target's path).
-      names.push_back(entry.path().lexically_relative(dir).generic_string());
+      std::string name = entry.path().lexically_relative(dir).generic_string();
+      const std::string problem = ImageNameProblem(name);
+      if (!problem.empty()) {
+        LOG(WARNING) << dir.string() << ": skipping image '" << ShownImageName(name) << "', whose name " << problem;
+        continue;
+      }
+      names.push_back(std::move(name));
     }
   }
   std::sort(names.begin(), names.end());

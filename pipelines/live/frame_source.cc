@@ -76,6 +76,8 @@ FrameSource::FrameSource(const FrameSourceOptions& options) : options_(options) 
   auto capture = std::make_unique<cv::VideoCapture>();
   if (kind_ == SourceKind::kDevice) {
     if (AllDigits(source)) {
+      // /dev/video0 .. /dev/video9999: a longer number is no device index.
+      if (source.size() > 4) throw InputError(source + ": no such video device index (0 to 9999, /dev/videoN)");
       capture->open(std::stoi(source), cv::CAP_V4L2);
     } else {
       capture->open(source, cv::CAP_V4L2);

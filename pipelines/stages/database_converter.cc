@@ -5,6 +5,7 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "database/database.h"
+#include "database/integrity_check.h"
 #include "database/new_database_file.h"
 
 namespace portcal {
@@ -18,13 +19,22 @@ void DatabaseConverterOptions::Check() const {
 
 DatabaseConverterSummary RunDatabaseConverter(const DatabaseConverterOptions& options, ProgressSink& progress) {
   options.Check();
+  CheckDatabaseIntegrity(options.database_path);
   DatabaseConverterSummary summary;
+  // A copy is made under a staging name and renamed when converted, as
+  // database_merger does: a killed run leaves no file under the output's
+  // name (which a rerun would refuse), only a staging file the rerun
+  // replaces.
+  const std::string staging = options.output_path.empty() ? "" : options.output_path + ".converting";
   std::string path = options.database_path;
-  NewDatabaseFile new_copy(options.output_path.empty() ? options.database_path : options.output_path);
-  if (!options.output_path.empty()) {
+  if (!staging.empty()) {
+    std::filesystem::remove(staging);
+    path = staging;
+  }
+  NewDatabaseFile new_copy(path);
+  if (!staging.empty()) {
     Database source(options.database_path, Database::OpenMode::kReadOnly);
-    source.CopyTo(options.output_path);
-    path = options.output_path;
+    source.CopyTo(staging);
   }
   {
     Database database(path, Database::OpenMode::kReadWrite);
@@ -35,6 +45,10 @@ DatabaseConverterSummary RunDatabaseConverter(const DatabaseConverterOptions& op
     progress.Advance(1);
     progress.End();
     summary.to = database.layout().VersionRange();
+  }
+  if (!staging.empty()) {
+    std::filesystem::rename(staging, options.output_path);
+    path = options.output_path;
   }
   new_copy.Keep();
   LOG(INFO) << path << ": converted from " << summary.from << "'s layout to " << summary.to << "'s ("

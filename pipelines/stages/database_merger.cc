@@ -9,6 +9,7 @@
 #include "colmap_ext/util/logging.h"
 #include "database/database.h"
 #include "database/database_merge.h"
+#include "database/integrity_check.h"
 #include "database/new_database_file.h"
 #include "database/stage_run.h"
 
@@ -51,6 +52,8 @@ void CheckNoNameInBoth(Database* first, Database* second) {
 
 DatabaseMergerSummary RunDatabaseMerger(const DatabaseMergerOptions& options, ProgressSink& progress) {
   options.Check();
+  CheckDatabaseIntegrity(options.database_path1);
+  CheckDatabaseIntegrity(options.database_path2);
   {
     Database first(options.database_path1, Database::OpenMode::kReadOnly);
     Database second(options.database_path2, Database::OpenMode::kReadOnly);

@@ -214,7 +214,6 @@ void UndistortImages(const ImageUndistorterOptions& options, const std::vector<I
   for (const ImageToUndistort& image : images) fs::create_directories((folder / image.name).parent_path());
   progress.Begin("undistorted images", images.size());
   ParallelFor(images.size(), options.num_threads, [&](size_t i) {
-    CancelFlag::ThrowIfRequested();
     const fs::path path = fs::path(options.image_path) / images[i].name;
     const cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
     if (image.empty()) throw InputError(path.string() + ": not an image OpenCV can read");
@@ -277,7 +276,8 @@ void ImageUndistorterOptions::Check() const {
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
 }
 
-ImageUndistorterSummary RunImageUndistorter(const ImageUndistorterOptions& options, ProgressSink& progress) {
+// The run itself; RunImageUndistorter names what a stop leaves.
+static ImageUndistorterSummary Run(const ImageUndistorterOptions& options, ProgressSink& progress) {
   options.Check();
   const UndistortionInput input = ReadInput(options);
   ImageUndistorterSummary summary;
@@ -319,12 +319,22 @@ ImageUndistorterSummary RunImageUndistorter(const ImageUndistorterOptions& optio
     }
   }
   WriteReports(summary, staging);
+  // The last moment to honour a stop; after it the output is replaced.
+  if (CancelFlag::Requested()) throw Cancelled("nothing was written to " + options.output_path);
   MoveIntoPlace(staging, output);
   new_paths.Keep();
   for (const std::string& warning : summary.warnings) LOG(WARNING) << warning;
   LOG(INFO) << summary.num_images << " images undistorted into " << options.output_path
             << " (report: " << (output / "undistortion.txt").string() << ")";
   return summary;
+}
+
+ImageUndistorterSummary RunImageUndistorter(const ImageUndistorterOptions& options, ProgressSink& progress) {
+  try {
+    return Run(options, progress);
+  } catch (const Cancelled&) {
+    throw Cancelled("nothing was written to " + options.output_path);  // not "the database"
+  }
 }
 
 }  // namespace portcal

@@ -47,12 +47,14 @@ DatabaseViews ReadViews(const PoseSuggesterOptions& options) {
   DatabaseViews result;
   std::optional<camera_t> camera_id;
   if (options.camera_id >= 0) camera_id = static_cast<camera_t>(options.camera_id);
-  try {
-    const TargetViews views = ReadTargetViews(&database);
+  // No views yet is a plan from nothing; a damaged one is an error.
+  const TargetViews views = ReadTargetViewsIfAny(&database);
+  if (!views.by_camera.empty() &&
+      (options.camera_id < 0 || views.by_camera.count(static_cast<camera_t>(options.camera_id)))) {
     camera_id = ChooseCamera(views, options.camera_id, options.database_path);
     result.views = views.by_camera.at(*camera_id);
     result.target = views.target;
-  } catch (const InputError&) {
+  } else {
     const std::vector<Camera> cameras = database.ReadAllCameras();
     if (!camera_id && cameras.size() == 1) camera_id = cameras[0].camera_id;
   }

@@ -403,6 +403,8 @@ void FinishSet(const SynthesizeOptions& options, const DatasetConfig& config, co
     WriteFileAtomically(staging / "target_dots.csv", false, [&](std::ostream& out) { out << csv; });
   }
   fs::copy_file(options.config_path, staging / "config_used.yaml", fs::copy_options::overwrite_existing);
+  // The last moment to honour a stop; after it the output is replaced.
+  if (CancelFlag::Requested()) throw Cancelled("nothing was written to " + options.output_path);
   for (const char* entry : {"images", "ground_truth.yaml", "target_dots.csv", "config_used.yaml", "navigation.txt",
                             "trajectory.yaml", "trajectory.avi", "trajectory_cam2.avi"}) {
     if (!fs::exists(staging / entry)) continue;
@@ -468,7 +470,8 @@ void RenderTrajectory(const DatasetConfig& config, const FrameRenderer& renderer
 
 }  // namespace
 
-SynthesizeSummary RunSynthesize(const SynthesizeOptions& options, ProgressSink& progress) {
+// The run itself; RunSynthesize names what a stop leaves.
+static SynthesizeSummary Run(const SynthesizeOptions& options, ProgressSink& progress) {
   options.Check();
   const auto start = Clock::now();
   DatasetConfig config = ReadDatasetConfig(options.config_path);
@@ -542,6 +545,14 @@ SynthesizeSummary RunSynthesize(const SynthesizeOptions& options, ProgressSink& 
             << " s (rays " << ray_seconds << " s once, " << summary.render_seconds_per_image
             << " s per image) -> " << output.string();
   return summary;
+}
+
+SynthesizeSummary RunSynthesize(const SynthesizeOptions& options, ProgressSink& progress) {
+  try {
+    return Run(options, progress);
+  } catch (const Cancelled&) {
+    throw Cancelled("nothing was written to " + options.output_path);  // not "the database"
+  }
 }
 
 }  // namespace portcal

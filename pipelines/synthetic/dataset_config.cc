@@ -7,12 +7,30 @@
 
 namespace portcal {
 
+namespace {
+
+// A rendered image is held with its supersamples in memory: 10^8 pixels
+// (100 megapixels, above any camera here) bounds one frame to a few GB.
+constexpr double kMaxRenderPixels = 1e8;
+
+void CheckRenderArea(const Camera& camera, const std::string& key) {
+  const double area = static_cast<double>(camera.width) * static_cast<double>(camera.height);
+  if (area > kMaxRenderPixels) {
+    throw OptionError(key + ".width x height", std::to_string(camera.width) + " x " + std::to_string(camera.height),
+                      "at most 10^8 pixels (100 megapixels) per image");
+  }
+}
+
+}  // namespace
+
 void DatasetConfig::Check() const {
   if (num_images < 1) throw OptionError("num_images", std::to_string(num_images), ">= 1");
   camera.Validate("camera");
+  CheckRenderArea(camera, "camera");
   if (housing) housing->ValidateInput("housing");
   if (stereo) {
     camera2.Validate("stereo.camera2");
+    CheckRenderArea(camera2, "stereo.camera2");
     if (housing2) housing2->ValidateInput("stereo.housing2");
   }
   if (survey) {

@@ -93,6 +93,40 @@ check_stage() {
   echo "$name: $kills kills within its ${whole_ms} ms" >&2
 }
 
+# check_new_file NAME OUTPUT COMMAND...: a stage that writes a new database
+# at OUTPUT (refusing an existing one), killed as above: OUTPUT is then
+# absent or the whole of an uninterrupted run's, and a rerun succeeds.
+check_new_file() {
+  local name="$1" out="$2"; shift 2
+  rm -f "$out"*
+  local start end; start=$(date +%s%N)
+  "$@" >/dev/null 2>&1 || { fail "$name: the uninterrupted run failed: $*"; return; }
+  end=$(date +%s%N)
+  local whole_ms=$(( (end - start) / 1000000 ))
+  local after; after="$(rows "$out")"
+  local k
+  for ((k = 1; k <= kills; k++)); do
+    rm -f "$out"
+    local at_ms=$(( RANDOM % (whole_ms > 1 ? whole_ms : 1) ))
+    "$@" >/dev/null 2>&1 &
+    local pid=$!
+    sleep "$(printf '%d.%03d' $((at_ms / 1000)) $((at_ms % 1000)))"
+    kill -KILL "$pid" 2>/dev/null || true
+    wait "$pid" 2>/dev/null || true
+    total_kills=$((total_kills + 1))
+    if [ -f "$out" ]; then
+      complete=$((complete + 1))
+      [ "$(sqlite3 "$out" 'PRAGMA integrity_check')" = "ok" ] || fail "$name: kill $k at ${at_ms} ms: damaged $out"
+      [ "$(rows "$out")" = "$after" ] || fail "$name: kill $k at ${at_ms} ms: $out holds part of the run's rows"
+      continue
+    fi
+    rolled_back=$((rolled_back + 1))
+    "$@" >/dev/null 2>&1 || { fail "$name: kill $k at ${at_ms} ms: the rerun failed"; continue; }
+    [ "$(rows "$out")" = "$after" ] || fail "$name: kill $k at ${at_ms} ms: the rerun differs from an uninterrupted run"
+  done
+  echo "$name: $kills kills within its ${whole_ms} ms" >&2
+}
+
 f="$work/fixture"
 check_stage database_creator "" "$portcal" database_creator --database_path @DB
 check_stage target_extractor "" "$portcal" target_extractor --database_path @DB --image_path "$f/set/images" \
@@ -108,6 +142,10 @@ check_stage pose_prior_importer "$f/feat.db" "$portcal" pose_prior_importer --da
   --input_path "$f/priors.txt"
 check_stage database_converter "$f/matched.db" "$portcal" database_converter --database_path @DB \
   --Database.colmap_version 4.1
+check_new_file database_converter_output "$work/converted.db" "$portcal" database_converter \
+  --database_path "$f/matched.db" --output_path "$work/converted.db" --Database.colmap_version 4.1
+check_new_file database_merger "$work/merged.db" "$portcal" database_merger \
+  --database_path1 "$f/matched.db" --database_path2 "$f/rig.db" --merged_database_path "$work/merged.db"
 # The calibrators on one thread: with two, Ceres sums its threads' costs in
 # varying order and the last bits of the parameters vary from run to run.
 check_stage camera_calibrator "$f/cam1.db" "$portcal" camera_calibrator --database_path @DB \
