@@ -32,8 +32,8 @@ std::string Describe(sqlite3* db, int code) {
     case SQLITE_READONLY:
       return "the file (or its folder, for the journal) cannot be written (SQLite: " + message + ")";
     case SQLITE_IOERR:
-      return "the file could not be read or written (SQLite: " + message + "; a failing disk, a removed drive or "
-             "a network folder that went away)";
+      return "the file could not be read or written (SQLite: " + message + "; a full disk or a file over its size "
+             "limit, a failing disk, a removed drive or a network folder that went away)";
     case SQLITE_CONSTRAINT:
       if (extended == SQLITE_CONSTRAINT_FOREIGNKEY) {
         return "a row would refer to a camera or image the database does not hold (SQLite: " + message +

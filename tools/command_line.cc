@@ -256,6 +256,12 @@ int ReportErrors(const std::function<void()>& body) {
     std::cerr << "error: OpenCV refused the input (" << e.err << " in " << e.func
               << "); an image or a size portcal did not check; please report it with the command\n";
     return kExitFailure;
+  } catch (const std::logic_error& e) {
+    // A library's bare words (map::at, vector::_M_range_check, stoi) or a
+    // failed internal check: never the user's fault alone, so say so.
+    std::cerr << "error: internal error (" << e.what()
+              << "): a bug, or a damaged input that portcal did not check; please report it with the command\n";
+    return kExitFailure;
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitFailure;

@@ -396,7 +396,7 @@ void LiveSession::PrintStatus(double time_s) {
   LOG(INFO) << line.str();
 }
 
-bool LiveSession::CheckSize(Channel* channel, const cv::Mat& gray, int64_t index) {
+bool LiveSession::CheckSize(Channel* channel, const cv::Mat& gray, const Frame& frame) {
   if (channel->size.area() == 0) {
     channel->size = gray.size();
     LiveEstimatorOptions& estimator = channel->estimator_options;
@@ -423,10 +423,13 @@ bool LiveSession::CheckSize(Channel* channel, const cv::Mat& gray, int64_t index
   }
   const std::string sizes = std::to_string(gray.cols) + "x" + std::to_string(gray.rows) + " instead of " +
                             std::to_string(channel->size.width) + "x" + std::to_string(channel->size.height);
+  // In the source's time, not the wall's: a recorded file read as fast as
+  // it decodes (--Live.realtime 0) spends seconds of video in a fraction of
+  // one, and a resolution that changed for good must fail there too.
   if (channel->other_size_since_s < 0) {
-    channel->other_size_since_s = WallSeconds();
-    Note(channel->source + ": frame " + std::to_string(index) + " is " + sizes + "; skipped", true);
-  } else if (WallSeconds() - channel->other_size_since_s > options_.source.stall_seconds) {
+    channel->other_size_since_s = frame.time_s;
+    Note(channel->source + ": frame " + std::to_string(frame.index) + " is " + sizes + "; skipped", true);
+  } else if (frame.time_s - channel->other_size_since_s > options_.source.stall_seconds) {
     throw InputError(channel->source + ": the frames changed size to " + sizes + " for " +
                      std::to_string(static_cast<int>(options_.source.stall_seconds)) +
                      " s (a stream's resolution changed?)");
@@ -498,7 +501,7 @@ LiveSummary LiveSession::Run() {
     for (const Frame* frame : {&frames.first, &frames.second}) {
       if (sights.size() == channels_.size() || frame->image.empty()) break;
       const cv::Mat gray = Gray(frame->image);
-      if (!CheckSize(&channels_[sights.size()], gray, frame->index)) break;
+      if (!CheckSize(&channels_[sights.size()], gray, *frame)) break;
       sights.push_back({frame, gray, {}});
     }
     if (sights.size() != channels_.size()) continue;

@@ -10,6 +10,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -22,7 +23,16 @@
 namespace portcal {
 
 // Where kept frames go (an image file and database rows: the stage's
-// business). Store throws to refuse a frame; the session goes on.
+// business). Store throws InputError or DatabaseError to refuse a frame;
+// the session goes on. It throws FrameStoreBroken where no frame can be
+// kept any more (a full disk, a folder that became read-only): the session
+// ends with that error, and the views kept before stay where they are
+// (a calibration of fewer views than the user held would look complete).
+class FrameStoreBroken : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 class KeptFrameStore {
  public:
   virtual ~KeptFrameStore() = default;
@@ -150,7 +160,7 @@ class LiveSession {
     std::unique_ptr<LiveEstimator> estimator;
     StillnessTracker tracker;
     cv::Size size;
-    double other_size_since_s = -1;  // wall time frames of another size began
+    double other_size_since_s = -1;  // the source's time (Frame::time_s) frames of another size began
     Frame sharpest;
     cv::Mat sharpest_gray;
     CornerMap sharpest_corners;
@@ -159,7 +169,7 @@ class LiveSession {
   void Process(std::vector<Sight>& sights, double arrival_wall_s);
   // The first frame fixes the image size (and the camera's, if unknown);
   // false for a frame of another size.
-  bool CheckSize(Channel* channel, const cv::Mat& gray, int64_t index);
+  bool CheckSize(Channel* channel, const cv::Mat& gray, const Frame& frame);
   // "" when the view is new, else why not (the kept view it repeats).
   std::string NotNovel(const std::vector<Sight>& sights) const;
   // Hands-free: the spells' states combined; the sharpest frames kept;

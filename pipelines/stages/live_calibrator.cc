@@ -69,8 +69,35 @@ class DatabaseFrameStore : public KeptFrameStore {
     // A continued session: the new frames join the camera of the kept ones
     // (a frame of another size is then refused, naming both).
     std::set<camera_t> cameras;
-    for (const DatabaseImage& image : database->ReadAllImages()) cameras.insert(image.camera_id);
+    for (const DatabaseImage& image : database->ReadAllImages()) {
+      cameras.insert(image.camera_id);
+      CheckContinues(image);
+    }
     if (!stereo && cameras.size() == 1) shared_.by_folder[""] = *cameras.begin();
+  }
+
+  // A continued session is of the same board and camera model as the kept
+  // views: refused at start, naming both, rather than a mixed database or
+  // a failure at the first keep.
+  void CheckContinues(const DatabaseImage& image) const {
+    // Only the views count: a database may hold other images too.
+    const std::optional<TargetDetectionStatus> status = database_->ReadTargetDetectionStatus(image.image_id);
+    if (!status || !status->found) return;
+    if (status->target != target_) {
+      throw InputError(options_.database_path + ": its views (" + image.name + ") are of the target '" +
+                       status->target + "', the --Target.* options describe '" + target_ +
+                       "'; continue with the same board, or give another --database_path");
+    }
+    const std::optional<Camera> camera = database_->ReadCamera(image.camera_id);
+    size_t c = 0;  // the camera whose folder holds the image (a rig's cam2/)
+    while (c + 1 < folders_.size() && image.name.rfind(folders_[c] + "/", 0) != 0) ++c;
+    const std::string& asked = readers_[c].camera_model;
+    if (camera && camera->ModelName() != asked) {
+      throw InputError(options_.database_path + ": its views (" + image.name + ") are of a " + camera->ModelName() +
+                       " camera, this session's is " + asked +
+                       " (--ImageReader.camera_model or --input_calibration); continue with the same model, or give "
+                       "another --database_path");
+    }
   }
 
   std::string Store(const std::vector<cv::Mat>& images, const std::vector<TargetDetection>& detections) override {
@@ -133,13 +160,29 @@ class DatabaseFrameStore : public KeptFrameStore {
     std::error_code error;
     // At the first keep: a session that keeps nothing leaves nothing.
     fs::create_directories(path.parent_path(), error);
-    if (error || !cv::imwrite(partial.string(), image)) {
-      throw InputError(partial.string() + ": cannot write the frame" + (error ? " (" + error.message() + ")" : ""));
+    bool written = false;
+    if (!error) {
+      try {
+        written = cv::imwrite(partial.string(), image);
+      } catch (const cv::Exception&) {
+        written = false;  // libpng's write error, as OpenCV reports it
+      }
+    }
+    if (!written) {
+      fs::remove(partial, error);
+      throw FrameStoreBroken(partial.string() + ": cannot write a kept frame (" +
+                             (error ? error.message() : "a full disk or a read-only folder?") + "); " +
+                             Kept() + " stay in " + options_.database_path + " and " + options_.image_path);
     }
     fs::rename(partial, path, error);
-    if (error) throw InputError(path.string() + ": cannot move the frame into place (" + error.message() + ")");
+    if (error) {
+      throw FrameStoreBroken(path.string() + ": cannot move a kept frame into place (" + error.message() + "); " +
+                             Kept() + " stay in " + options_.database_path + " and " + options_.image_path);
+    }
     return path;
   }
+
+  std::string Kept() const { return std::to_string(database_->NumImages()) + " images kept before"; }
 
   // live_NNNN.png after the highest such name in the folders or database.
   std::string NextName() {

@@ -25,7 +25,7 @@ SparseModel MakeModel() {
   for (image_t id : {1u, 2u, 5u}) {
     Image image;
     image.image_id = id;
-    image.name = "dir/img " + std::to_string(id) + ".png";  // with a space
+    image.name = "dir/Bild_" + std::to_string(id) + "_\u00e9'.png";  // non-ASCII and an apostrophe
     image.camera_id = id == 5 ? 7 : 1;
     image.cam_from_world = Rigid3d(
         Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * id, Eigen::Vector3d(1, 2, 3).normalized())),
@@ -103,6 +103,40 @@ TEST(SparseModel, BinaryAndTextRoundTripsAreExact) {
               testing::ReadFileToString(dir / "bin2" / name)) << name;
   }
   EXPECT_TRUE(fs::exists(dir / "bin" / "housings.txt"));
+}
+
+// colmap_ext/util/image_name.h: a space is kept in BIN and refused in
+// images.txt (COLMAP reads a name there up to the first space); a control
+// character is refused on both sides, naming the image.
+TEST(SparseModel, ImageNamesFollowOnePolicy) {
+  testing::TempDir dir;
+  SparseModel model = MakeModel();
+  model.images.at(2).name = "dir/img 2.png";
+  WriteSparseModel(model, dir / "bin", ModelFormat::kBinary);
+  ExpectSameModel(model, ReadSparseModel(dir / "bin"));
+  try {
+    WriteSparseModel(model, dir / "txt", ModelFormat::kText);
+    ADD_FAILURE() << "a name with a space went to images.txt";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("dir/img 2.png"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("BIN"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir / "txt" / "images.txt"));
+  model.images.at(2).name = "dir/img\n2.png";
+  EXPECT_THROW(WriteSparseModel(model, dir / "bin_newline", ModelFormat::kBinary), InputError);
+  // Read: a .bin whose name holds a tab.
+  std::string images = testing::ReadFileToString(dir / "bin" / "images.bin");
+  const size_t at = images.find("dir/img 2.png");
+  ASSERT_NE(at, std::string::npos);
+  images[at + 7] = '\t';
+  std::ofstream(dir / "bin" / "images.bin", std::ios::binary) << images;
+  try {
+    ReadSparseModel(dir / "bin");
+    ADD_FAILURE() << "a name with a tab was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("images.bin"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("dir/img\\x092.png"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SparseModel, ImportsTheRefractiveForksCamerasTxt) {

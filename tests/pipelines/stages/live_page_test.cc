@@ -9,6 +9,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -169,6 +170,42 @@ TEST(LivePage, ABrowserSeesTheStreamAndItsButtonsWork) {
   EXPECT_EQ(summary.session.end_reason, "finish requested");
   Database database(dir / "live.db", Database::OpenMode::kReadOnly);
   EXPECT_EQ(database.NumImages(), summary.session.kept);
+}
+
+// A hostile file name among the kept views of a continued session: the
+// page shows it as text; no element is made of it (names reach the page
+// through textContent only).
+TEST(LivePage, AHostileImageNameShowsAsText) {
+  if (testing::RunCommand("command -v chromium").exit_code != 0) {
+    GTEST_SKIP() << "chromium is not installed (bash workflows/test.sh installs it)";
+  }
+  const testing::TempDir dir;
+  testing::RenderSet(dir, kTrajectoryYaml);
+  std::vector<fs::path> frames;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir / "set/images")) frames.push_back(entry.path());
+  std::sort(frames.begin(), frames.end());
+  const int held = testing::TrajectoryPauses(dir / "set/trajectory.yaml").at(0).first;
+  const std::string hostile = "<img src=x onerror=document.title=7>.png";
+  fs::create_directories(dir / "kept");
+  fs::copy_file(frames.at(static_cast<size_t>(held)), dir / "kept" / hostile);
+  testing::ExtractBoard(dir / "kept", dir / "live.db", false);
+  std::promise<std::string> url_promise;
+  auto run = std::async(std::launch::async, [&] {
+    return RunLiveCalibrator(Options(dir), NoProgress(),
+                             [&](LiveSession&, const std::string& url) { url_promise.set_value(url); });
+  });
+  const std::string url = url_promise.get_future().get();
+  ASSERT_FALSE(url.empty());
+  const testing::CommandResult dom = testing::RunCommand(Chromium(dir, "--dump-dom", url));
+  EXPECT_NE(dom.output.find("&lt;img src=x onerror=document.title=7&gt;.png"), std::string::npos)
+      << "the kept name is not on the page as text: " << dom.output.substr(0, 4000);
+  EXPECT_EQ(dom.output.find("<img src=\"x\""), std::string::npos) << "a name became an element";
+  EXPECT_EQ(dom.output.find("<title>7</title>"), std::string::npos) << "a name's script ran";
+  std::smatch port;
+  ASSERT_TRUE(std::regex_search(url, port, std::regex(":([0-9]+)/")));
+  httplib::Client client("127.0.0.1", std::stoi(port[1]));
+  ASSERT_TRUE(client.Post("/finish"));
+  run.get();
 }
 
 // A rig: the page shows both cameras side by side, each camera's estimate
