@@ -120,7 +120,9 @@ int HousingCalibratorCommand(int argc, char** argv) {
   cli.Add("Calibration.initialize_from_data", &options.calibration.initialize_from_data,
           "initialise the port from the views (0: from --Housing.params)");
   cli.Add("Calibration.estimate_board_warp", &options.calibration.estimate_board_warp,
-          "fit the board's sag, shared with the in-air views of the same board (0 | 1)");
+          "fit the board's sag, the underwater views' and the in-air views' each (0 | 1)");
+  cli.Add("Calibration.share_board_warp", &options.share_board_warp,
+          "one sag for the in-air and underwater views of the same board (0 | 1; only for one session)");
   cli.Add("update_database", &options.update_database,
           "write the housing and the intrinsics into the database, for the next stage (0 | 1)");
   cli.Add("num_threads", &options.calibration.num_threads, "threads");

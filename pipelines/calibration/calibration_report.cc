@@ -411,6 +411,12 @@ std::string HousingUncertaintyNote(const HousingCalibrationResult& result) {
          << FormatFixed(result.in_air_residual_sigma_px, 3)
          << " px; each set weighted by its own): the intrinsics are refined by both sets, and the housing's "
             "standard deviations include their uncertainty";
+    if (result.in_air_board_warp) {
+      const Eigen::Vector2d sd = result.in_air_board_warp_std_dev.value_or(Eigen::Vector2d::Zero());
+      note << "; the in-air views' own board warp: x " << FormatFixed(1000 * result.in_air_board_warp->x(), 3)
+           << " +- " << FormatFixed(1000 * sd.x(), 3) << " mm, y " << FormatFixed(1000 * result.in_air_board_warp->y(), 3)
+           << " +- " << FormatFixed(1000 * sd.y(), 3) << " mm (a board's sag differs between sessions)";
+    }
   } else if (std::any_of(result.camera_std_dev.begin(), result.camera_std_dev.end(),
                          [](double s) { return s != 0; })) {
     note << "intrinsics refined from the underwater views alone; the standard deviations include their "

@@ -100,7 +100,8 @@ struct Inputs {
   const std::vector<CalibrationView>& views;
   const InAirViews* in_air;  // null: none
   int camera_model;
-  Eigen::Vector4d board_extent;
+  Eigen::Vector4d board_extent;         // the underwater views' (and shared in-air's)
+  Eigen::Vector4d in_air_board_extent;  // the in-air views' own warp's
   const HousingCalibrationSettings& settings;
   const Eigen::MatrixXd* lens_covariance;  // null: none given
   bool RefinesIntrinsics() const { return settings.refine_intrinsics || in_air != nullptr; }
@@ -120,10 +121,10 @@ struct JointProblem {
   }
 };
 
-// The board's extent over both sets when they show the same board.
+// The board's extent over both sets when they share a warp.
 Eigen::Vector4d SharedBoardExtent(const std::vector<CalibrationView>& views, const InAirViews* in_air) {
   Eigen::Vector4d extent = BoardExtent(views);
-  if (in_air != nullptr && in_air->same_board) {
+  if (in_air != nullptr && in_air->share_board_warp) {
     for (const CalibrationView& view : in_air->views) ExtendBoardExtent(view, &extent);
   }
   return extent;
@@ -161,7 +162,9 @@ void AddWaterResiduals(const Inputs& in, State* state, JointProblem* jp) {
 
 void AddAirResiduals(const Inputs& in, State* state, JointProblem* jp) {
   ceres::LossFunction* loss = WeightLoss(state->air_weight, &jp->air_loss);
-  double* warp = in.in_air->same_board ? state->warp.data() : state->in_air_warp.data();
+  const bool shared = in.in_air->share_board_warp;
+  double* warp = shared ? state->warp.data() : state->in_air_warp.data();
+  const Eigen::Vector4d& extent = shared ? in.board_extent : in.in_air_board_extent;
   VisitCameraModel(in.camera_model, [&](auto camera_tag) {
     using Functor = BoardReprojectionError<decltype(camera_tag)>;
     for (size_t v = 0; v < in.in_air->views.size(); ++v) {
@@ -170,7 +173,7 @@ void AddAirResiduals(const Inputs& in, State* state, JointProblem* jp) {
       for (size_t i = 0; i < view.pixels.size(); ++i) {
         const Eigen::Vector3d& p = view.points_in_target[i];
         jp->air_ids.back().push_back(jp->problem.AddResidualBlock(
-            Functor::Create(p, BoardWarpUv(p, in.board_extent), view.pixels[i]), loss,
+            Functor::Create(p, BoardWarpUv(p, extent), view.pixels[i]), loss,
             state->in_air_poses[v].data(), state->intrinsics.data(), warp));
       }
     }
@@ -310,7 +313,7 @@ int NumFreeParameters(const Inputs& in, const State& state) {
     num_free += static_cast<int>(state.intrinsics.size()) -
                 static_cast<int>(in.in_air != nullptr ? in.in_air->fixed_params.size() : 0);
   }
-  if (in.settings.estimate_board_warp) num_free += (in.in_air != nullptr && !in.in_air->same_board) ? 4 : 2;
+  if (in.settings.estimate_board_warp) num_free += (in.in_air != nullptr && !in.in_air->share_board_warp) ? 4 : 2;
   return num_free;
 }
 
@@ -337,6 +340,8 @@ void FillStdDevs(const Inputs& in, double variance, State* state, ceres::Problem
   std::vector<std::pair<const double*, const double*>> blocks = {{port, port}};
   if (in.RefinesIntrinsics()) blocks.emplace_back(state->intrinsics.data(), state->intrinsics.data());
   if (in.settings.estimate_board_warp) blocks.emplace_back(state->warp.data(), state->warp.data());
+  const bool own_air_warp = in.settings.estimate_board_warp && in.in_air != nullptr && !in.in_air->share_board_warp;
+  if (own_air_warp) blocks.emplace_back(state->in_air_warp.data(), state->in_air_warp.data());
   const int m = static_cast<int>(state->housing.params.size());
   const int n = static_cast<int>(state->intrinsics.size());
   result->housing_std_dev.assign(static_cast<size_t>(m), 0.0);
@@ -372,6 +377,10 @@ void FillStdDevs(const Inputs& in, double variance, State* state, ceres::Problem
   if (in.settings.estimate_board_warp) {
     const std::vector<double> warp = StdDevsOf(CovarianceOf(&covariance, state->warp.data(), 2, variance));
     result->board_warp_std_dev = Eigen::Vector2d(warp[0], warp[1]);
+  }
+  if (own_air_warp) {
+    const std::vector<double> warp = StdDevsOf(CovarianceOf(&covariance, state->in_air_warp.data(), 2, variance));
+    result->in_air_board_warp_std_dev = Eigen::Vector2d(warp[0], warp[1]);
   }
 }
 
@@ -415,6 +424,9 @@ HousingCalibrationResult ResultOf(const Inputs& in, const Camera& camera, State*
     result.in_air_views = ViewsOf(in.in_air->views, state->in_air_poses, air_rms);
     result.in_air_rms_px = std::sqrt(air / std::max(1, num_air_points));
     result.in_air_residual_sigma_px = std::sqrt(variance / state->air_weight);
+    if (in.settings.estimate_board_warp && !in.in_air->share_board_warp) {
+      result.in_air_board_warp = Eigen::Vector2d(state->in_air_warp[0], state->in_air_warp[1]);
+    }
   }
   return result;
 }
@@ -436,7 +448,13 @@ HousingCalibrationResult CalibrateHousing(const std::vector<CalibrationView>& vi
   }
   if (views.size() < 2) throw NumericalError("housing calibration needs at least 2 views");
   if (in_air != nullptr && in_air->views.empty()) throw NumericalError("housing calibration: no in-air views");
-  const Inputs in{views, in_air, camera.model_id, SharedBoardExtent(views, in_air), settings, lens_covariance};
+  const Inputs in{views,
+                  in_air,
+                  camera.model_id,
+                  SharedBoardExtent(views, in_air),
+                  in_air != nullptr ? BoardExtent(in_air->views) : Eigen::Vector4d::Zero(),
+                  settings,
+                  lens_covariance};
   State state;
   state.intrinsics = camera.params;
   state.housing = housing;

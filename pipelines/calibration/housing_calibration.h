@@ -24,6 +24,7 @@
 // errors whenever the intrinsics are not.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "colmap_ext/camera/camera.h"
@@ -35,8 +36,8 @@ namespace portcal {
 struct HousingCalibrationSettings {
   bool refine_intrinsics = false;  // jointly with the housing
   bool initialize_from_data = true;  // else start from the given parameters
-  // mrcal's board sag (board_warp.h), shared with the in-air views when
-  // they show the same board.
+  // mrcal's board sag (board_warp.h): the underwater views' own, and the
+  // in-air views' own unless InAirViews::share_board_warp.
   bool estimate_board_warp = false;
   int max_num_iterations = 200;
   int num_threads = 2;
@@ -46,7 +47,10 @@ struct HousingCalibrationSettings {
 // The camera's views in air (same lens, focus and zoom), solved jointly.
 struct InAirViews {
   std::vector<CalibrationView> views;
-  bool same_board = true;         // the board warp is shared; else each has its own
+  // One sag for both sets: only for the same board in one session. A board's
+  // sag is a property of the session, not of the board: on the real dome
+  // set it differs by 10 sigma between air and water (docs/calibration.md).
+  bool share_board_warp = false;
   std::vector<int> fixed_params;  // intrinsics held, as in the in-air calibration
 };
 
@@ -71,6 +75,8 @@ struct HousingCalibrationResult {
   Eigen::Vector2d board_warp = Eigen::Vector2d::Zero();  // metres, when estimated
   Eigen::Vector2d board_warp_std_dev = Eigen::Vector2d::Zero();
   bool board_warp_estimated = false;
+  // The in-air views' own sag (joint solve, warp not shared).
+  std::optional<Eigen::Vector2d> in_air_board_warp, in_air_board_warp_std_dev;
   // The joint solve's in-air half (empty without InAirViews).
   std::vector<CalibratedView> in_air_views;
   double in_air_rms_px = 0;

@@ -19,7 +19,8 @@ std::string ChessboardDescription(const MrcalBoardSolve& solve) {
 }  // namespace
 
 InAirViews InAirViewsOfMrcalSolve(const MrcalBoardSolve& solve, const Camera& camera,
-                                  const std::string& underwater_target, const std::string& context) {
+                                  const std::string& underwater_target, const std::string& context,
+                                  bool share_board_warp) {
   InAirViews in_air;
   const int per_board = solve.width_n * solve.height_n;
   for (size_t f = 0; f < solve.frames_rt_toref.size(); ++f) {
@@ -35,7 +36,7 @@ InAirViews InAirViewsOfMrcalSolve(const MrcalBoardSolve& solve, const Camera& ca
     if (view.pixels.size() >= 4) in_air.views.push_back(std::move(view));
   }
   if (in_air.views.empty()) throw InputError(context + ": no view in its solve keeps 4 corners");
-  in_air.same_board = underwater_target == ChessboardDescription(solve);
+  in_air.share_board_warp = share_board_warp && underwater_target == ChessboardDescription(solve);
   // mrcal's core is fx, fy, cx, cy: the first four parameters of the models
   // a .cameramodel reads as (PINHOLE, OPENCV, FULL_OPENCV); the rest are
   // the distortions.

@@ -53,7 +53,11 @@ InAirViews ReadInAirViews(const HousingCalibratorOptions& options, const std::st
                                              "--in_air_camera_id");
   InAirViews in_air;
   in_air.views = target_views.by_camera.at(camera_id);
-  in_air.same_board = target_views.target == underwater_target;
+  in_air.share_board_warp = options.share_board_warp && target_views.target == underwater_target;
+  if (options.share_board_warp && !in_air.share_board_warp) {
+    LOG(WARNING) << "housing_calibrator: --Calibration.share_board_warp: " << options.in_air_database_path
+                 << " shows another target ('" << target_views.target << "'), whose warp is its own";
+  }
   const Camera database_camera = *database.ReadCamera(camera_id);
   CheckImageSize(underwater_camera, database_camera, options.in_air_database_path, options.database_path);
   if (start->has_value()) {
@@ -71,7 +75,7 @@ InAirViews ReadInAirViews(const HousingCalibratorOptions& options, const std::st
     *start = report;
   }
   LOG(INFO) << "housing_calibrator: " << in_air.views.size() << " in-air views of "
-            << options.in_air_database_path << (in_air.same_board ? " (the same board)" : " (another board)")
+            << options.in_air_database_path << (in_air.share_board_warp ? " (the board's warp shared)" : "")
             << ", intrinsics refined jointly";
   return in_air;
 }
@@ -82,6 +86,7 @@ InAirViews ReadInAirViews(const HousingCalibratorOptions& options, const std::st
 // .cameramodel carries no covariance, so holding its lens would take it
 // as exact. None when the file keeps no solve.
 std::optional<InAirViews> InAirViewsOfCameraModel(const std::string& path, const std::string& underwater_target,
+                                                  bool share_board_warp,
                                                   const Camera& start) {
   if (std::filesystem::path(path).extension() != ".cameramodel") return std::nullopt;
   const MrcalCameraModelFile file = ReadMrcalCameraModel(path);
@@ -90,9 +95,10 @@ std::optional<InAirViews> InAirViewsOfCameraModel(const std::string& path, const
                  << "as exact (give the in-air views, --in_air_database_path, for a joint solve)";
     return std::nullopt;
   }
-  InAirViews in_air = InAirViewsOfMrcalSolve(ReadMrcalBoardSolve(file, path), start, underwater_target, path);
+  InAirViews in_air =
+      InAirViewsOfMrcalSolve(ReadMrcalBoardSolve(file, path), start, underwater_target, path, share_board_warp);
   LOG(INFO) << "housing_calibrator: " << in_air.views.size() << " in-air views from " << path
-            << "'s optimization_inputs" << (in_air.same_board ? " (the same board)" : " (another board)")
+            << "'s optimization_inputs" << (in_air.share_board_warp ? " (the board's warp shared)" : "")
             << ", intrinsics refined jointly";
   return in_air;
 }
@@ -116,7 +122,8 @@ HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& op
   if (!options.in_air_database_path.empty()) {
     in_air = ReadInAirViews(options, target_views.target, start ? start->camera : database_camera, &start);
   } else {
-    in_air = InAirViewsOfCameraModel(options.input_calibration, target_views.target, start->camera);
+    in_air = InAirViewsOfCameraModel(options.input_calibration, target_views.target, options.share_board_warp,
+                                     start->camera);
   }
   LOG(INFO) << "housing_calibrator: " << housing.ModelName() << ", camera " << start->camera.ModelName() << ", "
             << views.size() << " views";

@@ -36,9 +36,12 @@ struct HousingCalibratorOptions {
   std::string image_path;
   std::optional<Housing> housing;  // required: the constants and a guess
   int camera_id = -1;
-  // The board's sag fitted, as camera_calibrator does (one board, in air
-  // and under water).
+  // The board's sag fitted, as camera_calibrator does: the underwater
+  // views' own, and in a joint solve the in-air views' own too, unless
+  // share_board_warp (the same board in one session: a board's sag changes
+  // between sessions, 10 sigma in x on the real dome set).
   HousingCalibrationSettings calibration = HousingWithBoardWarp();
+  bool share_board_warp = false;
   // Writes the housing (portcal_housings) and the intrinsics into the
   // database camera, so that the next stage starts from them.
   bool update_database = false;

@@ -151,7 +151,7 @@ HousingCalibrationResult CalibrateJointly(const HousingSets& sets, const Housing
     held->exact.push_back((exact.housing.params[i] - sets.underwater.truth.housing->params[i]) /
                           exact.housing_std_dev[i]);
   }
-  const InAirViews joint{in_air_views, true, {}};
+  const InAirViews joint{in_air_views, /*share_board_warp=*/false, {}};  // each set's own sag, the default
   return CalibrateHousing(views, in_air.camera, guess, settings, &joint);
 }
 
