@@ -4,6 +4,7 @@
 #pragma once
 
 #include <boost/program_options.hpp>
+#include <cmath>
 #include <functional>
 #include <list>
 #include <optional>
@@ -43,6 +44,11 @@ class CommandLine {
     auto* semantic = boost::program_options::value<T>(value);
     if constexpr (std::is_floating_point_v<T>) {
       semantic->default_value(*value, FormatShortest(*value));
+      // "nan" and "inf" parse as numbers; no option of portcal means them
+      // (each names its "never" or "auto" value in its help).
+      semantic->notifier([name](T parsed) {
+        if (!std::isfinite(parsed)) throw OptionError("--" + name, FormatShortest(parsed), "a finite number");
+      });
     } else {
       semantic->default_value(*value);
     }
