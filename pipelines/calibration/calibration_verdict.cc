@@ -63,18 +63,34 @@ Eigen::MatrixXi CoverageCounts(int width, int height, const std::vector<Eigen::V
   return counts;
 }
 
+std::vector<std::string> EmptyImageCorners(int width, int height, const std::vector<Eigen::Vector2d>& pixels) {
+  bool seen[2][2] = {{false, false}, {false, false}};
+  for (const Eigen::Vector2d& p : pixels) {
+    const int col = static_cast<int>(3 * p.x() / width), row = static_cast<int>(3 * p.y() / height);
+    if ((col == 0 || col == 2) && (row == 0 || row == 2)) seen[row / 2][col / 2] = true;
+  }
+  std::vector<std::string> empty;
+  const char* names[2][2] = {{"top-left", "top-right"}, {"bottom-left", "bottom-right"}};
+  for (int r = 0; r < 2; ++r) {
+    for (int c = 0; c < 2; ++c) {
+      if (!seen[r][c]) empty.emplace_back(names[r][c]);
+    }
+  }
+  return empty;
+}
+
+std::string JoinedWords(const std::vector<std::string>& words) {
+  std::string text;
+  for (size_t i = 0; i < words.size(); ++i) text += (i == 0 ? "" : i + 1 == words.size() ? " and " : ", ") + words[i];
+  return text;
+}
+
 namespace {
 
 std::vector<Eigen::Vector2d> PixelsOf(const std::vector<CalibrationView>& views) {
   std::vector<Eigen::Vector2d> pixels;
   for (const CalibrationView& view : views) pixels.insert(pixels.end(), view.pixels.begin(), view.pixels.end());
   return pixels;
-}
-
-std::string Joined(const std::vector<std::string>& words) {
-  std::string text;
-  for (size_t i = 0; i < words.size(); ++i) text += (i == 0 ? "" : i + 1 == words.size() ? " and " : ", ") + words[i];
-  return text;
 }
 
 void JudgeRms(double rms, int num_points, const VerdictRules& rules, CalibrationVerdict* verdict) {
@@ -107,7 +123,7 @@ void JudgeViews(const std::vector<CalibratedView>& views, const VerdictRules& ru
     std::vector<std::string> named(outliers.begin(), outliers.begin() + std::min<size_t>(outliers.size(), 3));
     if (outliers.size() > 3) named.push_back(std::to_string(outliers.size() - 3) + " more");
     verdict->Add(VerdictStatus::kCheck, "views",
-                 std::to_string(outliers.size()) + " outlier view(s) kept in the solve: " + Joined(named) +
+                 std::to_string(outliers.size()) + " outlier view(s) kept in the solve: " + JoinedWords(named) +
                      " (look at them; --Calibration.drop_outlier_views 1 leaves them out)");
   }
   if (kept < rules.min_views) {
@@ -125,22 +141,11 @@ void JudgeCoverage(const Camera& camera, const std::vector<Eigen::Vector2d>& pix
   const Eigen::MatrixXi counts = CoverageCounts(width, height, pixels);
   const int cells = static_cast<int>(counts.size()), empty = static_cast<int>((counts.array() == 0).count());
   const double covered = cells > 0 ? 1.0 - static_cast<double>(empty) / cells : 0;
-  bool corner_seen[2][2] = {{false, false}, {false, false}};
-  for (const Eigen::Vector2d& p : pixels) {
-    const int col = static_cast<int>(3 * p.x() / width), row = static_cast<int>(3 * p.y() / height);
-    if ((col == 0 || col == 2) && (row == 0 || row == 2)) corner_seen[row / 2][col / 2] = true;
-  }
-  std::vector<std::string> empty_corners;
-  const char* names[2][2] = {{"top-left", "top-right"}, {"bottom-left", "bottom-right"}};
-  for (int r = 0; r < 2; ++r) {
-    for (int c = 0; c < 2; ++c) {
-      if (!corner_seen[r][c]) empty_corners.emplace_back(names[r][c]);
-    }
-  }
+  const std::vector<std::string> empty_corners = EmptyImageCorners(width, height, pixels);
   std::ostringstream text;
   text << empty << " of " << cells << " cells empty (" << std::lround(100 * covered) << " % covered)";
   if (!empty_corners.empty()) {
-    text << "; the image's " << Joined(empty_corners) << " corner" << (empty_corners.size() > 1 ? "s hold" : " holds")
+    text << "; the image's " << JoinedWords(empty_corners) << " corner" << (empty_corners.size() > 1 ? "s hold" : " holds")
          << " no point (of a 3 x 3 split)";
   }
   // One bare corner is common in good hand-held sets (the real in-air
@@ -279,7 +284,7 @@ CalibrationVerdict JudgeHeldOut(const HeldOutEvaluation& evaluation, const Calib
   if (!skipped.empty()) {
     std::vector<std::string> named(skipped.begin(), skipped.begin() + std::min<size_t>(skipped.size(), 3));
     if (skipped.size() > 3) named.push_back(std::to_string(skipped.size() - 3) + " more");
-    verdict.Add(VerdictStatus::kCheck, "views", std::to_string(skipped.size()) + " view(s) not evaluated: " + Joined(named));
+    verdict.Add(VerdictStatus::kCheck, "views", std::to_string(skipped.size()) + " view(s) not evaluated: " + JoinedWords(named));
   }
   if (!folds.empty()) {
     double train = 0;

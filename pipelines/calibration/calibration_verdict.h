@@ -66,6 +66,14 @@ struct VerdictRules {
 // proportion), as coverage.png draws them.
 Eigen::MatrixXi CoverageCounts(int width, int height, const std::vector<Eigen::Vector2d>& pixels);
 
+// The image's corners ("top-left", "top-right", "bottom-left",
+// "bottom-right") of a 3 x 3 split where no pixel falls: the verdict's
+// coverage rule and the live goal's limits name them.
+std::vector<std::string> EmptyImageCorners(int width, int height, const std::vector<Eigen::Vector2d>& pixels);
+
+// "a", "a and b", "a, b and c".
+std::string JoinedWords(const std::vector<std::string>& words);
+
 // Judges a target or self-calibration: its warnings (undetermined
 // parameters: FAIL; others: CHECK), RMS, outlier views, number of views,
 // coverage of `pixels` (the observations, COLMAP pixels), the projection

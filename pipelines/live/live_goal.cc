@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "colmap_ext/util/error.h"
+#include "pipelines/calibration/calibration_verdict.h"
 
 namespace portcal {
 
@@ -23,27 +24,11 @@ constexpr double kWantedDistanceRatio = 1.4;  // farthest / nearest kept view
 
 // Image corners (of a 3 x 3 split) that no kept view's corner falls in.
 std::vector<std::string> EmptyImageCorners(const std::vector<CornerMap>& kept, cv::Size image) {
-  bool seen[2][2] = {{false, false}, {false, false}};
+  std::vector<Eigen::Vector2d> pixels;
   for (const CornerMap& corners : kept) {
-    for (const auto& [id, xy] : corners) {
-      const int col = static_cast<int>(3 * xy.x() / image.width), row = static_cast<int>(3 * xy.y() / image.height);
-      if ((col == 0 || col == 2) && (row == 0 || row == 2)) seen[row / 2][col / 2] = true;
-    }
+    for (const auto& [id, xy] : corners) pixels.push_back(xy);
   }
-  std::vector<std::string> empty;
-  const char* names[2][2] = {{"top-left", "top-right"}, {"bottom-left", "bottom-right"}};
-  for (int r = 0; r < 2; ++r) {
-    for (int c = 0; c < 2; ++c) {
-      if (!seen[r][c]) empty.emplace_back(names[r][c]);
-    }
-  }
-  return empty;
-}
-
-std::string Joined(const std::vector<std::string>& words) {
-  std::string text;
-  for (size_t i = 0; i < words.size(); ++i) text += (i == 0 ? "" : i + 1 == words.size() ? " and " : ", ") + words[i];
-  return text;
+  return portcal::EmptyImageCorners(image.width, image.height, pixels);
 }
 
 }  // namespace
@@ -59,7 +44,7 @@ std::string LiveGoal::Summary() const {
     text << "expected projection uncertainty " << mean_px << " px, goal " << target_px << " px ("
          << std::setprecision(0) << 100 * progress << " %)";
   }
-  if (!limits.empty()) text << (met ? "; could still improve: " : "; still limiting: ") << Joined(limits);
+  if (!limits.empty()) text << (met ? "; could still improve: " : "; still limiting: ") << JoinedWords(limits);
   return text.str();
 }
 
@@ -77,7 +62,7 @@ LiveGoal EvaluateGoal(const LiveEstimate& estimate, const std::vector<CornerMap>
   if (image.area() > 0) {
     const std::vector<std::string> empty = EmptyImageCorners(kept_corners, image);
     if (!empty.empty()) {
-      goal.limits.push_back("the image's " + Joined(empty) + " corner" + (empty.size() > 1 ? "s have" : " has") +
+      goal.limits.push_back("the image's " + JoinedWords(empty) + " corner" + (empty.size() > 1 ? "s have" : " has") +
                             " no points (bring the target there)");
     }
   }
