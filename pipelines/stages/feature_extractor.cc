@@ -9,6 +9,7 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/parallel.h"
+#include "colmap_ext/util/string_utils.h"
 #include "database/database.h"
 #include "database/database_merge.h"
 #include "database/new_database_file.h"
@@ -62,6 +63,13 @@ std::map<std::string, int64_t> Counts(const FeatureExtractorSummary& summary) {
 
 // Success on nothing would log the stage as done with no image.
 void CheckSomethingExtracted(const FeatureExtractorOptions& options, const FeatureExtractorSummary& summary) {
+  if (summary.num_extracted > 0 && summary.num_features == 0) {
+    // A database of images without a feature is no work done: the matcher
+    // would find nothing, far from the cause.
+    throw InputError(options.image_path + ": no SIFT feature in any of the " + std::to_string(summary.num_extracted) +
+                     " images (blank or featureless images, or --SiftExtraction.peak_threshold " +
+                     FormatShortest(options.sift.peak_threshold) + " / edge_threshold too strict)");
+  }
   if (summary.num_extracted > 0 || summary.num_skipped > 0) return;
   throw InputError(options.image_path + ": none of the " + std::to_string(summary.num_images) +
                    " image files could be read and used (unreadable, or under " + std::to_string(kMinImageSide) +
