@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <map>
-#include <set>
 #include <sstream>
 #include <unordered_set>
 
@@ -13,44 +12,10 @@
 #include "database/database_merge.h"
 #include "database/stage_run.h"
 #include "pipelines/distributed/mpi_world.h"
-#include "pipelines/features/image_retrieval.h"
 
 namespace fs = std::filesystem;
 
 namespace portcal {
-
-std::string PairingModeName(PairingMode mode) {
-  switch (mode) {
-    case PairingMode::kExhaustive: return "exhaustive";
-    case PairingMode::kSequential: return "sequential";
-    case PairingMode::kSpatial: return "spatial";
-  }
-  return "unknown";
-}
-
-void SequentialPairingOptions::Check() const {
-  if (overlap < 1) throw OptionError("--SequentialMatching.overlap", std::to_string(overlap), ">= 1");
-  if (loop_detection_period < 1) {
-    throw OptionError("--SequentialMatching.loop_detection_period", std::to_string(loop_detection_period),
-                      ">= 1");
-  }
-  if (loop_detection_num_images < 1) {
-    throw OptionError("--SequentialMatching.loop_detection_num_images",
-                      std::to_string(loop_detection_num_images), ">= 1");
-  }
-  if (vocabulary_size < 2) {
-    throw OptionError("--SequentialMatching.vocabulary_size", std::to_string(vocabulary_size), ">= 2");
-  }
-}
-
-void SpatialPairingOptions::Check() const {
-  if (max_num_neighbors < 1) {
-    throw OptionError("--SpatialMatching.max_num_neighbors", std::to_string(max_num_neighbors), ">= 1");
-  }
-  if (!(max_distance_m > 0)) {
-    throw OptionError("--SpatialMatching.max_distance", std::to_string(max_distance_m), "> 0 m");
-  }
-}
 
 void FeatureMatcherOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
@@ -60,51 +25,6 @@ void FeatureMatcherOptions::Check() const {
   matching.Check();
   verification.Check();
   shard.Check();
-}
-
-std::vector<std::pair<image_t, image_t>> ExhaustivePairs(const std::vector<image_t>& images) {
-  std::vector<std::pair<image_t, image_t>> pairs;
-  for (size_t i = 0; i < images.size(); ++i) {
-    for (size_t j = i + 1; j < images.size(); ++j) pairs.emplace_back(images[i], images[j]);
-  }
-  return pairs;
-}
-
-std::vector<std::pair<image_t, image_t>> SequentialPairs(const std::vector<image_t>& images,
-                                                         const SequentialPairingOptions& options) {
-  std::vector<std::pair<image_t, image_t>> pairs;
-  const size_t n = images.size();
-  for (size_t i = 0; i < n; ++i) {
-    std::set<size_t> ahead;
-    for (int k = 1; k <= options.overlap; ++k) ahead.insert(i + static_cast<size_t>(k));
-    if (options.quadratic_overlap) {
-      for (int k = 0; k < options.overlap && k < 40; ++k) ahead.insert(i + (size_t{1} << k));
-    }
-    for (size_t j : ahead) {
-      if (j < n) pairs.emplace_back(images[i], images[j]);
-    }
-  }
-  return pairs;
-}
-
-std::vector<std::pair<image_t, image_t>> SpatialPairs(const std::vector<std::pair<image_t, Eigen::Vector3d>>& positions,
-                                                      const SpatialPairingOptions& options) {
-  std::vector<std::pair<image_t, image_t>> pairs;
-  std::vector<std::pair<double, size_t>> nearest;
-  for (size_t i = 0; i < positions.size(); ++i) {
-    nearest.clear();
-    for (size_t j = 0; j < positions.size(); ++j) {
-      if (j == i) continue;
-      Eigen::Vector3d d = positions[j].second - positions[i].second;
-      if (options.ignore_z) d.z() = 0;
-      const double distance = d.norm();
-      if (distance <= options.max_distance_m) nearest.emplace_back(distance, j);
-    }
-    const size_t k = std::min(nearest.size(), static_cast<size_t>(options.max_num_neighbors));
-    std::partial_sort(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(k), nearest.end());
-    for (size_t n = 0; n < k; ++n) pairs.emplace_back(positions[i].first, positions[nearest[n].second].first);
-  }
-  return pairs;
 }
 
 namespace {
@@ -135,76 +55,6 @@ std::string OptionsText(const FeatureMatcherOptions& o) {
   }
   out << "\noverwrite=" << o.overwrite << "\n";
   return out.str();
-}
-
-// Pairs between every `period`-th image and its most similar images outside
-// the sequential window.
-std::vector<std::pair<image_t, image_t>> LoopPairs(Database* database,
-                                                   const std::vector<image_t>& images,
-                                                   const SequentialPairingOptions& options,
-                                                   ProgressSink& progress) {
-  // Vocabulary from the descriptors of up to 200 images spread over the
-  // sequence; then each image's words, one image in memory at a time.
-  const size_t stride = std::max<size_t>(1, images.size() / 200);
-  std::vector<UnitDescriptors> samples;
-  for (size_t i = 0; i < images.size(); i += stride) {
-    samples.push_back(ToUnitDescriptors(database->ReadDescriptors(images[i])));
-  }
-  const VisualVocabulary vocabulary = VisualVocabulary::Train(samples, options.vocabulary_size);
-  samples.clear();
-  ImageRetrievalIndex index(vocabulary.NumWords());
-  progress.Begin("sequential_matcher: retrieval index", images.size());
-  for (size_t i = 0; i < images.size(); ++i) {
-    CancelFlag::ThrowIfRequested();
-    index.Add(vocabulary.Assign(ToUnitDescriptors(database->ReadDescriptors(images[i]))));
-    progress.Advance(1);
-  }
-  progress.End();
-  index.Finalize();
-  std::vector<std::pair<image_t, image_t>> pairs;
-  const int window = options.overlap;
-  for (size_t i = 0; i < images.size(); i += static_cast<size_t>(options.loop_detection_period)) {
-    const int q = static_cast<int>(i);
-    for (int j : index.Query(q, options.loop_detection_num_images,
-                             [&](int other) { return std::abs(other - q) <= window; })) {
-      pairs.emplace_back(images[i], images[static_cast<size_t>(j)]);
-    }
-  }
-  return pairs;
-}
-
-// The candidate pairs of the mode (and, sequential, the loop candidates).
-std::vector<std::pair<image_t, image_t>> CandidatePairs(const FeatureMatcherOptions& options,
-                                                        const std::vector<DatabaseImage>& images,
-                                                        const std::vector<image_t>& ids, const std::string& stage,
-                                                        Database* db, ProgressSink& progress,
-                                                        FeatureMatcherSummary* summary) {
-  std::vector<std::pair<image_t, image_t>> candidates;
-  if (options.mode == PairingMode::kExhaustive) {
-    candidates = ExhaustivePairs(ids);
-  } else if (options.mode == PairingMode::kSequential) {
-    candidates = SequentialPairs(ids, options.sequential);
-  } else {
-    std::vector<std::pair<image_t, Eigen::Vector3d>> positions;
-    for (const DatabaseImage& image : images) {
-      if (const auto position = image.PriorPosition()) positions.emplace_back(image.image_id, *position);
-    }
-    if (positions.size() < 2) {
-      throw InputError(options.database_path + ": " + std::to_string(positions.size()) +
-                       " image(s) with a position prior; spatial matching needs them (run pose_prior_importer)");
-    }
-    if (positions.size() < images.size()) {
-      LOG(WARNING) << stage << ": " << images.size() - positions.size()
-                   << " image(s) without a position prior are not matched";
-    }
-    candidates = SpatialPairs(positions, options.spatial);
-  }
-  if (options.mode == PairingMode::kSequential && options.sequential.loop_detection) {
-    const auto loops = LoopPairs(db, ids, options.sequential, progress);
-    summary->num_loop_pairs = static_cast<int64_t>(loops.size());
-    candidates.insert(candidates.end(), loops.begin(), loops.end());
-  }
-  return candidates;
 }
 
 // Unique unordered pairs, minus those already done unless `overwrite`.
@@ -319,8 +169,9 @@ FeatureMatcherSummary MatchPairs(const FeatureMatcherOptions& options, const std
   for (const Camera& camera : database->ReadAllCameras()) cameras[camera.camera_id] = camera;
 
   FeatureMatcherSummary summary;
-  const std::vector<std::pair<image_t, image_t>> candidates =
-      CandidatePairs(options, images, ids, stage, database, progress, &summary);
+  const ImagePairs candidates =
+      CandidatePairs({options.mode, options.sequential, options.spatial}, images, ids, options.database_path, stage,
+                     database, progress, &summary.num_loop_pairs);
   const std::vector<std::pair<image_t, image_t>> pairs =
       options.shard.Block(PairsToMatch(candidates, options.overwrite, database, &summary));
   LOG(INFO) << stage << ": " << images.size() << " images, " << summary.num_pairs << " pairs, " << pairs.size()
