@@ -16,10 +16,10 @@
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/new_paths.h"
 #include "pipelines/synthetic/dataset_config.h"
+#include "pipelines/synthetic/dataset_scene.h"
+#include "pipelines/synthetic/frame_renderer.h"
 #include "pipelines/synthetic/renderer.h"
-#include "pipelines/synthetic/scene.h"
-#include "pipelines/synthetic/target_builder.h"
-#include "pipelines/synthetic/view_sampler.h"
+#include "pipelines/synthetic/trajectory.h"
 
 namespace fs = std::filesystem;
 
@@ -44,118 +44,6 @@ std::string ImageName(int frame, int num_images) {
   const int digits = std::max(3, static_cast<int>(std::to_string(num_images).size()));
   name << "img_" << std::setw(digits) << std::setfill('0') << frame + 1 << ".png";
   return name.str();
-}
-
-// The static background: a fronto-parallel textured plane at `distance` in
-// the camera-1 frame, one texel per pixel there, covering the view.
-struct Clutter {
-  std::unique_ptr<SceneObject> object;
-  Rigid3d cam_from_clutter;
-  Eigen::Vector4d extent;
-  double texel = 0;
-};
-
-Clutter MakeClutter(const DatasetConfig& config) {
-  Clutter clutter;
-  const double d = config.clutter_distance_m;
-  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
-  const Camera& camera = config.camera;
-  for (const Eigen::Vector2d& pixel : {Eigen::Vector2d(0, 0), Eigen::Vector2d(camera.width, 0),
-                                       Eigen::Vector2d(0, camera.height),
-                                       Eigen::Vector2d(camera.width, camera.height)}) {
-    const auto ray = UnprojectPixel(camera, config.housing ? &*config.housing : nullptr, pixel);
-    const Eigen::Vector3d p = ray ? Eigen::Vector3d(ray->origin + (d - ray->origin.z()) /
-                                                                      ray->direction.z() * ray->direction)
-                                  : Eigen::Vector3d(d, d, d);
-    x0 = std::min(x0, p.x());
-    x1 = std::max(x1, p.x());
-    y0 = std::min(y0, p.y());
-    y1 = std::max(y1, p.y());
-  }
-  // Wider for a stereo rig's second camera.
-  const double pad = 0.2 * (x1 - x0) + (config.stereo ? config.cam2_from_cam1.translation.norm() : 0.0);
-  clutter.extent = Eigen::Vector4d(x0 - pad, x1 + pad, y0 - pad, y1 + pad);
-  clutter.texel = d / config.camera.MeanFocalLength();
-  const int cols = static_cast<int>(std::ceil((clutter.extent[1] - clutter.extent[0]) / clutter.texel));
-  const int rows = static_cast<int>(std::ceil((clutter.extent[3] - clutter.extent[2]) / clutter.texel));
-  const int scale = std::max(4, std::min(cols, rows) / 60);
-  auto texture = std::make_shared<RasterTexture>(
-      RandomShapesRaster(cols, rows, config.clutter_num_shapes, config.clutter_seed, scale / 2, 3 * scale),
-      clutter.extent[0], clutter.extent[2], clutter.texel);
-  clutter.object = std::make_unique<FacesObject>(std::vector<Face>{{texture, Rigid3d(), -1.0}},
-                                                 static_cast<float>(config.render.levels.back));
-  clutter.cam_from_clutter = Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, d));
-  return clutter;
-}
-
-// An opaque dark plate between the camera and a random part of the target.
-std::unique_ptr<SceneObject> MakeOccluder(const BuiltTarget& target, const Rigid3d& cam_from_target,
-                                          double fraction, std::mt19937_64* rng, Rigid3d* cam_from_occluder) {
-  std::uniform_real_distribution<double> unit(0, 1);
-  const auto& points = target.outline_points;
-  // One draw per statement (the operands' order is the compiler's; this is
-  // gcc's): the outline point, then how far towards it from the centre.
-  const Eigen::Vector3d& toward = points[static_cast<size_t>(unit(*rng) * points.size()) % points.size()];
-  const double reach = unit(*rng);
-  const Eigen::Vector3d anchor_in_target = target.center + reach * (toward - target.center);
-  double size = 0;
-  for (const auto& p : points) size = std::max(size, 2 * (p - target.center).norm());
-  const double along = 0.55;
-  const Eigen::Vector3d anchor = along * (cam_from_target * anchor_in_target);
-  const double side = std::sqrt(fraction) * size * along;
-  const int n = 16;
-  cv::Mat raster(n, n, CV_8UC1);
-  for (int r = 0; r < n; ++r) {
-    for (int c = 0; c < n; ++c) raster.at<uint8_t>(r, c) = static_cast<uint8_t>(20 + 40 * unit(*rng));
-  }
-  auto texture = std::make_shared<RasterTexture>(raster, -side / 2, -side / 2, side / n);
-  *cam_from_occluder = Rigid3d(
-      Eigen::Quaterniond(Eigen::AngleAxisd(2 * M_PI * unit(*rng), Eigen::Vector3d::UnitZ())), anchor);
-  return std::make_unique<FacesObject>(std::vector<Face>{{texture, Rigid3d(), -1.0}}, 40.0f);
-}
-
-// Ground truth of one camera's view of the target.
-ImageTruth TargetTruth(const Camera& camera, const Housing* housing, const BuiltTarget& target,
-                       const Rigid3d& cam_from_target, const std::vector<PlacedObject>& objects,
-                       bool check_occlusion) {
-  ImageTruth truth;
-  truth.cam_from_target = cam_from_target;
-  const auto inside = [&](const Eigen::Vector2d& p) {
-    return p.x() >= 0 && p.y() >= 0 && p.x() <= camera.width && p.y() <= camera.height;
-  };
-  bool any_hidden = false;
-  for (const Eigen::Vector3d& corner : target.description.corners_3d) {
-    const Eigen::Vector3d in_cam = cam_from_target * corner;
-    const std::optional<Eigen::Vector2d> pixel = ProjectPoint(camera, housing, in_cam);
-    truth.corners_px.push_back(pixel);
-    bool visible = pixel.has_value() && inside(*pixel);
-    if (visible && check_occlusion) {
-      // Visible if the pixel's ray hits the scene at the corner itself.
-      const auto ray = UnprojectPixel(camera, housing, *pixel);
-      Hit hit;
-      visible = ray && IntersectScene(objects, ray->origin, ray->direction, &hit) &&
-                (ray->origin + hit.t * ray->direction - in_cam).norm() < 1e-6;
-    }
-    any_hidden = any_hidden || !visible;
-    truth.corners_visible.push_back(visible);
-  }
-  if (!any_hidden) truth.corners_visible.clear();
-  for (const TargetMarker& marker : target.description.markers) {
-    ImageTruth::Marker seen;
-    seen.id = marker.id;
-    bool projects = true;
-    for (int k = 0; k < 4; ++k) {
-      const auto pixel = ProjectPoint(camera, housing, cam_from_target * marker.corners[k]);
-      if (!pixel) {
-        projects = false;
-        break;
-      }
-      seen.corners_px[k] = *pixel;
-      seen.fully_inside = seen.fully_inside && inside(*pixel);
-    }
-    if (projects) truth.markers.push_back(seen);
-  }
-  return truth;
 }
 
 std::string ExtraYaml(const DatasetConfig& config, const Clutter* clutter, const SurveyPath* survey,
@@ -249,6 +137,17 @@ void WriteImage(const fs::path& path, const cv::Mat& image) {
   if (!cv::imwrite(path.string(), image)) throw InputError(path.string() + ": cannot write image");
 }
 
+// Renders frame `frame` and writes its images into the staging folder.
+RenderedFrame RenderAndWrite(const FrameRenderer& renderer, const fs::path& staging, int frame,
+                             const Rigid3d& cam_from_target, const ImageFormationOptions& render,
+                             std::mt19937_64* rng) {
+  const std::string name = ImageName(frame, renderer.config.num_images);
+  RenderedFrame rendered = renderer.Render(frame, name, cam_from_target, render, rng);
+  WriteImage(staging / renderer.dir1 / name, rendered.image1);
+  if (!rendered.image2.empty()) WriteImage(staging / renderer.dir2 / name, rendered.image2);
+  return rendered;
+}
+
 // The set's ground truth before any frame: names, cameras, housings, rig.
 GroundTruth TruthHeader(const DatasetConfig& config, const std::string& dir1, const std::string& dir2) {
   GroundTruth truth;
@@ -264,128 +163,6 @@ GroundTruth TruthHeader(const DatasetConfig& config, const std::string& dir1, co
   }
   return truth;
 }
-
-// What the frames show: a target (with clutter) or, for a survey, a
-// textured seabed along a planned path.
-struct Scene {
-  BuiltTarget target;
-  std::unique_ptr<SeabedObject> seabed;
-  SeabedMarkers seabed_markers;  // on the seabed, if the survey has any
-  SurveyPath survey;
-  std::optional<Clutter> clutter;
-};
-
-Scene BuildScene(const DatasetConfig& config, const HousedCamera& camera1, GroundTruth* truth) {
-  Scene scene;
-  if (config.survey) {
-    scene.survey = PlanSurvey(config.camera, camera1.HousingOrNull(), config.survey_options);
-    const SurveyPath& survey = scene.survey;
-    const SurveyOptions& s = config.survey_options;
-    const int cols = static_cast<int>(std::ceil((survey.area[1] - survey.area[0]) / s.texel_m));
-    const int rows = static_cast<int>(std::ceil((survey.area[3] - survey.area[2]) / s.texel_m));
-    const int shapes = static_cast<int>((survey.area[1] - survey.area[0]) * (survey.area[3] - survey.area[2]) * 600);
-    auto texture = std::make_shared<RasterTexture>(
-        RandomShapesRaster(cols, rows, shapes, s.texture_seed, 2, 10), survey.area[0], survey.area[2], s.texel_m);
-    scene.seabed = std::make_unique<SeabedObject>(texture, s.roughness_m, s.relief_wavelength_m, s.texture_seed + 1);
-    scene.seabed_markers = PlaceSeabedMarkers(s.markers, *scene.seabed, survey.area, config.render.levels);
-    truth->target.type = "seabed";
-  } else {
-    scene.target = BuildTarget(config.target, config.render.levels);
-    truth->target = scene.target.description;
-  }
-  if (config.clutter) scene.clutter = MakeClutter(config);
-  return scene;
-}
-
-// A target view camera 1 sees; with a rig, resampled until camera 2 sees
-// the target too.
-Rigid3d SampleRigView(const DatasetConfig& config, const Scene& scene, const HousedCamera& camera1,
-                      const HousedCamera& camera2, const std::vector<Eigen::Vector3d>& check_points,
-                      std::mt19937_64* rng) {
-  for (int attempt = 0;; ++attempt) {
-    const Rigid3d cam_from_target = SampleTargetView(config.camera, camera1.HousingOrNull(), check_points,
-                                                     scene.target.center, scene.target.front_normal, config.poses, rng);
-    if (!config.stereo) return cam_from_target;
-    bool seen = true;
-    const double margin = config.poses.border_margin_px;
-    for (const Eigen::Vector3d& p : check_points) {
-      const auto pixel = camera2.Project(config.cam2_from_cam1 * cam_from_target * p);
-      seen = seen && pixel && pixel->x() >= margin && pixel->y() >= margin &&
-             pixel->x() <= config.camera2.width - margin && pixel->y() <= config.camera2.height - margin;
-    }
-    if (seen) return cam_from_target;
-    if (attempt > 200) {
-      throw NumericalError("stereo: no pose found where both cameras see the target; "
-                           "check stereo.cam2_from_cam1 and poses.distance");
-    }
-  }
-}
-
-// The rig's motion as camera 2 sees it: for a small motion M of camera 1,
-// camera 2 moves by T M T^-1 (T = cam2_from_cam1), whose rates are
-// w2 = R w1 and v2 = R v1 - w2 x t.
-ImageFormationOptions MotionInCamera2(ImageFormationOptions render, const Rigid3d& cam2_from_cam1) {
-  const Eigen::Matrix3d rotation = cam2_from_cam1.rotation.toRotationMatrix();
-  render.angular_velocity_rad_s = rotation * render.angular_velocity_rad_s;
-  render.velocity_m_s =
-      rotation * render.velocity_m_s - render.angular_velocity_rad_s.cross(cam2_from_cam1.translation);
-  return render;
-}
-
-// Renders one frame (both cameras of a rig) into the staging folder and
-// returns its truth.
-struct FrameRenderer {
-  const DatasetConfig& config;
-  const Scene& scene;
-  const HousedCamera& camera1;
-  const HousedCamera& camera2;
-  const RayMap& rays1;
-  const std::optional<RayMap>& rays2;  // with a rig
-  fs::path staging;
-  std::string dir1, dir2;
-
-  FrameTruth Render(int frame, const Rigid3d& cam_from_target, const ImageFormationOptions& render,
-                    std::mt19937_64* rng, cv::Mat* image1 = nullptr, cv::Mat* image2_out = nullptr) const {
-    std::vector<PlacedObject> objects;
-    objects.push_back({config.survey ? static_cast<const SceneObject*>(scene.seabed.get()) : scene.target.object.get(),
-                       cam_from_target});
-    if (scene.clutter) objects.push_back({scene.clutter->object.get(), scene.clutter->cam_from_clutter});
-    if (scene.seabed_markers.object) objects.push_back({scene.seabed_markers.object.get(), cam_from_target});
-    std::unique_ptr<SceneObject> occluder;
-    std::uniform_real_distribution<double> unit(0, 1);
-    if (!config.survey && unit(*rng) < config.occlusion_probability) {
-      Rigid3d cam_from_occluder;
-      occluder = MakeOccluder(scene.target, cam_from_target, config.occlusion_fraction, rng, &cam_from_occluder);
-      objects.push_back({occluder.get(), cam_from_occluder});
-    }
-    FrameTruth truth;
-    truth.frame = frame;
-    const std::string name = ImageName(frame, config.num_images);
-    const uint64_t noise_seed = config.seed * 1000003ULL + 2ULL * frame;
-    const cv::Mat image = RenderImage(rays1, objects, render, noise_seed);
-    WriteImage(staging / dir1 / name, image);
-    if (image1) *image1 = image;
-    truth.cam1 = config.survey ? ImageTruth{}
-                               : TargetTruth(config.camera, camera1.HousingOrNull(), scene.target, cam_from_target,
-                                             objects, occluder != nullptr);
-    truth.cam1.file = dir1 + "/" + name;
-    truth.cam1.cam_from_target = cam_from_target;
-    if (config.stereo) {
-      std::vector<PlacedObject> objects2 = objects;
-      for (PlacedObject& placed : objects2) placed.cam_from_object = config.cam2_from_cam1 * placed.cam_from_object;
-      const cv::Mat image2 = RenderImage(*rays2, objects2, MotionInCamera2(render, config.cam2_from_cam1), noise_seed + 1);
-      WriteImage(staging / dir2 / name, image2);
-      if (image2_out) *image2_out = image2;
-      const Rigid3d cam2_from_target = config.cam2_from_cam1 * cam_from_target;
-      truth.cam2 = config.survey ? ImageTruth{}
-                                 : TargetTruth(config.camera2, camera2.HousingOrNull(), scene.target,
-                                               cam2_from_target, objects2, occluder != nullptr);
-      truth.cam2->file = dir2 + "/" + name;
-      truth.cam2->cam_from_target = cam2_from_target;
-    }
-    return truth;
-  }
-};
 
 // The ground truth, navigation and dot files next to the images, then the
 // finished set moved into `output` (a failed run leaves it as it was).
@@ -455,11 +232,11 @@ void RenderTrajectory(const DatasetConfig& config, const FrameRenderer& renderer
     render.velocity_m_s = frames[f].velocity_m_s;
     render.angular_velocity_rad_s = frames[f].angular_velocity_rad_s;
     render.exposure_s = frames[f].pause < 0 ? options.exposure_s : 0.0;
-    cv::Mat image, image2;
-    truth->images.push_back(
-        renderer.Render(static_cast<int>(f), frames[f].cam_from_target, render, rng, &image, &image2));
-    if (video.isOpened()) video.write(image);
-    if (video2.isOpened()) video2.write(image2);
+    RenderedFrame rendered =
+        RenderAndWrite(renderer, staging, static_cast<int>(f), frames[f].cam_from_target, render, rng);
+    truth->images.push_back(std::move(rendered.truth));
+    if (video.isOpened()) video.write(rendered.image1);
+    if (video2.isOpened()) video2.write(rendered.image2);
     progress.Advance(1);
   }
   video.release();
@@ -510,8 +287,7 @@ static SynthesizeSummary Run(const SynthesizeOptions& options, ProgressSink& pro
 
   progress.Begin("synthesize: frames", config.num_images);
   const auto render_start = Clock::now();
-  const FrameRenderer renderer{config, scene, camera1, camera2, rays1, rays2,
-                               staging, dir1, dir2};
+  const FrameRenderer renderer{config, scene, camera1, camera2, rays1, rays2, dir1, dir2};
   if (trajectory.empty()) {
     const std::vector<Eigen::Vector3d>& check_points =
         config.poses.visibility == "markers" ? scene.target.marker_points : scene.target.outline_points;
@@ -524,7 +300,7 @@ static SynthesizeSummary Run(const SynthesizeOptions& options, ProgressSink& pro
       } catch (const NumericalError& e) {
         throw NumericalError(options.config_path + ": " + e.what());  // the config asks what cannot be
       }
-      truth.images.push_back(renderer.Render(frame, cam_from_target, config.render, &rng));
+      truth.images.push_back(RenderAndWrite(renderer, staging, frame, cam_from_target, config.render, &rng).truth);
       progress.Advance(1);
     }
   } else {
