@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "pipelines/live/hands_free.h"
-#include "pipelines/live/live_estimator.h"
+#include "pipelines/guidance/live_estimator.h"
 
 namespace portcal {
 

@@ -5,7 +5,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
-#include "pipelines/live/pose_preview.h"
+#include "pipelines/guidance/pose_preview.h"
 #include "pipelines/report/picture.h"
 
 namespace portcal {

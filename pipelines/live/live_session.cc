@@ -62,12 +62,6 @@ cv::Mat Gray(const cv::Mat& image) {
 
 }  // namespace
 
-TargetShape ShapeOfTarget(const TargetDetectorOptions& detector) {
-  std::vector<Eigen::Vector3d> points;
-  for (const BoardPoint& p : TargetLayout(detector)) points.push_back(p.point_in_target);
-  return TargetShape::FromPoints(points);
-}
-
 void LiveSessionOptions::Check() const {
   source.Check();
   detector.Check();

@@ -17,7 +17,7 @@
 #include "pipelines/detection/target_detector.h"
 #include "pipelines/live/frame_source.h"
 #include "pipelines/live/hands_free.h"
-#include "pipelines/live/live_estimator.h"
+#include "pipelines/guidance/live_estimator.h"
 #include "pipelines/live/live_goal.h"
 
 namespace portcal {
@@ -61,10 +61,6 @@ struct LiveSessionOptions {
   bool Stereo() const { return !source2.empty(); }
   void Check() const;             // throws OptionError naming the option
 };
-
-// The target as guidance sees it: every point the detector options'
-// target has.
-TargetShape ShapeOfTarget(const TargetDetectorOptions& detector);
 
 // One kept view as the session holds it.
 struct KeptView {

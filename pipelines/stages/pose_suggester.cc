@@ -13,8 +13,7 @@
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
 #include "pipelines/detection/detection_rows.h"
-#include "pipelines/live/live_session.h"
-#include "pipelines/live/pose_preview.h"
+#include "pipelines/guidance/pose_preview.h"
 
 namespace fs = std::filesystem;
 

@@ -11,7 +11,7 @@
 #include "colmap_ext/housing/housing.h"
 #include "colmap_ext/util/progress.h"
 #include "pipelines/detection/target_detector.h"
-#include "pipelines/live/live_estimator.h"
+#include "pipelines/guidance/live_estimator.h"
 
 namespace portcal {
 

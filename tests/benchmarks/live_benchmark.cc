@@ -18,7 +18,7 @@
 #include "pipelines/detection/target_detector.h"
 #include "pipelines/detection/target_pose.h"
 #include "pipelines/live/hands_free.h"
-#include "pipelines/live/live_estimator.h"
+#include "pipelines/guidance/live_estimator.h"
 #include "pipelines/live/live_overlay.h"
 #include "pipelines/live/live_server.h"
 #include "pipelines/live/live_session.h"

@@ -14,7 +14,7 @@
 #include "colmap_ext/util/logging.h"
 #include "pipelines/calibration/camera_calibration.h"
 #include "pipelines/calibration/housing_calibration.h"
-#include "pipelines/live/live_estimator.h"
+#include "pipelines/guidance/live_estimator.h"
 #include "pipelines/synthetic/view_sampler.h"
 #include "tests/pipelines/guidance/simulated_person.h"
 

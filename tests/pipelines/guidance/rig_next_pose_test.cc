@@ -9,7 +9,7 @@
 
 #include "colmap_ext/util/logging.h"
 #include "pipelines/guidance/next_pose.h"
-#include "pipelines/live/live_estimator.h"
+#include "pipelines/guidance/live_estimator.h"
 #include "pipelines/synthetic/view_sampler.h"
 #include "tests/pipelines/guidance/simulated_person.h"
 
@@ -83,7 +83,9 @@ TEST(RigNextPose, EverySuggestionKeepsTheTargetInBothViews) {
     EXPECT_LE(distance, options.distance_max_m + 1e-9);
     information1 += ViewInformation(rig.camera1, board.points, pose);
     information2 += ViewInformation(rig.camera2, board.points, rig.cam2_from_cam1 * pose);
-    if (kept >= 3) EXPECT_LT(next.after.mean_px, next.before.mean_px) << kept;
+    if (kept >= 3) {
+      EXPECT_LT(next.after.mean_px, next.before.mean_px) << kept;
+    }
   }
 }
 

@@ -13,7 +13,7 @@
 
 #include "pipelines/calibration/camera_calibration.h"
 #include "pipelines/guidance/next_pose.h"
-#include "pipelines/live/live_estimator.h"
+#include "pipelines/guidance/live_estimator.h"
 #include "pipelines/synthetic/view_sampler.h"
 
 namespace portcal::simulated {

@@ -1,4 +1,4 @@
-#include "pipelines/live/pose_preview.h"
+#include "pipelines/guidance/pose_preview.h"
 
 #include <opencv2/imgproc.hpp>
 

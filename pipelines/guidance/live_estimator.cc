@@ -1,4 +1,4 @@
-#include "pipelines/live/live_estimator.h"
+#include "pipelines/guidance/live_estimator.h"
 
 #include <iomanip>
 #include <sstream>
@@ -253,6 +253,12 @@ double LiveEstimator::Gain(const LiveEstimate& estimate, const CalibrationView& 
   if (!after.determined || !after_kept.determined || !(estimate.uncertainty.mean_px > 0)) return 0;
   return std::max({0.0, 1 - after.mean_px / estimate.uncertainty.mean_px,
                    1 - after_kept.mean_px / estimate.uncertainty.mean_px});
+}
+
+TargetShape ShapeOfTarget(const TargetDetectorOptions& detector) {
+  std::vector<Eigen::Vector3d> points;
+  for (const BoardPoint& p : TargetLayout(detector)) points.push_back(p.point_in_target);
+  return TargetShape::FromPoints(points);
 }
 
 }  // namespace portcal

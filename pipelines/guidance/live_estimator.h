@@ -12,6 +12,7 @@
 
 #include "colmap_ext/camera/housed_camera.h"
 #include "pipelines/calibration/camera_calibration.h"
+#include "pipelines/detection/target_detector.h"
 #include "pipelines/guidance/next_pose.h"
 
 namespace portcal {
@@ -114,5 +115,9 @@ LiveEstimate EstimateRig(const LiveEstimator& camera1, const LiveEstimator& came
 // larger of the two cameras' gains.
 double RigGain(const LiveEstimator& camera1, const LiveEstimator& camera2, const LiveEstimate& estimate,
                const CalibrationView& view1, const CalibrationView& view2);
+
+// The target as guidance sees it: every point the detector options'
+// target has.
+TargetShape ShapeOfTarget(const TargetDetectorOptions& detector);
 
 }  // namespace portcal
