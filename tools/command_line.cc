@@ -228,7 +228,7 @@ void CommandLine::AddHousing(std::optional<Housing>* housing, const std::string&
       return;
     }
     if (params.empty()) throw OptionError("--Housing.params", "''", "the parameters of --Housing.model " + model);
-    if (!ExistsHousingModelWithName(model)) throw OptionError("--Housing.model", model, "FLATPORT, DOMEPORT or NONE");
+    if (!ExistsHousingModelWithName(model)) throw OptionError("--Housing.model", model, HousingModelNames() + " or NONE");
     *housing = Housing::FromName(model, ParseDoubleList(params, "--Housing.params"), "--Housing.params");
     (*housing)->ValidateInput("--Housing.params");
   });

@@ -6,6 +6,24 @@
 
 namespace portcal {
 
+std::string HousingModelNames() {
+  std::string names;
+  ForEachModel(HousingModelList{}, [&](auto model) {
+    if (!names.empty()) names += ", ";
+    names += decltype(model)::kName;
+  });
+  return names;
+}
+
+std::string HousingModelIds() {
+  std::string ids;
+  ForEachModel(HousingModelList{}, [&](auto model) {
+    if (!ids.empty()) ids += ", ";
+    ids += std::string(decltype(model)::kName) + " = " + std::to_string(decltype(model)::kId);
+  });
+  return ids;
+}
+
 bool ExistsHousingModelWithName(const std::string& name) {
   return VisitModelByName(HousingModelList{}, name, [](auto) {});
 }
@@ -14,8 +32,7 @@ int HousingModelNameToId(const std::string& name) {
   int id = -1;
   if (!VisitModelByName(HousingModelList{}, name,
                         [&](auto model) { id = decltype(model)::kId; })) {
-    throw InputError("unknown housing model '" + name +
-                     "' (expected FLATPORT or DOMEPORT)");
+    throw InputError("unknown housing model '" + name + "' (expected one of " + HousingModelNames() + ")");
   }
   return id;
 }

@@ -12,11 +12,16 @@ namespace portcal {
 
 using HousingModelList = TypeList<FlatPort, DomePort>;
 
+// The models' names, ", "-separated in the list's order ("FLATPORT,
+// DOMEPORT"), and with their ids ("FLATPORT = 0, DOMEPORT = 1"): what
+// messages list, so a new model appears in them.
+std::string HousingModelNames();
+std::string HousingModelIds();
+
 template <typename F>
 void VisitHousingModel(int model_id, F&& f) {
   if (!VisitModelById(HousingModelList{}, model_id, std::forward<F>(f))) {
-    throw InputError("unknown housing model id " + std::to_string(model_id) +
-                     " (FLATPORT = 0, DOMEPORT = 1)");
+    throw InputError("unknown housing model id " + std::to_string(model_id) + " (" + HousingModelIds() + ")");
   }
 }
 

@@ -50,6 +50,11 @@ BundleAdjustmentOptions BundleAdjustmentOptions::WithWeightsHeld(double first_tr
   return held;
 }
 
+void MarkerScale::Check() const {
+  if (!(side_length_m >= 0)) throw OptionError("--Markers.side_length", std::to_string(side_length_m), ">= 0 m");
+  if (!(sigma_m > 0)) throw OptionError("--Markers.side_sigma", std::to_string(sigma_m), "> 0 m");
+}
+
 bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::string* why) {
   std::ostringstream text;
   const double ratio = after.MeanFocalLength() / before.MeanFocalLength();

@@ -82,6 +82,7 @@ struct MarkerCorner {
 struct MarkerScale {
   double side_length_m = 0;  // <= 0: markers do not constrain the scale
   double sigma_m = 0.0001;   // of each side and diagonal
+  void Check() const;        // throws OptionError naming --Markers.side_length or --Markers.side_sigma
 };
 
 // Marker corners seen by at least two registered images, triangulated from

@@ -12,12 +12,7 @@
 namespace portcal {
 
 void SelfCalibrationOptions::Check() const {
-  if (marker_scale.side_length_m < 0) {
-    throw OptionError("--Markers.side_length", std::to_string(marker_scale.side_length_m), ">= 0 m");
-  }
-  if (!(marker_scale.sigma_m > 0)) {
-    throw OptionError("--Markers.side_sigma", std::to_string(marker_scale.sigma_m), "> 0 m");
-  }
+  marker_scale.Check();
   if (!(max_reproj_error_px > 0)) {
     throw OptionError("--BundleAdjustment.max_reproj_error", std::to_string(max_reproj_error_px), "> 0 px");
   }

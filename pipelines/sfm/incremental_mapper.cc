@@ -44,12 +44,7 @@ void IncrementalMapperOptions::Check() const {
   angle(init_min_tri_angle_deg, "init_min_tri_angle");
   angle(filter_min_tri_angle_deg, "filter_min_tri_angle");
   angle(tri_min_angle_deg, "tri_min_angle");
-  if (!(marker_scale.side_length_m >= 0)) {
-    throw OptionError("--Markers.side_length", std::to_string(marker_scale.side_length_m), ">= 0 m");
-  }
-  if (!(marker_scale.sigma_m > 0)) {
-    throw OptionError("--Markers.side_sigma", std::to_string(marker_scale.sigma_m), "> 0 m");
-  }
+  marker_scale.Check();
   if (abs_pose_min_num_inliers < 6) {
     throw OptionError("--Mapper.abs_pose_min_num_inliers", std::to_string(abs_pose_min_num_inliers), ">= 6");
   }

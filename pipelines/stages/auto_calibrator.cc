@@ -32,12 +32,7 @@ void AutoCalibratorOptions::Check() const {
   if (max_num_starts < 1) {
     throw OptionError("--AutoCalibration.max_num_starts", std::to_string(max_num_starts), ">= 1");
   }
-  if (marker_scale.side_length_m < 0) {
-    throw OptionError("--Markers.side_length", std::to_string(marker_scale.side_length_m), ">= 0 m");
-  }
-  if (!(marker_scale.sigma_m > 0)) {
-    throw OptionError("--Markers.side_sigma", std::to_string(marker_scale.sigma_m), "> 0 m");
-  }
+  marker_scale.Check();
 }
 
 namespace {

@@ -26,7 +26,7 @@ void HousingCalibratorOptions::Check() const {
   }
   if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
   CheckOutputFolder("--output_path", output_path);
-  if (!housing) throw OptionError("--Housing.model", "''", "FLATPORT or DOMEPORT");
+  if (!housing) throw OptionError("--Housing.model", "''", "one of " + HousingModelNames());
   housing->ValidateInput("--Housing.params");
   calibration.Check();
 }
