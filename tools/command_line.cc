@@ -217,7 +217,9 @@ void CommandLine::AddHousing(std::optional<Housing>* housing, const std::string&
   if (housing->has_value()) {
     for (const double v : (*housing)->params) params += (params.empty() ? "" : ",") + FormatShortest(v);
   }
-  Add("Housing.model", &model, "FLATPORT | DOMEPORT | NONE: " + model_help);
+  std::string choices;
+  for (const std::string& name : SplitTokens(HousingModelNames(), ", ")) choices += name + " | ";
+  Add("Housing.model", &model, choices + "NONE: " + model_help);
   Add("Housing.params", &params,
       "the model's parameters, comma separated, metres (FLATPORT: Nx,Ny,Nz,int_dist,int_thick,na,ng,nw; "
       "DOMEPORT: Cx,Cy,Cz,int_radius,int_thick,na,ng,nw)");
@@ -227,8 +229,9 @@ void CommandLine::AddHousing(std::optional<Housing>* housing, const std::string&
       housing->reset();
       return;
     }
-    if (params.empty()) throw OptionError("--Housing.params", "''", "the parameters of --Housing.model " + model);
+    // The model first: the parameters' meaning depends on it.
     if (!ExistsHousingModelWithName(model)) throw OptionError("--Housing.model", model, HousingModelNames() + " or NONE");
+    if (params.empty()) throw OptionError("--Housing.params", "''", "the parameters of --Housing.model " + model);
     *housing = Housing::FromName(model, ParseDoubleList(params, "--Housing.params"), "--Housing.params");
     (*housing)->ValidateInput("--Housing.params");
   });
