@@ -4,7 +4,9 @@
 #   cmake -DUNIT=pipelines/sfm -DALLOWED="colmap_ext;database;..." \
 #         -DSOURCES="a.cc;b.h" -DSTAMP=out.stamp -P check_includes.cmake
 # A unit is a top-level folder (colmap_ext, database, tools) or a folder of
-# pipelines/ (pipelines/sfm).
+# pipelines/ (pipelines/sfm). In pipelines/stages a stage includes no other
+# stage unless it is one of COMPOSERS (the stages that run others: their
+# file names without extension); the rest only run.
 cmake_minimum_required(VERSION 3.18)
 set(errors "")
 foreach(source IN LISTS SOURCES)
@@ -18,6 +20,12 @@ foreach(source IN LISTS SOURCES)
     endif()
     if(NOT included STREQUAL UNIT AND NOT included IN_LIST ALLOWED)
       string(APPEND errors "  ${source}: ${line}\n")
+    elseif(UNIT STREQUAL "pipelines/stages" AND included STREQUAL UNIT)
+      get_filename_component(stage "${source}" NAME_WE)
+      string(REGEX MATCH "pipelines/stages/([a-z_]+)\\.h" other "${line}")
+      if(NOT CMAKE_MATCH_1 STREQUAL stage AND NOT stage IN_LIST COMPOSERS)
+        string(APPEND errors "  ${source}: ${line} (a stage that runs another is listed in PORTCAL_STAGE_COMPOSERS)\n")
+      endif()
     endif()
   endforeach()
 endforeach()

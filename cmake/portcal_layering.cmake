@@ -6,6 +6,7 @@ function(portcal_layering target unit folder)
   set(stamp "${CMAKE_CURRENT_BINARY_DIR}/${target}_layering.stamp")
   add_custom_command(OUTPUT "${stamp}"
     COMMAND ${CMAKE_COMMAND} "-DUNIT=${unit}" "-DALLOWED=${ARGN}" "-DSOURCES=${files}"
+            "-DCOMPOSERS=${PORTCAL_STAGE_COMPOSERS}"
             "-DSTAMP=${stamp}" -P "${PROJECT_SOURCE_DIR}/cmake/check_includes.cmake"
     DEPENDS ${files} "${PROJECT_SOURCE_DIR}/cmake/check_includes.cmake"
     COMMENT "Checking ${unit}'s includes against its declared dependencies"
