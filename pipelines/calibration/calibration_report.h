@@ -1,6 +1,8 @@
 // calibration.yaml (calibmar's keys, so calibmar imports it, plus portcal's
 // own: standard deviations, RMS, per-view table, target) and calibration.txt
-// for people.
+// for people. The report is built from a result with its notes and warnings
+// in calibration_report.cc, written in calibration_report_writer.cc, read
+// in calibration_report_reader.cc.
 #pragma once
 
 #include <filesystem>
