@@ -10,14 +10,7 @@ bool ExistsCameraModelWithName(const std::string& model_name) {
   return VisitModelByName(CameraModelList{}, model_name, [](auto) {});
 }
 
-std::string CameraModelNames() {
-  std::string names;
-  ForEachModel(CameraModelList{}, [&](auto model) {
-    if (!names.empty()) names += ", ";
-    names += decltype(model)::kName;
-  });
-  return names;
-}
+std::string CameraModelNames() { return ModelNames(CameraModelList{}); }
 
 int CameraModelNameToId(const std::string& model_name) {
   int id = -1;

@@ -6,14 +6,7 @@
 
 namespace portcal {
 
-std::string HousingModelNames() {
-  std::string names;
-  ForEachModel(HousingModelList{}, [&](auto model) {
-    if (!names.empty()) names += ", ";
-    names += decltype(model)::kName;
-  });
-  return names;
-}
+std::string HousingModelNames() { return ModelNames(HousingModelList{}); }
 
 std::string HousingModelIds() {
   std::string ids;

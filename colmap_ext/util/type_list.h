@@ -3,6 +3,7 @@
 // family, one fold expression per lookup.
 #pragma once
 
+#include <string>
 #include <string_view>
 #include <utility>
 
@@ -30,6 +31,15 @@ bool VisitModelByName(TypeList<Ms...>, std::string_view name, F&& f) {
 template <typename... Ms, typename F>
 void ForEachModel(TypeList<Ms...>, F&& f) {
   (f(Ms{}), ...);
+}
+
+// The models' names in the list's order, ", "-separated: what messages list,
+// so that a model added to the list appears in them.
+template <typename... Ms>
+std::string ModelNames(TypeList<Ms...>) {
+  std::string names;
+  ((names += (names.empty() ? "" : ", ") + std::string(Ms::kName)), ...);
+  return names;
 }
 
 }  // namespace portcal
