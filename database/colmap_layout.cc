@@ -18,7 +18,8 @@ bool HasTable(sqlite3* db, const std::string& path, const std::string& table) {
   return stmt.Step();
 }
 
-bool HasColumn(sqlite3* db, const std::string& path, const std::string& table, const std::string& column) {
+bool HasColumn(sqlite3* db, const std::string& path, const std::string& table,
+               const std::string& column) {
   Statement stmt(db, path, "SELECT 1 FROM pragma_table_info(?) WHERE name=?;");
   stmt.Bind(1, table).Bind(2, column);
   return stmt.Step();
@@ -32,9 +33,9 @@ std::string VersionOfNumber(int64_t user_version) {
 }  // namespace
 
 const std::vector<ColmapVersion>& AllColmapVersions() {
-  static const std::vector<ColmapVersion> kVersions = {ColmapVersion::k3_8,  ColmapVersion::k3_9,  ColmapVersion::k3_10,
-                                                       ColmapVersion::k3_11, ColmapVersion::k3_12, ColmapVersion::k3_13,
-                                                       ColmapVersion::k4_0,  ColmapVersion::k4_1};
+  static const std::vector<ColmapVersion> kVersions = {
+      ColmapVersion::k3_8,  ColmapVersion::k3_9,  ColmapVersion::k3_10, ColmapVersion::k3_11,
+      ColmapVersion::k3_12, ColmapVersion::k3_13, ColmapVersion::k4_0,  ColmapVersion::k4_1};
   return kVersions;
 }
 
@@ -54,7 +55,8 @@ ColmapVersion ParseColmapVersion(const std::string& name, const std::string& opt
 
 std::vector<std::pair<std::string, ColmapVersion>> ColmapVersionChoices() {
   std::vector<std::pair<std::string, ColmapVersion>> choices;
-  for (const ColmapVersion version : AllColmapVersions()) choices.emplace_back(ColmapVersionName(version), version);
+  for (const ColmapVersion version : AllColmapVersions())
+    choices.emplace_back(ColmapVersionName(version), version);
   return choices;
 }
 
@@ -76,9 +78,10 @@ ColmapLayout LayoutOf(ColmapVersion version) {
   ColmapLayout layout;
   layout.user_version = ColmapUserVersion(version);
   layout.image_prior_columns = v <= static_cast<int>(ColmapVersion::k3_9);
-  layout.pose_priors = v <= static_cast<int>(ColmapVersion::k3_9)    ? ColmapLayout::PosePriors::kNone
-                       : v <= static_cast<int>(ColmapVersion::k3_13) ? ColmapLayout::PosePriors::kPerImage
-                                                                     : ColmapLayout::PosePriors::kPerData;
+  layout.pose_priors = v <= static_cast<int>(ColmapVersion::k3_9) ? ColmapLayout::PosePriors::kNone
+                       : v <= static_cast<int>(ColmapVersion::k3_13)
+                           ? ColmapLayout::PosePriors::kPerImage
+                           : ColmapLayout::PosePriors::kPerData;
   layout.pose_prior_covariance = v >= static_cast<int>(ColmapVersion::k3_11);
   layout.rigs_and_frames = v >= static_cast<int>(ColmapVersion::k3_12);
   layout.descriptor_type = v >= static_cast<int>(ColmapVersion::k4_0);
@@ -102,7 +105,8 @@ ColmapVersion NewestVersionWith(const ColmapLayout& layout) {
                                  ? candidate.user_version / 10000 == layout.user_version / 10000
                                  : candidate.user_version == layout.user_version;
     if (same_number && candidate.pose_priors == layout.pose_priors &&
-        candidate.rigs_and_frames == layout.rigs_and_frames && candidate.descriptor_type == layout.descriptor_type &&
+        candidate.rigs_and_frames == layout.rigs_and_frames &&
+        candidate.descriptor_type == layout.descriptor_type &&
         candidate.pose_prior_covariance == layout.pose_prior_covariance) {
       newest = version;
     }
@@ -111,7 +115,8 @@ ColmapVersion NewestVersionWith(const ColmapLayout& layout) {
 }
 
 ColmapLayout DetectColmapLayout(sqlite3* db, const std::string& path) {
-  for (const char* table : {"cameras", "images", "keypoints", "descriptors", "matches", "two_view_geometries"}) {
+  for (const char* table :
+       {"cameras", "images", "keypoints", "descriptors", "matches", "two_view_geometries"}) {
     if (!HasTable(db, path, table)) {
       throw DatabaseError(path + ": no table '" + table + "': not a COLMAP database");
     }
@@ -120,19 +125,22 @@ ColmapLayout DetectColmapLayout(sqlite3* db, const std::string& path) {
   Statement version(db, path, "PRAGMA user_version;");
   layout.user_version = version.Step() ? version.ColumnInt64(0) : 0;
   if (layout.user_version > kNewestKnownUserVersion) {
-    throw DatabaseError(path + ": a database of COLMAP " + VersionOfNumber(layout.user_version) + " (user_version " +
-                        std::to_string(layout.user_version) + "), newer than portcal knows (COLMAP 3.8 to 4.1, " +
-                        "user_version up to " + std::to_string(kNewestKnownUserVersion) + ")");
+    throw DatabaseError(path + ": a database of COLMAP " + VersionOfNumber(layout.user_version) +
+                        " (user_version " + std::to_string(layout.user_version) +
+                        "), newer than portcal knows (COLMAP 3.8 to 4.1, " + "user_version up to " +
+                        std::to_string(kNewestKnownUserVersion) + ")");
   }
   if (layout.user_version != 3800 && layout.user_version != 3900 && layout.user_version < 4000000) {
-    throw DatabaseError(path + ": database schema version " + std::to_string(layout.user_version) +
-                        ", none of COLMAP 3.8 to 4.1's (3800, 3900, 4000000 and up); open it once with "
-                        "COLMAP 3.8 or newer to bring it up to date, or start a new database");
+    throw DatabaseError(
+        path + ": database schema version " + std::to_string(layout.user_version) +
+        ", none of COLMAP 3.8 to 4.1's (3800, 3900, 4000000 and up); open it once with "
+        "COLMAP 3.8 or newer to bring it up to date, or start a new database");
   }
   layout.image_prior_columns = HasColumn(db, path, "images", "prior_qw");
   if (HasTable(db, path, "pose_priors")) {
-    layout.pose_priors = HasColumn(db, path, "pose_priors", "corr_data_id") ? ColmapLayout::PosePriors::kPerData
-                                                                            : ColmapLayout::PosePriors::kPerImage;
+    layout.pose_priors = HasColumn(db, path, "pose_priors", "corr_data_id")
+                             ? ColmapLayout::PosePriors::kPerData
+                             : ColmapLayout::PosePriors::kPerImage;
     layout.pose_prior_covariance = HasColumn(db, path, "pose_priors", "position_covariance");
   } else {
     layout.pose_priors = ColmapLayout::PosePriors::kNone;
@@ -141,9 +149,10 @@ ColmapLayout DetectColmapLayout(sqlite3* db, const std::string& path) {
                            HasTable(db, path, "frame_data") && HasTable(db, path, "rig_sensors");
   layout.descriptor_type = HasColumn(db, path, "descriptors", "type");
   if (layout.pose_priors == ColmapLayout::PosePriors::kNone && !layout.image_prior_columns) {
-    throw DatabaseError(path +
-                        ": the images table has no prior_* columns and there is no pose_priors table: "
-                        "no COLMAP version writes that");
+    throw DatabaseError(
+        path +
+        ": the images table has no prior_* columns and there is no pose_priors table: "
+        "no COLMAP version writes that");
   }
   return layout;
 }

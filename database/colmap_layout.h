@@ -36,8 +36,10 @@ constexpr int64_t kDescriptorTypeSift = 0;  // FeatureExtractorType::SIFT
 struct ColmapLayout {
   enum class PosePriors {
     kNone,      // 3.8, 3.9: images.prior_* only
-    kPerImage,  // 3.10-3.13: pose_priors(image_id, position, coordinate_system[, position_covariance])
-    kPerData,   // 4.x: pose_priors(pose_prior_id, corr_data_id, corr_sensor_id, corr_sensor_type, ...)
+    kPerImage,  // 3.10-3.13: pose_priors(image_id, position, coordinate_system[,
+                // position_covariance])
+    kPerData,   // 4.x: pose_priors(pose_prior_id, corr_data_id, corr_sensor_id, corr_sensor_type,
+                // ...)
   };
   int64_t user_version = 3800;
   bool image_prior_columns = true;  // images.prior_qw..prior_tz

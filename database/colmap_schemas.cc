@@ -65,11 +65,26 @@ constexpr const char* kDescriptors40 =
 }  // namespace
 
 const std::vector<std::string>& ColmapSchemaSql(ColmapVersion version) {
-  static const std::vector<std::string> k3_9 = {kCameras, kImages38, kIndexName, kKeypoints38, kDescriptors38, kMatches, kTwoViewGeometries};
-  static const std::vector<std::string> k3_10 = {kCameras, kImages310, kIndexName, kPosePriors310, kKeypoints38, kDescriptors38, kMatches, kTwoViewGeometries};
-  static const std::vector<std::string> k3_11 = {kCameras, kImages310, kIndexName, kPosePriors311, kKeypoints38, kDescriptors38, kMatches, kTwoViewGeometries};
-  static const std::vector<std::string> k3_12 = {kRigs, kRigRefSensorIndex, kRigSensors, kRigSensorIndex, kCameras, kFrames, kFrameData, kFrameSensorIndex, kImages312, kIndexName, kPosePriors312, kKeypoints312, kDescriptors312, kMatches, kTwoViewGeometries};
-  static const std::vector<std::string> k4_1 = {kRigs, kRigRefSensorIndex, kRigSensors, kRigSensorIndex, kCameras, kFrames, kFrameData, kFrameSensorIndex, kImages312, kIndexName, kPosePriors40, kPosePriorDataIndex, kKeypoints312, kDescriptors40, kMatches, kTwoViewGeometries};
+  static const std::vector<std::string> k3_9 = {
+      kCameras, kImages38, kIndexName, kKeypoints38, kDescriptors38, kMatches, kTwoViewGeometries};
+  static const std::vector<std::string> k3_10 = {kCameras,       kImages310,        kIndexName,
+                                                 kPosePriors310, kKeypoints38,      kDescriptors38,
+                                                 kMatches,       kTwoViewGeometries};
+  static const std::vector<std::string> k3_11 = {kCameras,       kImages310,        kIndexName,
+                                                 kPosePriors311, kKeypoints38,      kDescriptors38,
+                                                 kMatches,       kTwoViewGeometries};
+  static const std::vector<std::string> k3_12 = {
+      kRigs,          kRigRefSensorIndex, kRigSensors,       kRigSensorIndex, kCameras,
+      kFrames,        kFrameData,         kFrameSensorIndex, kImages312,      kIndexName,
+      kPosePriors312, kKeypoints312,      kDescriptors312,   kMatches,        kTwoViewGeometries};
+  static const std::vector<std::string> k4_1 = {kRigs,         kRigRefSensorIndex,
+                                                kRigSensors,   kRigSensorIndex,
+                                                kCameras,      kFrames,
+                                                kFrameData,    kFrameSensorIndex,
+                                                kImages312,    kIndexName,
+                                                kPosePriors40, kPosePriorDataIndex,
+                                                kKeypoints312, kDescriptors40,
+                                                kMatches,      kTwoViewGeometries};
   switch (version) {
     case ColmapVersion::k3_8:
     case ColmapVersion::k3_9:

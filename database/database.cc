@@ -35,15 +35,17 @@ void CheckImagesHaveCameras(sqlite3* db, const std::string& path) {
                  "SELECT image_id, name, camera_id FROM images WHERE camera_id NOT IN "
                  "(SELECT camera_id FROM cameras) ORDER BY image_id LIMIT 1;");
   if (!stmt.Step()) return;
-  throw InputError(path + ": image " + std::to_string(stmt.ColumnInt64(0)) + " (" + stmt.ColumnText(1) +
-                   ") refers to camera " + std::to_string(stmt.ColumnInt64(2)) +
-                   ", which the database does not hold (a damaged or hand-edited file; `sqlite3 " + path +
-                   " 'PRAGMA foreign_key_check'` lists such rows)");
+  throw InputError(path + ": image " + std::to_string(stmt.ColumnInt64(0)) + " (" +
+                   stmt.ColumnText(1) + ") refers to camera " +
+                   std::to_string(stmt.ColumnInt64(2)) +
+                   ", which the database does not hold (a damaged or hand-edited file; `sqlite3 " +
+                   path + " 'PRAGMA foreign_key_check'` lists such rows)");
 }
 
 }  // namespace
 
-Database::Database(const fs::path& path, OpenMode mode, ColmapVersion version_if_created) : path_(path.string()) {
+Database::Database(const fs::path& path, OpenMode mode, ColmapVersion version_if_created)
+    : path_(path.string()) {
   const bool exists = fs::exists(path);
   if (!exists && mode != OpenMode::kCreate) {
     throw DatabaseError(path_ + ": no such database file");
@@ -51,9 +53,8 @@ Database::Database(const fs::path& path, OpenMode mode, ColmapVersion version_if
   if (exists && fs::is_directory(path)) {
     throw DatabaseError(path_ + ": is a directory, not a database file");
   }
-  const int flags = mode == OpenMode::kReadOnly
-                        ? SQLITE_OPEN_READONLY
-                        : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE;
+  const int flags = mode == OpenMode::kReadOnly ? SQLITE_OPEN_READONLY
+                                                : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE;
   if (sqlite3_open_v2(path_.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
     const std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
     sqlite3_close(db_);
@@ -63,8 +64,7 @@ Database::Database(const fs::path& path, OpenMode mode, ColmapVersion version_if
     lock_wait_ = std::make_unique<LockWait>(path_, DatabaseBusyTimeout());
     lock_wait_->Install(db_);
     // Fails with "file is not a database" for other files.
-    const int64_t num_tables =
-        QueryInt("SELECT count(*) FROM sqlite_master WHERE type='table';");
+    const int64_t num_tables = QueryInt("SELECT count(*) FROM sqlite_master WHERE type='table';");
     if (mode != OpenMode::kReadOnly) {
       ExecuteSql(db_, path_, "PRAGMA foreign_keys = ON;");
     }
@@ -96,7 +96,8 @@ void Database::CreateSchema(ColmapVersion version) {
   // while creating the database leaves it empty or whole.
   Transaction transaction(db_, path_);
   for (const std::string& sql : ColmapSchemaSql(version)) ExecuteSql(db_, path_, sql + ";");
-  ExecuteSql(db_, path_, "PRAGMA user_version = " + std::to_string(ColmapUserVersion(version)) + ";");
+  ExecuteSql(db_, path_,
+             "PRAGMA user_version = " + std::to_string(ColmapUserVersion(version)) + ";");
   for (const std::string& sql : PortcalSchemaSql()) ExecuteSql(db_, path_, sql + ";");
   Statement stmt(db_, path_, "INSERT INTO portcal_meta(key, value) VALUES('schema_version', ?);");
   stmt.Bind(1, std::to_string(kPortcalSchemaVersion)).Execute();
@@ -105,11 +106,10 @@ void Database::CreateSchema(ColmapVersion version) {
 
 void Database::CheckSchema() {
   layout_ = DetectColmapLayout(db_, path_);
-  const int64_t has_meta = QueryInt(
-      "SELECT count(*) FROM sqlite_master WHERE name='portcal_meta';");
+  const int64_t has_meta =
+      QueryInt("SELECT count(*) FROM sqlite_master WHERE name='portcal_meta';");
   if (has_meta == 1) {
-    Statement stmt(db_, path_,
-                   "SELECT value FROM portcal_meta WHERE key='schema_version';");
+    Statement stmt(db_, path_, "SELECT value FROM portcal_meta WHERE key='schema_version';");
     const std::string value = stmt.Step() ? stmt.ColumnText(0) : "";
     if (value == "1" && sqlite3_db_readonly(db_, "main") != 1) {
       // Version 2 added a table; the others are as they were.
@@ -123,8 +123,7 @@ void Database::CheckSchema() {
     // Version 1 read-only: its tables are a subset of version 2's.
     if (value != std::to_string(kPortcalSchemaVersion) && value != "1") {
       throw DatabaseError(path_ + ": portcal tables of schema version '" + value +
-                          "', this portcal reads version " +
-                          std::to_string(kPortcalSchemaVersion));
+                          "', this portcal reads version " + std::to_string(kPortcalSchemaVersion));
     }
     return;
   }
@@ -132,8 +131,7 @@ void Database::CheckSchema() {
   // A database made by COLMAP: add portcal's tables.
   Transaction transaction(db_, path_);
   for (const std::string& sql : PortcalSchemaSql()) ExecuteSql(db_, path_, sql + ";");
-  Statement stmt(db_, path_,
-                 "INSERT INTO portcal_meta(key, value) VALUES('schema_version', ?);");
+  Statement stmt(db_, path_, "INSERT INTO portcal_meta(key, value) VALUES('schema_version', ?);");
   stmt.Bind(1, std::to_string(kPortcalSchemaVersion)).Execute();
   transaction.Commit();
 }
@@ -157,9 +155,9 @@ int64_t Database::QueryInt(const std::string& sql) {
 
 void Database::WriteKeypoints(image_t image_id, const FeatureKeypoints& keypoints) {
   static_assert(sizeof(FeatureKeypoint) == 6 * sizeof(float));
-  Statement& stmt = Prepare(
-      "write_keypoints",
-      "INSERT OR REPLACE INTO keypoints(image_id, rows, cols, data) VALUES(?, ?, 6, ?);");
+  Statement& stmt =
+      Prepare("write_keypoints",
+              "INSERT OR REPLACE INTO keypoints(image_id, rows, cols, data) VALUES(?, ?, 6, ?);");
   stmt.Bind(1, static_cast<int64_t>(image_id))
       .Bind(2, static_cast<int64_t>(keypoints.size()))
       .BindBlob(3, keypoints.data(), keypoints.size() * sizeof(FeatureKeypoint));
@@ -182,17 +180,18 @@ FeatureKeypoints Database::ReadKeypoints(image_t image_id) {
   const std::vector<float> data = BlobAs<float>(stmt.ColumnBlob(2));
   if (rows < 0 || (cols != 2 && cols != 4 && cols != 6) ||
       static_cast<int64_t>(data.size()) != rows * cols) {
-    throw DatabaseError(path_ + ": keypoints of " + ImageLabel(image_id) + " have an invalid blob (" +
-                        std::to_string(rows) + " x " + std::to_string(cols) + ", " + std::to_string(data.size()) +
-                        " floats)");
+    throw DatabaseError(path_ + ": keypoints of " + ImageLabel(image_id) +
+                        " have an invalid blob (" + std::to_string(rows) + " x " +
+                        std::to_string(cols) + ", " + std::to_string(data.size()) + " floats)");
   }
   // A damaged or edited blob: NaN, inf or 3e38 would pass the matchers,
   // the masker and the mapper as if they were points.
   for (size_t i = 0; i < data.size(); ++i) {
     const bool coordinate = i % cols < 2;
     if (!std::isfinite(data[i]) || (coordinate && std::abs(data[i]) > kMaxKeypointCoordinate)) {
-      throw InputError(path_ + ": keypoint " + std::to_string(i / cols) + " of " + ImageLabel(image_id) + " holds " +
-                       FormatShortest(data[i]) + (coordinate ? " as a coordinate" : " in its shape") +
+      throw InputError(path_ + ": keypoint " + std::to_string(i / cols) + " of " +
+                       ImageLabel(image_id) + " holds " + FormatShortest(data[i]) +
+                       (coordinate ? " as a coordinate" : " in its shape") +
                        " (a damaged or edited database: extract this image's features again)");
     }
   }
@@ -214,10 +213,11 @@ void Database::WriteDescriptors(image_t image_id, const FeatureDescriptors& desc
   // COLMAP 4 records the extractor: SIFT.
   Statement& stmt = Prepare(
       "write_descriptors",
-      layout_.descriptor_type ? "INSERT OR REPLACE INTO descriptors(image_id, rows, cols, data, type) "
-                                "VALUES(?, ?, 128, ?, " +
-                                    std::to_string(kDescriptorTypeSift) + ");"
-                              : "INSERT OR REPLACE INTO descriptors(image_id, rows, cols, data) VALUES(?, ?, 128, ?);");
+      layout_.descriptor_type
+          ? "INSERT OR REPLACE INTO descriptors(image_id, rows, cols, data, type) "
+            "VALUES(?, ?, 128, ?, " +
+                std::to_string(kDescriptorTypeSift) + ");"
+          : "INSERT OR REPLACE INTO descriptors(image_id, rows, cols, data) VALUES(?, ?, 128, ?);");
   stmt.Bind(1, static_cast<int64_t>(image_id))
       .Bind(2, static_cast<int64_t>(descriptors.rows()))
       .BindBlob(3, descriptors.data(), descriptors.size());
@@ -225,27 +225,30 @@ void Database::WriteDescriptors(image_t image_id, const FeatureDescriptors& desc
 }
 
 FeatureDescriptors Database::ReadDescriptors(image_t image_id) {
-  Statement& stmt = Prepare("read_descriptors", layout_.descriptor_type
-                                                    ? "SELECT rows, cols, data, type FROM descriptors WHERE image_id=?;"
-                                                    : "SELECT rows, cols, data FROM descriptors WHERE image_id=?;");
+  Statement& stmt = Prepare("read_descriptors",
+                            layout_.descriptor_type
+                                ? "SELECT rows, cols, data, type FROM descriptors WHERE image_id=?;"
+                                : "SELECT rows, cols, data FROM descriptors WHERE image_id=?;");
   stmt.Bind(1, static_cast<int64_t>(image_id));
   if (!stmt.Step()) return FeatureDescriptors(0, 128);
   if (layout_.descriptor_type && stmt.ColumnInt64(3) != kDescriptorTypeSift) {
     // COLMAP 4's other extractors (ALIKED: float descriptors) cannot be
     // matched as SIFT.
-    throw DatabaseError(path_ + ": descriptors of " + ImageLabel(image_id) + " are of type " +
-                        std::to_string(stmt.ColumnInt64(3)) + " (COLMAP 4's " +
-                        (stmt.ColumnInt64(3) == 1   ? "ALIKED_N16ROT"
-                         : stmt.ColumnInt64(3) == 2 ? "ALIKED_N32"
-                                                    : "not SIFT") +
-                        "); portcal matches SIFT descriptors (type 0) only: extract this image's features again");
+    throw DatabaseError(
+        path_ + ": descriptors of " + ImageLabel(image_id) + " are of type " +
+        std::to_string(stmt.ColumnInt64(3)) + " (COLMAP 4's " +
+        (stmt.ColumnInt64(3) == 1   ? "ALIKED_N16ROT"
+         : stmt.ColumnInt64(3) == 2 ? "ALIKED_N32"
+                                    : "not SIFT") +
+        "); portcal matches SIFT descriptors (type 0) only: extract this image's features again");
   }
   const int64_t rows = stmt.ColumnInt64(0);
   const int64_t cols = stmt.ColumnInt64(1);
   const std::vector<uint8_t> data = stmt.ColumnBlob(2);
   if (rows < 0 || cols != 128 || static_cast<int64_t>(data.size()) != rows * cols) {
-    throw DatabaseError(path_ + ": descriptors of " + ImageLabel(image_id) + " are not uint8 x 128 (" +
-                        std::to_string(rows) + " x " + std::to_string(cols) + ")");
+    throw DatabaseError(path_ + ": descriptors of " + ImageLabel(image_id) +
+                        " are not uint8 x 128 (" + std::to_string(rows) + " x " +
+                        std::to_string(cols) + ")");
   }
   FeatureDescriptors descriptors(rows, 128);
   if (rows > 0) std::memcpy(descriptors.data(), data.data(), data.size());
@@ -259,8 +262,7 @@ bool Database::ExistsKeypoints(image_t image_id) {
 }
 
 bool Database::ExistsDescriptors(image_t image_id) {
-  Statement& stmt =
-      Prepare("exists_descriptors", "SELECT 1 FROM descriptors WHERE image_id=?;");
+  Statement& stmt = Prepare("exists_descriptors", "SELECT 1 FROM descriptors WHERE image_id=?;");
   stmt.Bind(1, static_cast<int64_t>(image_id));
   return stmt.Step();
 }

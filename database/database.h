@@ -83,21 +83,17 @@ class Database {
   void WriteKeypoints(image_t image_id, const FeatureKeypoints& keypoints);
   // Reads 6-, 4- (x, y, scale, orientation) and 2-column blobs.
   FeatureKeypoints ReadKeypoints(image_t image_id);
-  void WriteDescriptors(image_t image_id,
-                        const FeatureDescriptors& descriptors);
+  void WriteDescriptors(image_t image_id, const FeatureDescriptors& descriptors);
   FeatureDescriptors ReadDescriptors(image_t image_id);
   bool ExistsKeypoints(image_t image_id);
   bool ExistsDescriptors(image_t image_id);
 
   // Matches are stored for (min id, max id); reading swaps back as needed.
-  void WriteMatches(image_t image_id1, image_t image_id2,
-                    const FeatureMatches& matches);
+  void WriteMatches(image_t image_id1, image_t image_id2, const FeatureMatches& matches);
   FeatureMatches ReadMatches(image_t image_id1, image_t image_id2);
   std::vector<std::pair<image_pair_t, FeatureMatches>> ReadAllMatches();
-  void WriteTwoViewGeometry(image_t image_id1, image_t image_id2,
-                            const TwoViewGeometry& geometry);
-  std::optional<TwoViewGeometry> ReadTwoViewGeometry(image_t image_id1,
-                                                     image_t image_id2);
+  void WriteTwoViewGeometry(image_t image_id1, image_t image_id2, const TwoViewGeometry& geometry);
+  std::optional<TwoViewGeometry> ReadTwoViewGeometry(image_t image_id1, image_t image_id2);
   std::vector<std::pair<image_pair_t, TwoViewGeometry>> ReadTwoViewGeometries();
   // Pair ids that have a matches row.
   std::vector<image_pair_t> ReadMatchPairIds();
@@ -115,9 +111,9 @@ class Database {
 
   int64_t NumCameras();
   int64_t NumImages();
-  int64_t NumKeypoints();   // summed over images
+  int64_t NumKeypoints();  // summed over images
   int64_t NumDescriptors();
-  int64_t NumMatches();     // summed over pairs
+  int64_t NumMatches();  // summed over pairs
   int64_t NumInlierMatches();
   int64_t NumMatchedImagePairs();
   int64_t NumVerifiedImagePairs();
@@ -128,20 +124,19 @@ class Database {
   std::map<camera_t, Housing> ReadAllHousings();
 
   // Replace the image's rows.
-  void WriteTargetObservations(image_t image_id,
-                               const std::vector<TargetObservation>& rows);
+  void WriteTargetObservations(image_t image_id, const std::vector<TargetObservation>& rows);
   std::vector<TargetObservation> ReadTargetObservations(image_t image_id);
   void WriteTargetDetectionStatus(image_t image_id, const TargetDetectionStatus& status);
   std::optional<TargetDetectionStatus> ReadTargetDetectionStatus(image_t image_id);
-  void WriteMarkerDetections(image_t image_id,
-                             const std::vector<MarkerDetection>& rows);
+  void WriteMarkerDetections(image_t image_id, const std::vector<MarkerDetection>& rows);
   std::vector<MarkerDetection> ReadMarkerDetections(image_t image_id);
 
   // An image's features before feature_masker first masked them.
   void WriteUnmaskedFeatures(image_t image_id, const FeatureKeypoints& keypoints,
                              const FeatureDescriptors& descriptors);
   // False (the outputs untouched) where the image has none.
-  bool ReadUnmaskedFeatures(image_t image_id, FeatureKeypoints* keypoints, FeatureDescriptors* descriptors);
+  bool ReadUnmaskedFeatures(image_t image_id, FeatureKeypoints* keypoints,
+                            FeatureDescriptors* descriptors);
   void DeleteUnmaskedFeatures(image_t image_id);
   int64_t NumImagesWithUnmaskedFeatures();
 

@@ -67,10 +67,12 @@ bool Database::DeleteCameraIfUnused(camera_t camera_id) {
     // The camera's sensor row, and its rig when nothing else is left in it.
     Statement sensor(db_, path_, "DELETE FROM rig_sensors WHERE sensor_id=? AND sensor_type=?;");
     sensor.Bind(1, static_cast<int64_t>(camera_id)).Bind(2, kSensorTypeCamera).Execute();
-    Statement rig(db_, path_,
-                  "DELETE FROM rigs WHERE ref_sensor_id=? AND ref_sensor_type=? AND NOT EXISTS (SELECT 1 FROM frames "
-                  "WHERE frames.rig_id=rigs.rig_id) AND NOT EXISTS (SELECT 1 FROM rig_sensors WHERE "
-                  "rig_sensors.rig_id=rigs.rig_id);");
+    Statement rig(
+        db_, path_,
+        "DELETE FROM rigs WHERE ref_sensor_id=? AND ref_sensor_type=? AND NOT EXISTS (SELECT 1 "
+        "FROM frames "
+        "WHERE frames.rig_id=rigs.rig_id) AND NOT EXISTS (SELECT 1 FROM rig_sensors WHERE "
+        "rig_sensors.rig_id=rigs.rig_id);");
     rig.Bind(1, static_cast<int64_t>(camera_id)).Bind(2, kSensorTypeCamera).Execute();
   }
   return true;
@@ -114,9 +116,9 @@ DatabaseImage ImageFromRow(const Statement& stmt, bool legacy_priors, const std:
     has_prior = has_prior && std::isfinite(prior[i]);
   }
   if (has_prior) {
-    image.cam_from_world_prior =
-        Rigid3d(QuaternionFromWxyz(Eigen::Vector4d(prior[0], prior[1], prior[2], prior[3])).normalized(),
-                Eigen::Vector3d(prior[4], prior[5], prior[6]));
+    image.cam_from_world_prior = Rigid3d(
+        QuaternionFromWxyz(Eigen::Vector4d(prior[0], prior[1], prior[2], prior[3])).normalized(),
+        Eigen::Vector3d(prior[4], prior[5], prior[6]));
   } else if (std::isfinite(prior[4]) && std::isfinite(prior[5]) && std::isfinite(prior[6])) {
     image.position_prior = Eigen::Vector3d(prior[4], prior[5], prior[6]);
   }
@@ -128,13 +130,16 @@ DatabaseImage ImageFromRow(const Statement& stmt, bool legacy_priors, const std:
 std::string SelectImages(const ColmapLayout& layout) {
   switch (layout.pose_priors) {
     case ColmapLayout::PosePriors::kNone:
-      return "SELECT image_id, name, camera_id, prior_qw, prior_qx, prior_qy, prior_qz, prior_tx, prior_ty, "
+      return "SELECT image_id, name, camera_id, prior_qw, prior_qx, prior_qy, prior_qz, prior_tx, "
+             "prior_ty, "
              "prior_tz FROM images";
     case ColmapLayout::PosePriors::kPerImage:
-      return "SELECT images.image_id, name, camera_id, pose_priors.position FROM images LEFT JOIN pose_priors "
+      return "SELECT images.image_id, name, camera_id, pose_priors.position FROM images LEFT JOIN "
+             "pose_priors "
              "ON pose_priors.image_id = images.image_id";
     default:
-      return "SELECT images.image_id, name, camera_id, pose_priors.position FROM images LEFT JOIN pose_priors "
+      return "SELECT images.image_id, name, camera_id, pose_priors.position FROM images LEFT JOIN "
+             "pose_priors "
              "ON pose_priors.corr_data_id = images.image_id AND pose_priors.corr_sensor_type = " +
              std::to_string(kSensorTypeCamera);
   }
@@ -162,10 +167,11 @@ image_t Database::WriteImage(const DatabaseImage& image, bool use_image_id) {
   // database that a 3.10 opened keeps the columns, left NULL.
   const bool legacy_priors = layout_.pose_priors == ColmapLayout::PosePriors::kNone;
   Statement& stmt = Prepare(
-      "write_image", layout_.image_prior_columns
-                         ? "INSERT INTO images(image_id, name, camera_id, prior_qw, prior_qx, prior_qy, prior_qz, "
-                           "prior_tx, prior_ty, prior_tz) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?);"
-                         : "INSERT INTO images(image_id, name, camera_id) VALUES(?, ?, ?);");
+      "write_image",
+      layout_.image_prior_columns
+          ? "INSERT INTO images(image_id, name, camera_id, prior_qw, prior_qx, prior_qy, prior_qz, "
+            "prior_tx, prior_ty, prior_tz) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?);"
+          : "INSERT INTO images(image_id, name, camera_id) VALUES(?, ?, ?);");
   if (use_image_id) {
     stmt.Bind(1, static_cast<int64_t>(image.image_id));
   } else {
@@ -194,7 +200,8 @@ image_t Database::WriteImage(const DatabaseImage& image, bool use_image_id) {
 }
 
 void Database::UpdateImageCamera(image_t image_id, camera_t camera_id) {
-  Statement& stmt = Prepare("update_image_camera", "UPDATE images SET camera_id=? WHERE image_id=?;");
+  Statement& stmt =
+      Prepare("update_image_camera", "UPDATE images SET camera_id=? WHERE image_id=?;");
   stmt.Bind(1, static_cast<int64_t>(camera_id)).Bind(2, static_cast<int64_t>(image_id));
   stmt.Execute();
   if (sqlite3_changes(db_) != 1) {
@@ -206,16 +213,20 @@ void Database::UpdateImageCamera(image_t image_id, camera_t camera_id) {
     AddFrame(image_id, camera_id);
   }
   if (layout_.pose_priors == ColmapLayout::PosePriors::kPerData) {
-    Statement prior(db_, path_, "UPDATE pose_priors SET corr_sensor_id=? WHERE corr_data_id=? AND corr_sensor_type=?;");
+    Statement prior(
+        db_, path_,
+        "UPDATE pose_priors SET corr_sensor_id=? WHERE corr_data_id=? AND corr_sensor_type=?;");
     prior.Bind(1, static_cast<int64_t>(camera_id)).Bind(2, static_cast<int64_t>(image_id));
     prior.Bind(3, kSensorTypeCamera).Execute();
   }
 }
 
-void Database::UpdatePositionPrior(image_t image_id, const std::optional<Eigen::Vector3d>& position) {
+void Database::UpdatePositionPrior(image_t image_id,
+                                   const std::optional<Eigen::Vector3d>& position) {
   const std::optional<DatabaseImage> image = ReadImage(image_id);
   if (!image) {
-    throw InputError(path_ + ": no image with id " + std::to_string(image_id) + " for a position prior");
+    throw InputError(path_ + ": no image with id " + std::to_string(image_id) +
+                     " for a position prior");
   }
   if (layout_.pose_priors != ColmapLayout::PosePriors::kNone) {
     DeletePosePriorRows(image_id);
@@ -253,7 +264,9 @@ std::optional<DatabaseImage> Database::ReadImageWithName(const std::string& name
 std::vector<DatabaseImage> Database::ReadAllImages() {
   Statement& stmt = Prepare("read_images", SelectImages(layout_) + " ORDER BY images.image_id;");
   std::vector<DatabaseImage> images;
-  while (stmt.Step()) images.push_back(ImageFromRow(stmt, layout_.pose_priors == ColmapLayout::PosePriors::kNone, path_));
+  while (stmt.Step())
+    images.push_back(
+        ImageFromRow(stmt, layout_.pose_priors == ColmapLayout::PosePriors::kNone, path_));
   return images;
 }
 

@@ -24,12 +24,12 @@ std::vector<uint32_t> FlattenMatches(const FeatureMatches& matches, bool swap) {
 // `where` names the row for a message (a query, so made only on an error).
 using Where = std::function<std::string()>;
 
-FeatureMatches MatchesFromBlob(const std::vector<uint8_t>& blob, int64_t rows,
-                               int64_t cols, const Where& where) {
+FeatureMatches MatchesFromBlob(const std::vector<uint8_t>& blob, int64_t rows, int64_t cols,
+                               const Where& where) {
   if (rows < 0 || (rows > 0 && cols != 2) ||
       blob.size() != static_cast<size_t>(rows) * 2 * sizeof(uint32_t)) {
-    throw DatabaseError(where() + ": matches blob is not uint32 x 2 (" +
-                        std::to_string(rows) + " x " + std::to_string(cols) + ")");
+    throw DatabaseError(where() + ": matches blob is not uint32 x 2 (" + std::to_string(rows) +
+                        " x " + std::to_string(cols) + ")");
   }
   FeatureMatches matches(rows);
   for (int64_t i = 0; i < rows; ++i) {
@@ -66,12 +66,13 @@ Eigen::Matrix3d MatrixFromBlob(const std::vector<uint8_t>& blob) {
 
 TwoViewGeometry GeometryFromRow(const Statement& stmt, const Where& where) {
   TwoViewGeometry geometry;
-  geometry.inlier_matches = MatchesFromBlob(stmt.ColumnBlob(3), stmt.ColumnInt64(1),
-                                            stmt.ColumnInt64(2), where);
+  geometry.inlier_matches =
+      MatchesFromBlob(stmt.ColumnBlob(3), stmt.ColumnInt64(1), stmt.ColumnInt64(2), where);
   const int64_t config = stmt.ColumnInt64(4);
   if (config < static_cast<int>(TwoViewGeometryConfig::kUndefined) ||
       config > static_cast<int>(TwoViewGeometryConfig::kMultiple)) {
-    throw DatabaseError(where() + ": config " + std::to_string(config) + " is none of COLMAP's (0 to 8)");
+    throw DatabaseError(where() + ": config " + std::to_string(config) +
+                        " is none of COLMAP's (0 to 8)");
   }
   geometry.config = static_cast<TwoViewGeometryConfig>(config);
   geometry.F = MatrixFromBlob(stmt.ColumnBlob(5));
@@ -84,13 +85,15 @@ TwoViewGeometry GeometryFromRow(const Statement& stmt, const Where& where) {
   };
   if (!finite(qvec) || !finite(tvec) || !geometry.F.allFinite() || !geometry.E.allFinite() ||
       !geometry.H.allFinite()) {
-    throw InputError(where() + ": the relative pose or F, E or H holds NaN or inf (a damaged or edited database: "
-                               "match these images again)");
+    throw InputError(
+        where() +
+        ": the relative pose or F, E or H holds NaN or inf (a damaged or edited database: "
+        "match these images again)");
   }
   if (qvec.size() == 4 && tvec.size() == 3) {
-    geometry.cam2_from_cam1 = Rigid3d(
-        QuaternionFromWxyz(Eigen::Vector4d(qvec[0], qvec[1], qvec[2], qvec[3])),
-        Eigen::Vector3d(tvec[0], tvec[1], tvec[2]));
+    geometry.cam2_from_cam1 =
+        Rigid3d(QuaternionFromWxyz(Eigen::Vector4d(qvec[0], qvec[1], qvec[2], qvec[3])),
+                Eigen::Vector3d(tvec[0], tvec[1], tvec[2]));
   }
   return geometry;
 }
@@ -100,16 +103,15 @@ TwoViewGeometry GeometryFromRow(const Statement& stmt, const Where& where) {
 std::string Database::PairLabel(image_pair_t pair_id) {
   image_t image_id1 = 0, image_id2 = 0;
   PairIdToImagePair(pair_id, &image_id1, &image_id2);
-  return "pair " + std::to_string(pair_id) + " (" + ImageLabel(image_id1) + ", " + ImageLabel(image_id2) + ")";
+  return "pair " + std::to_string(pair_id) + " (" + ImageLabel(image_id1) + ", " +
+         ImageLabel(image_id2) + ")";
 }
 
-void Database::WriteMatches(image_t image_id1, image_t image_id2,
-                            const FeatureMatches& matches) {
-  const std::vector<uint32_t> flat =
-      FlattenMatches(matches, SwapImagePair(image_id1, image_id2));
-  Statement& stmt = Prepare(
-      "write_matches",
-      "INSERT OR REPLACE INTO matches(pair_id, rows, cols, data) VALUES(?, ?, 2, ?);");
+void Database::WriteMatches(image_t image_id1, image_t image_id2, const FeatureMatches& matches) {
+  const std::vector<uint32_t> flat = FlattenMatches(matches, SwapImagePair(image_id1, image_id2));
+  Statement& stmt =
+      Prepare("write_matches",
+              "INSERT OR REPLACE INTO matches(pair_id, rows, cols, data) VALUES(?, ?, 2, ?);");
   stmt.Bind(1, static_cast<int64_t>(ImagePairToPairId(image_id1, image_id2)))
       .Bind(2, static_cast<int64_t>(matches.size()))
       .BindBlob(3, flat.data(), flat.size() * sizeof(uint32_t));
@@ -121,9 +123,9 @@ FeatureMatches Database::ReadMatches(image_t image_id1, image_t image_id2) {
       Prepare("read_matches", "SELECT rows, cols, data FROM matches WHERE pair_id=?;");
   stmt.Bind(1, static_cast<int64_t>(ImagePairToPairId(image_id1, image_id2)));
   if (!stmt.Step()) return {};
-  FeatureMatches matches =
-      MatchesFromBlob(stmt.ColumnBlob(2), stmt.ColumnInt64(0), stmt.ColumnInt64(1),
-                      [&] { return path_ + ": matches of " + PairLabel(ImagePairToPairId(image_id1, image_id2)); });
+  FeatureMatches matches = MatchesFromBlob(
+      stmt.ColumnBlob(2), stmt.ColumnInt64(0), stmt.ColumnInt64(1),
+      [&] { return path_ + ": matches of " + PairLabel(ImagePairToPairId(image_id1, image_id2)); });
   if (SwapImagePair(image_id1, image_id2)) {
     for (FeatureMatch& match : matches) std::swap(match.point2D_idx1, match.point2D_idx2);
   }
@@ -136,17 +138,17 @@ std::vector<std::pair<image_pair_t, FeatureMatches>> Database::ReadAllMatches() 
   std::vector<std::pair<image_pair_t, FeatureMatches>> all;
   while (stmt.Step()) {
     const image_pair_t pair_id = stmt.ColumnInt64(0);
-    all.emplace_back(pair_id, MatchesFromBlob(stmt.ColumnBlob(3), stmt.ColumnInt64(1), stmt.ColumnInt64(2),
-                                              [&] { return path_ + ": matches of " + PairLabel(pair_id); }));
+    all.emplace_back(pair_id,
+                     MatchesFromBlob(stmt.ColumnBlob(3), stmt.ColumnInt64(1), stmt.ColumnInt64(2),
+                                     [&] { return path_ + ": matches of " + PairLabel(pair_id); }));
   }
   return all;
 }
 
 void Database::WriteTwoViewGeometry(image_t image_id1, image_t image_id2,
                                     const TwoViewGeometry& geometry_in) {
-  const TwoViewGeometry geometry = SwapImagePair(image_id1, image_id2)
-                                       ? geometry_in.Inverse()
-                                       : geometry_in;
+  const TwoViewGeometry geometry =
+      SwapImagePair(image_id1, image_id2) ? geometry_in.Inverse() : geometry_in;
   const std::vector<uint32_t> flat = FlattenMatches(geometry.inlier_matches, false);
   // Buffers bound below must outlive Execute().
   const std::vector<double> F = RowMajor(geometry.F);
@@ -155,10 +157,9 @@ void Database::WriteTwoViewGeometry(image_t image_id1, image_t image_id2,
   const Eigen::Vector4d qvec = QuaternionToWxyz(geometry.cam2_from_cam1.rotation);
   const Eigen::Vector3d tvec = geometry.cam2_from_cam1.translation;
   const bool has_inliers = !geometry.inlier_matches.empty();
-  Statement& stmt = Prepare(
-      "write_geometry",
-      "INSERT OR REPLACE INTO two_view_geometries(pair_id, rows, cols, data, "
-      "config, F, E, H, qvec, tvec) VALUES(?, ?, 2, ?, ?, ?, ?, ?, ?, ?);");
+  Statement& stmt = Prepare("write_geometry",
+                            "INSERT OR REPLACE INTO two_view_geometries(pair_id, rows, cols, data, "
+                            "config, F, E, H, qvec, tvec) VALUES(?, ?, 2, ?, ?, ?, ?, ?, ?, ?);");
   stmt.Bind(1, static_cast<int64_t>(ImagePairToPairId(image_id1, image_id2)))
       .Bind(2, static_cast<int64_t>(geometry.inlier_matches.size()))
       .BindBlob(3, flat.data(), flat.size() * sizeof(uint32_t))
@@ -167,9 +168,11 @@ void Database::WriteTwoViewGeometry(image_t image_id1, image_t image_id2,
   // inliers. COLMAP 4: NULL for what was not estimated, which its
   // migration tells by the same zeros and identity.
   const bool null_for_unset = layout_.NullForUnset();
-  const bool has_pose = !(geometry.cam2_from_cam1.rotation.coeffs() == Eigen::Quaterniond::Identity().coeffs() &&
-                          geometry.cam2_from_cam1.translation.isZero(0));
-  const auto bind_matrix = [&](int index, const std::vector<double>& values, const Eigen::Matrix3d& m) {
+  const bool has_pose =
+      !(geometry.cam2_from_cam1.rotation.coeffs() == Eigen::Quaterniond::Identity().coeffs() &&
+        geometry.cam2_from_cam1.translation.isZero(0));
+  const auto bind_matrix = [&](int index, const std::vector<double>& values,
+                               const Eigen::Matrix3d& m) {
     if (null_for_unset && (!has_inliers || m.isZero(0))) {
       stmt.BindNull(index);
     } else {
@@ -182,17 +185,16 @@ void Database::WriteTwoViewGeometry(image_t image_id1, image_t image_id2,
   if (null_for_unset && (!has_inliers || !has_pose)) {
     stmt.BindNull(8).BindNull(9);
   } else {
-    stmt.BindBlob(8, qvec.data(), has_inliers ? 32 : 0).BindBlob(9, tvec.data(), has_inliers ? 24 : 0);
+    stmt.BindBlob(8, qvec.data(), has_inliers ? 32 : 0)
+        .BindBlob(9, tvec.data(), has_inliers ? 24 : 0);
   }
   stmt.Execute();
 }
 
-std::optional<TwoViewGeometry> Database::ReadTwoViewGeometry(image_t image_id1,
-                                                             image_t image_id2) {
-  Statement& stmt = Prepare(
-      "read_geometry",
-      "SELECT pair_id, rows, cols, data, config, F, E, H, qvec, tvec FROM "
-      "two_view_geometries WHERE pair_id=?;");
+std::optional<TwoViewGeometry> Database::ReadTwoViewGeometry(image_t image_id1, image_t image_id2) {
+  Statement& stmt = Prepare("read_geometry",
+                            "SELECT pair_id, rows, cols, data, config, F, E, H, qvec, tvec FROM "
+                            "two_view_geometries WHERE pair_id=?;");
   stmt.Bind(1, static_cast<int64_t>(ImagePairToPairId(image_id1, image_id2)));
   if (!stmt.Step()) return std::nullopt;
   const TwoViewGeometry geometry = GeometryFromRow(stmt, [&] {
@@ -202,10 +204,9 @@ std::optional<TwoViewGeometry> Database::ReadTwoViewGeometry(image_t image_id1,
 }
 
 std::vector<std::pair<image_pair_t, TwoViewGeometry>> Database::ReadTwoViewGeometries() {
-  Statement& stmt = Prepare(
-      "read_all_geometries",
-      "SELECT pair_id, rows, cols, data, config, F, E, H, qvec, tvec FROM "
-      "two_view_geometries ORDER BY pair_id;");
+  Statement& stmt = Prepare("read_all_geometries",
+                            "SELECT pair_id, rows, cols, data, config, F, E, H, qvec, tvec FROM "
+                            "two_view_geometries ORDER BY pair_id;");
   std::vector<std::pair<image_pair_t, TwoViewGeometry>> all;
   while (stmt.Step()) {
     const image_pair_t pair_id = stmt.ColumnInt64(0);
@@ -232,8 +233,9 @@ std::vector<image_pair_t> Database::ReadTwoViewGeometryPairIds() {
 }
 
 std::vector<std::pair<image_pair_t, int>> Database::ReadTwoViewGeometryNumInliers() {
-  Statement& stmt = Prepare("read_geometry_num_inliers",
-                            "SELECT pair_id, rows FROM two_view_geometries WHERE rows > 0 ORDER BY pair_id;");
+  Statement& stmt =
+      Prepare("read_geometry_num_inliers",
+              "SELECT pair_id, rows FROM two_view_geometries WHERE rows > 0 ORDER BY pair_id;");
   std::vector<std::pair<image_pair_t, int>> counts;
   while (stmt.Step()) {
     counts.emplace_back(static_cast<image_pair_t>(stmt.ColumnInt64(0)),
@@ -259,8 +261,9 @@ void Database::DeleteImage(image_t image_id) {
   if (layout_.pose_priors != ColmapLayout::PosePriors::kNone) DeletePosePriorRows(image_id);
   // Explicitly, not by ON DELETE CASCADE: COLMAP opens databases without
   // foreign keys enforced, and so may whoever wrote this one.
-  for (const char* table : {"keypoints", "descriptors", "portcal_target_observations", "portcal_target_detections",
-                            "portcal_marker_detections", "portcal_unmasked_features", "images"}) {
+  for (const char* table :
+       {"keypoints", "descriptors", "portcal_target_observations", "portcal_target_detections",
+        "portcal_marker_detections", "portcal_unmasked_features", "images"}) {
     Statement stmt(db_, path_, std::string("DELETE FROM ") + table + " WHERE image_id = ?1;");
     stmt.Bind(1, static_cast<int64_t>(image_id));
     stmt.Execute();
@@ -275,9 +278,7 @@ int64_t Database::NumKeypoints() {
 int64_t Database::NumDescriptors() {
   return QueryInt("SELECT COALESCE(SUM(rows), 0) FROM descriptors;");
 }
-int64_t Database::NumMatches() {
-  return QueryInt("SELECT COALESCE(SUM(rows), 0) FROM matches;");
-}
+int64_t Database::NumMatches() { return QueryInt("SELECT COALESCE(SUM(rows), 0) FROM matches;"); }
 int64_t Database::NumInlierMatches() {
   return QueryInt("SELECT COALESCE(SUM(rows), 0) FROM two_view_geometries;");
 }

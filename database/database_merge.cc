@@ -9,11 +9,13 @@ namespace portcal {
 
 namespace {
 
-std::string FolderOf(const std::string& name) { return std::filesystem::path(name).parent_path().generic_string(); }
+std::string FolderOf(const std::string& name) {
+  return std::filesystem::path(name).parent_path().generic_string();
+}
 
 bool SameCamera(const Camera& a, const Camera& b) {
-  return a.model_id == b.model_id && a.width == b.width && a.height == b.height && a.params == b.params &&
-         a.has_prior_focal_length == b.has_prior_focal_length;
+  return a.model_id == b.model_id && a.width == b.width && a.height == b.height &&
+         a.params == b.params && a.has_prior_focal_length == b.has_prior_focal_length;
 }
 
 // The folder scope each new camera of `database` is shared in ("" for all).
@@ -22,12 +24,14 @@ std::map<camera_t, std::set<std::string>> CameraFolders(Database* database, came
   std::map<camera_t, std::set<std::string>> folders;
   for (const DatabaseImage& image : database->ReadAllImages()) {
     if (image.camera_id <= base) continue;
-    folders[image.camera_id].insert(sharing == MergeOptions::CameraSharing::kAll ? "" : FolderOf(image.name));
+    folders[image.camera_id].insert(
+        sharing == MergeOptions::CameraSharing::kAll ? "" : FolderOf(image.name));
   }
   return folders;
 }
 
-void MergeCameras(Database* source, Database* target, const MergeOptions& options, MergeSummary* summary) {
+void MergeCameras(Database* source, Database* target, const MergeOptions& options,
+                  MergeSummary* summary) {
   const camera_t base = options.base_camera_id;
   const auto target_folders = CameraFolders(target, base, options.camera_sharing);
   const auto source_folders = CameraFolders(source, base, options.camera_sharing);
@@ -39,13 +43,17 @@ void MergeCameras(Database* source, Database* target, const MergeOptions& option
       continue;
     }
     std::optional<camera_t> shared;
-    if (options.camera_sharing != MergeOptions::CameraSharing::kNone && source_folders.count(camera.camera_id)) {
+    if (options.camera_sharing != MergeOptions::CameraSharing::kNone &&
+        source_folders.count(camera.camera_id)) {
       for (const auto& [id, folders] : target_folders) {
-        if (folders == source_folders.at(camera.camera_id) && SameCamera(target_cameras.at(id), camera)) shared = id;
+        if (folders == source_folders.at(camera.camera_id) &&
+            SameCamera(target_cameras.at(id), camera))
+          shared = id;
       }
     }
     summary->cameras[camera.camera_id] = shared ? *shared : target->WriteCamera(camera);
-    if (const std::optional<Housing> housing = source->ReadHousing(camera.camera_id); housing && !shared) {
+    if (const std::optional<Housing> housing = source->ReadHousing(camera.camera_id);
+        housing && !shared) {
       target->WriteHousing(summary->cameras[camera.camera_id], *housing);
     }
   }
@@ -64,11 +72,13 @@ void MergeImageRows(Database* source, Database* target, image_t from, image_t to
   if (!observations.empty() && target->ReadTargetObservations(to).empty()) {
     target->WriteTargetObservations(to, observations);
   }
-  if (const auto status = source->ReadTargetDetectionStatus(from); status && !target->ReadTargetDetectionStatus(to)) {
+  if (const auto status = source->ReadTargetDetectionStatus(from);
+      status && !target->ReadTargetDetectionStatus(to)) {
     target->WriteTargetDetectionStatus(to, *status);
   }
   const std::vector<MarkerDetection> markers = source->ReadMarkerDetections(from);
-  if (!markers.empty() && target->ReadMarkerDetections(to).empty()) target->WriteMarkerDetections(to, markers);
+  if (!markers.empty() && target->ReadMarkerDetections(to).empty())
+    target->WriteMarkerDetections(to, markers);
   FeatureKeypoints keypoints;
   FeatureDescriptors descriptors;
   FeatureKeypoints unused_keypoints;
@@ -79,7 +89,8 @@ void MergeImageRows(Database* source, Database* target, image_t from, image_t to
   }
 }
 
-void MergeImages(Database* source, Database* target, const MergeOptions& options, MergeSummary* summary) {
+void MergeImages(Database* source, Database* target, const MergeOptions& options,
+                 MergeSummary* summary) {
   for (const DatabaseImage& image : source->ReadAllImages()) {
     if (image.image_id <= options.base_image_id) {
       summary->images[image.image_id] = image.image_id;

@@ -38,8 +38,8 @@ struct DatabaseImage {
 
 // portcal_target_observations: a target point seen in an image.
 struct TargetObservation {
-  int64_t point_id = 0;                                   // index on the target
-  Eigen::Vector2d xy = Eigen::Vector2d::Zero();           // COLMAP pixels
+  int64_t point_id = 0;                                       // index on the target
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();               // COLMAP pixels
   Eigen::Vector3d point_in_target = Eigen::Vector3d::Zero();  // metres
 };
 
@@ -58,16 +58,15 @@ struct StageLogEntry {
   std::string options;     // the options as "name=value" lines
   std::string start_time;  // ISO 8601 UTC
   std::string end_time;
-  std::string status;      // "succeeded"
-  std::string counts;      // "name=value" lines
+  std::string status;  // "succeeded"
+  std::string counts;  // "name=value" lines
 };
 
 constexpr image_t kMaxNumImages = 2147483647;
 
 // COLMAP's pair id: id1 * 2147483647 + id2 with id1 < id2.
 image_pair_t ImagePairToPairId(image_t image_id1, image_t image_id2);
-void PairIdToImagePair(image_pair_t pair_id, image_t* image_id1,
-                       image_t* image_id2);
+void PairIdToImagePair(image_pair_t pair_id, image_t* image_id1, image_t* image_id2);
 bool SwapImagePair(image_t image_id1, image_t image_id2);
 
 }  // namespace portcal

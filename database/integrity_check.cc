@@ -20,7 +20,8 @@ class ReadOnlyConnection {
  public:
   explicit ReadOnlyConnection(const std::string& path) : lock_wait_(path, DatabaseBusyTimeout()) {
     std::error_code error;
-    if (!std::filesystem::is_regular_file(path, error)) throw DatabaseError(path + ": no such database file");
+    if (!std::filesystem::is_regular_file(path, error))
+      throw DatabaseError(path + ": no such database file");
     if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
       const std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
       sqlite3_close(db_);
@@ -72,15 +73,16 @@ void CheckReferences(sqlite3* db, const std::string& path) {
   int num_problems = 0;
   while (check.Step()) {
     if (num_problems < kMaxProblems) {
-      problems += std::string(num_problems ? "; " : "") + "a row of " + check.ColumnText(0) + " (rowid " +
-                  std::to_string(check.ColumnInt64(1)) + ") refers to a missing row of " + check.ColumnText(2);
+      problems += std::string(num_problems ? "; " : "") + "a row of " + check.ColumnText(0) +
+                  " (rowid " + std::to_string(check.ColumnInt64(1)) +
+                  ") refers to a missing row of " + check.ColumnText(2);
     }
     ++num_problems;
   }
   if (num_problems == 0) return;
   throw InputError(path + ": the database is inconsistent: " + std::to_string(num_problems) +
-                   " rows refer to rows it does not hold (" + problems + (num_problems > kMaxProblems ? "; ..." : "") +
-                   ")" + DamagedAdvice());
+                   " rows refer to rows it does not hold (" + problems +
+                   (num_problems > kMaxProblems ? "; ..." : "") + ")" + DamagedAdvice());
 }
 
 }  // namespace

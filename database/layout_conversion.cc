@@ -50,7 +50,8 @@ std::vector<uint8_t> NaNBlob(int count) {
 // the position itself, or with a rotation the centre of the pose.
 Eigen::Vector3d LegacyPriorPosition(const Statement& stmt) {
   const Eigen::Vector3d t(stmt.ColumnDouble(2), stmt.ColumnDouble(3), stmt.ColumnDouble(4));
-  const Eigen::Vector4d wxyz(stmt.ColumnDouble(5), stmt.ColumnDouble(6), stmt.ColumnDouble(7), stmt.ColumnDouble(8));
+  const Eigen::Vector4d wxyz(stmt.ColumnDouble(5), stmt.ColumnDouble(6), stmt.ColumnDouble(7),
+                             stmt.ColumnDouble(8));
   if (!wxyz.allFinite() || !(wxyz.norm() > 0)) return t;
   const Eigen::Quaterniond rotation(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
   return -(rotation.normalized().inverse() * t);
@@ -68,22 +69,28 @@ std::vector<std::string> CreateStatementsOf(ColmapVersion version, const std::st
   return statements;
 }
 
-std::vector<PriorRow> ReadPriorRows(sqlite3* db, const std::string& path, const ColmapLayout& layout) {
+std::vector<PriorRow> ReadPriorRows(sqlite3* db, const std::string& path,
+                                    const ColmapLayout& layout) {
   std::string sql;
   switch (layout.pose_priors) {
     case ColmapLayout::PosePriors::kNone:
       sql =
-          "SELECT image_id, camera_id, prior_tx, prior_ty, prior_tz, prior_qw, prior_qx, prior_qy, prior_qz FROM "
-          "images WHERE prior_tx IS NOT NULL AND prior_ty IS NOT NULL AND prior_tz IS NOT NULL ORDER BY image_id;";
+          "SELECT image_id, camera_id, prior_tx, prior_ty, prior_tz, prior_qw, prior_qx, prior_qy, "
+          "prior_qz FROM "
+          "images WHERE prior_tx IS NOT NULL AND prior_ty IS NOT NULL AND prior_tz IS NOT NULL "
+          "ORDER BY image_id;";
       break;
     case ColmapLayout::PosePriors::kPerImage:
-      sql = std::string("SELECT pose_priors.image_id, images.camera_id, position, coordinate_system, ") +
+      sql = std::string(
+                "SELECT pose_priors.image_id, images.camera_id, position, coordinate_system, ") +
             (layout.pose_prior_covariance ? "position_covariance" : "NULL") +
-            " FROM pose_priors JOIN images ON images.image_id = pose_priors.image_id ORDER BY pose_priors.image_id;";
+            " FROM pose_priors JOIN images ON images.image_id = pose_priors.image_id ORDER BY "
+            "pose_priors.image_id;";
       break;
     default:
       sql =
-          "SELECT corr_data_id, corr_sensor_id, position, coordinate_system, position_covariance, gravity, "
+          "SELECT corr_data_id, corr_sensor_id, position, coordinate_system, position_covariance, "
+          "gravity, "
           "corr_sensor_type FROM pose_priors ORDER BY corr_data_id;";
   }
   Statement stmt(db, path, sql);
@@ -104,8 +111,9 @@ std::vector<PriorRow> ReadPriorRows(sqlite3* db, const std::string& path, const 
     if (layout.pose_priors == ColmapLayout::PosePriors::kPerData) {
       row.gravity = stmt.ColumnBlob(5);
       if (stmt.ColumnInt64(6) != kSensorTypeCamera) {
-        throw InputError(path + ": pose prior of sensor " + std::to_string(row.camera_id) + " of type " +
-                         std::to_string(stmt.ColumnInt64(6)) + " (not a camera): COLMAP 3.x keeps camera priors only");
+        throw InputError(path + ": pose prior of sensor " + std::to_string(row.camera_id) +
+                         " of type " + std::to_string(stmt.ColumnInt64(6)) +
+                         " (not a camera): COLMAP 3.x keeps camera priors only");
       }
     }
     rows.push_back(std::move(row));
@@ -114,24 +122,29 @@ std::vector<PriorRow> ReadPriorRows(sqlite3* db, const std::string& path, const 
 }
 
 // What a 3.x target cannot hold of a prior, checked before anything changes.
-void CheckPriorsFit(const std::vector<PriorRow>& rows, const ColmapLayout& target, const std::string& path) {
+void CheckPriorsFit(const std::vector<PriorRow>& rows, const ColmapLayout& target,
+                    const std::string& path) {
   for (const PriorRow& row : rows) {
     const std::string which = path + ": the pose prior of image " + std::to_string(row.image_id);
-    if (target.pose_priors != ColmapLayout::PosePriors::kPerData && !row.gravity.empty() && !AllNaN(row.gravity)) {
+    if (target.pose_priors != ColmapLayout::PosePriors::kPerData && !row.gravity.empty() &&
+        !AllNaN(row.gravity)) {
       throw InputError(which + " has a gravity direction, which COLMAP 3.x does not keep");
     }
     if (!target.pose_prior_covariance && !row.covariance.empty() && !AllNaN(row.covariance)) {
-      throw InputError(which + " has a position covariance, which the target version does not keep");
+      throw InputError(which +
+                       " has a position covariance, which the target version does not keep");
     }
     if (row.position.size() != 24) throw InputError(which + ": its position is not 3 float64");
   }
 }
 
 void AddLegacyPriorColumns(sqlite3* db, const std::string& path) {
-  for (const char* column : {"prior_qw", "prior_qx", "prior_qy", "prior_qz", "prior_tx", "prior_ty", "prior_tz"}) {
+  for (const char* column :
+       {"prior_qw", "prior_qx", "prior_qy", "prior_qz", "prior_tx", "prior_ty", "prior_tz"}) {
     Statement has(db, path, "SELECT 1 FROM pragma_table_info('images') WHERE name=?;");
     has.Bind(1, std::string(column));
-    if (!has.Step()) ExecuteSql(db, path, std::string("ALTER TABLE images ADD COLUMN ") + column + " REAL;");
+    if (!has.Step())
+      ExecuteSql(db, path, std::string("ALTER TABLE images ADD COLUMN ") + column + " REAL;");
   }
 }
 
@@ -145,20 +158,31 @@ void WriteLegacyPriors(sqlite3* db, const std::string& path, const std::vector<P
     mark.Bind(1, row.image_id).Execute();
     Eigen::Vector3d position;
     std::memcpy(position.data(), row.position.data(), 24);
-    Statement current(db, path,
-                      "SELECT image_id, camera_id, prior_tx, prior_ty, prior_tz, prior_qw, prior_qx, prior_qy, "
-                      "prior_qz FROM images WHERE image_id=? AND prior_tx IS NOT NULL AND prior_ty IS NOT NULL AND "
-                      "prior_tz IS NOT NULL;");
+    Statement current(
+        db, path,
+        "SELECT image_id, camera_id, prior_tx, prior_ty, prior_tz, prior_qw, prior_qx, prior_qy, "
+        "prior_qz FROM images WHERE image_id=? AND prior_tx IS NOT NULL AND prior_ty IS NOT NULL "
+        "AND "
+        "prior_tz IS NOT NULL;");
     current.Bind(1, row.image_id);
-    if (current.Step() && (LegacyPriorPosition(current) - position).norm() <= 1e-9 * (1 + position.norm())) continue;
-    Statement stmt(db, path,
-                   "UPDATE images SET prior_qw=NULL, prior_qx=NULL, prior_qy=NULL, prior_qz=NULL, prior_tx=?, "
-                   "prior_ty=?, prior_tz=? WHERE image_id=?;");
-    stmt.Bind(1, position[0]).Bind(2, position[1]).Bind(3, position[2]).Bind(4, row.image_id).Execute();
+    if (current.Step() &&
+        (LegacyPriorPosition(current) - position).norm() <= 1e-9 * (1 + position.norm()))
+      continue;
+    Statement stmt(
+        db, path,
+        "UPDATE images SET prior_qw=NULL, prior_qx=NULL, prior_qy=NULL, prior_qz=NULL, prior_tx=?, "
+        "prior_ty=?, prior_tz=? WHERE image_id=?;");
+    stmt.Bind(1, position[0])
+        .Bind(2, position[1])
+        .Bind(3, position[2])
+        .Bind(4, row.image_id)
+        .Execute();
   }
   ExecuteSql(db, path,
-             "UPDATE images SET prior_qw=NULL, prior_qx=NULL, prior_qy=NULL, prior_qz=NULL, prior_tx=NULL, "
-             "prior_ty=NULL, prior_tz=NULL WHERE image_id NOT IN (SELECT image_id FROM portcal_prior_images);");
+             "UPDATE images SET prior_qw=NULL, prior_qx=NULL, prior_qy=NULL, prior_qz=NULL, "
+             "prior_tx=NULL, "
+             "prior_ty=NULL, prior_tz=NULL WHERE image_id NOT IN (SELECT image_id FROM "
+             "portcal_prior_images);");
   ExecuteSql(db, path, "DROP TABLE portcal_prior_images;");
 }
 
@@ -169,32 +193,43 @@ void WritePriorRows(sqlite3* db, const std::string& path, const std::vector<Prio
     return;
   }
   for (const PriorRow& row : rows) {
-    const std::vector<uint8_t> covariance = row.covariance.size() == 72 ? row.covariance : NaNBlob(9);
+    const std::vector<uint8_t> covariance =
+        row.covariance.size() == 72 ? row.covariance : NaNBlob(9);
     if (target.pose_priors == ColmapLayout::PosePriors::kPerImage) {
-      Statement stmt(db, path,
-                     target.pose_prior_covariance
-                         ? "INSERT INTO pose_priors(image_id, position, coordinate_system, "
-                           "position_covariance) VALUES(?, ?, ?, ?);"
-                         : "INSERT INTO pose_priors(image_id, position, coordinate_system) VALUES(?, ?, ?);");
-      stmt.Bind(1, row.image_id).BindBlob(2, row.position.data(), 24).Bind(3, row.coordinate_system);
+      Statement stmt(
+          db, path,
+          target.pose_prior_covariance
+              ? "INSERT INTO pose_priors(image_id, position, coordinate_system, "
+                "position_covariance) VALUES(?, ?, ?, ?);"
+              : "INSERT INTO pose_priors(image_id, position, coordinate_system) VALUES(?, ?, ?);");
+      stmt.Bind(1, row.image_id)
+          .BindBlob(2, row.position.data(), 24)
+          .Bind(3, row.coordinate_system);
       if (target.pose_prior_covariance) stmt.BindBlob(4, covariance.data(), 72);
       stmt.Execute();
       continue;
     }
     // COLMAP 4's migration: the image id as the prior's id and its data id.
     const std::vector<uint8_t> gravity = row.gravity.size() == 24 ? row.gravity : NaNBlob(3);
-    Statement stmt(db, path,
-                   "INSERT INTO pose_priors(pose_prior_id, corr_data_id, corr_sensor_id, corr_sensor_type, position, "
-                   "position_covariance, gravity, coordinate_system) VALUES(?, ?, ?, ?, ?, ?, ?, ?);");
-    stmt.Bind(1, row.image_id).Bind(2, row.image_id).Bind(3, row.camera_id).Bind(4, kSensorTypeCamera);
-    stmt.BindBlob(5, row.position.data(), 24).BindBlob(6, covariance.data(), 72).BindBlob(7, gravity.data(), 24);
+    Statement stmt(
+        db, path,
+        "INSERT INTO pose_priors(pose_prior_id, corr_data_id, corr_sensor_id, corr_sensor_type, "
+        "position, "
+        "position_covariance, gravity, coordinate_system) VALUES(?, ?, ?, ?, ?, ?, ?, ?);");
+    stmt.Bind(1, row.image_id)
+        .Bind(2, row.image_id)
+        .Bind(3, row.camera_id)
+        .Bind(4, kSensorTypeCamera);
+    stmt.BindBlob(5, row.position.data(), 24)
+        .BindBlob(6, covariance.data(), 72)
+        .BindBlob(7, gravity.data(), 24);
     stmt.Bind(8, row.coordinate_system).Execute();
   }
 }
 
 bool SamePriorTable(const ColmapLayout& a, const ColmapLayout& b) {
-  return a.pose_priors == b.pose_priors &&
-         (a.pose_priors == ColmapLayout::PosePriors::kNone || a.pose_prior_covariance == b.pose_prior_covariance);
+  return a.pose_priors == b.pose_priors && (a.pose_priors == ColmapLayout::PosePriors::kNone ||
+                                            a.pose_prior_covariance == b.pose_prior_covariance);
 }
 
 }  // namespace
@@ -225,7 +260,8 @@ void Database::ConvertPosePriors(ColmapVersion target_version) {
   if (SamePriorTable(layout_, target)) return;
   const std::vector<PriorRow> rows = ReadPriorRows(db_, path_, layout_);
   CheckPriorsFit(rows, target, path_);
-  if (layout_.pose_priors != ColmapLayout::PosePriors::kNone) ExecuteSql(db_, path_, "DROP TABLE pose_priors;");
+  if (layout_.pose_priors != ColmapLayout::PosePriors::kNone)
+    ExecuteSql(db_, path_, "DROP TABLE pose_priors;");
   if (target.pose_priors == ColmapLayout::PosePriors::kNone) {
     AddLegacyPriorColumns(db_, path_);
   } else {
@@ -245,18 +281,21 @@ void Database::ConvertRigsAndFrames(ColmapVersion target_version) {
   if (layout_.rigs_and_frames == target.rigs_and_frames) return;
   if (target.rigs_and_frames) {
     for (const char* table : {"rigs", "rig_sensors", "frames", "frame_data"}) {
-      for (const std::string& sql : CreateStatementsOf(target_version, table)) ExecuteSql(db_, path_, sql + ";");
+      for (const std::string& sql : CreateStatementsOf(target_version, table))
+        ExecuteSql(db_, path_, sql + ";");
     }
     const std::string camera = std::to_string(kSensorTypeCamera);
-    ExecuteSql(db_, path_,
-               "INSERT INTO rigs(rig_id, ref_sensor_id, ref_sensor_type) SELECT camera_id, camera_id, " + camera +
-                   " FROM cameras ORDER BY camera_id;");
-    ExecuteSql(db_, path_,
-               "INSERT INTO frames(frame_id, rig_id) SELECT image_id, camera_id FROM images ORDER BY image_id;");
     ExecuteSql(
         db_, path_,
-        "INSERT INTO frame_data(frame_id, data_id, sensor_id, sensor_type) SELECT image_id, image_id, camera_id, " +
-            camera + " FROM images ORDER BY image_id;");
+        "INSERT INTO rigs(rig_id, ref_sensor_id, ref_sensor_type) SELECT camera_id, camera_id, " +
+            camera + " FROM cameras ORDER BY camera_id;");
+    ExecuteSql(db_, path_,
+               "INSERT INTO frames(frame_id, rig_id) SELECT image_id, camera_id FROM images ORDER "
+               "BY image_id;");
+    ExecuteSql(db_, path_,
+               "INSERT INTO frame_data(frame_id, data_id, sensor_id, sensor_type) SELECT image_id, "
+               "image_id, camera_id, " +
+                   camera + " FROM images ORDER BY image_id;");
     return;
   }
   const std::string camera = std::to_string(kSensorTypeCamera);
@@ -265,9 +304,11 @@ void Database::ConvertRigsAndFrames(ColmapVersion target_version) {
       {"SELECT count(*) FROM rig_sensors;", "rig sensors beside the reference cameras"},
       {"SELECT count(*) FROM rigs WHERE ref_sensor_type != " + camera + ";",
        "rigs whose reference sensor is not a camera"},
-      {"SELECT count(*) FROM (SELECT frame_id FROM frame_data GROUP BY frame_id HAVING count(*) > 1);",
+      {"SELECT count(*) FROM (SELECT frame_id FROM frame_data GROUP BY frame_id HAVING count(*) > "
+       "1);",
        "frames of several images"},
-      {"SELECT count(*) FROM frame_data WHERE sensor_type != " + camera + ";", "data of other sensors"}};
+      {"SELECT count(*) FROM frame_data WHERE sensor_type != " + camera + ";",
+       "data of other sensors"}};
   std::string refused;
   for (const auto& [query, what] : kept_only_by_rigs) {
     const int64_t count = QueryInt(query);
@@ -292,11 +333,12 @@ void Database::ConvertDescriptors(const ColmapLayout& target) {
                    std::to_string(kDescriptorTypeSift) + ";");
     return;
   }
-  const int64_t others =
-      QueryInt("SELECT count(*) FROM descriptors WHERE type != " + std::to_string(kDescriptorTypeSift) + ";");
+  const int64_t others = QueryInt("SELECT count(*) FROM descriptors WHERE type != " +
+                                  std::to_string(kDescriptorTypeSift) + ";");
   if (others > 0) {
     throw InputError(path_ + ": " + std::to_string(others) +
-                     " images have descriptors other than SIFT (COLMAP 4's ALIKED), which COLMAP 3.x would read as "
+                     " images have descriptors other than SIFT (COLMAP 4's ALIKED), which COLMAP "
+                     "3.x would read as "
                      "SIFT: extract them with SIFT first");
   }
   ExecuteSql(db_, path_, "ALTER TABLE descriptors DROP COLUMN type;");
@@ -311,28 +353,31 @@ void Database::ConvertTwoViewGeometries(const ColmapLayout& target) {
     const std::string zero_matrix = "zeroblob(72)";
     for (const char* column : {"F", "E", "H"}) {
       ExecuteSql(db_, path_,
-                 std::string("UPDATE two_view_geometries SET ") + column + " = NULL WHERE length(" + column +
-                     ") = 0 OR " + column + " = " + zero_matrix + ";");
+                 std::string("UPDATE two_view_geometries SET ") + column + " = NULL WHERE length(" +
+                     column + ") = 0 OR " + column + " = " + zero_matrix + ";");
     }
     const Eigen::Vector4d identity(1, 0, 0, 0);
-    Statement pose(db_, path_,
-                   "UPDATE two_view_geometries SET qvec = NULL, tvec = NULL WHERE length(qvec) = 0 OR "
-                   "qvec = zeroblob(32) OR (qvec = ? AND tvec = zeroblob(24));");
+    Statement pose(
+        db_, path_,
+        "UPDATE two_view_geometries SET qvec = NULL, tvec = NULL WHERE length(qvec) = 0 OR "
+        "qvec = zeroblob(32) OR (qvec = ? AND tvec = zeroblob(24));");
     pose.BindBlob(1, identity.data(), 32).Execute();
     return;
   }
   const Eigen::Vector4d identity(1, 0, 0, 0);
   Statement empty(db_, path_,
-                  "UPDATE two_view_geometries SET F = COALESCE(F, x''), E = COALESCE(E, x''), H = COALESCE(H, x''), "
+                  "UPDATE two_view_geometries SET F = COALESCE(F, x''), E = COALESCE(E, x''), H = "
+                  "COALESCE(H, x''), "
                   "qvec = COALESCE(qvec, x''), tvec = COALESCE(tvec, x'') WHERE rows = 0;");
   empty.Execute();
   for (const char* column : {"F", "E", "H"}) {
-    ExecuteSql(
-        db_, path_,
-        std::string("UPDATE two_view_geometries SET ") + column + " = zeroblob(72) WHERE " + column + " IS NULL;");
+    ExecuteSql(db_, path_,
+               std::string("UPDATE two_view_geometries SET ") + column + " = zeroblob(72) WHERE " +
+                   column + " IS NULL;");
   }
   Statement pose(db_, path_,
-                 "UPDATE two_view_geometries SET qvec = ?, tvec = zeroblob(24) WHERE qvec IS NULL OR tvec IS NULL;");
+                 "UPDATE two_view_geometries SET qvec = ?, tvec = zeroblob(24) WHERE qvec IS NULL "
+                 "OR tvec IS NULL;");
   pose.BindBlob(1, identity.data(), 32).Execute();
 }
 

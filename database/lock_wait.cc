@@ -37,7 +37,8 @@ int LockWait::OnBusy(void* self, int attempt) {
   // Said after 2 s, then every 5 s: a short wait is normal and silent.
   if (waited >= 2 && waited - wait.last_said_s_ >= (wait.last_said_s_ == 0 ? 2 : 5)) {
     LOG(WARNING) << wait.path_ << ": waiting for another process's lock on the database ("
-                 << static_cast<int>(waited) << " s of " << wait.timeout_s_ << " s, --Database.busy_timeout)";
+                 << static_cast<int>(waited) << " s of " << wait.timeout_s_
+                 << " s, --Database.busy_timeout)";
     wait.last_said_s_ = waited;
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(attempt < 10 ? 2 : 20));

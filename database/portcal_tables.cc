@@ -8,9 +8,9 @@ namespace portcal {
 
 void Database::WriteHousing(camera_t camera_id, const Housing& housing) {
   housing.Validate(path_ + ": housing of camera " + std::to_string(camera_id));
-  Statement& stmt = Prepare(
-      "write_housing",
-      "INSERT OR REPLACE INTO portcal_housings(camera_id, model, params) VALUES(?, ?, ?);");
+  Statement& stmt =
+      Prepare("write_housing",
+              "INSERT OR REPLACE INTO portcal_housings(camera_id, model, params) VALUES(?, ?, ?);");
   stmt.Bind(1, static_cast<int64_t>(camera_id))
       .Bind(2, static_cast<int64_t>(housing.model_id))
       .BindBlob(3, housing.params.data(), housing.params.size() * sizeof(double));
@@ -33,16 +33,15 @@ Housing HousingFromRow(const Statement& stmt, const std::string& path) {
 
 std::optional<Housing> Database::ReadHousing(camera_t camera_id) {
   Statement& stmt = Prepare(
-      "read_housing",
-      "SELECT camera_id, model, params FROM portcal_housings WHERE camera_id=?;");
+      "read_housing", "SELECT camera_id, model, params FROM portcal_housings WHERE camera_id=?;");
   stmt.Bind(1, static_cast<int64_t>(camera_id));
   if (!stmt.Step()) return std::nullopt;
   return HousingFromRow(stmt, path_);
 }
 
 std::map<camera_t, Housing> Database::ReadAllHousings() {
-  Statement& stmt = Prepare("read_housings",
-                            "SELECT camera_id, model, params FROM portcal_housings;");
+  Statement& stmt =
+      Prepare("read_housings", "SELECT camera_id, model, params FROM portcal_housings;");
   std::map<camera_t, Housing> housings;
   while (stmt.Step()) {
     housings[static_cast<camera_t>(stmt.ColumnInt64(0))] = HousingFromRow(stmt, path_);
@@ -52,13 +51,12 @@ std::map<camera_t, Housing> Database::ReadAllHousings() {
 
 void Database::WriteTargetObservations(image_t image_id,
                                        const std::vector<TargetObservation>& rows) {
-  Statement& remove = Prepare(
-      "delete_observations", "DELETE FROM portcal_target_observations WHERE image_id=?;");
+  Statement& remove =
+      Prepare("delete_observations", "DELETE FROM portcal_target_observations WHERE image_id=?;");
   remove.Bind(1, static_cast<int64_t>(image_id)).Execute();
-  Statement& insert = Prepare(
-      "write_observation",
-      "INSERT INTO portcal_target_observations(image_id, point_id, x, y, "
-      "target_x, target_y, target_z) VALUES(?, ?, ?, ?, ?, ?, ?);");
+  Statement& insert = Prepare("write_observation",
+                              "INSERT INTO portcal_target_observations(image_id, point_id, x, y, "
+                              "target_x, target_y, target_z) VALUES(?, ?, ?, ?, ?, ?, ?);");
   for (const TargetObservation& row : rows) {
     if (!row.xy.allFinite() || !row.point_in_target.allFinite()) {
       throw InputError(path_ + ": non-finite target observation in image " +
@@ -76,29 +74,26 @@ void Database::WriteTargetObservations(image_t image_id,
 }
 
 std::vector<TargetObservation> Database::ReadTargetObservations(image_t image_id) {
-  Statement& stmt = Prepare(
-      "read_observations",
-      "SELECT point_id, x, y, target_x, target_y, target_z FROM "
-      "portcal_target_observations WHERE image_id=? ORDER BY point_id;");
+  Statement& stmt = Prepare("read_observations",
+                            "SELECT point_id, x, y, target_x, target_y, target_z FROM "
+                            "portcal_target_observations WHERE image_id=? ORDER BY point_id;");
   stmt.Bind(1, static_cast<int64_t>(image_id));
   std::vector<TargetObservation> rows;
   while (stmt.Step()) {
     TargetObservation row;
     row.point_id = stmt.ColumnInt64(0);
     row.xy = {stmt.ColumnDouble(1), stmt.ColumnDouble(2)};
-    row.point_in_target = {stmt.ColumnDouble(3), stmt.ColumnDouble(4),
-                           stmt.ColumnDouble(5)};
+    row.point_in_target = {stmt.ColumnDouble(3), stmt.ColumnDouble(4), stmt.ColumnDouble(5)};
     rows.push_back(row);
   }
   return rows;
 }
 
-void Database::WriteTargetDetectionStatus(image_t image_id,
-                                          const TargetDetectionStatus& status) {
-  Statement& stmt = Prepare(
-      "write_detection_status",
-      "INSERT OR REPLACE INTO portcal_target_detections(image_id, target, found, "
-      "num_points, reason) VALUES(?, ?, ?, ?, ?);");
+void Database::WriteTargetDetectionStatus(image_t image_id, const TargetDetectionStatus& status) {
+  Statement& stmt =
+      Prepare("write_detection_status",
+              "INSERT OR REPLACE INTO portcal_target_detections(image_id, target, found, "
+              "num_points, reason) VALUES(?, ?, ?, ?, ?);");
   stmt.Bind(1, static_cast<int64_t>(image_id))
       .Bind(2, status.target)
       .Bind(3, static_cast<int64_t>(status.found))
@@ -121,23 +116,21 @@ std::optional<TargetDetectionStatus> Database::ReadTargetDetectionStatus(image_t
   return status;
 }
 
-void Database::WriteMarkerDetections(image_t image_id,
-                                     const std::vector<MarkerDetection>& rows) {
-  Statement& remove = Prepare(
-      "delete_markers", "DELETE FROM portcal_marker_detections WHERE image_id=?;");
+void Database::WriteMarkerDetections(image_t image_id, const std::vector<MarkerDetection>& rows) {
+  Statement& remove =
+      Prepare("delete_markers", "DELETE FROM portcal_marker_detections WHERE image_id=?;");
   remove.Bind(1, static_cast<int64_t>(image_id)).Execute();
-  Statement& insert = Prepare(
-      "write_marker",
-      "INSERT INTO portcal_marker_detections(image_id, dictionary, marker_id, "
-      "x0, y0, x1, y1, x2, y2, x3, y3) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?);");
+  Statement& insert =
+      Prepare("write_marker",
+              "INSERT INTO portcal_marker_detections(image_id, dictionary, marker_id, "
+              "x0, y0, x1, y1, x2, y2, x3, y3) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?);");
   for (const MarkerDetection& row : rows) {
     insert.Bind(1, static_cast<int64_t>(image_id))
         .Bind(2, row.dictionary)
         .Bind(3, static_cast<int64_t>(row.marker_id));
     for (int k = 0; k < 4; ++k) {
       if (!row.corners[k].allFinite()) {
-        throw InputError(path_ + ": non-finite marker corner in image " +
-                         std::to_string(image_id));
+        throw InputError(path_ + ": non-finite marker corner in image " + std::to_string(image_id));
       }
       insert.Bind(4 + 2 * k, row.corners[k].x()).Bind(5 + 2 * k, row.corners[k].y());
     }
@@ -146,10 +139,9 @@ void Database::WriteMarkerDetections(image_t image_id,
 }
 
 std::vector<MarkerDetection> Database::ReadMarkerDetections(image_t image_id) {
-  Statement& stmt = Prepare(
-      "read_markers",
-      "SELECT dictionary, marker_id, x0, y0, x1, y1, x2, y2, x3, y3 FROM "
-      "portcal_marker_detections WHERE image_id=? ORDER BY detection_id;");
+  Statement& stmt = Prepare("read_markers",
+                            "SELECT dictionary, marker_id, x0, y0, x1, y1, x2, y2, x3, y3 FROM "
+                            "portcal_marker_detections WHERE image_id=? ORDER BY detection_id;");
   stmt.Bind(1, static_cast<int64_t>(image_id));
   std::vector<MarkerDetection> rows;
   while (stmt.Step()) {
@@ -165,10 +157,9 @@ std::vector<MarkerDetection> Database::ReadMarkerDetections(image_t image_id) {
 }
 
 int64_t Database::WriteStageLog(const StageLogEntry& entry) {
-  Statement& stmt = Prepare(
-      "write_stage_log",
-      "INSERT INTO portcal_stage_log(stage, options, start_time, end_time, "
-      "status, counts) VALUES(?, ?, ?, ?, ?, ?);");
+  Statement& stmt = Prepare("write_stage_log",
+                            "INSERT INTO portcal_stage_log(stage, options, start_time, end_time, "
+                            "status, counts) VALUES(?, ?, ?, ?, ?, ?);");
   stmt.Bind(1, entry.stage)
       .Bind(2, entry.options)
       .Bind(3, entry.start_time)
@@ -180,10 +171,9 @@ int64_t Database::WriteStageLog(const StageLogEntry& entry) {
 }
 
 std::vector<StageLogEntry> Database::ReadStageLog() {
-  Statement& stmt = Prepare(
-      "read_stage_log",
-      "SELECT run_id, stage, options, start_time, end_time, status, counts "
-      "FROM portcal_stage_log ORDER BY run_id;");
+  Statement& stmt = Prepare("read_stage_log",
+                            "SELECT run_id, stage, options, start_time, end_time, status, counts "
+                            "FROM portcal_stage_log ORDER BY run_id;");
   std::vector<StageLogEntry> entries;
   while (stmt.Step()) {
     StageLogEntry entry;
@@ -203,12 +193,14 @@ void Database::WriteUnmaskedFeatures(image_t image_id, const FeatureKeypoints& k
                                      const FeatureDescriptors& descriptors) {
   static_assert(sizeof(FeatureKeypoint) == 6 * sizeof(float));
   if (static_cast<size_t>(descriptors.rows()) != keypoints.size()) {
-    throw DatabaseError(path_ + ": image " + std::to_string(image_id) + ": " + std::to_string(keypoints.size()) +
-                        " keypoints but " + std::to_string(descriptors.rows()) + " descriptors");
+    throw DatabaseError(path_ + ": image " + std::to_string(image_id) + ": " +
+                        std::to_string(keypoints.size()) + " keypoints but " +
+                        std::to_string(descriptors.rows()) + " descriptors");
   }
-  Statement& stmt = Prepare("write_unmasked",
-                            "INSERT OR REPLACE INTO portcal_unmasked_features(image_id, rows, keypoints, "
-                            "descriptors) VALUES(?, ?, ?, ?);");
+  Statement& stmt =
+      Prepare("write_unmasked",
+              "INSERT OR REPLACE INTO portcal_unmasked_features(image_id, rows, keypoints, "
+              "descriptors) VALUES(?, ?, ?, ?);");
   stmt.Bind(1, static_cast<int64_t>(image_id))
       .Bind(2, static_cast<int64_t>(keypoints.size()))
       .BindBlob(3, keypoints.data(), keypoints.size() * sizeof(FeatureKeypoint))
@@ -218,14 +210,17 @@ void Database::WriteUnmaskedFeatures(image_t image_id, const FeatureKeypoints& k
 
 bool Database::ReadUnmaskedFeatures(image_t image_id, FeatureKeypoints* keypoints,
                                     FeatureDescriptors* descriptors) {
-  Statement& stmt = Prepare("read_unmasked",
-                            "SELECT rows, keypoints, descriptors FROM portcal_unmasked_features WHERE image_id=?;");
+  Statement& stmt = Prepare(
+      "read_unmasked",
+      "SELECT rows, keypoints, descriptors FROM portcal_unmasked_features WHERE image_id=?;");
   stmt.Bind(1, static_cast<int64_t>(image_id));
   if (!stmt.Step()) return false;
   const int64_t rows = stmt.ColumnInt64(0);
   const std::vector<uint8_t> keypoint_bytes = stmt.ColumnBlob(1);
   const std::vector<uint8_t> descriptor_bytes = stmt.ColumnBlob(2);
-  if (rows < 0 || static_cast<int64_t>(keypoint_bytes.size()) != rows * static_cast<int64_t>(sizeof(FeatureKeypoint)) ||
+  if (rows < 0 ||
+      static_cast<int64_t>(keypoint_bytes.size()) !=
+          rows * static_cast<int64_t>(sizeof(FeatureKeypoint)) ||
       static_cast<int64_t>(descriptor_bytes.size()) != rows * 128) {
     throw DatabaseError(path_ + ": unmasked features of image " + std::to_string(image_id) +
                         " have invalid blobs (" + std::to_string(rows) + " rows)");

@@ -14,12 +14,9 @@ std::string CurrentTimeIso8601() {
 }
 
 StageRun::StageRun(std::string stage, std::string options)
-    : stage_(std::move(stage)),
-      options_(std::move(options)),
-      start_time_(CurrentTimeIso8601()) {}
+    : stage_(std::move(stage)), options_(std::move(options)), start_time_(CurrentTimeIso8601()) {}
 
-void StageRun::Finish(Database* database,
-                      const std::map<std::string, int64_t>& counts) {
+void StageRun::Finish(Database* database, const std::map<std::string, int64_t>& counts) {
   StageLogEntry entry;
   entry.stage = stage_;
   entry.options = options_;

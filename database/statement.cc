@@ -20,8 +20,10 @@ std::string Describe(sqlite3* db, int code) {
   switch (code & 0xFF) {
     case SQLITE_BUSY:
     case SQLITE_LOCKED:
-      return message + " (another process held the database past --Database.busy_timeout; wait for it to finish, "
-                       "or give a longer timeout)";
+      return message +
+             " (another process held the database past --Database.busy_timeout; wait for it to "
+             "finish, "
+             "or give a longer timeout)";
     case SQLITE_CORRUPT:
       return "the database file is damaged (SQLite: " + message +
              "); restore it from a copy, or re-run the stages that made it";
@@ -30,14 +32,16 @@ std::string Describe(sqlite3* db, int code) {
     case SQLITE_FULL:
       return "the disk is full (SQLite: " + message + "); free some space and run again";
     case SQLITE_READONLY:
-      return "the file (or its folder, for the journal) cannot be written (SQLite: " + message + ")";
+      return "the file (or its folder, for the journal) cannot be written (SQLite: " + message +
+             ")";
     case SQLITE_IOERR:
-      return "the file could not be read or written (SQLite: " + message + "; a full disk or a file over its size "
+      return "the file could not be read or written (SQLite: " + message +
+             "; a full disk or a file over its size "
              "limit, a failing disk, a removed drive or a network folder that went away)";
     case SQLITE_CONSTRAINT:
       if (extended == SQLITE_CONSTRAINT_FOREIGNKEY) {
-        return "a row would refer to a camera or image the database does not hold (SQLite: " + message +
-               "); the database is inconsistent";
+        return "a row would refer to a camera or image the database does not hold (SQLite: " +
+               message + "); the database is inconsistent";
       }
       return message;
     default:
@@ -47,8 +51,7 @@ std::string Describe(sqlite3* db, int code) {
 
 }  // namespace
 
-Statement::Statement(sqlite3* db, const std::string& path,
-                     const std::string& sql)
+Statement::Statement(sqlite3* db, const std::string& path, const std::string& sql)
     : db_(db), path_(path), sql_(sql) {
   const int code = sqlite3_prepare_v2(db_, sql.c_str(), -1, &stmt_, nullptr);
   if (code != SQLITE_OK) Fail(Describe(db_, code));
@@ -77,16 +80,15 @@ Statement& Statement::Bind(int index, double value) {
 }
 
 Statement& Statement::Bind(int index, const std::string& value) {
-  const int code = sqlite3_bind_text(stmt_, index, value.c_str(),
-                                     static_cast<int>(value.size()),
+  const int code = sqlite3_bind_text(stmt_, index, value.c_str(), static_cast<int>(value.size()),
                                      SQLITE_TRANSIENT);
   if (code != SQLITE_OK) Fail(Describe(db_, code));
   return *this;
 }
 
 Statement& Statement::BindBlob(int index, const void* data, size_t num_bytes) {
-  const int code = sqlite3_bind_blob64(stmt_, index, num_bytes ? data : "",
-                                       num_bytes, SQLITE_STATIC);
+  const int code =
+      sqlite3_bind_blob64(stmt_, index, num_bytes ? data : "", num_bytes, SQLITE_STATIC);
   if (code != SQLITE_OK) Fail(Describe(db_, code));
   return *this;
 }
@@ -116,9 +118,7 @@ void Statement::Reset() {
   sqlite3_clear_bindings(stmt_);
 }
 
-int64_t Statement::ColumnInt64(int column) const {
-  return sqlite3_column_int64(stmt_, column);
-}
+int64_t Statement::ColumnInt64(int column) const { return sqlite3_column_int64(stmt_, column); }
 
 double Statement::ColumnDouble(int column) const {
   // Text or a blob in a REAL column (an edited row) is no number: NaN, which
@@ -135,8 +135,7 @@ bool Statement::ColumnIsNull(int column) const {
 std::string Statement::ColumnText(int column) const {
   const unsigned char* text = sqlite3_column_text(stmt_, column);
   if (text == nullptr) return "";
-  return std::string(reinterpret_cast<const char*>(text),
-                     sqlite3_column_bytes(stmt_, column));
+  return std::string(reinterpret_cast<const char*>(text), sqlite3_column_bytes(stmt_, column));
 }
 
 std::vector<uint8_t> Statement::ColumnBlob(int column) const {
@@ -161,8 +160,7 @@ void ExecuteSql(sqlite3* db, const std::string& path, const std::string& sql) {
   }
 }
 
-Transaction::Transaction(sqlite3* db, const std::string& path)
-    : db_(db), path_(path) {
+Transaction::Transaction(sqlite3* db, const std::string& path) : db_(db), path_(path) {
   ExecuteSql(db_, path_, "BEGIN IMMEDIATE TRANSACTION;");
 }
 

@@ -7,9 +7,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
-
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 
 #include "colmap_ext/util/string_utils.h"
 #include "pipelines/stages/synthesize.h"
@@ -118,15 +117,16 @@ cv::Mat ClutteredScene(int width, int height, uint64_t seed) {
     const cv::Scalar gray(rng.uniform(20, 240));
     switch (i % 3) {
       case 0:
-        cv::rectangle(scene, cv::Rect(centre, cv::Size(rng.uniform(5, 120), rng.uniform(5, 80))), gray, cv::FILLED);
+        cv::rectangle(scene, cv::Rect(centre, cv::Size(rng.uniform(5, 120), rng.uniform(5, 80))),
+                      gray, cv::FILLED);
         break;
       case 1:
-        cv::ellipse(scene, centre, cv::Size(rng.uniform(5, 70), rng.uniform(5, 40)), rng.uniform(0, 180), 0, 360,
-                    gray, cv::FILLED);
+        cv::ellipse(scene, centre, cv::Size(rng.uniform(5, 70), rng.uniform(5, 40)),
+                    rng.uniform(0, 180), 0, 360, gray, cv::FILLED);
         break;
       default:
-        cv::line(scene, centre, centre + cv::Point(rng.uniform(-150, 150), rng.uniform(-150, 150)), gray,
-                 rng.uniform(1, 6));
+        cv::line(scene, centre, centre + cv::Point(rng.uniform(-150, 150), rng.uniform(-150, 150)),
+                 gray, rng.uniform(1, 6));
     }
   }
   cv::GaussianBlur(scene, scene, cv::Size(), 1.0);

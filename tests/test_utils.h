@@ -29,9 +29,7 @@ class TempDir {
   TempDir();
   ~TempDir();
   const std::filesystem::path& path() const { return path_; }
-  std::filesystem::path operator/(const std::string& name) const {
-    return path_ / name;
-  }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
 
  private:
   std::filesystem::path path_;
@@ -74,11 +72,11 @@ extern const char* const kThreeFaceTargetYaml;
 }  // namespace portcal
 
 // Skips the test with a message when the shared data folder is absent.
-#define PORTCAL_REQUIRE_SHARED(var)                                        \
-  const auto var##_opt = ::portcal::testing::SharedDir();                  \
+#define PORTCAL_REQUIRE_SHARED(var)                                                \
+  const auto var##_opt = ::portcal::testing::SharedDir();                          \
   if (!var##_opt) GTEST_SKIP() << "../shared is absent: shared-data test skipped"; \
   const std::filesystem::path var = *var##_opt
 
-#define PORTCAL_REQUIRE_COLMAP(var)                                         \
-  const std::string var = ::portcal::testing::ColmapBinary();              \
+#define PORTCAL_REQUIRE_COLMAP(var)                           \
+  const std::string var = ::portcal::testing::ColmapBinary(); \
   if (var.empty()) GTEST_SKIP() << "the colmap binary was not found: interop test skipped"

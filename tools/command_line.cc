@@ -19,9 +19,7 @@ namespace po = boost::program_options;
 namespace portcal {
 
 CommandLine::CommandLine(std::string command, std::string summary)
-    : command_(std::move(command)),
-      summary_(std::move(summary)),
-      options_("Options", 100, 50) {
+    : command_(std::move(command)), summary_(std::move(summary)), options_("Options", 100, 50) {
   options_.add_options()("help,h", "print this help and exit")(
       "log_level", po::value<std::string>(&log_level_)->default_value(log_level_),
       "error | warn | info | debug")(
@@ -118,12 +116,14 @@ std::string CommandLine::Suggestions(std::string name) const {
   }
   std::sort(ranked.begin(), ranked.end());
   std::string text;
-  for (size_t k = 0; k < ranked.size() && k < 3; ++k) text += (k ? ", --" : "--") + ranked[k].second;
+  for (size_t k = 0; k < ranked.size() && k < 3; ++k)
+    text += (k ? ", --" : "--") + ranked[k].second;
   return text;
 }
 
 std::string CommandLine::StrayWords(int argc, char** argv) const {
-  const po::parsed_options parsed = po::command_line_parser(argc, argv).options(options_).allow_unregistered().run();
+  const po::parsed_options parsed =
+      po::command_line_parser(argc, argv).options(options_).allow_unregistered().run();
   std::string words;
   for (const std::string& word : po::collect_unrecognized(parsed.options, po::include_positional)) {
     words += (words.empty() ? "'" : ", '") + word + "'";
@@ -132,14 +132,16 @@ std::string CommandLine::StrayWords(int argc, char** argv) const {
 }
 
 void CommandLine::StoreProjectFile(const std::string& path, po::variables_map* vm) const {
-  if (!std::filesystem::is_regular_file(path)) throw UsageError("--project_path " + path + ": not a file");
+  if (!std::filesystem::is_regular_file(path))
+    throw UsageError("--project_path " + path + ": not a file");
   std::ifstream file(path);
   if (!file) throw UsageError("--project_path " + path + ": cannot open");
   try {
     po::store(po::parse_config_file(file, options_), *vm);
   } catch (const po::unknown_option& e) {
     const std::string suggestions = Suggestions(e.get_option_name());
-    throw UsageError(path + ": " + e.what() + (suggestions.empty() ? "" : "; did you mean " + suggestions + "?"));
+    throw UsageError(path + ": " + e.what() +
+                     (suggestions.empty() ? "" : "; did you mean " + suggestions + "?"));
   } catch (const po::error& e) {
     throw UsageError(path + ": " + e.what());
   }
@@ -154,20 +156,26 @@ bool CommandLine::Parse(int argc, char** argv) {
   try {
     // No guessing: an abbreviated option is an error, not silently the one
     // it happens to abbreviate.
-    const int style = po::command_line_style::default_style & ~po::command_line_style::allow_guessing;
+    const int style =
+        po::command_line_style::default_style & ~po::command_line_style::allow_guessing;
     // An empty positional description: a stray word is an error, not ignored.
     const po::positional_options_description no_positional;
-    po::store(po::command_line_parser(argc, argv).options(options_).positional(no_positional).style(style).run(),
+    po::store(po::command_line_parser(argc, argv)
+                  .options(options_)
+                  .positional(no_positional)
+                  .style(style)
+                  .run(),
               vm);
     if (vm.count("project_path")) StoreProjectFile(vm["project_path"].as<std::string>(), &vm);
     po::notify(vm);
   } catch (const po::unknown_option& e) {
     const std::string suggestions = Suggestions(e.get_option_name());
-    throw UsageError(std::string(e.what()) + (suggestions.empty() ? "" : "; did you mean " + suggestions + "?") +
+    throw UsageError(std::string(e.what()) +
+                     (suggestions.empty() ? "" : "; did you mean " + suggestions + "?") +
                      " (see portcal " + command_ + " -h)");
   } catch (const po::too_many_positional_options_error&) {
-    throw UsageError(StrayWords(argc, argv) + ": not an option; options are --name value (see portcal " + command_ +
-                     " -h)");
+    throw UsageError(StrayWords(argc, argv) +
+                     ": not an option; options are --name value (see portcal " + command_ + " -h)");
   } catch (const po::error& e) {
     throw UsageError(std::string(e.what()) + " (see portcal " + command_ + " -h)");
   }
@@ -181,7 +189,8 @@ bool CommandLine::Parse(int argc, char** argv) {
   return true;
 }
 
-void CommandLine::AddTriState(const std::string& name, std::optional<bool>* value, const std::string& help) {
+void CommandLine::AddTriState(const std::string& name, std::optional<bool>* value,
+                              const std::string& help) {
   int& raw = ints_.emplace_back(value->has_value() ? static_cast<int>(**value) : -1);
   Add(name, &raw, help);
   conversions_.push_back([name, value, &raw] {
@@ -190,7 +199,8 @@ void CommandLine::AddTriState(const std::string& name, std::optional<bool>* valu
   });
 }
 
-void CommandLine::AddRange(const std::string& name, double* low, double* high, const std::string& help) {
+void CommandLine::AddRange(const std::string& name, double* low, double* high,
+                           const std::string& help) {
   std::string& raw = strings_.emplace_back(FormatShortest(*low) + "," + FormatShortest(*high));
   Add(name, &raw, help);
   conversions_.push_back([name, low, high, &raw] {
@@ -215,24 +225,30 @@ void CommandLine::AddHousing(std::optional<Housing>* housing, const std::string&
   std::string& model = strings_.emplace_back(housing->has_value() ? (*housing)->ModelName() : "");
   std::string& params = strings_.emplace_back();
   if (housing->has_value()) {
-    for (const double v : (*housing)->params) params += (params.empty() ? "" : ",") + FormatShortest(v);
+    for (const double v : (*housing)->params)
+      params += (params.empty() ? "" : ",") + FormatShortest(v);
   }
   std::string choices;
   for (const std::string& name : SplitTokens(HousingModelNames(), ", ")) choices += name + " | ";
   Add("Housing.model", &model, choices + "NONE: " + model_help);
   Add("Housing.params", &params,
-      "the model's parameters, comma separated, metres (FLATPORT: Nx,Ny,Nz,int_dist,int_thick,na,ng,nw; "
+      "the model's parameters, comma separated, metres (FLATPORT: "
+      "Nx,Ny,Nz,int_dist,int_thick,na,ng,nw; "
       "DOMEPORT: Cx,Cy,Cz,int_radius,int_thick,na,ng,nw)");
   conversions_.push_back([housing, &model, &params] {
     if (model.empty() || model == "NONE") {
-      if (!params.empty()) throw OptionError("--Housing.params", params, "given together with --Housing.model");
+      if (!params.empty())
+        throw OptionError("--Housing.params", params, "given together with --Housing.model");
       housing->reset();
       return;
     }
     // The model first: the parameters' meaning depends on it.
-    if (!ExistsHousingModelWithName(model)) throw OptionError("--Housing.model", model, HousingModelNames() + " or NONE");
-    if (params.empty()) throw OptionError("--Housing.params", "''", "the parameters of --Housing.model " + model);
-    *housing = Housing::FromName(model, ParseDoubleList(params, "--Housing.params"), "--Housing.params");
+    if (!ExistsHousingModelWithName(model))
+      throw OptionError("--Housing.model", model, HousingModelNames() + " or NONE");
+    if (params.empty())
+      throw OptionError("--Housing.params", "''", "the parameters of --Housing.model " + model);
+    *housing =
+        Housing::FromName(model, ParseDoubleList(params, "--Housing.params"), "--Housing.params");
     (*housing)->ValidateInput("--Housing.params");
   });
 }
@@ -250,7 +266,8 @@ int ReportErrors(const std::function<void()>& body) {
   } catch (const std::bad_alloc&) {
     // Sizes are bounded before work starts; what is left is an input too
     // large for this machine's memory as a whole.
-    std::cerr << "error: out of memory: the input (its images, features or sizes) needs more memory than this "
+    std::cerr << "error: out of memory: the input (its images, features or sizes) needs more "
+                 "memory than this "
                  "machine has; use smaller or fewer images, or a machine with more memory\n";
     return kExitFailure;
   } catch (const cv::Exception& e) {
@@ -263,7 +280,8 @@ int ReportErrors(const std::function<void()>& body) {
     // A library's bare words (map::at, vector::_M_range_check, stoi) or a
     // failed internal check: never the user's fault alone, so say so.
     std::cerr << "error: internal error (" << e.what()
-              << "): a bug, or a damaged input that portcal did not check; please report it with the command\n";
+              << "): a bug, or a damaged input that portcal did not check; please report it with "
+                 "the command\n";
     return kExitFailure;
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";

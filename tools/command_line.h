@@ -47,7 +47,8 @@ class CommandLine {
       // "nan" and "inf" parse as numbers; no option of portcal means them
       // (each names its "never" or "auto" value in its help).
       semantic->notifier([name](T parsed) {
-        if (!std::isfinite(parsed)) throw OptionError("--" + name, FormatShortest(parsed), "a finite number");
+        if (!std::isfinite(parsed))
+          throw OptionError("--" + name, FormatShortest(parsed), "a finite number");
       });
     } else {
       semantic->default_value(*value);
@@ -57,15 +58,14 @@ class CommandLine {
   // Required option without default.
   template <typename T>
   void AddRequired(const std::string& name, T* value, const std::string& help) {
-    options_.add_options()(name.c_str(),
-                           boost::program_options::value<T>(value)->required(),
+    options_.add_options()(name.c_str(), boost::program_options::value<T>(value)->required(),
                            help.c_str());
   }
 
   // --name as one of `choices`' names (the value's default shown by name).
   template <typename T>
-  void AddChoice(const std::string& name, T* value, const std::vector<std::pair<std::string, T>>& choices,
-                 const std::string& help) {
+  void AddChoice(const std::string& name, T* value,
+                 const std::vector<std::pair<std::string, T>>& choices, const std::string& help) {
     std::string names, current;
     for (const auto& [choice, v] : choices) {
       names += (names.empty() ? "" : " | ") + choice;

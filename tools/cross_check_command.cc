@@ -22,14 +22,16 @@ int CrossCheckCommand(int argc, char** argv) {
                   "PASS or FAIL (exit code 0 either way).");
   cli.AddRequired("database_path", &options.database_path, "database with target observations");
   cli.AddRequired("input_calibration", &options.input_calibration, "portcal's calibration.yaml");
-  cli.AddRequired("output_path", &options.output_path,
-                  "directory for cross_check.txt/.yaml, report.html, heat maps and .cameramodel files");
+  cli.AddRequired(
+      "output_path", &options.output_path,
+      "directory for cross_check.txt/.yaml, report.html, heat maps and .cameramodel files");
   cli.Add("camera_id", &options.camera_id, "camera (-1: the only one with observations)");
   cli.Add("CrossCheck.folds", &options.folds, "cross-validation folds (0: none, else >= 2)");
   cli.Add("CrossCheck.max_diff_px", &options.max_diff_px,
           "PASS threshold on the projection diff's 95th percentile, px");
   cli.Add("CrossCheck.gridn_width", &options.gridn_width, "projection-diff grid points across");
-  cli.Add("CrossCheck.mrcal_board_warp", &options.mrcal_board_warp, "mrcal fits the board warp (0 | 1)");
+  cli.Add("CrossCheck.mrcal_board_warp", &options.mrcal_board_warp,
+          "mrcal fits the board warp (0 | 1)");
   cli.Add("CrossCheck.mrcal_outlier_rejection", &options.mrcal_outlier_rejection,
           "mrcal rejects outlier corners (0 | 1)");
   cli.Add("CrossCheck.mrcal_regularization", &options.mrcal_regularization,

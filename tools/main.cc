@@ -83,14 +83,16 @@ const std::vector<Command>& Commands() {
 }
 
 void PrintHelp() {
-  std::cout << "portcal " << PORTCAL_VERSION
-            << " -- camera, stereo and housing calibration for underwater "
-               "photogrammetry\n\nUsage:\n  portcal <command> [options]\n"
-               "  portcal <command> -h [GROUP]    the command's options (with GROUP: only --GROUP.*)\n"
-               "  portcal help <command> [GROUP]  the same\n\nCommands:\n";
+  std::cout
+      << "portcal " << PORTCAL_VERSION
+      << " -- camera, stereo and housing calibration for underwater "
+         "photogrammetry\n\nUsage:\n  portcal <command> [options]\n"
+         "  portcal <command> -h [GROUP]    the command's options (with GROUP: only --GROUP.*)\n"
+         "  portcal help <command> [GROUP]  the same\n\nCommands:\n";
   // The summaries start two spaces after the longest name.
   size_t width = std::string("help").size();
-  for (const Command& command : Commands()) width = std::max(width, std::string(command.name).size());
+  for (const Command& command : Commands())
+    width = std::max(width, std::string(command.name).size());
   const auto print = [width](const std::string& name, const std::string& summary) {
     std::cout << "  " << name << std::string(width + 2 - name.size(), ' ') << summary << "\n";
   };
@@ -115,12 +117,14 @@ std::string DidYouMean(const std::string& word) {
   std::vector<std::pair<size_t, std::string>> ranked;
   for (const Command& command : Commands()) {
     const std::string name = command.name;
-    const size_t distance = name.rfind(word, 0) == 0 && word.size() >= 3 ? 0 : portcal::EditDistance(word, name);
+    const size_t distance =
+        name.rfind(word, 0) == 0 && word.size() >= 3 ? 0 : portcal::EditDistance(word, name);
     if (distance <= std::max<size_t>(2, word.size() / 4)) ranked.emplace_back(distance, name);
   }
   std::sort(ranked.begin(), ranked.end());
   std::string text;
-  for (size_t k = 0; k < ranked.size() && k < 3; ++k) text += (k ? ", " : "; did you mean ") + ranked[k].second;
+  for (size_t k = 0; k < ranked.size() && k < 3; ++k)
+    text += (k ? ", " : "; did you mean ") + ranked[k].second;
   return text.empty() ? text : text + "?";
 }
 
@@ -139,8 +143,8 @@ int RunCommandLine(int argc, char** argv) {
               << " (portcal help lists the commands)\n";
     return portcal::kExitUsage;
   }
-  if (argc < 2 || std::strcmp(argv[1], "help") == 0 ||
-      std::strcmp(argv[1], "-h") == 0 || std::strcmp(argv[1], "--help") == 0) {
+  if (argc < 2 || std::strcmp(argv[1], "help") == 0 || std::strcmp(argv[1], "-h") == 0 ||
+      std::strcmp(argv[1], "--help") == 0) {
     PrintHelp();
     return argc < 2 ? portcal::kExitUsage : portcal::kExitSuccess;
   }

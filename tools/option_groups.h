@@ -3,18 +3,19 @@
 // The fields keep their defaults as the flags' defaults.
 #pragma once
 
-#include "pipelines/stages/target_extractor.h"
 #include "pipelines/images/image_reader.h"
 #include "pipelines/stages/feature_extractor.h"
 #include "pipelines/stages/feature_matcher.h"
 #include "pipelines/stages/refractive_bundle_adjuster.h"
 #include "pipelines/stages/refractive_mapper.h"
+#include "pipelines/stages/target_extractor.h"
 #include "tools/command_line.h"
 
 namespace portcal {
 
 // Flags two commands give to fields of their own.
-inline constexpr const char* kMarkersDictionaryHelp = "ArUco dictionary of the markers, e.g. DICT_4X4_50";
+inline constexpr const char* kMarkersDictionaryHelp =
+    "ArUco dictionary of the markers, e.g. DICT_4X4_50";
 inline constexpr const char* kMaskEnlargementHelp =
     "features kept within each marker's quad scaled by this about its centroid (>= 1)";
 

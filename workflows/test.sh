@@ -3,8 +3,9 @@
 # (against the real colmap binary) and accuracy tests.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-# chromium: the live page's browser test (tests/pipelines/stages/live_page_test.cc).
-bash workflows/setup.sh chromium
+# chromium: the live page's browser test (tests/pipelines/stages/live_page_test.cc);
+# clang-format: the format check (tests/tools/format_check.sh).
+bash workflows/setup.sh chromium clang-format
 cd build
 jobs="$(nproc 2>/dev/null || echo 2)"
 echo "test: ctest, $jobs at a time (about 20 minutes on 2 cores; a line per test as it ends)" >&2

@@ -21,8 +21,7 @@ struct Camera {
   bool has_prior_focal_length = false;
 
   // Builds a camera with COLMAP's default parameters for this focal length.
-  static Camera FromModelName(const std::string& model_name,
-                              double focal_length, uint64_t width,
+  static Camera FromModelName(const std::string& model_name, double focal_length, uint64_t width,
                               uint64_t height);
 
   std::string ModelName() const;
@@ -39,8 +38,7 @@ struct Camera {
 
   // Point in the camera frame -> pixel (COLMAP convention). nullopt behind the
   // camera.
-  std::optional<Eigen::Vector2d> ImgFromCam(
-      const Eigen::Vector3d& point_in_cam) const;
+  std::optional<Eigen::Vector2d> ImgFromCam(const Eigen::Vector3d& point_in_cam) const;
   // Pixel -> ray direction (u, v, 1) in the camera frame. nullopt where the
   // distortion cannot be inverted.
   std::optional<Eigen::Vector3d> CamFromImg(const Eigen::Vector2d& pixel) const;

@@ -16,10 +16,9 @@ namespace portcal {
 
 // In COLMAP's id order (SIMPLE_PINHOLE 0 ... THIN_PRISM_FISHEYE 10).
 using CameraModelList =
-    TypeList<SimplePinholeModel, PinholeModel, SimpleRadialModel, RadialModel,
-             OpenCVModel, OpenCVFisheyeModel, FullOpenCVModel, FOVModel,
-             SimpleRadialFisheyeModel, RadialFisheyeModel,
-             ThinPrismFisheyeModel>;
+    TypeList<SimplePinholeModel, PinholeModel, SimpleRadialModel, RadialModel, OpenCVModel,
+             OpenCVFisheyeModel, FullOpenCVModel, FOVModel, SimpleRadialFisheyeModel,
+             RadialFisheyeModel, ThinPrismFisheyeModel>;
 
 constexpr int kNumCameraModels = CameraModelList::kSize;
 
@@ -45,8 +44,7 @@ std::vector<int> CameraModelPrincipalPointIdxs(int model_id);
 std::vector<int> CameraModelExtraParamsIdxs(int model_id);
 // Built on the equidistant angle (OPENCV_FISHEYE and the other *_FISHEYE).
 bool CameraModelIsFisheye(int model_id);
-std::vector<double> CameraModelInitializeParams(int model_id,
-                                                double focal_length, int width,
+std::vector<double> CameraModelInitializeParams(int model_id, double focal_length, int width,
                                                 int height);
 // "SIMPLE_PINHOLE, PINHOLE, ..." for help texts and errors.
 std::string CameraModelNames();

@@ -14,8 +14,7 @@ struct AutoDiffFunctor {
 
   template <typename... Args>
   static ceres::CostFunction* Create(Args&&... args) {
-    return new ceres::AutoDiffCostFunction<Functor, kNumResiduals,
-                                           kBlockSizes...>(
+    return new ceres::AutoDiffCostFunction<Functor, kNumResiduals, kBlockSizes...>(
         new Functor(std::forward<Args>(args)...));
   }
 };

@@ -21,7 +21,8 @@ template <typename CameraModel, typename Port, PortErrorKind kError, typename T>
 bool PortPointResidual(const T* intrinsics, const T* port, const Eigen::Vector2d& observed,
                        const VectorT<T, 3>& in_cam, T* residual) {
   if constexpr (kError == PortErrorKind::kVirtualCamera) {
-    return VirtualCameraResidual<CameraModel, Port, T>(intrinsics, port, observed, in_cam, residual);
+    return VirtualCameraResidual<CameraModel, Port, T>(intrinsics, port, observed, in_cam,
+                                                       residual);
   } else {
     T x, y;
     if (!ImgFromWater<CameraModel, Port, T>(intrinsics, port, in_cam, &x, &y)) return false;
@@ -35,9 +36,8 @@ bool PortPointResidual(const T* intrinsics, const T* port, const Eigen::Vector2d
 // (7), intrinsics, port (the model's parameters; what is held is the
 // manifold's business).
 template <typename CameraModel, typename Port, PortErrorKind kError>
-struct BoardThroughPortError
-    : AutoDiffFunctor<BoardThroughPortError<CameraModel, Port, kError>, 2, 7,
-                      CameraModel::kNumParams, Port::kNumParams> {
+struct BoardThroughPortError : AutoDiffFunctor<BoardThroughPortError<CameraModel, Port, kError>, 2,
+                                               7, CameraModel::kNumParams, Port::kNumParams> {
   BoardThroughPortError(const Eigen::Vector3d& point, const Eigen::Vector2d& observed)
       : point_(point), observed_(observed) {}
 
@@ -46,7 +46,8 @@ struct BoardThroughPortError
     const Eigen::Map<const Eigen::Quaternion<T>> rotation(cam_from_target);
     const Eigen::Map<const VectorT<T, 3>> translation(cam_from_target + 4);
     const VectorT<T, 3> in_cam = rotation * point_.cast<T>() + translation;
-    return PortPointResidual<CameraModel, Port, kError, T>(intrinsics, port, observed_, in_cam, residual);
+    return PortPointResidual<CameraModel, Port, kError, T>(intrinsics, port, observed_, in_cam,
+                                                           residual);
   }
 
  private:
@@ -72,7 +73,8 @@ struct WarpedBoardThroughPortError
     VectorT<T, 3> point = point_.cast<T>();
     point.z() += BoardSag(warp, warp_uv_);
     const VectorT<T, 3> in_cam = rotation * point + translation;
-    return PortPointResidual<CameraModel, Port, kError, T>(intrinsics, port, observed_, in_cam, residual);
+    return PortPointResidual<CameraModel, Port, kError, T>(intrinsics, port, observed_, in_cam,
+                                                           residual);
   }
 
  private:

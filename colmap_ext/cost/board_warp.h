@@ -11,7 +11,8 @@ namespace portcal {
 
 // A target point's (u, v) over the board's extent (x min, x max, y min,
 // y max).
-inline Eigen::Vector2d BoardWarpUv(const Eigen::Vector3d& point, const Eigen::Vector4d& board_extent) {
+inline Eigen::Vector2d BoardWarpUv(const Eigen::Vector3d& point,
+                                   const Eigen::Vector4d& board_extent) {
   return Eigen::Vector2d(
       2 * (point.x() - board_extent[0]) / std::max(1e-12, board_extent[1] - board_extent[0]) - 1,
       2 * (point.y() - board_extent[2]) / std::max(1e-12, board_extent[3] - board_extent[2]) - 1);

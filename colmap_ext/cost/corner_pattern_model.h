@@ -42,9 +42,10 @@ struct PixelRule {
       rule.weights = {5.0 / 18, 8.0 / 18, 5.0 / 18};
     } else {
       rule.n = 5;
-      rule.nodes = {-0.4530899229693320, -0.2692346550528415, 0, 0.2692346550528415, 0.4530899229693320};
-      rule.weights = {0.1184634425280945, 0.2393143352496832, 0.2844444444444444, 0.2393143352496832,
-                      0.1184634425280945};
+      rule.nodes = {-0.4530899229693320, -0.2692346550528415, 0, 0.2692346550528415,
+                    0.4530899229693320};
+      rule.weights = {0.1184634425280945, 0.2393143352496832, 0.2844444444444444,
+                      0.2393143352496832, 0.1184634425280945};
     }
     return rule;
   }
@@ -188,8 +189,12 @@ class CornerPatternModel {
   double U2(double x, double y) const { return (c2_ * (x - cx_) + s2_ * (y - cy_)) * scale_; }
   // How far u changes from a pixel's centre to points `half_extent` away in
   // x and y.
-  double Reach1(double half_extent) const { return half_extent * (std::abs(c1_) + std::abs(s1_)) * scale_; }
-  double Reach2(double half_extent) const { return half_extent * (std::abs(c2_) + std::abs(s2_)) * scale_; }
+  double Reach1(double half_extent) const {
+    return half_extent * (std::abs(c1_) + std::abs(s1_)) * scale_;
+  }
+  double Reach2(double half_extent) const {
+    return half_extent * (std::abs(c2_) + std::abs(s2_)) * scale_;
+  }
 
   PixelRule rule_;
   double cx_, cy_, c1_, s1_, c2_, s2_, mean_, contrast_, scale_;

@@ -15,7 +15,8 @@
 namespace portcal {
 
 struct FixedRayError : AutoDiffFunctor<FixedRayError, 2, 7, 3> {
-  FixedRayError(const Eigen::Vector3d& center, const Eigen::Vector3d& direction, double focal, double sigma)
+  FixedRayError(const Eigen::Vector3d& center, const Eigen::Vector3d& direction, double focal,
+                double sigma)
       : center_(center), observed_(direction.head<2>() / direction.z()), scale_(focal / sigma) {}
   template <typename T>
   bool operator()(const T* cam_from_world, const T* point, T* residual) const {

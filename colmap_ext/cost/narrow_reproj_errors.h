@@ -50,12 +50,14 @@ constexpr int PortSize() {
 // The residual of both narrow errors: the port's constants cast to T,
 // the point moved into the camera and projected.
 template <typename CameraModel, typename Port, typename T, int kPort>
-bool PixelResidual(const T* intrinsics, const PortConstants<kPort>& port_values, const T* cam_from_world,
-                   const T* point, const Eigen::Vector2d& observed, double inv_sigma, T* residual) {
+bool PixelResidual(const T* intrinsics, const PortConstants<kPort>& port_values,
+                   const T* cam_from_world, const T* point, const Eigen::Vector2d& observed,
+                   double inv_sigma, T* residual) {
   T port[kPort > 0 ? kPort : 1];
   for (int i = 0; i < kPort; ++i) port[i] = T(port_values.values[i]);
   T x, y;
-  if (!Project<CameraModel, Port, T>(intrinsics, port, PointInCam(cam_from_world, point), &x, &y)) return false;
+  if (!Project<CameraModel, Port, T>(intrinsics, port, PointInCam(cam_from_world, point), &x, &y))
+    return false;
   residual[0] = (x - observed.x()) * inv_sigma;
   residual[1] = (y - observed.y()) * inv_sigma;
   return true;
@@ -76,8 +78,8 @@ struct PosePointError : AutoDiffFunctor<PosePointError<CameraModel, Port>, 2, 7,
   bool operator()(const T* cam_from_world, const T* point, T* residual) const {
     T intrinsics[CameraModel::kNumParams];
     for (int i = 0; i < CameraModel::kNumParams; ++i) intrinsics[i] = T(intrinsics_[i]);
-    return internal::PixelResidual<CameraModel, Port>(intrinsics, port_, cam_from_world, point, observed_,
-                                                      inv_sigma_, residual);
+    return internal::PixelResidual<CameraModel, Port>(intrinsics, port_, cam_from_world, point,
+                                                      observed_, inv_sigma_, residual);
   }
   Eigen::Vector2d observed_;
   double inv_sigma_;
@@ -87,16 +89,17 @@ struct PosePointError : AutoDiffFunctor<PosePointError<CameraModel, Port>, 2, 7,
 
 // Pose, point and intrinsics free; port constant.
 template <typename CameraModel, typename Port>
-struct PosePointIntrinsicsError
-    : AutoDiffFunctor<PosePointIntrinsicsError<CameraModel, Port>, 2, 7, 3, CameraModel::kNumParams> {
-  PosePointIntrinsicsError(const std::vector<double>& housing, const Eigen::Vector2d& observed, double sigma)
+struct PosePointIntrinsicsError : AutoDiffFunctor<PosePointIntrinsicsError<CameraModel, Port>, 2, 7,
+                                                  3, CameraModel::kNumParams> {
+  PosePointIntrinsicsError(const std::vector<double>& housing, const Eigen::Vector2d& observed,
+                           double sigma)
       : observed_(observed), inv_sigma_(1.0 / sigma) {
     for (int i = 0; i < internal::PortSize<Port>(); ++i) port_.values[i] = housing.at(i);
   }
   template <typename T>
   bool operator()(const T* cam_from_world, const T* point, const T* intrinsics, T* residual) const {
-    return internal::PixelResidual<CameraModel, Port>(intrinsics, port_, cam_from_world, point, observed_,
-                                                      inv_sigma_, residual);
+    return internal::PixelResidual<CameraModel, Port>(intrinsics, port_, cam_from_world, point,
+                                                      observed_, inv_sigma_, residual);
   }
   Eigen::Vector2d observed_;
   double inv_sigma_;
@@ -109,12 +112,14 @@ struct PosePointIntrinsicsError
 template <typename CameraModel, typename Port>
 struct PosePointHousingError
     : AutoDiffFunctor<PosePointHousingError<CameraModel, Port>, 2, 7, 3, Port::kNumParams> {
-  PosePointHousingError(const std::vector<double>& intrinsics, const Eigen::Vector2d& observed_px, double sigma_px)
+  PosePointHousingError(const std::vector<double>& intrinsics, const Eigen::Vector2d& observed_px,
+                        double sigma_px)
       : error_(observed_px, sigma_px) {
     for (int i = 0; i < CameraModel::kNumParams; ++i) intrinsics_[i] = intrinsics.at(i);
   }
   template <typename T>
-  bool operator()(const T* cam_from_world, const T* point_in_world, const T* housing, T* residual) const {
+  bool operator()(const T* cam_from_world, const T* point_in_world, const T* housing,
+                  T* residual) const {
     T intrinsics[CameraModel::kNumParams];
     for (int i = 0; i < CameraModel::kNumParams; ++i) intrinsics[i] = T(intrinsics_[i]);
     return error_(cam_from_world, point_in_world, intrinsics, housing, residual);

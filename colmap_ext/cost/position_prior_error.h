@@ -10,7 +10,8 @@
 namespace portcal {
 
 struct PositionPriorError : AutoDiffFunctor<PositionPriorError, 3, 7> {
-  PositionPriorError(const Eigen::Vector3d& prior, double sigma) : prior(prior), inv_sigma(1.0 / sigma) {}
+  PositionPriorError(const Eigen::Vector3d& prior, double sigma)
+      : prior(prior), inv_sigma(1.0 / sigma) {}
   template <typename T>
   bool operator()(const T* pose, T* residual) const {
     const Eigen::Map<const Eigen::Quaternion<T>> rotation(pose);

@@ -17,22 +17,20 @@
 namespace portcal {
 
 template <typename CameraModel, typename Port>
-struct RefractiveReprojError
-    : AutoDiffFunctor<RefractiveReprojError<CameraModel, Port>, 2, 7, 3,
-                      CameraModel::kNumParams, Port::kNumParams> {
+struct RefractiveReprojError : AutoDiffFunctor<RefractiveReprojError<CameraModel, Port>, 2, 7, 3,
+                                               CameraModel::kNumParams, Port::kNumParams> {
   RefractiveReprojError(const Eigen::Vector2d& observed_px, double sigma_px)
       : observed_px_(observed_px), inv_sigma_(1.0 / sigma_px) {}
 
   template <typename T>
-  bool operator()(const T* cam_from_world, const T* point_in_world,
-                  const T* intrinsics, const T* housing, T* residual) const {
+  bool operator()(const T* cam_from_world, const T* point_in_world, const T* intrinsics,
+                  const T* housing, T* residual) const {
     const Eigen::Map<const Eigen::Quaternion<T>> rotation(cam_from_world);
     const Eigen::Map<const VectorT<T, 3>> translation(cam_from_world + 4);
     const Eigen::Map<const VectorT<T, 3>> point(point_in_world);
     const VectorT<T, 3> point_in_cam = rotation * point + translation;
     T x, y;
-    if (!ImgFromWater<CameraModel, Port, T>(intrinsics, housing, point_in_cam,
-                                            &x, &y)) {
+    if (!ImgFromWater<CameraModel, Port, T>(intrinsics, housing, point_in_cam, &x, &y)) {
       return false;
     }
     residual[0] = (x - observed_px_.x()) * inv_sigma_;

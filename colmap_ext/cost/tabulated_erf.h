@@ -34,7 +34,8 @@ class TabulatedErf {
     // spacing, for the value and for the slope alike: the slope interpolated
     // in its own right is ~1000 times closer than the value's derivative,
     // which matters where it enters erf's antiderivatives (erf_pixel_average.h).
-    const double h00 = g * g * (1 + 2 * f), h01 = f * f * (3 - 2 * f), h10 = h * f * g * g, h11 = -h * f * f * g;
+    const double h00 = g * g * (1 + 2 * f), h01 = f * f * (3 - 2 * f), h10 = h * f * g * g,
+                 h11 = -h * f * f * g;
     *slope = h00 * a.slope + h01 * b.slope + h10 * a.curvature + h11 * b.curvature;
     return h00 * a.value + h01 * b.value + h10 * a.slope + h11 * b.slope;
   }

@@ -25,8 +25,9 @@ namespace portcal {
 // observed pixel and a point in the camera frame. False where the pixel has
 // no ray in water or the point is behind the virtual camera.
 template <typename CameraModel, typename Port, typename T>
-bool VirtualCameraResidual(const T* intrinsics, const T* housing, const Eigen::Vector2d& observed_px,
-                           const VectorT<T, 3>& point_in_cam, T* residual) {
+bool VirtualCameraResidual(const T* intrinsics, const T* housing,
+                           const Eigen::Vector2d& observed_px, const VectorT<T, 3>& point_in_cam,
+                           T* residual) {
   VectorT<T, 3> origin, dir;
   if (!WaterFromImg<CameraModel, Port, T>(intrinsics, housing, T(observed_px.x()),
                                           T(observed_px.y()), &origin, &dir)) {
@@ -52,15 +53,14 @@ bool VirtualCameraResidual(const T* intrinsics, const T* housing, const Eigen::V
 }
 
 template <typename CameraModel, typename Port>
-struct VirtualCameraError
-    : AutoDiffFunctor<VirtualCameraError<CameraModel, Port>, 2, 7, 3,
-                      CameraModel::kNumParams, Port::kNumParams> {
+struct VirtualCameraError : AutoDiffFunctor<VirtualCameraError<CameraModel, Port>, 2, 7, 3,
+                                            CameraModel::kNumParams, Port::kNumParams> {
   VirtualCameraError(const Eigen::Vector2d& observed_px, double sigma_px)
       : observed_px_(observed_px), inv_sigma_(1.0 / sigma_px) {}
 
   template <typename T>
-  bool operator()(const T* cam_from_world, const T* point_in_world,
-                  const T* intrinsics, const T* housing, T* residual) const {
+  bool operator()(const T* cam_from_world, const T* point_in_world, const T* intrinsics,
+                  const T* housing, T* residual) const {
     const Eigen::Map<const Eigen::Quaternion<T>> rotation(cam_from_world);
     const Eigen::Map<const VectorT<T, 3>> translation(cam_from_world + 4);
     const Eigen::Map<const VectorT<T, 3>> point(point_in_world);

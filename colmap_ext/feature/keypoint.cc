@@ -4,8 +4,7 @@
 
 namespace portcal {
 
-FeatureKeypoint FeatureKeypoint::FromScaleOrientation(float x, float y,
-                                                      float scale,
+FeatureKeypoint FeatureKeypoint::FromScaleOrientation(float x, float y, float scale,
                                                       float orientation) {
   FeatureKeypoint keypoint;
   keypoint.x = x;
@@ -19,12 +18,9 @@ FeatureKeypoint FeatureKeypoint::FromScaleOrientation(float x, float y,
 }
 
 float FeatureKeypoint::ComputeScale() const {
-  return 0.5f * (std::sqrt(a11 * a11 + a21 * a21) +
-                 std::sqrt(a12 * a12 + a22 * a22));
+  return 0.5f * (std::sqrt(a11 * a11 + a21 * a21) + std::sqrt(a12 * a12 + a22 * a22));
 }
 
-float FeatureKeypoint::ComputeOrientation() const {
-  return std::atan2(a21, a11);
-}
+float FeatureKeypoint::ComputeOrientation() const { return std::atan2(a21, a11); }
 
 }  // namespace portcal

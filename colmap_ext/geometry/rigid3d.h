@@ -21,8 +21,7 @@ struct Rigid3d {
   }
   // c_from_a = c_from_b * b_from_a (reads right to left).
   Rigid3d operator*(const Rigid3d& b_from_a) const {
-    return Rigid3d(rotation * b_from_a.rotation,
-                   rotation * b_from_a.translation + translation);
+    return Rigid3d(rotation * b_from_a.rotation, rotation * b_from_a.translation + translation);
   }
   Rigid3d Inverse() const {
     const Eigen::Quaterniond inv = rotation.inverse();

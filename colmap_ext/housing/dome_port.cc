@@ -20,14 +20,15 @@ std::optional<std::string> DomePort::Invalidity(const double* port) {
   // No medium has an index below vacuum's 1 (air 1.0, glass about 1.5,
   // water 1.33); a smaller one is a typo, and the solve would fail on it.
   if (!(AirIndex(port) >= 1 && GlassIndex(port) >= 1 && WaterIndex(port) >= 1)) {
-    return "DOMEPORT refractive indices na, ng, nw must be at least 1 (air 1.0, glass ~1.5, water ~1.33)";
+    return "DOMEPORT refractive indices na, ng, nw must be at least 1 (air 1.0, glass ~1.5, water "
+           "~1.33)";
   }
   const double decentering = Center(port).norm();
   if (!(decentering < InnerRadius(port))) {
     return "DOMEPORT: the camera centre must lie inside the dome, but the "
-           "decentering |C| = " + std::to_string(decentering) +
-           " m is not below int_radius = " + std::to_string(InnerRadius(port)) +
-           " m";
+           "decentering |C| = " +
+           std::to_string(decentering) +
+           " m is not below int_radius = " + std::to_string(InnerRadius(port)) + " m";
   }
   return std::nullopt;
 }
@@ -54,7 +55,8 @@ bool DomePort::AtBound(const double* port) {
   return false;
 }
 
-std::vector<std::vector<double>> DomePort::StartCandidates(const double* port, const Eigen::Vector3d& axis) {
+std::vector<std::vector<double>> DomePort::StartCandidates(const double* port,
+                                                           const Eigen::Vector3d& axis) {
   std::vector<std::vector<double>> starts;
   for (const Eigen::Vector3d& direction :
        {axis, Eigen::Vector3d(Eigen::Vector3d::UnitX()), Eigen::Vector3d(Eigen::Vector3d::UnitY()),
@@ -85,17 +87,17 @@ std::string DomePort::InWords(const double* port) {
   const auto side = [](double mm, const char* positive, const char* negative) {
     return FormatFixed(std::abs(mm), 2) + " mm " + (mm >= 0 ? positive : negative);
   };
-  return "the dome's centre lies " + side(c.x(), "right", "left") + ", " + side(c.y(), "down", "up") + " and " +
-         side(c.z(), "ahead of", "behind") + " the camera's projection centre (" +
-         FormatFixed(c.norm(), 2) + " mm off it)";
+  return "the dome's centre lies " + side(c.x(), "right", "left") + ", " +
+         side(c.y(), "down", "up") + " and " + side(c.z(), "ahead of", "behind") +
+         " the camera's projection centre (" + FormatFixed(c.norm(), 2) + " mm off it)";
 }
 
 std::optional<std::string> DomePort::Implausibility(const double* port) {
   constexpr double kMaxPlausibleDecenteringFraction = 0.25;
   const double decentering = Center(port).norm();
   if (decentering > kMaxPlausibleDecenteringFraction * InnerRadius(port)) {
-    return "the dome's centre is " + FormatFixed(1000 * decentering, 1) + " mm from the camera centre, " +
-           FormatFixed(100 * decentering / InnerRadius(port), 0) +
+    return "the dome's centre is " + FormatFixed(1000 * decentering, 1) +
+           " mm from the camera centre, " + FormatFixed(100 * decentering / InnerRadius(port), 0) +
            " % of its radius, where dome housings centre the lens to a few mm";
   }
   return std::nullopt;
@@ -160,10 +162,9 @@ class PlaneOfRefraction {
   // After Residual: whether X lies in front of the water ray's start on the
   // outer sphere (not on its backward extension).
   bool PointAhead() const {
-    const std::complex<double> to_point =
-        std::complex<double>(x_, y_) - outer_ * exit_direction_;
-    return to_point.real() * water_direction_.real() +
-               to_point.imag() * water_direction_.imag() > 0;
+    const std::complex<double> to_point = std::complex<double>(x_, y_) - outer_ * exit_direction_;
+    return to_point.real() * water_direction_.real() + to_point.imag() * water_direction_.imag() >
+           0;
   }
 
   // Start for Newton: with asin(a) ~ a the water ray's direction is
@@ -182,8 +183,7 @@ class PlaneOfRefraction {
 
 }  // namespace
 
-bool DomePort::AirRayToPointValue(const double* port,
-                                  const Eigen::Vector3d& point,
+bool DomePort::AirRayToPointValue(const double* port, const Eigen::Vector3d& point,
                                   Eigen::Vector3d* dir_in_air) {
   const Eigen::Vector3d center = Center(port);
   if (!((point - center).norm() > OuterRadius(port))) return false;

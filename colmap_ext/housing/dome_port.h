@@ -23,8 +23,7 @@ struct DomePort {
   static constexpr int kId = 1;
   static constexpr const char* kName = "DOMEPORT";
   static constexpr int kNumParams = 8;
-  static constexpr const char* kParamsInfo =
-      "Cx, Cy, Cz, int_radius, int_thick, na, ng, nw";
+  static constexpr const char* kParamsInfo = "Cx, Cy, Cz, int_radius, int_thick, na, ng, nw";
 
   template <typename T>
   static VectorT<T, 3> Center(const T* port) {
@@ -41,15 +40,25 @@ struct DomePort {
     return true;
   }
   template <typename T>
-  static const T& InnerRadius(const T* port) { return port[3]; }
+  static const T& InnerRadius(const T* port) {
+    return port[3];
+  }
   template <typename T>
-  static T OuterRadius(const T* port) { return port[3] + port[4]; }
+  static T OuterRadius(const T* port) {
+    return port[3] + port[4];
+  }
   template <typename T>
-  static const T& AirIndex(const T* port) { return port[5]; }
+  static const T& AirIndex(const T* port) {
+    return port[5];
+  }
   template <typename T>
-  static const T& GlassIndex(const T* port) { return port[6]; }
+  static const T& GlassIndex(const T* port) {
+    return port[6];
+  }
   template <typename T>
-  static const T& WaterIndex(const T* port) { return port[7]; }
+  static const T& WaterIndex(const T* port) {
+    return port[7];
+  }
 
   static std::optional<std::string> Invalidity(const double* port);
 
@@ -77,7 +86,8 @@ struct DomePort {
   // show: decenterings of up to 81 % of the inner radius along that axis
   // and, because a nearly central dome shows its axis poorly, along the
   // camera's own axes; the radius and constants from `port`.
-  static std::vector<std::vector<double>> StartCandidates(const double* port, const Eigen::Vector3d& axis);
+  static std::vector<std::vector<double>> StartCandidates(const double* port,
+                                                          const Eigen::Vector3d& axis);
   // Centred, a dome does not magnify paraxial rays; decentring's effect is
   // left to the adjustment.
   static double InAirFocalRatio(const double* /*port*/) { return 1.0; }
@@ -86,27 +96,22 @@ struct DomePort {
   // through both spheres. Templated on the dimension so the forward solve can
   // run it inside the 2-D plane of refraction.
   template <typename T, int Dim>
-  [[nodiscard]] static bool Trace(const VectorT<T, Dim>& center,
-                                  const T* port,
-                                  const VectorT<T, Dim>& origin,
-                                  const VectorT<T, Dim>& dir_in_air,
-                                  VectorT<T, Dim>* water_origin,
-                                  VectorT<T, Dim>* water_dir) {
+  [[nodiscard]] static bool Trace(const VectorT<T, Dim>& center, const T* port,
+                                  const VectorT<T, Dim>& origin, const VectorT<T, Dim>& dir_in_air,
+                                  VectorT<T, Dim>* water_origin, VectorT<T, Dim>* water_dir) {
     const VectorT<T, Dim> d0 = dir_in_air.normalized();
     T s0;
-    if (!ExitDistanceFromInside<T, Dim>(origin, d0, center, InnerRadius(port),
-                                        &s0)) {
+    if (!ExitDistanceFromInside<T, Dim>(origin, d0, center, InnerRadius(port), &s0)) {
       return false;
     }
     const VectorT<T, Dim> p1 = origin + s0 * d0;
     VectorT<T, Dim> d1;
-    if (!Refract<T, Dim>(d0, (p1 - center) / InnerRadius(port),
-                         AirIndex(port) / GlassIndex(port), &d1)) {
+    if (!Refract<T, Dim>(d0, (p1 - center) / InnerRadius(port), AirIndex(port) / GlassIndex(port),
+                         &d1)) {
       return false;
     }
     T s1;
-    if (!ExitDistanceFromInside<T, Dim>(p1, d1, center, OuterRadius(port),
-                                        &s1)) {
+    if (!ExitDistanceFromInside<T, Dim>(p1, d1, center, OuterRadius(port), &s1)) {
       return false;
     }
     *water_origin = p1 + s1 * d1;
@@ -118,12 +123,9 @@ struct DomePort {
   // water (origin on the outer sphere, unit direction). False on total
   // internal reflection at the glass-water surface.
   template <typename T>
-  [[nodiscard]] static bool RayInWater(const T* port,
-                                       const VectorT<T, 3>& dir_in_air,
-                                       VectorT<T, 3>* origin,
-                                       VectorT<T, 3>* dir) {
-    return Trace<T, 3>(Center(port), port, VectorT<T, 3>::Zero(), dir_in_air,
-                       origin, dir);
+  [[nodiscard]] static bool RayInWater(const T* port, const VectorT<T, 3>& dir_in_air,
+                                       VectorT<T, 3>* origin, VectorT<T, 3>* dir) {
+    return Trace<T, 3>(Center(port), port, VectorT<T, 3>::Zero(), dir_in_air, origin, dir);
   }
 
   // Forward projection, exact: unit air direction of the ray that reaches
@@ -133,8 +135,7 @@ struct DomePort {
   // the ray from C) gives the water ray of the air angle phi in closed form,
   // and phi solves a 1-D equation by safeguarded Newton with its analytic
   // derivative (see dome_port.cc). False if no ray reaches the point.
-  static bool AirRayToPointValue(const double* port,
-                                 const Eigen::Vector3d& point,
+  static bool AirRayToPointValue(const double* port, const Eigen::Vector3d& point,
                                  Eigen::Vector3d* dir_in_air);
 };
 

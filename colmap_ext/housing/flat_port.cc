@@ -29,13 +29,15 @@ std::optional<std::string> FlatPort::Invalidity(const double* port) {
   // No medium has an index below vacuum's 1 (air 1.0, glass about 1.5,
   // water 1.33); a smaller one is a typo, and the solve would fail on it.
   if (!(AirIndex(port) >= 1 && GlassIndex(port) >= 1 && WaterIndex(port) >= 1)) {
-    return "FLATPORT refractive indices na, ng, nw must be at least 1 (air 1.0, glass ~1.5, water ~1.33)";
+    return "FLATPORT refractive indices na, ng, nw must be at least 1 (air 1.0, glass ~1.5, water "
+           "~1.33)";
   }
   return std::nullopt;
 }
 
 std::optional<std::string> FlatPort::UnitMistake(const double* port) {
-  if (auto mistake = LengthInMillimetres(kName, "int_dist", InterfaceDistance(port))) return mistake;
+  if (auto mistake = LengthInMillimetres(kName, "int_dist", InterfaceDistance(port)))
+    return mistake;
   return LengthInMillimetres(kName, "int_thick", Thickness(port));
 }
 
@@ -45,10 +47,12 @@ std::string FlatPort::InWords(const double* port) {
   // The camera frame: x right, y down, z forward (the optical axis).
   const double right_deg = std::atan2(n.x(), n.z()) * 180.0 / M_PI;
   const double down_deg = std::atan2(n.y(), n.z()) * 180.0 / M_PI;
-  return "the port's normal is tilted " + FormatFixed(tilt_deg, 2) + " deg from the optical axis (" +
-         FormatFixed(std::abs(right_deg), 2) + " deg towards the image's " + (right_deg >= 0 ? "right" : "left") +
-         ", " + FormatFixed(std::abs(down_deg), 2) + " deg towards its " + (down_deg >= 0 ? "bottom" : "top") +
-         "); its inner surface is " + FormatFixed(1000 * InterfaceDistance(port), 2) +
+  return "the port's normal is tilted " + FormatFixed(tilt_deg, 2) +
+         " deg from the optical axis (" + FormatFixed(std::abs(right_deg), 2) +
+         " deg towards the image's " + (right_deg >= 0 ? "right" : "left") + ", " +
+         FormatFixed(std::abs(down_deg), 2) + " deg towards its " +
+         (down_deg >= 0 ? "bottom" : "top") + "); its inner surface is " +
+         FormatFixed(1000 * InterfaceDistance(port), 2) +
          " mm in front of the camera's projection centre";
 }
 
@@ -83,9 +87,12 @@ HousingRefinement FlatPort::Refinement(const double* /*port*/) {
   return refinement;
 }
 
-bool FlatPort::AtBound(const double* port) { return InterfaceDistance(port) <= 1.5 * kMinAdjustedDistance; }
+bool FlatPort::AtBound(const double* port) {
+  return InterfaceDistance(port) <= 1.5 * kMinAdjustedDistance;
+}
 
-std::vector<std::vector<double>> FlatPort::StartCandidates(const double* port, const Eigen::Vector3d& axis) {
+std::vector<std::vector<double>> FlatPort::StartCandidates(const double* port,
+                                                           const Eigen::Vector3d& axis) {
   const Eigen::Vector3d normal = axis.z() < 0 ? Eigen::Vector3d(-axis) : axis;
   std::vector<std::vector<double>> starts;
   for (int i = 0; i < 15; ++i) {
@@ -97,8 +104,7 @@ std::vector<std::vector<double>> FlatPort::StartCandidates(const double* port, c
   return starts;
 }
 
-bool FlatPort::AirRayToPointValue(const double* port,
-                                  const Eigen::Vector3d& point,
+bool FlatPort::AirRayToPointValue(const double* port, const Eigen::Vector3d& point,
                                   Eigen::Vector3d* dir_in_air) {
   const Eigen::Vector3d n = Normal(port);
   const double d = InterfaceDistance(port);

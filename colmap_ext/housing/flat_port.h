@@ -25,8 +25,7 @@ struct FlatPort {
   static constexpr int kId = 0;
   static constexpr const char* kName = "FLATPORT";
   static constexpr int kNumParams = 8;
-  static constexpr const char* kParamsInfo =
-      "Nx, Ny, Nz, int_dist, int_thick, na, ng, nw";
+  static constexpr const char* kParamsInfo = "Nx, Ny, Nz, int_dist, int_thick, na, ng, nw";
 
   // Normalized, so that derivatives w.r.t. (Nx, Ny, Nz) are those of the
   // direction (the stored vector is unit up to rounding; Invalidity checks).
@@ -35,15 +34,25 @@ struct FlatPort {
     return VectorT<T, 3>(port[0], port[1], port[2]).normalized();
   }
   template <typename T>
-  static const T& InterfaceDistance(const T* port) { return port[3]; }
+  static const T& InterfaceDistance(const T* port) {
+    return port[3];
+  }
   template <typename T>
-  static const T& Thickness(const T* port) { return port[4]; }
+  static const T& Thickness(const T* port) {
+    return port[4];
+  }
   template <typename T>
-  static const T& AirIndex(const T* port) { return port[5]; }
+  static const T& AirIndex(const T* port) {
+    return port[5];
+  }
   template <typename T>
-  static const T& GlassIndex(const T* port) { return port[6]; }
+  static const T& GlassIndex(const T* port) {
+    return port[6];
+  }
   template <typename T>
-  static const T& WaterIndex(const T* port) { return port[7]; }
+  static const T& WaterIndex(const T* port) {
+    return port[7];
+  }
 
   // The unit axis every plane of refraction contains, through the camera
   // centre: the normal (always there).
@@ -80,7 +89,8 @@ struct FlatPort {
   // Starts for a housing calibration given the refraction axis the views
   // show (up to sign): that normal, facing forward, at distances from 1 mm
   // to 15 cm on a log grid; the constants from `port`.
-  static std::vector<std::vector<double>> StartCandidates(const double* port, const Eigen::Vector3d& axis);
+  static std::vector<std::vector<double>> StartCandidates(const double* port,
+                                                          const Eigen::Vector3d& axis);
   // In-air focal length over the one the camera appears to have behind the
   // port near the axis: a flat port magnifies paraxial rays by nw / na
   // (tan a_air = nw / na tan a_water).
@@ -90,10 +100,8 @@ struct FlatPort {
   // length) -> ray in water, origin on the outer surface, unit direction.
   // False if the ray misses the port (n . d <= 0) or is totally reflected.
   template <typename T>
-  [[nodiscard]] static bool RayInWater(const T* port,
-                                       const VectorT<T, 3>& dir_in_air,
-                                       VectorT<T, 3>* origin,
-                                       VectorT<T, 3>* dir) {
+  [[nodiscard]] static bool RayInWater(const T* port, const VectorT<T, 3>& dir_in_air,
+                                       VectorT<T, 3>* origin, VectorT<T, 3>* dir) {
     const VectorT<T, 3> n = Normal(port);
     const VectorT<T, 3> d0 = dir_in_air.normalized();
     const T cos0 = n.dot(d0);
@@ -116,8 +124,7 @@ struct FlatPort {
   // whose left side is convex and increasing in s, so a safeguarded Newton
   // iteration with the analytic derivative converges from any start.
   // False if the point is not beyond the outer surface.
-  static bool AirRayToPointValue(const double* port,
-                                 const Eigen::Vector3d& point,
+  static bool AirRayToPointValue(const double* port, const Eigen::Vector3d& point,
                                  Eigen::Vector3d* dir_in_air);
 };
 

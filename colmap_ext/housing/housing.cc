@@ -23,36 +23,32 @@ bool ExistsHousingModelWithName(const std::string& name) {
 
 int HousingModelNameToId(const std::string& name) {
   int id = -1;
-  if (!VisitModelByName(HousingModelList{}, name,
-                        [&](auto model) { id = decltype(model)::kId; })) {
-    throw InputError("unknown housing model '" + name + "' (expected one of " + HousingModelNames() + ")");
+  if (!VisitModelByName(HousingModelList{}, name, [&](auto model) { id = decltype(model)::kId; })) {
+    throw InputError("unknown housing model '" + name + "' (expected one of " +
+                     HousingModelNames() + ")");
   }
   return id;
 }
 
 std::string HousingModelIdToName(int model_id) {
   std::string name;
-  VisitHousingModel(model_id,
-                    [&](auto model) { name = decltype(model)::kName; });
+  VisitHousingModel(model_id, [&](auto model) { name = decltype(model)::kName; });
   return name;
 }
 
 int HousingModelNumParams(int model_id) {
   int n = 0;
-  VisitHousingModel(model_id,
-                    [&](auto model) { n = decltype(model)::kNumParams; });
+  VisitHousingModel(model_id, [&](auto model) { n = decltype(model)::kNumParams; });
   return n;
 }
 
 std::string HousingModelParamsInfo(int model_id) {
   std::string info;
-  VisitHousingModel(model_id,
-                    [&](auto model) { info = decltype(model)::kParamsInfo; });
+  VisitHousingModel(model_id, [&](auto model) { info = decltype(model)::kParamsInfo; });
   return info;
 }
 
-Housing Housing::FromName(const std::string& model_name,
-                          std::vector<double> params,
+Housing Housing::FromName(const std::string& model_name, std::vector<double> params,
                           const std::string& context) {
   Housing housing;
   try {
@@ -65,29 +61,23 @@ Housing Housing::FromName(const std::string& model_name,
   return housing;
 }
 
-std::string Housing::ModelName() const {
-  return HousingModelIdToName(model_id);
-}
+std::string Housing::ModelName() const { return HousingModelIdToName(model_id); }
 
-std::string Housing::ParamsInfo() const {
-  return HousingModelParamsInfo(model_id);
-}
+std::string Housing::ParamsInfo() const { return HousingModelParamsInfo(model_id); }
 
 void Housing::Validate(const std::string& context) const {
   std::optional<std::string> problem;
   bool known = VisitModelById(HousingModelList{}, model_id, [&](auto model) {
     using Port = decltype(model);
     if (static_cast<int>(params.size()) != Port::kNumParams) {
-      problem = std::string(Port::kName) + " takes " +
-                std::to_string(Port::kNumParams) + " parameters (" +
-                Port::kParamsInfo + "), got " + std::to_string(params.size());
+      problem = std::string(Port::kName) + " takes " + std::to_string(Port::kNumParams) +
+                " parameters (" + Port::kParamsInfo + "), got " + std::to_string(params.size());
     } else {
       problem = Port::Invalidity(params.data());
     }
   });
   if (!known) {
-    throw InputError(context + ": unknown housing model id " +
-                     std::to_string(model_id));
+    throw InputError(context + ": unknown housing model id " + std::to_string(model_id));
   }
   if (problem) throw InputError(context + ": " + *problem);
 }
@@ -112,7 +102,8 @@ void Housing::ValidateInput(const std::string& context) const {
   std::optional<std::string> mistake;
   VisitModelById(HousingModelList{}, model_id, [&](auto model) {
     using Port = decltype(model);
-    if (static_cast<int>(params.size()) == Port::kNumParams) mistake = Port::UnitMistake(params.data());
+    if (static_cast<int>(params.size()) == Port::kNumParams)
+      mistake = Port::UnitMistake(params.data());
   });
   if (mistake) throw InputError(context + ": " + *mistake);
   Validate(context);
@@ -158,8 +149,7 @@ double Housing::InAirFocalRatio() const {
   return ratio;
 }
 
-std::optional<Eigen::Vector2d> ProjectPoint(const Camera& camera,
-                                            const Housing* housing,
+std::optional<Eigen::Vector2d> ProjectPoint(const Camera& camera, const Housing* housing,
                                             const Eigen::Vector3d& point_in_cam) {
   if (housing == nullptr) return camera.ImgFromCam(point_in_cam);
   std::optional<Eigen::Vector2d> pixel;
@@ -170,9 +160,8 @@ std::optional<Eigen::Vector2d> ProjectPoint(const Camera& camera,
       PORTCAL_CHECK(camera.params.size() == CameraModel::kNumParams);
       PORTCAL_CHECK(housing->params.size() == Port::kNumParams);
       Eigen::Vector2d xy;
-      if (ImgFromWater<CameraModel, Port, double>(
-              camera.params.data(), housing->params.data(), point_in_cam,
-              &xy.x(), &xy.y())) {
+      if (ImgFromWater<CameraModel, Port, double>(camera.params.data(), housing->params.data(),
+                                                  point_in_cam, &xy.x(), &xy.y())) {
         pixel = xy;
       }
     });
@@ -180,8 +169,7 @@ std::optional<Eigen::Vector2d> ProjectPoint(const Camera& camera,
   return pixel;
 }
 
-std::optional<Ray3d> UnprojectPixel(const Camera& camera,
-                                    const Housing* housing,
+std::optional<Ray3d> UnprojectPixel(const Camera& camera, const Housing* housing,
                                     const Eigen::Vector2d& pixel) {
   const std::optional<Eigen::Vector3d> dir = camera.CamFromImg(pixel);
   if (!dir) return std::nullopt;
@@ -194,8 +182,7 @@ std::optional<Ray3d> UnprojectPixel(const Camera& camera,
   VisitHousingModel(housing->model_id, [&](auto port_model) {
     using Port = decltype(port_model);
     PORTCAL_CHECK(housing->params.size() == Port::kNumParams);
-    ok = Port::RayInWater(housing->params.data(), *dir, &ray.origin,
-                          &ray.direction);
+    ok = Port::RayInWater(housing->params.data(), *dir, &ray.origin, &ray.direction);
   });
   if (!ok) return std::nullopt;
   return ray;

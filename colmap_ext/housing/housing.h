@@ -18,8 +18,7 @@ struct Housing {
 
   // Throws InputError (prefixed by `context`) for unknown names or invalid
   // parameters.
-  static Housing FromName(const std::string& model_name,
-                          std::vector<double> params,
+  static Housing FromName(const std::string& model_name, std::vector<double> params,
                           const std::string& context);
 
   std::string ModelName() const;
@@ -57,15 +56,13 @@ struct Ray3d {
 // Point in the camera frame -> pixel, through the housing if there is one.
 // nullopt where the point cannot be seen (behind the camera, inside the
 // housing, total internal reflection).
-std::optional<Eigen::Vector2d> ProjectPoint(const Camera& camera,
-                                            const Housing* housing,
+std::optional<Eigen::Vector2d> ProjectPoint(const Camera& camera, const Housing* housing,
                                             const Eigen::Vector3d& point_in_cam);
 
 // Pixel -> ray in the camera frame: in water (origin on the outer surface) if
 // there is a housing, else from the camera centre. nullopt where the pixel
 // has no ray.
-std::optional<Ray3d> UnprojectPixel(const Camera& camera,
-                                    const Housing* housing,
+std::optional<Ray3d> UnprojectPixel(const Camera& camera, const Housing* housing,
                                     const Eigen::Vector2d& pixel);
 
 }  // namespace portcal

@@ -13,7 +13,8 @@
 
 namespace portcal {
 
-void SetHousingRefinement(const Housing& model, bool refine_position, double* housing, ceres::Problem* problem) {
+void SetHousingRefinement(const Housing& model, bool refine_position, double* housing,
+                          ceres::Problem* problem) {
   const HousingRefinement refinement = model.Refinement();
   const int n = static_cast<int>(model.params.size());
   std::vector<bool> refined(static_cast<size_t>(n), false);
@@ -38,12 +39,15 @@ void SetHousingRefinement(const Housing& model, bool refine_position, double* ho
     for (int k = 3; k < n; ++k) {
       if (!refined[static_cast<size_t>(k)]) held.push_back(k - 3);
     }
-    problem->SetManifold(housing, new ceres::ProductManifold<ceres::SphereManifold<3>, ceres::SubsetManifold>(
-                                      ceres::SphereManifold<3>(), ceres::SubsetManifold(n - 3, held)));
+    problem->SetManifold(
+        housing, new ceres::ProductManifold<ceres::SphereManifold<3>, ceres::SubsetManifold>(
+                     ceres::SphereManifold<3>(), ceres::SubsetManifold(n - 3, held)));
   }
   for (const HousingParamBound& bound : refinement.bounds) {
-    if (std::isfinite(bound.lower)) problem->SetParameterLowerBound(housing, bound.index, bound.lower);
-    if (std::isfinite(bound.upper)) problem->SetParameterUpperBound(housing, bound.index, bound.upper);
+    if (std::isfinite(bound.lower))
+      problem->SetParameterLowerBound(housing, bound.index, bound.lower);
+    if (std::isfinite(bound.upper))
+      problem->SetParameterUpperBound(housing, bound.index, bound.upper);
   }
 }
 

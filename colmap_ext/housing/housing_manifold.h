@@ -11,6 +11,7 @@ namespace portcal {
 
 // `housing` gives the model (and the bounds that depend on its constants);
 // `params` is the block in `problem`, already added.
-void SetHousingRefinement(const Housing& housing, bool refine_position, double* params, ceres::Problem* problem);
+void SetHousingRefinement(const Housing& housing, bool refine_position, double* params,
+                          ceres::Problem* problem);
 
 }  // namespace portcal

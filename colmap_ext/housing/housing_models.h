@@ -21,7 +21,8 @@ std::string HousingModelIds();
 template <typename F>
 void VisitHousingModel(int model_id, F&& f) {
   if (!VisitModelById(HousingModelList{}, model_id, std::forward<F>(f))) {
-    throw InputError("unknown housing model id " + std::to_string(model_id) + " (" + HousingModelIds() + ")");
+    throw InputError("unknown housing model id " + std::to_string(model_id) + " (" +
+                     HousingModelIds() + ")");
   }
 }
 

@@ -16,13 +16,10 @@ namespace internal {
 // Distance of `point` from the water ray of the air direction
 // base + alpha e1 + beta e2, expressed in the fixed basis (b1, b2).
 template <typename Port, typename S>
-bool WaterRayMiss(const S* port, const VectorT<S, 3>& point,
-                  const Eigen::Vector3d& base, const Eigen::Vector3d& e1,
-                  const Eigen::Vector3d& e2, const Eigen::Vector3d& b1,
-                  const Eigen::Vector3d& b2, const S& alpha, const S& beta,
-                  S* miss) {
-  const VectorT<S, 3> dir = base.cast<S>() + alpha * e1.cast<S>() +
-                            beta * e2.cast<S>();
+bool WaterRayMiss(const S* port, const VectorT<S, 3>& point, const Eigen::Vector3d& base,
+                  const Eigen::Vector3d& e1, const Eigen::Vector3d& e2, const Eigen::Vector3d& b1,
+                  const Eigen::Vector3d& b2, const S& alpha, const S& beta, S* miss) {
+  const VectorT<S, 3> dir = base.cast<S>() + alpha * e1.cast<S>() + beta * e2.cast<S>();
   VectorT<S, 3> origin, water_dir;
   if (!Port::RayInWater(port, dir, &origin, &water_dir)) return false;
   VectorT<S, 3> q = point - origin;
@@ -33,8 +30,7 @@ bool WaterRayMiss(const S* port, const VectorT<S, 3>& point,
 }
 
 // Any orthonormal pair perpendicular to the unit vector v.
-inline void PerpendicularBasis(const Eigen::Vector3d& v, Eigen::Vector3d* a,
-                               Eigen::Vector3d* b) {
+inline void PerpendicularBasis(const Eigen::Vector3d& v, Eigen::Vector3d* a, Eigen::Vector3d* b) {
   *a = v.unitOrthogonal();
   *b = v.cross(*a);
 }
@@ -85,9 +81,8 @@ template <typename Port, typename T>
     VectorT<Inner, 3> point_inner;
     for (int k = 0; k < 3; ++k) point_inner[k] = Inner(point_value[k], kPointOffset + k);
     Inner miss_inner[2];
-    if (!internal::WaterRayMiss<Port, Inner>(port_inner, point_inner, base, e1,
-                                             e2, b1, b2, Inner(0.0, 0),
-                                             Inner(0.0, 1), miss_inner)) {
+    if (!internal::WaterRayMiss<Port, Inner>(port_inner, point_inner, base, e1, e2, b1, b2,
+                                             Inner(0.0, 0), Inner(0.0, 1), miss_inner)) {
       return false;
     }
     const double j00 = miss_inner[0].v[0], j01 = miss_inner[0].v[1];
@@ -108,9 +103,7 @@ template <typename Port, typename T>
     }
     const T alpha = -(j11 * miss[0] - j01 * miss[1]) / det;
     const T beta = -(-j10 * miss[0] + j00 * miss[1]) / det;
-    *dir_in_air =
-        (base.cast<T>() + alpha * e1.cast<T>() + beta * e2.cast<T>())
-            .normalized();
+    *dir_in_air = (base.cast<T>() + alpha * e1.cast<T>() + beta * e2.cast<T>()).normalized();
     return true;
   }
 }
@@ -118,8 +111,7 @@ template <typename Port, typename T>
 // Point in water (camera frame) -> pixel, through the port and the lens.
 template <typename CameraModel, typename Port, typename T>
 [[nodiscard]] bool ImgFromWater(const T* intrinsics, const T* port,
-                                const VectorT<T, 3>& point_in_cam, T* x,
-                                T* y) {
+                                const VectorT<T, 3>& point_in_cam, T* x, T* y) {
   VectorT<T, 3> dir;
   if (!AirRayToPoint<Port, T>(port, point_in_cam, &dir)) return false;
   return CameraModel::ImgFromCam(intrinsics, dir[0], dir[1], dir[2], x, y);
@@ -128,9 +120,8 @@ template <typename CameraModel, typename Port, typename T>
 // Pixel -> ray in water (origin on the port's outer surface, unit
 // direction), in the camera frame.
 template <typename CameraModel, typename Port, typename T>
-[[nodiscard]] bool WaterFromImg(const T* intrinsics, const T* port, const T& x,
-                                const T& y, VectorT<T, 3>* origin,
-                                VectorT<T, 3>* dir) {
+[[nodiscard]] bool WaterFromImg(const T* intrinsics, const T* port, const T& x, const T& y,
+                                VectorT<T, 3>* origin, VectorT<T, 3>* dir) {
   T u, v;
   if (!CameraModel::CamFromImg(intrinsics, x, y, &u, &v)) return false;
   return Port::RayInWater(port, VectorT<T, 3>(u, v, T(1)), origin, dir);

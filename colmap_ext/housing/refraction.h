@@ -19,8 +19,8 @@ using VectorT = Eigen::Matrix<T, Dim, 1>;
 // the side the ray goes to (n . d > 0). Writes the unit refracted direction.
 // False on total internal reflection (or a ray that does not cross).
 template <typename T, int Dim>
-[[nodiscard]] bool Refract(const VectorT<T, Dim>& d, const VectorT<T, Dim>& n,
-                           const T& index_ratio, VectorT<T, Dim>* refracted) {
+[[nodiscard]] bool Refract(const VectorT<T, Dim>& d, const VectorT<T, Dim>& n, const T& index_ratio,
+                           VectorT<T, Dim>* refracted) {
   using std::sqrt;
   const T c = n.dot(d);
   if (!(c > T(0))) return false;
@@ -34,10 +34,8 @@ template <typename T, int Dim>
 // to the sphere of `radius` around `center`. False if the origin is not
 // strictly inside (then the discriminant may vanish).
 template <typename T, int Dim>
-[[nodiscard]] bool ExitDistanceFromInside(const VectorT<T, Dim>& origin,
-                                          const VectorT<T, Dim>& d,
-                                          const VectorT<T, Dim>& center,
-                                          const T& radius, T* s) {
+[[nodiscard]] bool ExitDistanceFromInside(const VectorT<T, Dim>& origin, const VectorT<T, Dim>& d,
+                                          const VectorT<T, Dim>& center, const T& radius, T* s) {
   using std::sqrt;
   const VectorT<T, Dim> q = origin - center;
   const T c = q.squaredNorm() - radius * radius;

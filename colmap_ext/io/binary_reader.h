@@ -13,7 +13,8 @@ namespace portcal {
 
 class BinaryReader {
  public:
-  explicit BinaryReader(const std::filesystem::path& path) : path_(path), file_(path, std::ios::binary) {
+  explicit BinaryReader(const std::filesystem::path& path)
+      : path_(path), file_(path, std::ios::binary) {
     if (!file_) throw InputError(path.string() + ": cannot open");
   }
 
@@ -54,7 +55,8 @@ class BinaryReader {
     const auto end = file_.tellg();
     file_.seekg(position);
     if (item_bytes > 0 && count > static_cast<uint64_t>(end - position) / item_bytes) {
-      throw InputError(path_.string() + ": implausible " + what + " " + std::to_string(count) + " (file too short)");
+      throw InputError(path_.string() + ": implausible " + what + " " + std::to_string(count) +
+                       " (file too short)");
     }
     return count;
   }

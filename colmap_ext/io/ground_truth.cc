@@ -41,8 +41,7 @@ class Reader {
     return value;
   }
 
-  std::vector<double> Vector(const YAML::Node& node, const std::string& key,
-                             size_t size) const {
+  std::vector<double> Vector(const YAML::Node& node, const std::string& key, size_t size) const {
     const std::vector<double> values = Get<std::vector<double>>(node, key);
     if (size > 0 && values.size() != size) {
       Fail(key, "expected " + std::to_string(size) + " numbers");
@@ -91,8 +90,8 @@ class Reader {
 
   std::optional<Housing> ReadHousing(const YAML::Node& node, const std::string& key) const {
     if (!node[key] || node[key].IsNull()) return std::nullopt;
-    return Housing::FromName(Get<std::string>(node[key], "model"),
-                             Vector(node[key], "params", 0), path_ + ": " + key);
+    return Housing::FromName(Get<std::string>(node[key], "model"), Vector(node[key], "params", 0),
+                             path_ + ": " + key);
   }
 
   ImageTruth ReadImage(const YAML::Node& node, const std::string& where) const {
@@ -111,7 +110,8 @@ class Reader {
       }
     }
     if (node["corners_visible"]) {
-      for (const YAML::Node& c : node["corners_visible"]) image.corners_visible.push_back(c.as<bool>());
+      for (const YAML::Node& c : node["corners_visible"])
+        image.corners_visible.push_back(c.as<bool>());
     }
     if (node["markers"]) {
       for (const YAML::Node& m : node["markers"]) {
@@ -181,7 +181,8 @@ class Reader {
         if (f["extent_xy"]) {
           const auto x = f["extent_xy"][0].as<std::vector<double>>();
           const auto y = f["extent_xy"][1].as<std::vector<double>>();
-          if (x.size() != 2 || y.size() != 2) Fail("target.faces extent_xy", "expected two pairs of numbers");
+          if (x.size() != 2 || y.size() != 2)
+            Fail("target.faces extent_xy", "expected two pairs of numbers");
           face.extent_x = {x[0], x[1]};
           face.extent_y = {y[0], y[1]};
         }
@@ -331,8 +332,8 @@ void WriteTarget(std::ostream& out, const TargetDescription& t) {
       out << "  - name: " << face.name << "\n";
       WritePose(out, "    ", "target_from_face", face.target_from_face);
       out << "    extent_xy:\n    - " << List(face.extent_x) << "\n    - " << List(face.extent_y)
-          << "\n    marker_id: " << face.marker_id << "\n    marker_side: "
-          << Num(face.marker_side) << "\n    marker_module: " << Num(face.marker_module)
+          << "\n    marker_id: " << face.marker_id << "\n    marker_side: " << Num(face.marker_side)
+          << "\n    marker_module: " << Num(face.marker_module)
           << "\n    quiet_zone: " << Num(face.quiet_zone) << "\n    marker_corners_3d:\n";
       for (const auto& c : t.markers.at(f).corners) out << "    - " << List(c) << "\n";
       out << "    num_dots: " << face.num_dots << "\n";
@@ -449,8 +450,8 @@ void WriteGroundTruth(const GroundTruth& truth, const fs::path& path,
     WriteCamera(out, "  ", "camera2", truth.stereo->camera2);
     WriteHousing(out, "  ", "housing2", truth.stereo->housing2);
     out << "  baseline: " << Num(truth.stereo->baseline) << "\n"
-        << "  image_dirs: [" << truth.stereo->image_dirs[0] << ", "
-        << truth.stereo->image_dirs[1] << "]\n";
+        << "  image_dirs: [" << truth.stereo->image_dirs[0] << ", " << truth.stereo->image_dirs[1]
+        << "]\n";
   } else {
     out << "stereo: null\n";
   }

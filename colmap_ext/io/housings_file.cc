@@ -14,8 +14,7 @@ namespace fs = std::filesystem;
 namespace portcal {
 namespace {
 
-std::vector<double> ParseParams(const std::vector<std::string>& tokens,
-                                size_t begin, size_t end,
+std::vector<double> ParseParams(const std::vector<std::string>& tokens, size_t begin, size_t end,
                                 const std::string& where) {
   std::vector<double> params;
   for (size_t i = begin; i < end; ++i) {
@@ -39,10 +38,10 @@ std::map<camera_t, Housing> ReadHousingsText(const fs::path& path) {
     if (tokens.size() < 2) {
       throw InputError(where + ": expected CAMERA_ID MODEL PARAMS");
     }
-    const camera_t camera_id = static_cast<camera_t>(
-        ParseInteger(tokens[0], where + " camera id", 0, 0xFFFFFFFELL));
-    Housing housing = Housing::FromName(
-        tokens[1], ParseParams(tokens, 2, tokens.size(), where), where);
+    const camera_t camera_id =
+        static_cast<camera_t>(ParseInteger(tokens[0], where + " camera id", 0, 0xFFFFFFFELL));
+    Housing housing =
+        Housing::FromName(tokens[1], ParseParams(tokens, 2, tokens.size(), where), where);
     if (!housings.emplace(camera_id, std::move(housing)).second) {
       throw InputError(where + ": second housing for camera " + tokens[0]);
     }
@@ -50,8 +49,7 @@ std::map<camera_t, Housing> ReadHousingsText(const fs::path& path) {
   return housings;
 }
 
-void WriteHousingsText(const std::map<camera_t, Housing>& housings,
-                       std::ostream& out) {
+void WriteHousingsText(const std::map<camera_t, Housing>& housings, std::ostream& out) {
   out.precision(17);
   out << "# Housing list with one line of data per camera behind a port:\n"
       << "#   CAMERA_ID, MODEL, PARAMS[]\n"
@@ -65,8 +63,7 @@ void WriteHousingsText(const std::map<camera_t, Housing>& housings,
   }
 }
 
-void ImportRefractiveCamerasText(const fs::path& path,
-                                 std::map<camera_t, Camera>* cameras,
+void ImportRefractiveCamerasText(const fs::path& path, std::map<camera_t, Camera>* cameras,
                                  std::map<camera_t, Housing>* housings) {
   std::ifstream file(path);
   if (!file) throw InputError(path.string() + ": cannot open");
@@ -80,8 +77,8 @@ void ImportRefractiveCamerasText(const fs::path& path,
       throw InputError(where + ": expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS");
     }
     Camera camera;
-    camera.camera_id = static_cast<camera_t>(
-        ParseInteger(tokens[0], where + " camera id", 0, 0xFFFFFFFELL));
+    camera.camera_id =
+        static_cast<camera_t>(ParseInteger(tokens[0], where + " camera id", 0, 0xFFFFFFFELL));
     try {
       camera.model_id = CameraModelNameToId(tokens[1]);
     } catch (const InputError& e) {
@@ -100,8 +97,7 @@ void ImportRefractiveCamerasText(const fs::path& path,
     camera.Validate(where);
     if (tokens.size() > params_end) {
       (*housings)[camera.camera_id] = Housing::FromName(
-          tokens[params_end],
-          ParseParams(tokens, params_end + 1, tokens.size(), where), where);
+          tokens[params_end], ParseParams(tokens, params_end + 1, tokens.size(), where), where);
     }
     if (!cameras->emplace(camera.camera_id, camera).second) {
       throw InputError(where + ": duplicate camera id " + tokens[0]);

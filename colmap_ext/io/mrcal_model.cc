@@ -43,16 +43,19 @@ std::string MrcalLensModelFor(const std::string& colmap_model) {
   std::string nearest;
   if (colmap_model == "OPENCV_FISHEYE" || colmap_model == "SIMPLE_RADIAL_FISHEYE" ||
       colmap_model == "RADIAL_FISHEYE" || colmap_model == "THIN_PRISM_FISHEYE") {
-    nearest = "LENSMODEL_SPLINED_STEREOGRAPHIC (or LENSMODEL_OPENCV8 for fields of view "
-              "below ~100 deg, i.e. COLMAP's FULL_OPENCV)";
+    nearest =
+        "LENSMODEL_SPLINED_STEREOGRAPHIC (or LENSMODEL_OPENCV8 for fields of view "
+        "below ~100 deg, i.e. COLMAP's FULL_OPENCV)";
   } else if (colmap_model == "FOV") {
     nearest = "LENSMODEL_OPENCV8 (COLMAP's FULL_OPENCV)";
   } else {
     throw InputError("camera model " + colmap_model + " is not a COLMAP model (one of " +
                      CameraModelNames() + ")");
   }
-  throw InputError("camera model " + colmap_model + " has no mrcal counterpart (mrcal 2.2); "
-                   "nearest: " + nearest + ". Re-calibrate with that model to cross-check it");
+  throw InputError("camera model " + colmap_model +
+                   " has no mrcal counterpart (mrcal 2.2); "
+                   "nearest: " +
+                   nearest + ". Re-calibrate with that model to cross-check it");
 }
 
 std::string MrcalExtraFreedom(const std::string& colmap_model) {
@@ -99,11 +102,13 @@ Camera CameraFromMrcalLens(const MrcalLens& lens, uint64_t width, uint64_t heigh
   } else if (lens.lensmodel == "LENSMODEL_OPENCV8" && p.size() == 12) {
     model = "FULL_OPENCV";
   } else if (lens.lensmodel == "LENSMODEL_OPENCV12") {
-    throw InputError(context + ": " + lens.lensmodel + " (thin prism) has no COLMAP "
+    throw InputError(context + ": " + lens.lensmodel +
+                     " (thin prism) has no COLMAP "
                      "counterpart; nearest: FULL_OPENCV (LENSMODEL_OPENCV8)");
   } else {
     throw InputError(context + ": mrcal lens model " + lens.lensmodel + " with " +
-                     std::to_string(p.size()) + " intrinsics has no COLMAP counterpart (COLMAP "
+                     std::to_string(p.size()) +
+                     " intrinsics has no COLMAP counterpart (COLMAP "
                      "expresses LENSMODEL_PINHOLE, OPENCV4, OPENCV5 and OPENCV8)");
   }
   p[2] += kPixelShift;
@@ -120,14 +125,16 @@ Camera CameraFromMrcalLens(const MrcalLens& lens, uint64_t width, uint64_t heigh
 std::array<double, 6> RtFromRigid(const Rigid3d& b_from_a) {
   const Eigen::AngleAxisd aa(b_from_a.rotation.normalized());
   const Eigen::Vector3d r = aa.angle() * aa.axis();
-  return {r[0], r[1], r[2], b_from_a.translation[0], b_from_a.translation[1], b_from_a.translation[2]};
+  return {
+      r[0], r[1], r[2], b_from_a.translation[0], b_from_a.translation[1], b_from_a.translation[2]};
 }
 
 Rigid3d RigidFromRt(const double* rt) {
   const Eigen::Vector3d r(rt[0], rt[1], rt[2]);
   const double angle = r.norm();
-  const Eigen::Quaterniond rotation =
-      angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, r / angle)) : Eigen::Quaterniond::Identity();
+  const Eigen::Quaterniond rotation = angle > 0
+                                          ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, r / angle))
+                                          : Eigen::Quaterniond::Identity();
   return Rigid3d(rotation, Eigen::Vector3d(rt[3], rt[4], rt[5]));
 }
 
@@ -140,7 +147,8 @@ namespace {
 // matched, nothing after the closing brace -- before mrcal sees it.
 void CheckCompleteDictLiteral(const std::string& text, const std::string& path) {
   const auto fail = [&](const std::string& what, size_t at) {
-    throw InputError(path + ": not a complete mrcal .cameramodel (" + what + " at byte " + std::to_string(at) + ")");
+    throw InputError(path + ": not a complete mrcal .cameramodel (" + what + " at byte " +
+                     std::to_string(at) + ")");
   };
   std::string open;  // the brackets not yet closed
   bool seen_dict = false;
@@ -184,13 +192,14 @@ size_t TopLevelValue(const std::string& text, const std::string& key) {
     } else if (c == '\'' || c == '"') {
       size_t j = i + 1;
       while (j < text.size() && text[j] != c) j += text[j] == '\\' ? 2 : 1;
-      const bool is_key = depth == 1 && (previous == '{' || previous == ',') && text.compare(i + 1, j - i - 1, key) == 0 &&
-                          j - i - 1 == key.size();
+      const bool is_key = depth == 1 && (previous == '{' || previous == ',') &&
+                          text.compare(i + 1, j - i - 1, key) == 0 && j - i - 1 == key.size();
       i = j;
       previous = c;
       if (is_key) {
         const size_t colon = text.find_first_not_of(" \t\r\n", j + 1);
-        if (colon != std::string::npos && text[colon] == ':') return text.find_first_not_of(" \t\r\n", colon + 1);
+        if (colon != std::string::npos && text[colon] == ':')
+          return text.find_first_not_of(" \t\r\n", colon + 1);
       }
     } else if (!std::isspace(static_cast<unsigned char>(c))) {
       if (c == '{' || c == '[' || c == '(') ++depth;
@@ -205,7 +214,8 @@ size_t TopLevelValue(const std::string& text, const std::string& key) {
 void ReadSolveFields(const std::string& text, const std::string& path, MrcalCameraModelFile* file) {
   const size_t inputs = TopLevelValue(text, "optimization_inputs");
   if (inputs == std::string::npos) return;
-  if (inputs + 2 >= text.size() || text[inputs] != 'b' || (text[inputs + 1] != '\'' && text[inputs + 1] != '"')) {
+  if (inputs + 2 >= text.size() || text[inputs] != 'b' ||
+      (text[inputs + 1] != '\'' && text[inputs + 1] != '"')) {
     throw InputError(path + ": 'optimization_inputs' is not a bytes literal (b'...')");
   }
   const size_t end = text.find(text[inputs + 1], inputs + 2);  // base 85 has no quotes
@@ -213,9 +223,12 @@ void ReadSolveFields(const std::string& text, const std::string& path, MrcalCame
   file->optimization_inputs_base85 = text.substr(inputs + 2, end - inputs - 2);
   const size_t icam = TopLevelValue(text, "icam_intrinsics");
   char* parsed_end = nullptr;
-  const long value = icam == std::string::npos ? -1 : std::strtol(text.c_str() + icam, &parsed_end, 10);
-  if (icam == std::string::npos || parsed_end == text.c_str() + icam || value < 0 || value > 1000000) {
-    throw InputError(path + ": 'optimization_inputs' without a valid 'icam_intrinsics' (mrcal requires one)");
+  const long value =
+      icam == std::string::npos ? -1 : std::strtol(text.c_str() + icam, &parsed_end, 10);
+  if (icam == std::string::npos || parsed_end == text.c_str() + icam || value < 0 ||
+      value > 1000000) {
+    throw InputError(
+        path + ": 'optimization_inputs' without a valid 'icam_intrinsics' (mrcal requires one)");
   }
   file->icam_intrinsics = static_cast<int>(value);
 }
@@ -235,7 +248,8 @@ MrcalCameraModelFile ReadMrcalCameraModel(const std::filesystem::path& path) {
   std::unique_ptr<mrcal_cameramodel_t, CameraModelDeleter> model(
       mrcal_read_cameramodel_string(text.c_str(), static_cast<int>(text.size())));
   if (!model) {
-    throw InputError(path.string() + ": not a readable mrcal .cameramodel (mrcal's parser "
+    throw InputError(path.string() +
+                     ": not a readable mrcal .cameramodel (mrcal's parser "
                      "rejected it; its message is above)");
   }
   const int num_params = mrcal_lensmodel_num_params(&model->lensmodel);
@@ -247,8 +261,8 @@ MrcalCameraModelFile ReadMrcalCameraModel(const std::filesystem::path& path) {
   lens.lensmodel = name;
   lens.intrinsics.assign(model->intrinsics, model->intrinsics + num_params);
   MrcalCameraModelFile file;
-  file.camera = CameraFromMrcalLens(lens, model->imagersize[0], model->imagersize[1],
-                                    path.string());
+  file.camera =
+      CameraFromMrcalLens(lens, model->imagersize[0], model->imagersize[1], path.string());
   file.cam_from_ref = RigidFromRt(model->rt_cam_ref);
   ReadSolveFields(text, path.string(), &file);
   return file;
@@ -280,8 +294,8 @@ void WriteMrcalCameraModel(const Camera& camera, const Rigid3d& cam_from_ref,
       out << "  'icam_intrinsics': 0,\n"
           << "  # mrcal.optimize()'s inputs at portcal's solution (an .npz archive in base 85,\n"
           << "  # as mrcal stores them), for mrcal's uncertainty and diagnostic tools\n"
-          << "  'optimization_inputs': b'" << EncodeBase85(MrcalOptimizationInputsArchive(lens, camera, *solve))
-          << "',\n";
+          << "  'optimization_inputs': b'"
+          << EncodeBase85(MrcalOptimizationInputsArchive(lens, camera, *solve)) << "',\n";
     }
     out << "}\n";
   });

@@ -94,6 +94,7 @@ MrcalCameraModelFile ReadMrcalCameraModel(const std::filesystem::path& path);
 // with `solve`, also its optimization_inputs (regularisation and outlier
 // rejection off: portcal's solution has neither) and icam_intrinsics 0.
 void WriteMrcalCameraModel(const Camera& camera, const Rigid3d& cam_from_ref,
-                           const std::filesystem::path& path, const MrcalBoardSolve* solve = nullptr);
+                           const std::filesystem::path& path,
+                           const MrcalBoardSolve* solve = nullptr);
 
 }  // namespace portcal

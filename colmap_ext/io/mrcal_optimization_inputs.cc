@@ -11,10 +11,13 @@ namespace portcal {
 
 // mrcal.optimize()'s keyword arguments for `solve`, as an .npz archive
 // (mrcal's own serialisation: None is stored as '').
-std::string MrcalOptimizationInputsArchive(const MrcalLens& lens, const Camera& camera, const MrcalBoardSolve& solve) {
+std::string MrcalOptimizationInputsArchive(const MrcalLens& lens, const Camera& camera,
+                                           const MrcalBoardSolve& solve) {
   const int64_t num_frames = static_cast<int64_t>(solve.frames_rt_toref.size());
-  if (static_cast<int64_t>(solve.observations.size()) != num_frames * solve.height_n * solve.width_n * 3) {
-    throw std::invalid_argument("MrcalBoardSolve: observations do not match the frames and the board");
+  if (static_cast<int64_t>(solve.observations.size()) !=
+      num_frames * solve.height_n * solve.width_n * 3) {
+    throw std::invalid_argument(
+        "MrcalBoardSolve: observations do not match the frames and the board");
   }
   NpzArchive npz;
   npz.AddDoubles("intrinsics", {1, static_cast<int64_t>(lens.intrinsics.size())}, lens.intrinsics);
@@ -27,12 +30,14 @@ std::string MrcalOptimizationInputsArchive(const MrcalLens& lens, const Camera& 
   }
   npz.AddDoubles("frames_rt_toref", {num_frames, 6}, frames);
   npz.AddString("points", "");
-  npz.AddDoubles("observations_board", {num_frames, solve.height_n, solve.width_n, 3}, solve.observations);
+  npz.AddDoubles("observations_board", {num_frames, solve.height_n, solve.width_n, 3},
+                 solve.observations);
   npz.AddInt32s("indices_frame_camintrinsics_camextrinsics", {num_frames, 3}, indices);
   npz.AddString("observations_point", "");
   npz.AddString("indices_point_camintrinsics_camextrinsics", "");
   npz.AddString("lensmodel", lens.lensmodel);
-  npz.AddInt32s("imagersizes", {1, 2}, {static_cast<int32_t>(camera.width), static_cast<int32_t>(camera.height)});
+  npz.AddInt32s("imagersizes", {1, 2},
+                {static_cast<int32_t>(camera.width), static_cast<int32_t>(camera.height)});
   if (solve.warp_estimated) {
     npz.AddDoubles("calobject_warp", {2}, {solve.calobject_warp.x(), solve.calobject_warp.y()});
   } else {
@@ -75,14 +80,17 @@ class SolveArrays {
   std::vector<double> FiniteDoubles(const std::string& name, size_t rank, int64_t tail = -1) const {
     std::vector<double> values = Get(name, rank, tail).Doubles(Where(name));
     for (const double value : values) {
-      if (!std::isfinite(value)) throw InputError(context_ + ": optimization_inputs' '" + name + "' is not finite");
+      if (!std::isfinite(value))
+        throw InputError(context_ + ": optimization_inputs' '" + name + "' is not finite");
     }
     return values;
   }
   bool Flag(const std::string& name, bool fallback) const {
     return Has(name) ? Get(name, 0).Doubles(Where(name))[0] != 0 : fallback;
   }
-  std::string Where(const std::string& name) const { return context_ + ": optimization_inputs' '" + name + "'"; }
+  std::string Where(const std::string& name) const {
+    return context_ + ": optimization_inputs' '" + name + "'";
+  }
   const std::string& context() const { return context_; }
 
  private:
@@ -100,31 +108,36 @@ std::vector<Rigid3d> Poses(const std::vector<double>& rts) {
 
 MrcalBoardSolve ReadMrcalBoardSolve(const MrcalCameraModelFile& file, const std::string& context) {
   if (file.optimization_inputs_base85.empty()) {
-    throw InputError(context + ": carries no optimization_inputs (write it with mrcal-calibrate-cameras or "
+    throw InputError(context +
+                     ": carries no optimization_inputs (write it with mrcal-calibrate-cameras or "
                      "portcal camera_calibrator to keep them)");
   }
-  const SolveArrays arrays(ReadNpz(DecodeBase85(file.optimization_inputs_base85, context), context), context);
+  const SolveArrays arrays(ReadNpz(DecodeBase85(file.optimization_inputs_base85, context), context),
+                           context);
   if (!arrays.Has("observations_board")) {
     throw InputError(context + ": its solve observed no calibration board (points only)");
   }
   const NpyArray& observed = arrays.Get("observations_board", 4, 3);
   const std::vector<double> observations = arrays.FiniteDoubles("observations_board", 4, 3);
-  const std::vector<int64_t> indices =
-      arrays.Get("indices_frame_camintrinsics_camextrinsics", 2, 3).Integers(arrays.Where("indices"));
+  const std::vector<int64_t> indices = arrays.Get("indices_frame_camintrinsics_camextrinsics", 2, 3)
+                                           .Integers(arrays.Where("indices"));
   const std::vector<Rigid3d> frames = Poses(arrays.FiniteDoubles("frames_rt_toref", 2, 6));
   const std::vector<Rigid3d> extrinsics =
-      arrays.Has("extrinsics_rt_fromref") ? Poses(arrays.FiniteDoubles("extrinsics_rt_fromref", 2, 6))
-                                          : std::vector<Rigid3d>();
+      arrays.Has("extrinsics_rt_fromref")
+          ? Poses(arrays.FiniteDoubles("extrinsics_rt_fromref", 2, 6))
+          : std::vector<Rigid3d>();
   const int64_t num_observations = observed.shape[0];
   if (static_cast<int64_t>(indices.size()) != 3 * num_observations) {
-    throw InputError(context + ": optimization_inputs' indices do not match its board observations");
+    throw InputError(context +
+                     ": optimization_inputs' indices do not match its board observations");
   }
   MrcalBoardSolve solve;
   solve.height_n = static_cast<int>(observed.shape[1]);
   solve.width_n = static_cast<int>(observed.shape[2]);
   solve.spacing = arrays.FiniteDoubles("calibration_object_spacing", 0)[0];
   if (!(solve.spacing > 0) || solve.width_n < 2 || solve.height_n < 2) {
-    throw InputError(context + ": optimization_inputs' board is not a grid of at least 2x2 corners with a "
+    throw InputError(context +
+                     ": optimization_inputs' board is not a grid of at least 2x2 corners with a "
                      "positive spacing");
   }
   const std::vector<std::string> paths =
@@ -145,14 +158,16 @@ MrcalBoardSolve ReadMrcalBoardSolve(const MrcalCameraModelFile& file, const std:
                               observations.begin() + (i + 1) * per_board);
     solve.image_paths.push_back(static_cast<int64_t>(paths.size()) == num_observations
                                     ? paths[i]
-                                    : "frame " + std::to_string(frame) + " (observation " + std::to_string(i) + ")");
+                                    : "frame " + std::to_string(frame) + " (observation " +
+                                          std::to_string(i) + ")");
   }
   if (solve.frames_rt_toref.empty()) {
     throw InputError(context + ": camera " + std::to_string(file.icam_intrinsics) +
                      " (icam_intrinsics) observed no board in the solve");
   }
   // A warp that was held keeps no freedom for a joint solve to use.
-  solve.warp_estimated = arrays.Has("calobject_warp") && arrays.Flag("do_optimize_calobject_warp", true);
+  solve.warp_estimated =
+      arrays.Has("calobject_warp") && arrays.Flag("do_optimize_calobject_warp", true);
   if (arrays.Has("calobject_warp")) {
     const std::vector<double> warp = arrays.FiniteDoubles("calobject_warp", 1, 2);
     solve.calobject_warp = Eigen::Vector2d(warp[0], warp[1]);

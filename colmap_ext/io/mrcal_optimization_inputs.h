@@ -13,7 +13,8 @@ namespace portcal {
 
 // The .npz archive (not yet base 85) of `solve` for `camera` (as `lens`),
 // regularisation and outlier rejection off: portcal's solution has neither.
-std::string MrcalOptimizationInputsArchive(const MrcalLens& lens, const Camera& camera, const MrcalBoardSolve& solve);
+std::string MrcalOptimizationInputsArchive(const MrcalLens& lens, const Camera& camera,
+                                           const MrcalBoardSolve& solve);
 
 // The board observations of `file`'s camera (its icam_intrinsics) in its
 // optimization_inputs, as a one-camera solve: frames posed in that camera's

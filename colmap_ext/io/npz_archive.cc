@@ -34,8 +34,15 @@ std::vector<uint32_t> CodePoints(const std::string& text) {
   std::vector<uint32_t> points;
   for (size_t i = 0; i < text.size();) {
     const unsigned char lead = static_cast<unsigned char>(text[i]);
-    const int length = lead < 0x80 ? 1 : (lead >> 5) == 0x6 ? 2 : (lead >> 4) == 0xe ? 3 : (lead >> 3) == 0x1e ? 4 : 0;
-    uint32_t point = length == 1 ? lead : length == 2 ? lead & 0x1f : length == 3 ? lead & 0x0f : lead & 0x07;
+    const int length = lead < 0x80           ? 1
+                       : (lead >> 5) == 0x6  ? 2
+                       : (lead >> 4) == 0xe  ? 3
+                       : (lead >> 3) == 0x1e ? 4
+                                             : 0;
+    uint32_t point = length == 1   ? lead
+                     : length == 2 ? lead & 0x1f
+                     : length == 3 ? lead & 0x0f
+                                   : lead & 0x07;
     bool valid = length > 0 && i + length <= text.size();
     for (int k = 1; valid && k < length; ++k) {
       const unsigned char next = static_cast<unsigned char>(text[i + k]);
@@ -43,7 +50,8 @@ std::vector<uint32_t> CodePoints(const std::string& text) {
       point = (point << 6) | (next & 0x3f);
     }
     valid = valid && point <= 0x10ffff && !(point >= 0xd800 && point <= 0xdfff) &&
-            !(length == 2 && point < 0x80) && !(length == 3 && point < 0x800) && !(length == 4 && point < 0x10000);
+            !(length == 2 && point < 0x80) && !(length == 3 && point < 0x800) &&
+            !(length == 4 && point < 0x10000);
     points.push_back(valid ? point : 0xfffd);
     i += valid ? length : 1;
   }
@@ -54,7 +62,8 @@ std::vector<uint32_t> CodePoints(const std::string& text) {
 // with zeros.
 std::string Utf32Strings(const std::vector<std::vector<uint32_t>>& values, size_t width) {
   std::vector<uint32_t> units(values.size() * width, 0);
-  for (size_t i = 0; i < values.size(); ++i) std::copy(values[i].begin(), values[i].end(), units.begin() + i * width);
+  for (size_t i = 0; i < values.size(); ++i)
+    std::copy(values[i].begin(), values[i].end(), units.begin() + i * width);
   return RawBytes(units);
 }
 
@@ -66,9 +75,10 @@ std::string Utf32Strings(const std::vector<std::vector<uint32_t>>& values, size_
 
 }  // namespace
 
-void NpzArchive::Add(const std::string& name, const std::string& descr, const std::vector<int64_t>& shape,
-                     const std::string& data) {
-  std::string header = "{'descr': '" + descr + "', 'fortran_order': False, 'shape': " + ShapeTuple(shape) + ", }";
+void NpzArchive::Add(const std::string& name, const std::string& descr,
+                     const std::vector<int64_t>& shape, const std::string& data) {
+  std::string header =
+      "{'descr': '" + descr + "', 'fortran_order': False, 'shape': " + ShapeTuple(shape) + ", }";
   // Magic (6) + version (2) + length (2) + header, padded with spaces to a
   // multiple of 64 and ended by a newline.
   const size_t total = 10 + header.size() + 1;
@@ -81,8 +91,8 @@ void NpzArchive::Add(const std::string& name, const std::string& descr, const st
 }
 
 template <typename T>
-void NpzArchive::AddNumbers(const std::string& name, const std::string& descr, const std::vector<int64_t>& shape,
-                            const std::vector<T>& values) {
+void NpzArchive::AddNumbers(const std::string& name, const std::string& descr,
+                            const std::vector<int64_t>& shape, const std::vector<T>& values) {
   if (NumValues(shape) != static_cast<int64_t>(values.size())) {
     throw std::invalid_argument("npz: '" + name + "' has " + std::to_string(values.size()) +
                                 " values for shape " + ShapeTuple(shape));
@@ -117,7 +127,8 @@ void NpzArchive::AddStrings(const std::string& name, const std::vector<std::stri
     points.push_back(CodePoints(value));
     width = std::max(width, points.back().size());
   }
-  Add(name, "<U" + std::to_string(width), {static_cast<int64_t>(values.size())}, Utf32Strings(points, width));
+  Add(name, "<U" + std::to_string(width), {static_cast<int64_t>(values.size())},
+      Utf32Strings(points, width));
 }
 
 std::string NpzArchive::Bytes() const {
@@ -140,12 +151,14 @@ std::string NpzArchive::Bytes() const {
   for (const Entry& entry : entries_) {
     zip_source_t* source = zip_source_buffer(archive, entry.npy.data(), entry.npy.size(), 0);
     if (!source) fail("adding " + entry.name);
-    const zip_int64_t index = zip_file_add(archive, (entry.name + ".npy").c_str(), source, ZIP_FL_ENC_UTF_8);
+    const zip_int64_t index =
+        zip_file_add(archive, (entry.name + ".npy").c_str(), source, ZIP_FL_ENC_UTF_8);
     if (index < 0) {
       zip_source_free(source);
       fail("adding " + entry.name);
     }
-    if (zip_set_file_compression(archive, index, ZIP_CM_DEFLATE, 0) != 0) fail("compressing " + entry.name);
+    if (zip_set_file_compression(archive, index, ZIP_CM_DEFLATE, 0) != 0)
+      fail("compressing " + entry.name);
   }
   if (zip_close(archive) != 0) fail("writing the archive");
   std::string bytes;
@@ -158,7 +171,8 @@ std::string NpzArchive::Bytes() const {
   const zip_int64_t read = zip_source_read(buffer, bytes.data(), bytes.size());
   zip_source_close(buffer);
   zip_source_free(buffer);
-  if (read != static_cast<zip_int64_t>(bytes.size())) throw std::runtime_error("npz: short read of the archive");
+  if (read != static_cast<zip_int64_t>(bytes.size()))
+    throw std::runtime_error("npz: short read of the archive");
   return bytes;
 }
 

@@ -14,8 +14,10 @@ namespace portcal {
 class NpzArchive {
  public:
   // Arrays in C order; `shape` empty for a scalar (then one value).
-  void AddDoubles(const std::string& name, const std::vector<int64_t>& shape, const std::vector<double>& values);
-  void AddInt32s(const std::string& name, const std::vector<int64_t>& shape, const std::vector<int32_t>& values);
+  void AddDoubles(const std::string& name, const std::vector<int64_t>& shape,
+                  const std::vector<double>& values);
+  void AddInt32s(const std::string& name, const std::vector<int64_t>& shape,
+                 const std::vector<int32_t>& values);
   void AddDouble(const std::string& name, double value) { AddDoubles(name, {}, {value}); }
   void AddBool(const std::string& name, bool value);
   // A scalar string, or a 1-D array of them (NumPy's '<U' strings: UTF-32,
@@ -34,8 +36,8 @@ class NpzArchive {
   void Add(const std::string& name, const std::string& descr, const std::vector<int64_t>& shape,
            const std::string& data);
   template <typename T>
-  void AddNumbers(const std::string& name, const std::string& descr, const std::vector<int64_t>& shape,
-                  const std::vector<T>& values);
+  void AddNumbers(const std::string& name, const std::string& descr,
+                  const std::vector<int64_t>& shape, const std::vector<T>& values);
   std::vector<Entry> entries_;
 };
 

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <fstream>
 #include <iomanip>
-#include <sstream>
 #include <ostream>
+#include <sstream>
 #include <vector>
 
 #include "colmap_ext/camera/camera_models.h"
@@ -54,8 +54,7 @@ OpenCvCamera ToOpenCv(const Camera& camera) {
     }
   } else {
     throw InputError("camera model " + model + " cannot be written for OpenCV/ROS; nearest: " +
-                     (model == "FOV" ? std::string("FULL_OPENCV")
-                                     : std::string("OPENCV_FISHEYE")) +
+                     (model == "FOV" ? std::string("FULL_OPENCV") : std::string("OPENCV_FISHEYE")) +
                      " (re-calibrate with it)");
   }
   return out;
@@ -134,8 +133,10 @@ YAML::Node LoadOpenCvYaml(const std::filesystem::path& path) {
   }
 }
 
-std::vector<double> MatrixData(const YAML::Node& root, const std::string& key, const std::filesystem::path& path) {
-  if (!root[key] || !root[key]["data"]) throw InputError(path.string() + ": no '" + key + "' with 'data'");
+std::vector<double> MatrixData(const YAML::Node& root, const std::string& key,
+                               const std::filesystem::path& path) {
+  if (!root[key] || !root[key]["data"])
+    throw InputError(path.string() + ": no '" + key + "' with 'data'");
   try {
     return root[key]["data"].as<std::vector<double>>();
   } catch (const YAML::Exception& e) {
@@ -143,7 +144,8 @@ std::vector<double> MatrixData(const YAML::Node& root, const std::string& key, c
   }
 }
 
-uint64_t ImageSize(const YAML::Node& root, const std::string& key, const std::filesystem::path& path) {
+uint64_t ImageSize(const YAML::Node& root, const std::string& key,
+                   const std::filesystem::path& path) {
   try {
     if (root[key]) return root[key].as<uint64_t>();
   } catch (const YAML::Exception& e) {
@@ -153,8 +155,9 @@ uint64_t ImageSize(const YAML::Node& root, const std::string& key, const std::fi
 }
 
 // The COLMAP camera of OpenCV's coefficients (see ReadOpenCvCameraYaml).
-Camera CameraOfOpenCv(double fx, double fy, double cx, double cy, const std::vector<double>& d, bool fisheye,
-                      uint64_t width, uint64_t height, const std::filesystem::path& path) {
+Camera CameraOfOpenCv(double fx, double fy, double cx, double cy, const std::vector<double>& d,
+                      bool fisheye, uint64_t width, uint64_t height,
+                      const std::filesystem::path& path) {
   // COLMAP puts the centre of the top-left pixel at (0.5, 0.5), OpenCV at 0.
   std::vector<double> params = {fx, fy, cx + 0.5, cy + 0.5};
   std::string model;
@@ -163,7 +166,8 @@ Camera CameraOfOpenCv(double fx, double fy, double cx, double cy, const std::vec
                        [](double v) { return v == 0; });
   };
   if (fisheye) {
-    if (d.size() != 4) throw InputError(path.string() + ": a fisheye camera needs 4 distortion coefficients");
+    if (d.size() != 4)
+      throw InputError(path.string() + ": a fisheye camera needs 4 distortion coefficients");
     model = "OPENCV_FISHEYE";
     params.insert(params.end(), d.begin(), d.end());
   } else if (all_zero(0)) {
@@ -212,18 +216,21 @@ Camera ReadOpenCvCameraYamlUnguarded(const std::filesystem::path& path) {
   const YAML::Node root = LoadOpenCvYaml(path);
   const std::vector<double> k = MatrixData(root, "camera_matrix", path);
   if (k.size() != 9) throw InputError(path.string() + ": 'camera_matrix' needs 9 values");
-  const std::vector<double> d =
-      root["distortion_coefficients"] ? MatrixData(root, "distortion_coefficients", path) : std::vector<double>();
+  const std::vector<double> d = root["distortion_coefficients"]
+                                    ? MatrixData(root, "distortion_coefficients", path)
+                                    : std::vector<double>();
   std::string distortion_model;
   if (root["distortion_model"]) distortion_model = root["distortion_model"].as<std::string>();
   const bool fisheye = distortion_model == "fisheye" || distortion_model == "equidistant";
-  if (!fisheye && !distortion_model.empty() && distortion_model != "standard" && distortion_model != "plumb_bob" &&
-      distortion_model != "rational_polynomial") {
-    throw InputError(path.string() + ": distortion_model '" + distortion_model +
-                     "'; portcal reads plumb_bob, rational_polynomial, equidistant (ROS) or standard, fisheye "
-                     "(OpenCV)");
+  if (!fisheye && !distortion_model.empty() && distortion_model != "standard" &&
+      distortion_model != "plumb_bob" && distortion_model != "rational_polynomial") {
+    throw InputError(
+        path.string() + ": distortion_model '" + distortion_model +
+        "'; portcal reads plumb_bob, rational_polynomial, equidistant (ROS) or standard, fisheye "
+        "(OpenCV)");
   }
-  if (k[1] != 0) throw InputError(path.string() + ": a skewed camera_matrix (COLMAP's models have no skew)");
+  if (k[1] != 0)
+    throw InputError(path.string() + ": a skewed camera_matrix (COLMAP's models have no skew)");
   return CameraOfOpenCv(k[0], k[4], k[2], k[5], d, fisheye, ImageSize(root, "image_width", path),
                         ImageSize(root, "image_height", path), path);
 }

@@ -22,7 +22,8 @@ void SparseModel::Validate(const std::string& context, const std::string& extens
   std::map<std::string, image_t> image_of_name;
   for (const auto& [image_id, image] : images) {
     CheckImageName(image.name, in("images") + ": image " + std::to_string(image_id));
-    const std::string where = in("images") + ": image " + std::to_string(image_id) + " (" + image.name + ")";
+    const std::string where =
+        in("images") + ": image " + std::to_string(image_id) + " (" + image.name + ")";
     const auto [other, inserted] = image_of_name.emplace(image.name, image_id);
     if (!inserted) {
       throw InputError(where + " has the name of image " + std::to_string(other->second) +
@@ -31,7 +32,8 @@ void SparseModel::Validate(const std::string& context, const std::string& extens
     if (cameras.count(image.camera_id) == 0) {
       throw InputError(where + " refers to unknown camera " + std::to_string(image.camera_id));
     }
-    if (!image.cam_from_world.rotation.coeffs().allFinite() || !image.cam_from_world.translation.allFinite()) {
+    if (!image.cam_from_world.rotation.coeffs().allFinite() ||
+        !image.cam_from_world.translation.allFinite()) {
       throw InputError(where + " has a non-finite pose");
     }
     // The readers normalise; a zero quaternion stays zero and is no rotation.
@@ -42,32 +44,37 @@ void SparseModel::Validate(const std::string& context, const std::string& extens
     for (const Point2D& point2D : image.points2D) {
       if (!point2D.xy.allFinite()) throw InputError(where + " has a non-finite 2D point");
       if (point2D.point3D_id != kInvalidPoint3DId && points3D.count(point2D.point3D_id) == 0) {
-        throw InputError(where + " refers to unknown 3D point " + std::to_string(point2D.point3D_id));
+        throw InputError(where + " refers to unknown 3D point " +
+                         std::to_string(point2D.point3D_id));
       }
     }
   }
   for (const auto& [point3D_id, point3D] : points3D) {
     const std::string where = in("points3D") + ": 3D point " + std::to_string(point3D_id);
-    if (!point3D.xyz.allFinite() || !std::isfinite(point3D.error)) throw InputError(where + " is not finite");
+    if (!point3D.xyz.allFinite() || !std::isfinite(point3D.error))
+      throw InputError(where + " is not finite");
     for (const TrackElement& element : point3D.track) {
       const auto image = images.find(element.image_id);
       if (image == images.end() || element.point2D_idx >= image->second.points2D.size()) {
-        throw InputError(where + " observes unknown image " + std::to_string(element.image_id) + " / point " +
-                         std::to_string(element.point2D_idx));
+        throw InputError(where + " observes unknown image " + std::to_string(element.image_id) +
+                         " / point " + std::to_string(element.point2D_idx));
       }
     }
   }
-  const std::string housings_file = extension.empty() ? context : (fs::path(context) / "housings.txt").string();
+  const std::string housings_file =
+      extension.empty() ? context : (fs::path(context) / "housings.txt").string();
   for (const auto& [camera_id, housing] : housings) {
     if (cameras.count(camera_id) == 0) {
       throw InputError(housings_file + ": housing of unknown camera " + std::to_string(camera_id));
     }
     housing.Validate(housings_file + ": housing of camera " + std::to_string(camera_id));
   }
-  const std::string frames_file = extension.empty() ? context : (fs::path(context) / ("frames" + extension)).string();
+  const std::string frames_file =
+      extension.empty() ? context : (fs::path(context) / ("frames" + extension)).string();
   for (const auto& [frame_id, frame] : frames) {
     const std::string where = frames_file + ": frame " + std::to_string(frame_id);
-    if (rigs.count(frame.rig_id) == 0) throw InputError(where + " of unknown rig " + std::to_string(frame.rig_id));
+    if (rigs.count(frame.rig_id) == 0)
+      throw InputError(where + " of unknown rig " + std::to_string(frame.rig_id));
     for (const auto& [sensor, data_id] : frame.data) {
       if (sensor.type == kModelSensorCamera && cameras.count(sensor.id) == 0) {
         throw InputError(where + " holds data of unknown camera " + std::to_string(sensor.id));
@@ -95,8 +102,7 @@ SparseModel ReadSparseModel(const fs::path& dir) {
   } else if (fs::exists(dir / "cameras.txt") && fs::exists(dir / "images.txt") &&
              fs::exists(dir / "points3D.txt")) {
     // Accepts the refractive fork's cameras.txt too (port after the camera).
-    ImportRefractiveCamerasText(dir / "cameras.txt", &model.cameras,
-                                &model.housings);
+    ImportRefractiveCamerasText(dir / "cameras.txt", &model.cameras, &model.housings);
     model.images = ReadImagesText(dir / "images.txt");
     model.points3D = ReadPoints3DText(dir / "points3D.txt");
     if (fs::exists(dir / "rigs.txt") && fs::exists(dir / "frames.txt")) {
@@ -104,8 +110,7 @@ SparseModel ReadSparseModel(const fs::path& dir) {
       model.frames = ReadFramesText(dir / "frames.txt");
     }
   } else {
-    throw InputError(dir.string() +
-                     ": no cameras/images/points3D .bin or .txt files");
+    throw InputError(dir.string() + ": no cameras/images/points3D .bin or .txt files");
   }
   if (fs::exists(dir / "housings.txt")) {
     if (!model.housings.empty()) {
@@ -124,8 +129,7 @@ void WriteFileAtomically(const fs::path& path, bool binary,
   const fs::path tmp = path.string() + ".tmp";
   try {
     {
-      std::ofstream out(tmp, binary ? std::ios::binary | std::ios::trunc
-                                    : std::ios::trunc);
+      std::ofstream out(tmp, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
       if (!out) throw InputError(tmp.string() + ": cannot open for writing");
       write(out);
       out.flush();
@@ -148,15 +152,15 @@ void CheckNamesFitText(const SparseModel& model) {
   for (const auto& [image_id, image] : model.images) {
     if (image.name.find(' ') == std::string::npos) continue;
     throw InputError("image " + std::to_string(image_id) + " (" + image.name +
-                     "): a name with a space cannot be written to images.txt (COLMAP reads names there up to the "
+                     "): a name with a space cannot be written to images.txt (COLMAP reads names "
+                     "there up to the "
                      "first space); write the model as BIN, which keeps any name");
   }
 }
 
 }  // namespace
 
-void WriteSparseModel(const SparseModel& model, const fs::path& dir,
-                      ModelFormat format) {
+void WriteSparseModel(const SparseModel& model, const fs::path& dir, ModelFormat format) {
   model.Validate("model to write to " + dir.string());
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -191,9 +195,8 @@ void WriteSparseModel(const SparseModel& model, const fs::path& dir,
   }
   const fs::path housings_path = dir / "housings.txt";
   if (!model.housings.empty()) {
-    WriteFileAtomically(housings_path, false, [&](std::ostream& out) {
-      WriteHousingsText(model.housings, out);
-    });
+    WriteFileAtomically(housings_path, false,
+                        [&](std::ostream& out) { WriteHousingsText(model.housings, out); });
   } else if (fs::exists(housings_path)) {
     // A stale sidecar would attach housings to cameras that have none.
     fs::remove(housings_path);

@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
-#include <ostream>
 #include <map>
 #include <optional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -65,7 +65,8 @@ struct ModelRig {
 struct ModelFrame {
   uint32_t rig_id = 0;
   Rigid3d rig_from_world;
-  std::vector<std::pair<ModelSensor, uint64_t>> data;  // (sensor, data id: an image id for a camera)
+  std::vector<std::pair<ModelSensor, uint64_t>>
+      data;  // (sensor, data id: an image id for a camera)
 };
 
 struct SparseModel {
@@ -95,18 +96,16 @@ SparseModel ReadSparseModel(const std::filesystem::path& dir);
 // Writes into `dir` (created if needed) atomically per file: each is written
 // to a temporary and renamed, so a failure leaves no partial file.
 // housings.txt is written only if the model has housings.
-void WriteSparseModel(const SparseModel& model,
-                      const std::filesystem::path& dir, ModelFormat format);
+void WriteSparseModel(const SparseModel& model, const std::filesystem::path& dir,
+                      ModelFormat format);
 
 // Individual files (used by the above and by the tests).
 std::map<camera_t, Camera> ReadCamerasText(const std::filesystem::path& path);
 std::map<image_t, Image> ReadImagesText(const std::filesystem::path& path);
-std::map<point3D_t, Point3D> ReadPoints3DText(
-    const std::filesystem::path& path);
+std::map<point3D_t, Point3D> ReadPoints3DText(const std::filesystem::path& path);
 std::map<camera_t, Camera> ReadCamerasBinary(const std::filesystem::path& path);
 std::map<image_t, Image> ReadImagesBinary(const std::filesystem::path& path);
-std::map<point3D_t, Point3D> ReadPoints3DBinary(
-    const std::filesystem::path& path);
+std::map<point3D_t, Point3D> ReadPoints3DBinary(const std::filesystem::path& path);
 void WriteCamerasText(const SparseModel& model, std::ostream& out);
 void WriteImagesText(const SparseModel& model, std::ostream& out);
 void WritePoints3DText(const SparseModel& model, std::ostream& out);
@@ -131,8 +130,7 @@ void AddOneRigPerCamera(SparseModel* model);
 
 // housings.txt: "CAMERA_ID MODEL PARAMS..." per line, '#' comments.
 std::map<camera_t, Housing> ReadHousingsText(const std::filesystem::path& path);
-void WriteHousingsText(const std::map<camera_t, Housing>& housings,
-                       std::ostream& out);
+void WriteHousingsText(const std::map<camera_t, Housing>& housings, std::ostream& out);
 
 // The refractive COLMAP fork's cameras.txt: each line is a COLMAP camera
 // followed, optionally, by "FLATPORT|DOMEPORT params...". Fills cameras and

@@ -19,18 +19,17 @@ std::map<camera_t, Camera> ReadCamerasBinary(const fs::path& path) {
     Camera camera;
     camera.camera_id = reader.Read<uint32_t>("camera id");
     camera.model_id = reader.Read<int32_t>("camera model");
-    const std::string where =
-        path.string() + ": camera " + std::to_string(camera.camera_id);
+    const std::string where = path.string() + ": camera " + std::to_string(camera.camera_id);
     if (!ExistsCameraModelWithId(camera.model_id)) {
-      throw InputError(where + ": unknown camera model id " +
-                       std::to_string(camera.model_id));
+      throw InputError(where + ": unknown camera model id " + std::to_string(camera.model_id));
     }
     camera.width = reader.Read<uint64_t>("width");
     camera.height = reader.Read<uint64_t>("height");
     camera.params.resize(CameraModelNumParams(camera.model_id));
     for (double& param : camera.params) param = reader.ReadFinite("camera parameter");
     camera.Validate(where);
-    if (!cameras.emplace(camera.camera_id, camera).second) throw InputError(where + ": a second camera of this id");
+    if (!cameras.emplace(camera.camera_id, camera).second)
+      throw InputError(where + ": a second camera of this id");
   }
   return cameras;
 }
@@ -59,7 +58,8 @@ std::map<image_t, Image> ReadImagesBinary(const fs::path& path) {
     }
     const image_t image_id = image.image_id;
     if (!images.emplace(image_id, std::move(image)).second) {
-      throw InputError(path.string() + ": image " + std::to_string(image_id) + ": a second image of this id");
+      throw InputError(path.string() + ": image " + std::to_string(image_id) +
+                       ": a second image of this id");
     }
   }
   return images;
@@ -82,7 +82,8 @@ std::map<point3D_t, Point3D> ReadPoints3DBinary(const fs::path& path) {
       element.point2D_idx = reader.Read<uint32_t>("track point index");
     }
     if (!points3D.emplace(id, std::move(point)).second) {
-      throw InputError(path.string() + ": 3D point " + std::to_string(id) + ": a second point of this id");
+      throw InputError(path.string() + ": 3D point " + std::to_string(id) +
+                       ": a second point of this id");
     }
   }
   return points3D;
@@ -103,8 +104,7 @@ void WriteImagesBinary(const SparseModel& model, std::ostream& out) {
   WriteLittleEndian<uint64_t>(out, model.images.size());
   for (const auto& [image_id, image] : model.images) {
     WriteLittleEndian<uint32_t>(out, image_id);
-    const Eigen::Vector4d wxyz =
-        QuaternionToWxyz(image.cam_from_world.rotation.normalized());
+    const Eigen::Vector4d wxyz = QuaternionToWxyz(image.cam_from_world.rotation.normalized());
     for (int k = 0; k < 4; ++k) WriteLittleEndian<double>(out, wxyz[k]);
     for (int k = 0; k < 3; ++k) {
       WriteLittleEndian<double>(out, image.cam_from_world.translation[k]);

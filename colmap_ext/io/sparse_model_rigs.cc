@@ -23,7 +23,8 @@ std::string SensorTypeName(int type) {
     case 1:
       return "IMU";
     default:
-      throw InputError("sensor type " + std::to_string(type) + " is none of COLMAP's (INVALID, CAMERA, IMU)");
+      throw InputError("sensor type " + std::to_string(type) +
+                       " is none of COLMAP's (INVALID, CAMERA, IMU)");
   }
 }
 
@@ -35,7 +36,8 @@ int SensorTypeOf(const std::string& name, const std::string& where) {
 }
 
 int CheckedSensorType(int type, const std::string& where) {
-  if (type < -1 || type > 1) throw InputError(where + ": sensor type " + std::to_string(type) + " is none of COLMAP's");
+  if (type < -1 || type > 1)
+    throw InputError(where + ": sensor type " + std::to_string(type) + " is none of COLMAP's");
   return type;
 }
 
@@ -61,8 +63,9 @@ Rigid3d ReadPose(std::istream& in) {
 }
 
 void WritePose(std::ostream& out, const Rigid3d& pose) {
-  out << pose.rotation.w() << " " << pose.rotation.x() << " " << pose.rotation.y() << " " << pose.rotation.z() << " "
-      << pose.translation.x() << " " << pose.translation.y() << " " << pose.translation.z();
+  out << pose.rotation.w() << " " << pose.rotation.x() << " " << pose.rotation.y() << " "
+      << pose.rotation.z() << " " << pose.translation.x() << " " << pose.translation.y() << " "
+      << pose.translation.z();
 }
 
 Rigid3d ReadBinaryPose(BinaryReader* in, const char* what) {
@@ -104,9 +107,12 @@ std::map<uint32_t, ModelRig> ReadRigsText(const fs::path& path) {
       in >> type >> sensor.id >> has_pose;
       if (!in) break;
       sensor.type = SensorTypeOf(type, where);
-      rig.sensors.emplace_back(sensor, has_pose == 1 ? std::optional<Rigid3d>(ReadPose(in)) : std::nullopt);
+      rig.sensors.emplace_back(sensor,
+                               has_pose == 1 ? std::optional<Rigid3d>(ReadPose(in)) : std::nullopt);
     }
-    if (!in) throw InputError(where + ": expected RIG_ID NUM_SENSORS REF_SENSOR_TYPE REF_SENSOR_ID SENSORS[]");
+    if (!in)
+      throw InputError(where +
+                       ": expected RIG_ID NUM_SENSORS REF_SENSOR_TYPE REF_SENSOR_ID SENSORS[]");
     if (!rigs.emplace(rig_id, std::move(rig)).second)
       throw InputError(where + ": rig " + std::to_string(rig_id) + " again");
   }
@@ -133,7 +139,9 @@ std::map<uint32_t, ModelFrame> ReadFramesText(const fs::path& path) {
       sensor.type = SensorTypeOf(type, where);
       frame.data.emplace_back(sensor, data_id);
     }
-    if (!in) throw InputError(where + ": expected FRAME_ID RIG_ID QW QX QY QZ TX TY TZ NUM_DATA_IDS DATA_IDS[]");
+    if (!in)
+      throw InputError(where +
+                       ": expected FRAME_ID RIG_ID QW QX QY QZ TX TY TZ NUM_DATA_IDS DATA_IDS[]");
     if (!frames.emplace(frame_id, std::move(frame)).second) {
       throw InputError(where + ": frame " + std::to_string(frame_id) + " again");
     }
@@ -161,7 +169,8 @@ std::map<uint32_t, ModelRig> ReadRigsBinary(const fs::path& path) {
       sensor.id = in.Read<uint32_t>("sensor id");
       const bool has_pose = in.Read<uint8_t>("sensor pose flag") == 1;
       rig.sensors.emplace_back(
-          sensor, has_pose ? std::optional<Rigid3d>(ReadBinaryPose(&in, "sensor_from_rig")) : std::nullopt);
+          sensor,
+          has_pose ? std::optional<Rigid3d>(ReadBinaryPose(&in, "sensor_from_rig")) : std::nullopt);
     }
     if (!rigs.emplace(rig_id, std::move(rig)).second) {
       throw InputError(path.string() + ": rig " + std::to_string(rig_id) + " again");
@@ -197,14 +206,17 @@ void WriteRigsText(const SparseModel& model, std::ostream& out) {
   out.imbue(std::locale::classic());
   out.precision(17);
   out << "# Rig calib list with one line of data per calib:\n"
-      << "#   RIG_ID, NUM_SENSORS, REF_SENSOR_TYPE, REF_SENSOR_ID, SENSORS[] as (SENSOR_TYPE, SENSOR_ID, HAS_POSE, "
+      << "#   RIG_ID, NUM_SENSORS, REF_SENSOR_TYPE, REF_SENSOR_ID, SENSORS[] as (SENSOR_TYPE, "
+         "SENSOR_ID, HAS_POSE, "
          "[QW, QX, QY, QZ, TX, TY, TZ])\n"
       << "# Number of rigs: " << model.rigs.size() << '\n';
   for (const auto& [rig_id, rig] : model.rigs) {
     out << rig_id << " " << (rig.ref_sensor ? rig.sensors.size() + 1 : 0);
-    if (rig.ref_sensor) out << " " << SensorTypeName(rig.ref_sensor->type) << " " << rig.ref_sensor->id;
+    if (rig.ref_sensor)
+      out << " " << SensorTypeName(rig.ref_sensor->type) << " " << rig.ref_sensor->id;
     for (const auto& [sensor, sensor_from_rig] : rig.sensors) {
-      out << " " << SensorTypeName(sensor.type) << " " << sensor.id << " " << (sensor_from_rig ? 1 : 0);
+      out << " " << SensorTypeName(sensor.type) << " " << sensor.id << " "
+          << (sensor_from_rig ? 1 : 0);
       if (sensor_from_rig) {
         out << " ";
         WritePose(out, *sensor_from_rig);
@@ -218,7 +230,8 @@ void WriteFramesText(const SparseModel& model, std::ostream& out) {
   out.imbue(std::locale::classic());
   out.precision(17);
   out << "# Frame list with one line of data per frame:\n"
-      << "#   FRAME_ID, RIG_ID, RIG_FROM_WORLD[QW, QX, QY, QZ, TX, TY, TZ], NUM_DATA_IDS, DATA_IDS[] as "
+      << "#   FRAME_ID, RIG_ID, RIG_FROM_WORLD[QW, QX, QY, QZ, TX, TY, TZ], NUM_DATA_IDS, "
+         "DATA_IDS[] as "
          "(SENSOR_TYPE, SENSOR_ID, DATA_ID)\n"
       << "# Number of frames: " << model.frames.size() << '\n';
   for (const auto& [frame_id, frame] : model.frames) {
@@ -236,7 +249,8 @@ void WriteRigsBinary(const SparseModel& model, std::ostream& out) {
   WriteLittleEndian<uint64_t>(out, model.rigs.size());
   for (const auto& [rig_id, rig] : model.rigs) {
     WriteLittleEndian<uint32_t>(out, rig_id);
-    WriteLittleEndian<uint32_t>(out, static_cast<uint32_t>(rig.ref_sensor ? rig.sensors.size() + 1 : 0));
+    WriteLittleEndian<uint32_t>(out,
+                                static_cast<uint32_t>(rig.ref_sensor ? rig.sensors.size() + 1 : 0));
     if (rig.ref_sensor) {
       WriteLittleEndian<int>(out, rig.ref_sensor->type);
       WriteLittleEndian<uint32_t>(out, rig.ref_sensor->id);

@@ -26,29 +26,35 @@ fs::path ConfinedPath(const fs::path& folder, const std::string& name, const std
   const auto refuse = [&](const std::string& why) {
     std::string shown;
     for (const char c : name) shown += static_cast<unsigned char>(c) < 0x20 ? '?' : c;
-    throw InputError(what + " '" + shown + "' " + why + "; names must stay inside " + folder.string());
+    throw InputError(what + " '" + shown + "' " + why + "; names must stay inside " +
+                     folder.string());
   };
   if (name.empty()) refuse("is empty");
   for (const char c : name) {
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) refuse("holds a control character");
   }
   const fs::path relative(name);
-  if (relative.is_absolute() || relative.has_root_name() || relative.has_root_directory()) refuse("is absolute");
+  if (relative.is_absolute() || relative.has_root_name() || relative.has_root_directory())
+    refuse("is absolute");
   for (const fs::path& part : relative) {
     if (part == "..") refuse("climbs out with '..'");
   }
   const fs::path joined = folder / relative;
-  if (!Inside(Resolved(joined), Resolved(folder))) refuse("leaves the folder through a symbolic link");
+  if (!Inside(Resolved(joined), Resolved(folder)))
+    refuse("leaves the folder through a symbolic link");
   std::error_code error;
   const fs::file_status status = fs::symlink_status(joined, error);
-  if (fs::exists(status) && !fs::is_regular_file(fs::status(joined, error))) refuse("names something not a regular file");
+  if (fs::exists(status) && !fs::is_regular_file(fs::status(joined, error)))
+    refuse("names something not a regular file");
   return joined;
 }
 
-void CheckOutputFile(const std::string& option, const std::string& output, const std::vector<std::string>& inputs) {
+void CheckOutputFile(const std::string& option, const std::string& output,
+                     const std::vector<std::string>& inputs) {
   std::error_code error;
   for (const std::string& input : inputs) {
-    if (!input.empty() && fs::exists(input, error) && fs::exists(output, error) && fs::equivalent(input, output, error)) {
+    if (!input.empty() && fs::exists(input, error) && fs::exists(output, error) &&
+        fs::equivalent(input, output, error)) {
       throw OptionError(option, output, "a new file, not the input " + input);
     }
   }

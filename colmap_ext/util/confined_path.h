@@ -22,6 +22,7 @@ std::filesystem::path ConfinedPath(const std::filesystem::path& folder, const st
 // For Options::Check(): an output file (`option`'s value) that is one of
 // `inputs` (the same file, by any path) or exists and is not a regular file
 // (a device, a folder, a fifo) is an OptionError naming `option`.
-void CheckOutputFile(const std::string& option, const std::string& output, const std::vector<std::string>& inputs);
+void CheckOutputFile(const std::string& option, const std::string& output,
+                     const std::vector<std::string>& inputs);
 
 }  // namespace portcal

@@ -18,10 +18,8 @@ class InputError : public std::runtime_error {
 // An option value outside its documented range (thrown by Options::Check()).
 class OptionError : public InputError {
  public:
-  OptionError(const std::string& option, const std::string& value,
-              const std::string& expected)
-      : InputError("option " + option + " = " + value + ": expected " +
-                   expected) {}
+  OptionError(const std::string& option, const std::string& value, const std::string& expected)
+      : InputError("option " + option + " = " + value + ": expected " + expected) {}
 };
 
 // SQLite failure: carries sqlite3_errmsg, the database path and the SQL.
@@ -45,23 +43,22 @@ class Cancelled : public std::runtime_error {
   explicit Cancelled(const std::string& kept) : std::runtime_error("cancelled; " + kept) {}
 };
 
-[[noreturn]] void ThrowCheckFailure(const char* file, int line,
-                                    const char* condition,
+[[noreturn]] void ThrowCheckFailure(const char* file, int line, const char* condition,
                                     const std::string& message);
 
 }  // namespace portcal
 
 // Programming errors (violated invariants), never user errors.
-#define PORTCAL_CHECK(condition)                                            \
-  do {                                                                      \
-    if (!(condition)) {                                                     \
-      ::portcal::ThrowCheckFailure(__FILE__, __LINE__, #condition, "");     \
-    }                                                                       \
+#define PORTCAL_CHECK(condition)                                        \
+  do {                                                                  \
+    if (!(condition)) {                                                 \
+      ::portcal::ThrowCheckFailure(__FILE__, __LINE__, #condition, ""); \
+    }                                                                   \
   } while (false)
 
-#define PORTCAL_CHECK_MSG(condition, message)                               \
-  do {                                                                      \
-    if (!(condition)) {                                                     \
+#define PORTCAL_CHECK_MSG(condition, message)                                \
+  do {                                                                       \
+    if (!(condition)) {                                                      \
       ::portcal::ThrowCheckFailure(__FILE__, __LINE__, #condition, message); \
-    }                                                                       \
+    }                                                                        \
   } while (false)

@@ -40,7 +40,8 @@ std::string ShownImageName(const std::string& name) {
 
 void CheckImageName(const std::string& name, const std::string& where) {
   const std::string problem = ImageNameProblem(name);
-  if (!problem.empty()) throw InputError(where + ": image name '" + ShownImageName(name) + "' " + problem);
+  if (!problem.empty())
+    throw InputError(where + ": image name '" + ShownImageName(name) + "' " + problem);
 }
 
 }  // namespace portcal

@@ -19,8 +19,9 @@ std::atomic<bool> debug_level{false};
 // Ceres' words stay in the debug log, marked as Ceres'.
 class StderrSink : public google::LogSink {
  public:
-  void send(google::LogSeverity severity, const char* full_filename, const char* base_filename, int line,
-            const google::LogMessageTime& time, const char* message, size_t message_len) override {
+  void send(google::LogSeverity severity, const char* full_filename, const char* base_filename,
+            int line, const google::LogMessageTime& time, const char* message,
+            size_t message_len) override {
     if (severity >= google::GLOG_FATAL) return;  // glog writes those itself
     const bool from_ceres = IsCeresSource(full_filename);
     if (from_ceres && !debug_level) return;
@@ -46,7 +47,8 @@ void RouteThroughSink() {
   FLAGS_logtostderr = false;
   FLAGS_alsologtostderr = false;
   FLAGS_stderrthreshold = google::GLOG_FATAL;
-  for (const google::LogSeverity severity : {google::GLOG_INFO, google::GLOG_WARNING, google::GLOG_ERROR}) {
+  for (const google::LogSeverity severity :
+       {google::GLOG_INFO, google::GLOG_WARNING, google::GLOG_ERROR}) {
     google::SetLogDestination(severity, "");
   }
   google::AddLogSink(&Sink());

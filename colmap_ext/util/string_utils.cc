@@ -1,8 +1,8 @@
 #include "colmap_ext/util/string_utils.h"
 
 #include <cerrno>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <iomanip>
 #include <sstream>
@@ -18,8 +18,7 @@ std::string Trim(const std::string& s) {
   return s.substr(begin, end - begin + 1);
 }
 
-std::vector<std::string> SplitTokens(const std::string& s,
-                                     const std::string& delimiters) {
+std::vector<std::string> SplitTokens(const std::string& s, const std::string& delimiters) {
   std::vector<std::string> tokens;
   size_t pos = 0;
   while (pos < s.size()) {
@@ -47,26 +46,23 @@ double ParseDouble(const std::string& token, const std::string& context) {
   return value;
 }
 
-long long ParseInteger(const std::string& token, const std::string& context,
-                       long long min_value, long long max_value) {
+long long ParseInteger(const std::string& token, const std::string& context, long long min_value,
+                       long long max_value) {
   const std::string trimmed = Trim(token);
   char* end = nullptr;
   errno = 0;
   const long long value = std::strtoll(trimmed.c_str(), &end, 10);
-  if (trimmed.empty() || end != trimmed.c_str() + trimmed.size() ||
-      errno == ERANGE) {
+  if (trimmed.empty() || end != trimmed.c_str() + trimmed.size() || errno == ERANGE) {
     throw InputError(context + ": '" + token + "' is not an integer");
   }
   if (value < min_value || value > max_value) {
-    throw InputError(context + ": " + token + " is outside [" +
-                     std::to_string(min_value) + ", " +
+    throw InputError(context + ": " + token + " is outside [" + std::to_string(min_value) + ", " +
                      std::to_string(max_value) + "]");
   }
   return value;
 }
 
-std::vector<double> ParseDoubleList(const std::string& s,
-                                    const std::string& context) {
+std::vector<double> ParseDoubleList(const std::string& s, const std::string& context) {
   std::vector<double> values;
   for (const std::string& token : SplitTokens(s)) {
     values.push_back(ParseDouble(token, context));

@@ -8,16 +8,14 @@ namespace portcal {
 
 std::string Trim(const std::string& s);
 // Splits on any run of the delimiter characters; no empty tokens.
-std::vector<std::string> SplitTokens(const std::string& s,
-                                     const std::string& delimiters = " \t,");
+std::vector<std::string> SplitTokens(const std::string& s, const std::string& delimiters = " \t,");
 // Parses a finite double; throws InputError("<context>: ...") otherwise.
 double ParseDouble(const std::string& token, const std::string& context);
 // Parses an integer within [min, max]; throws InputError otherwise.
-long long ParseInteger(const std::string& token, const std::string& context,
-                       long long min_value, long long max_value);
+long long ParseInteger(const std::string& token, const std::string& context, long long min_value,
+                       long long max_value);
 // "1.0, 2 3" -> {1, 2, 3}; throws InputError naming `context`.
-std::vector<double> ParseDoubleList(const std::string& s,
-                                    const std::string& context);
+std::vector<double> ParseDoubleList(const std::string& s, const std::string& context);
 // `value` with `digits` digits after the point (std::fixed), for reports.
 std::string FormatFixed(double value, int digits);
 // The shortest text that reads back as exactly `value` ("0.04", where

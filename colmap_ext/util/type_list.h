@@ -23,8 +23,7 @@ bool VisitModelById(TypeList<Ms...>, int id, F&& f) {
 
 template <typename... Ms, typename F>
 bool VisitModelByName(TypeList<Ms...>, std::string_view name, F&& f) {
-  return ((std::string_view(Ms::kName) == name ? (f(Ms{}), true) : false) ||
-          ...);
+  return ((std::string_view(Ms::kName) == name ? (f(Ms{}), true) : false) || ...);
 }
 
 // Calls f(M{}) for every model of the list, in order.

@@ -15,24 +15,29 @@
 namespace portcal {
 
 void BundleAdjustmentOptions::Check() const {
-  if (!(sigma_px > 0)) throw OptionError("--BundleAdjustment.sigma_px", std::to_string(sigma_px), "> 0");
+  if (!(sigma_px > 0))
+    throw OptionError("--BundleAdjustment.sigma_px", std::to_string(sigma_px), "> 0");
   if (max_num_iterations < 1) {
-    throw OptionError("--BundleAdjustment.max_num_iterations", std::to_string(max_num_iterations), ">= 1");
+    throw OptionError("--BundleAdjustment.max_num_iterations", std::to_string(max_num_iterations),
+                      ">= 1");
   }
-  if (!(loss_scale >= 0)) throw OptionError("--BundleAdjustment.loss_scale", std::to_string(loss_scale), ">= 0");
+  if (!(loss_scale >= 0))
+    throw OptionError("--BundleAdjustment.loss_scale", std::to_string(loss_scale), ">= 0");
   if (!(position_prior_sigma_m >= 0)) {
-    throw OptionError("--PosePrior.position_sigma", std::to_string(position_prior_sigma_m), ">= 0 m");
+    throw OptionError("--PosePrior.position_sigma", std::to_string(position_prior_sigma_m),
+                      ">= 0 m");
   }
   if (!(function_tolerance > 0)) {
-    throw OptionError("--BundleAdjustment.function_tolerance", std::to_string(function_tolerance), "> 0");
+    throw OptionError("--BundleAdjustment.function_tolerance", std::to_string(function_tolerance),
+                      "> 0");
   }
   if (!(max_unsettled_weight_fraction >= 0 && max_unsettled_weight_fraction < 1)) {
-    throw OptionError("--BundleAdjustment.robust_max_unsettled_weights", std::to_string(max_unsettled_weight_fraction),
-                      "in [0, 1)");
+    throw OptionError("--BundleAdjustment.robust_max_unsettled_weights",
+                      std::to_string(max_unsettled_weight_fraction), "in [0, 1)");
   }
   if (!(initial_trust_region_radius > 0 && initial_trust_region_radius <= 1e16)) {
-    throw OptionError("--BundleAdjustment.held_trust_region_radius", std::to_string(initial_trust_region_radius),
-                      "in (0, 1e16]");
+    throw OptionError("--BundleAdjustment.held_trust_region_radius",
+                      std::to_string(initial_trust_region_radius), "in (0, 1e16]");
   }
 }
 
@@ -42,7 +47,8 @@ BundleAdjustmentOptions BundleAdjustmentOptions::WithIntrinsicsHeld() const {
   return held;
 }
 
-BundleAdjustmentOptions BundleAdjustmentOptions::WithWeightsHeld(double first_trust_region_radius) const {
+BundleAdjustmentOptions BundleAdjustmentOptions::WithWeightsHeld(
+    double first_trust_region_radius) const {
   BundleAdjustmentOptions held = *this;
   held.hold_loss_weights = true;
   held.max_unsettled_weight_fraction = 0;  // the weights no longer move
@@ -51,7 +57,8 @@ BundleAdjustmentOptions BundleAdjustmentOptions::WithWeightsHeld(double first_tr
 }
 
 void MarkerScale::Check() const {
-  if (!(side_length_m >= 0)) throw OptionError("--Markers.side_length", std::to_string(side_length_m), ">= 0 m");
+  if (!(side_length_m >= 0))
+    throw OptionError("--Markers.side_length", std::to_string(side_length_m), ">= 0 m");
   if (!(sigma_m > 0)) throw OptionError("--Markers.side_sigma", std::to_string(sigma_m), "> 0 m");
 }
 
@@ -59,7 +66,8 @@ bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::strin
   std::ostringstream text;
   const double ratio = after.MeanFocalLength() / before.MeanFocalLength();
   if (!(ratio > 0.5 && ratio < 2.0)) {
-    text << "focal length " << after.MeanFocalLength() << " px from " << before.MeanFocalLength() << " px";
+    text << "focal length " << after.MeanFocalLength() << " px from " << before.MeanFocalLength()
+         << " px";
   }
   const std::vector<std::string> names = SplitTokens(after.ParamsInfo(), ", ");
   for (int idx : CameraModelExtraParamsIdxs(after.model_id)) {
@@ -71,7 +79,8 @@ bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::strin
   return text.tellp() > 0;
 }
 
-std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconstruction, double max_error_px) {
+std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconstruction,
+                                                   double max_error_px) {
   std::map<std::pair<int, int>, MarkerCorner> corners;
   for (const auto& [image_id, pose] : reconstruction.poses()) {
     for (const MarkerDetection& m : reconstruction.inputs().images.at(image_id).markers) {
@@ -99,7 +108,8 @@ std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconst
     for (const auto& [image_id, pixel] : corner.observations) {
       const HousedCamera& camera = reconstruction.CameraOf(image_id);
       const auto projected = camera.Project(reconstruction.poses().at(image_id) * *xyz);
-      if (projected && (*projected - pixel).norm() < max_error_px) kept.emplace_back(image_id, pixel);
+      if (projected && (*projected - pixel).norm() < max_error_px)
+        kept.emplace_back(image_id, pixel);
     }
     if (kept.size() < 2) continue;
     corner.observations = kept;
@@ -109,10 +119,11 @@ std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconst
   return result;
 }
 
-std::optional<double> MarkerScaleRatio(const std::vector<MarkerCorner>& corners, double side_length_m,
-                                       bool with_diagonals) {
+std::optional<double> MarkerScaleRatio(const std::vector<MarkerCorner>& corners,
+                                       double side_length_m, bool with_diagonals) {
   std::map<int, std::map<int, Eigen::Vector3d>> corners_of;
-  for (const MarkerCorner& corner : corners) corners_of[corner.marker_id][corner.corner] = corner.xyz;
+  for (const MarkerCorner& corner : corners)
+    corners_of[corner.marker_id][corner.corner] = corner.xyz;
   std::vector<double> ratios;
   for (const auto& [id, placed] : corners_of) {
     for (auto a = placed.begin(); a != placed.end(); ++a) {
@@ -130,9 +141,11 @@ std::optional<double> MarkerScaleRatio(const std::vector<MarkerCorner>& corners,
   return ratios[ratios.size() / 2];
 }
 
-std::optional<double> ScaleToMarkers(Reconstruction* reconstruction, double max_error_px, double side_length_m) {
+std::optional<double> ScaleToMarkers(Reconstruction* reconstruction, double max_error_px,
+                                     double side_length_m) {
   const std::optional<double> ratio =
-      MarkerScaleRatio(TriangulateMarkerCorners(*reconstruction, max_error_px), side_length_m, /*with_diagonals=*/true);
+      MarkerScaleRatio(TriangulateMarkerCorners(*reconstruction, max_error_px), side_length_m,
+                       /*with_diagonals=*/true);
   if (!ratio) return std::nullopt;
   const double scale = *ratio;
   for (auto& [id, pose] : reconstruction->mutable_poses()) pose.translation *= scale;
@@ -148,19 +161,22 @@ std::optional<double> ScaleToMarkers(Reconstruction* reconstruction, double max_
   return scale;
 }
 
-std::vector<MarkerCorner> UpdateMarkerCorners(const Reconstruction& reconstruction, double max_error_px,
+std::vector<MarkerCorner> UpdateMarkerCorners(const Reconstruction& reconstruction,
+                                              double max_error_px,
                                               const std::vector<MarkerCorner>& adjusted) {
   std::map<std::pair<int, int>, Eigen::Vector3d> placed;
-  for (const MarkerCorner& corner : adjusted) placed[{corner.marker_id, corner.corner}] = corner.xyz;
+  for (const MarkerCorner& corner : adjusted)
+    placed[{corner.marker_id, corner.corner}] = corner.xyz;
   std::vector<MarkerCorner> corners = TriangulateMarkerCorners(reconstruction, max_error_px);
   for (MarkerCorner& corner : corners) {
     const auto it = placed.find({corner.marker_id, corner.corner});
     if (it == placed.end()) continue;
-    const bool agrees = std::all_of(corner.observations.begin(), corner.observations.end(), [&](const auto& seen) {
-      const auto projected =
-          reconstruction.CameraOf(seen.first).Project(reconstruction.poses().at(seen.first) * it->second);
-      return projected && (*projected - seen.second).norm() < max_error_px;
-    });
+    const bool agrees =
+        std::all_of(corner.observations.begin(), corner.observations.end(), [&](const auto& seen) {
+          const auto projected = reconstruction.CameraOf(seen.first)
+                                     .Project(reconstruction.poses().at(seen.first) * it->second);
+          return projected && (*projected - seen.second).norm() < max_error_px;
+        });
     if (agrees) corner.xyz = it->second;
   }
   return corners;

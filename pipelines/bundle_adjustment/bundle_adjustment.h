@@ -82,20 +82,21 @@ struct MarkerCorner {
 struct MarkerScale {
   double side_length_m = 0;  // <= 0: markers do not constrain the scale
   double sigma_m = 0.0001;   // of each side and diagonal
-  void Check() const;        // throws OptionError naming --Markers.side_length or --Markers.side_sigma
+  void Check() const;  // throws OptionError naming --Markers.side_length or --Markers.side_sigma
 };
 
 // Marker corners seen by at least two registered images, triangulated from
 // the current poses (corners whose rays miss each other are dropped).
-std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconstruction, double max_error_px);
+std::vector<MarkerCorner> TriangulateMarkerCorners(const Reconstruction& reconstruction,
+                                                   double max_error_px);
 
 // The median, over the markers' sides (0-1, 1-2, 2-3, 3-0) and with
 // `with_diagonals` their diagonals (0-2, 1-3, known length side * sqrt 2),
 // of known over triangulated length: the factor that brings `corners` to
 // the markers' size. Nothing where no two corners of a marker make a side
 // (or, with the diagonals, a diagonal).
-std::optional<double> MarkerScaleRatio(const std::vector<MarkerCorner>& corners, double side_length_m,
-                                       bool with_diagonals);
+std::optional<double> MarkerScaleRatio(const std::vector<MarkerCorner>& corners,
+                                       double side_length_m, bool with_diagonals);
 
 // Scales the model (points, camera centres; the origin stays) so that the
 // markers' sides, triangulated from the current poses, have their known
@@ -108,7 +109,8 @@ std::optional<double> MarkerScaleRatio(const std::vector<MarkerCorner>& corners,
 // housing's estimate of the moment (docs/scale.md: 2.7-3.7 times the
 // markers'), and its adjustments, rather than rescale it, pull the corners
 // off their rays, which the robust loss lets them do at little cost.
-std::optional<double> ScaleToMarkers(Reconstruction* reconstruction, double max_error_px, double side_length_m);
+std::optional<double> ScaleToMarkers(Reconstruction* reconstruction, double max_error_px,
+                                     double side_length_m);
 
 // The corners for the next of a series of adjustments: triangulated afresh
 // as above (corners newly seen by two images, the observations that agree),
@@ -118,7 +120,8 @@ std::optional<double> ScaleToMarkers(Reconstruction* reconstruction, double max_
 // adjustment's fit to the markers' sides (sigma 0.1 mm): millimetres of
 // triangulation noise are tens of sigmas, which every adjustment would
 // first have to remove again.
-std::vector<MarkerCorner> UpdateMarkerCorners(const Reconstruction& reconstruction, double max_error_px,
+std::vector<MarkerCorner> UpdateMarkerCorners(const Reconstruction& reconstruction,
+                                              double max_error_px,
                                               const std::vector<MarkerCorner>& adjusted);
 
 struct BundleAdjustmentScope {
@@ -163,8 +166,11 @@ camera_t CameraWithHousingAtBound(const std::map<camera_t, HousedCamera>& camera
 // registered image's pose is held, and, without marker scale, one
 // translation coordinate of the second.
 // Returns Ceres' summary; throws NumericalError if the solve fails.
-ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const BundleAdjustmentOptions& options,
-                                    const BundleAdjustmentScope& scope, std::vector<MarkerCorner>* markers,
-                                    const MarkerScale& marker_scale, CalibrationStdDevs* std_devs = nullptr);
+ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction,
+                                    const BundleAdjustmentOptions& options,
+                                    const BundleAdjustmentScope& scope,
+                                    std::vector<MarkerCorner>* markers,
+                                    const MarkerScale& marker_scale,
+                                    CalibrationStdDevs* std_devs = nullptr);
 
 }  // namespace portcal

@@ -35,7 +35,7 @@ struct ObservationModel {
   int camera_model_id = 0;
   std::vector<double> intrinsics;  // used as constants where not a block
   int housing_model_id = kNoHousing;
-  std::vector<double> housing;     // used as a constant where not a block
+  std::vector<double> housing;  // used as a constant where not a block
 
   bool HasHousing() const { return housing_model_id != kNoHousing; }
 

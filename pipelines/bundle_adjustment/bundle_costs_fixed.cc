@@ -11,24 +11,27 @@ namespace portcal {
 namespace {
 
 template <typename CameraModel, typename Port>
-ceres::CostFunction* Create(const ObservationModel& model, CostBlocks blocks, const Eigen::Vector2d& observed,
-                            double sigma) {
+ceres::CostFunction* Create(const ObservationModel& model, CostBlocks blocks,
+                            const Eigen::Vector2d& observed, double sigma) {
   if (blocks == CostBlocks::kPosePoint) {
-    return PosePointError<CameraModel, Port>::Create(model.intrinsics, model.housing, observed, sigma);
+    return PosePointError<CameraModel, Port>::Create(model.intrinsics, model.housing, observed,
+                                                     sigma);
   }
   return PosePointIntrinsicsError<CameraModel, Port>::Create(model.housing, observed, sigma);
 }
 
 }  // namespace
 
-ceres::CostFunction* CreateFixedRayCost(const Eigen::Vector3d& center, const Eigen::Vector3d& direction,
-                                        double focal, double sigma_px) {
+ceres::CostFunction* CreateFixedRayCost(const Eigen::Vector3d& center,
+                                        const Eigen::Vector3d& direction, double focal,
+                                        double sigma_px) {
   PORTCAL_CHECK(direction.z() > 0);
   return FixedRayError::Create(center, direction, focal, sigma_px);
 }
 
 ceres::CostFunction* CreateFixedReprojectionCost(const ObservationModel& model, CostBlocks blocks,
-                                                 const Eigen::Vector2d& observed_px, double sigma_px) {
+                                                 const Eigen::Vector2d& observed_px,
+                                                 double sigma_px) {
   PORTCAL_CHECK(blocks != CostBlocks::kAll || !model.HasHousing());
   ceres::CostFunction* cost = nullptr;
   VisitCameraModel(model.camera_model_id, [&](auto camera_tag) {

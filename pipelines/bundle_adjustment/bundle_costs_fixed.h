@@ -8,7 +8,8 @@ namespace portcal {
 
 // kPosePoint and kPosePointIntrinsics for any housing, and kAll without one.
 ceres::CostFunction* CreateFixedReprojectionCost(const ObservationModel& model, CostBlocks blocks,
-                                                 const Eigen::Vector2d& observed_px, double sigma_px);
+                                                 const Eigen::Vector2d& observed_px,
+                                                 double sigma_px);
 
 }  // namespace portcal
 
@@ -19,7 +20,8 @@ namespace portcal {
 // refraction axis, Jordt 2016), so the residual is a pinhole projection --
 // the cheap error for registration and local adjustment. `center` and
 // `direction` in the camera frame; `focal` scales it to pixels.
-ceres::CostFunction* CreateFixedRayCost(const Eigen::Vector3d& center, const Eigen::Vector3d& direction,
-                                        double focal, double sigma_px);
+ceres::CostFunction* CreateFixedRayCost(const Eigen::Vector3d& center,
+                                        const Eigen::Vector3d& direction, double focal,
+                                        double sigma_px);
 
 }  // namespace portcal

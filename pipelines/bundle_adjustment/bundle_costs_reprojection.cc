@@ -24,7 +24,8 @@ ceres::CostFunction* CreateReprojectionCost(const ObservationModel& model, CostB
     VisitHousingModel(model.housing_model_id, [&](auto port_tag) {
       using Port = decltype(port_tag);
       if (blocks == CostBlocks::kPosePointHousing) {
-        cost = PosePointHousingError<CameraModel, Port>::Create(model.intrinsics, observed_px, sigma_px);
+        cost = PosePointHousingError<CameraModel, Port>::Create(model.intrinsics, observed_px,
+                                                                sigma_px);
       } else {
         cost = RefractiveReprojError<CameraModel, Port>::Create(observed_px, sigma_px);
       }

@@ -43,13 +43,16 @@ constexpr size_t kMaxSparseSchurBlocks = 200000;
 // The parameter indices of a camera that stay constant.
 std::vector<int> ConstantIntrinsics(const Camera& camera, const BundleAdjustmentOptions& o) {
   std::vector<int> constant;
-  const auto add = [&](const std::vector<int>& idxs) { constant.insert(constant.end(), idxs.begin(), idxs.end()); };
+  const auto add = [&](const std::vector<int>& idxs) {
+    constant.insert(constant.end(), idxs.begin(), idxs.end());
+  };
   if (!o.refine_focal_length) add(CameraModelFocalLengthIdxs(camera.model_id));
   if (!o.refine_principal_point) add(CameraModelPrincipalPointIdxs(camera.model_id));
   const std::vector<int> extra = CameraModelExtraParamsIdxs(camera.model_id);
   if (!o.refine_extra_params) {
     add(extra);
-  } else if (o.max_num_extra_params >= 0 && static_cast<size_t>(o.max_num_extra_params) < extra.size()) {
+  } else if (o.max_num_extra_params >= 0 &&
+             static_cast<size_t>(o.max_num_extra_params) < extra.size()) {
     add(std::vector<int>(extra.begin() + o.max_num_extra_params, extra.end()));
   }
   return constant;
@@ -107,8 +110,8 @@ class BundleProblem {
     local_ = !scope.variable_images.empty();
     // Which blocks the residuals carry: constants are captured instead (see
     // bundle_costs.h), which makes the autodiff Jets much narrower.
-    refine_intrinsics_ =
-        !local_ && (options.refine_focal_length || options.refine_principal_point || options.refine_extra_params);
+    refine_intrinsics_ = !local_ && (options.refine_focal_length ||
+                                     options.refine_principal_point || options.refine_extra_params);
     refine_housing_ = !local_ && options.refine_housing;
   }
 
@@ -148,12 +151,14 @@ class BundleProblem {
   // is 16 bytes here; as a ScaledLoss owned by the problem it was an
   // allocation and an entry in Ceres' table of the losses it owns, several
   // times that per observation (docs/scale.md).
-  std::unique_ptr<ceres::LossFunction> loss_;         // the robust loss, shared
-  std::unique_ptr<ceres::LossFunction> weight_loss_;  // with hold_loss_weights: the weights' robust loss
-  std::deque<HeldWeight> held_weights_;               // with hold_loss_weights: one per residual block
-  ceres::HuberLoss prior_loss_{3.0};                  // position priors' (3 sigma)
+  std::unique_ptr<ceres::LossFunction> loss_;  // the robust loss, shared
+  std::unique_ptr<ceres::LossFunction>
+      weight_loss_;                      // with hold_loss_weights: the weights' robust loss
+  std::deque<HeldWeight> held_weights_;  // with hold_loss_weights: one per residual block
+  ceres::HuberLoss prior_loss_{3.0};     // position priors' (3 sigma)
   ceres::Problem problem_{ProblemOptions()};
-  std::vector<ceres::ResidualBlockId> robust_blocks_;  // under loss_, with max_unsettled_weight_fraction
+  std::vector<ceres::ResidualBlockId>
+      robust_blocks_;  // under loss_, with max_unsettled_weight_fraction
   bool local_ = false;
   bool refine_intrinsics_ = false;
   bool refine_housing_ = false;
@@ -164,15 +169,18 @@ class BundleProblem {
 
 CostBlocks BundleProblem::BlocksOf(const HousedCamera& camera) const {
   if (refine_housing_ && camera.housing) {
-    return refine_intrinsics_ || options_.virtual_camera_error ? CostBlocks::kAll : CostBlocks::kPosePointHousing;
+    return refine_intrinsics_ || options_.virtual_camera_error ? CostBlocks::kAll
+                                                               : CostBlocks::kPosePointHousing;
   }
   if (refine_intrinsics_ || (options_.virtual_camera_error && camera.housing)) {
-    return camera.housing && options_.virtual_camera_error ? CostBlocks::kAll : CostBlocks::kPosePointIntrinsics;
+    return camera.housing && options_.virtual_camera_error ? CostBlocks::kAll
+                                                           : CostBlocks::kPosePointIntrinsics;
   }
   return CostBlocks::kPosePoint;
 }
 
-void BundleProblem::AddObservation(image_t image_id, const Eigen::Vector2d& pixel, double* xyz, double sigma) {
+void BundleProblem::AddObservation(image_t image_id, const Eigen::Vector2d& pixel, double* xyz,
+                                   double sigma) {
   const SfmImage& image = reconstruction_->inputs().images.at(image_id);
   const HousedCamera& camera = cameras_.at(image.camera_id);
   const ObservationModel model = ObservationModel::Of(camera);
@@ -196,7 +204,8 @@ void BundleProblem::AddObservation(image_t image_id, const Eigen::Vector2d& pixe
 // held, under its weight rho'(|r|^2) at the current parameters (a residual
 // that cannot be evaluated there gets weight 1: the solve then fails on it
 // and says so).
-void BundleProblem::AddRobustResidual(ceres::CostFunction* cost, const std::vector<double*>& blocks) {
+void BundleProblem::AddRobustResidual(ceres::CostFunction* cost,
+                                      const std::vector<double*>& blocks) {
   num_residuals_ += cost->num_residuals();
   if (!weight_loss_) {
     const ceres::ResidualBlockId id = problem_.AddResidualBlock(cost, loss_.get(), blocks);
@@ -220,7 +229,8 @@ void BundleProblem::AddRobustResidual(ceres::CostFunction* cost, const std::vect
 double BundleProblem::SigmaOf(const TrackElement& e) const {
   const SfmImage& image = reconstruction_->inputs().images.at(e.image_id);
   if (!options_.scale_weighting || image.scales.empty()) return options_.sigma_px;
-  const double r = std::max(1.0, static_cast<double>(image.scales[e.point2D_idx]) / kReferenceScale);
+  const double r =
+      std::max(1.0, static_cast<double>(image.scales[e.point2D_idx]) / kReferenceScale);
   return options_.sigma_px * r * r;
 }
 
@@ -231,7 +241,8 @@ void BundleProblem::AddPoints() {
       point_blocks_[point_id] = reconstruction_->points().at(point_id).xyz;
     }
   } else {
-    for (const auto& [point_id, point] : reconstruction_->points()) point_blocks_[point_id] = point.xyz;
+    for (const auto& [point_id, point] : reconstruction_->points())
+      point_blocks_[point_id] = point.xyz;
   }
   for (auto& [point_id, xyz] : point_blocks_) {
     for (const TrackElement& e : reconstruction_->points().at(point_id).track) {
@@ -240,12 +251,13 @@ void BundleProblem::AddPoints() {
       const auto& ray = reconstruction_->RayOf(e.image_id, e.point2D_idx);
       if (BlocksOf(camera) == CostBlocks::kPosePoint && ray && ray->direction.z() > 1e-6) {
         // Intrinsics and housing held: the cheap fixed-ray error.
-        AddRobustResidual(
-            CreateFixedRayCost(VirtualCenterOf(camera, *ray), ray->direction, camera.camera.MeanFocalLength(), sigma),
-            {pose_blocks_.at(e.image_id).data(), xyz.data()});
+        AddRobustResidual(CreateFixedRayCost(VirtualCenterOf(camera, *ray), ray->direction,
+                                             camera.camera.MeanFocalLength(), sigma),
+                          {pose_blocks_.at(e.image_id).data(), xyz.data()});
         continue;
       }
-      AddObservation(e.image_id, reconstruction_->inputs().images.at(e.image_id).keypoints[e.point2D_idx],
+      AddObservation(e.image_id,
+                     reconstruction_->inputs().images.at(e.image_id).keypoints[e.point2D_idx],
                      xyz.data(), sigma);
     }
   }
@@ -259,9 +271,11 @@ void BundleProblem::AddMarkers() {
   std::map<int, std::array<double*, 4>> corners_of;
   for (MarkerCorner& corner : *markers_) {
     for (const auto& [image_id, pixel] : corner.observations) {
-      if (poses_.count(image_id)) AddObservation(image_id, pixel, corner.xyz.data(), options_.marker_sigma_px);
+      if (poses_.count(image_id))
+        AddObservation(image_id, pixel, corner.xyz.data(), options_.marker_sigma_px);
     }
-    if (!corners_of.count(corner.marker_id)) corners_of[corner.marker_id] = {nullptr, nullptr, nullptr, nullptr};
+    if (!corners_of.count(corner.marker_id))
+      corners_of[corner.marker_id] = {nullptr, nullptr, nullptr, nullptr};
     corners_of[corner.marker_id][corner.corner] = corner.xyz.data();
   }
   const double side = marker_scale_.side_length_m;
@@ -270,7 +284,8 @@ void BundleProblem::AddMarkers() {
       for (int b = a + 1; b < 4; ++b) {
         if (!c[a] || !c[b]) continue;
         const double length = (b - a == 2) ? side * std::sqrt(2.0) : side;
-        problem_.AddResidualBlock(DistanceError::Create(length, marker_scale_.sigma_m), nullptr, c[a], c[b]);
+        problem_.AddResidualBlock(DistanceError::Create(length, marker_scale_.sigma_m), nullptr,
+                                  c[a], c[b]);
       }
     }
   }
@@ -279,7 +294,8 @@ void BundleProblem::AddMarkers() {
 // Position priors: residuals on the camera centres, robust (a navigation
 // fix can jump) at 3 sigma.
 void BundleProblem::AddPositionPriors() {
-  use_priors_ = !local_ && options_.position_prior_sigma_m > 0 && NumUsablePositionPriors(*reconstruction_) > 0;
+  use_priors_ = !local_ && options_.position_prior_sigma_m > 0 &&
+                NumUsablePositionPriors(*reconstruction_) > 0;
   if (!use_priors_) return;
   for (auto& [id, block] : pose_blocks_) {
     const auto& prior = reconstruction_->inputs().images.at(id).position_prior;
@@ -327,9 +343,10 @@ void BundleProblem::SetGauge() {
       const Eigen::Vector3d t(block[4], block[5], block[6]);
       int k;
       t.cwiseAbs().maxCoeff(&k);
-      problem_.SetManifold(block.data(),
-                           new ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::SubsetManifold>(
-                               ceres::EigenQuaternionManifold(), ceres::SubsetManifold(3, {k})));
+      problem_.SetManifold(
+          block.data(),
+          new ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::SubsetManifold>(
+              ceres::EigenQuaternionManifold(), ceres::SubsetManifold(3, {k})));
       continue;
     }
     problem_.SetManifold(block.data(), PoseManifold());
@@ -342,7 +359,8 @@ void BundleProblem::SetCalibrationBlocks() {
     const HousedCamera& camera = cameras_.at(id);
     double* params = intrinsics_.at(id).data();
     if (problem_.HasParameterBlock(params)) {
-      const std::vector<int> constant = local_ ? std::vector<int>() : ConstantIntrinsics(camera.camera, options_);
+      const std::vector<int> constant =
+          local_ ? std::vector<int>() : ConstantIntrinsics(camera.camera, options_);
       const int n = static_cast<int>(camera.camera.params.size());
       if (local_ || static_cast<int>(constant.size()) == n) {
         problem_.SetParameterBlockConstant(params);
@@ -375,13 +393,14 @@ ceres::Solver::Options BundleProblem::SolverOptions(int* num_free_poses) const {
   ceres::Solver::Options solver;
   *num_free_poses = 0;
   for (const auto& [id, block] : pose_blocks_) *num_free_poses += FreePose(id);
-  const bool sparse_available = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE);
+  const bool sparse_available =
+      ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE);
   const auto free_pose = [this](image_t id) { return FreePose(id); };
   if (*num_free_poses <= 50) {
     solver.linear_solver_type = ceres::DENSE_SCHUR;
-  } else if (sparse_available &&
-             (*num_free_poses <= 1000 ||
-              ReducedCameraSystemBlocks(*reconstruction_, point_blocks_, free_pose) <= kMaxSparseSchurBlocks)) {
+  } else if (sparse_available && (*num_free_poses <= 1000 ||
+                                  ReducedCameraSystemBlocks(*reconstruction_, point_blocks_,
+                                                            free_pose) <= kMaxSparseSchurBlocks)) {
     solver.linear_solver_type = ceres::SPARSE_SCHUR;
     solver.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
   } else {
@@ -414,22 +433,24 @@ ceres::Solver::Summary BundleProblem::Solve() {
   ceres::Solver::Options solver = SolverOptions(&num_free_poses);
   std::unique_ptr<WeightsSettledCallback> weights_settled;
   if (!robust_blocks_.empty()) {
-    weights_settled = std::make_unique<WeightsSettledCallback>(&problem_, std::move(robust_blocks_), loss_.get(),
-                                                               options_.max_unsettled_weight_fraction);
+    weights_settled = std::make_unique<WeightsSettledCallback>(
+        &problem_, std::move(robust_blocks_), loss_.get(), options_.max_unsettled_weight_fraction);
     solver.callbacks.push_back(weights_settled.get());
     solver.update_state_every_iteration = true;
   }
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem_, &summary);
   if (!summary.IsSolutionUsable()) {
-    throw NumericalError("bundle adjustment failed: " + summary.BriefReport() +
-                         DescribeUnevaluableResiduals(problem_, [this](const std::vector<double*>& blocks) {
-                           return DescribeResidual(blocks);
-                         }));
+    throw NumericalError(
+        "bundle adjustment failed: " + summary.BriefReport() +
+        DescribeUnevaluableResiduals(problem_, [this](const std::vector<double*>& blocks) {
+          return DescribeResidual(blocks);
+        }));
   }
-  VLOG(1) << "bundle adjustment: " << num_free_poses << " free poses, " << point_blocks_.size() << " points, "
-          << num_residuals_ << " residuals, " << summary.iterations.size() << " iterations, "
-          << summary.total_time_in_seconds << " s (" << summary.BriefReport() << ")";
+  VLOG(1) << "bundle adjustment: " << num_free_poses << " free poses, " << point_blocks_.size()
+          << " points, " << num_residuals_ << " residuals, " << summary.iterations.size()
+          << " iterations, " << summary.total_time_in_seconds << " s (" << summary.BriefReport()
+          << ")";
   VLOG(2) << summary.FullReport();
   return summary;
 }
@@ -443,8 +464,9 @@ std::string BundleProblem::Describe(const double* block, int index) const {
     }
   }
   for (const auto& [id, b] : intrinsics_) {
-    if (b.data() == block) return "an intrinsic parameter of camera " + std::to_string(id) + " (refined ones: " +
-                                  cameras_.at(id).camera.ParamsInfo() + ")";
+    if (b.data() == block)
+      return "an intrinsic parameter of camera " + std::to_string(id) +
+             " (refined ones: " + cameras_.at(id).camera.ParamsInfo() + ")";
   }
   for (const auto& [id, b] : housings_) {
     if (b.data() == block) return "a housing parameter of camera " + std::to_string(id);
@@ -457,19 +479,23 @@ std::string BundleProblem::Describe(const double* block, int index) const {
 std::string BundleProblem::DescribeResidual(const std::vector<double*>& blocks) const {
   std::string image;
   for (const auto& [id, block] : pose_blocks_) {
-    if (block.data() == blocks[0]) image = "image '" + reconstruction_->inputs().images.at(id).name + "'";
+    if (block.data() == blocks[0])
+      image = "image '" + reconstruction_->inputs().images.at(id).name + "'";
   }
   if (image.empty()) return "a marker's side";
   if (blocks.size() == 1) return "the position prior of " + image;
   for (const auto& [id, xyz] : point_blocks_) {
-    if (xyz.data() == blocks[1]) return "the observation of 3D point " + std::to_string(id) + " in " + image;
+    if (xyz.data() == blocks[1])
+      return "the observation of 3D point " + std::to_string(id) + " in " + image;
   }
   return "the observation of a marker corner in " + image;
 }
 
-void BundleProblem::ComputeStdDevs(const ceres::Solver::Summary& summary, CalibrationStdDevs* std_devs) {
+void BundleProblem::ComputeStdDevs(const ceres::Solver::Summary& summary,
+                                   CalibrationStdDevs* std_devs) {
   std_devs->num_residuals = num_residuals_;
-  const double dof = std::max<double>(1.0, summary.num_residuals_reduced - summary.num_effective_parameters_reduced);
+  const double dof = std::max<double>(
+      1.0, summary.num_residuals_reduced - summary.num_effective_parameters_reduced);
   // sigma0^2 = sum of squared (sigma-normalised) residuals / dof, from the
   // unrobustified residuals.
   double sum_sq = 0;
@@ -509,12 +535,14 @@ void BundleProblem::ComputeStdDevs(const ceres::Solver::Summary& summary, Calibr
   if (wanted.empty()) return;
   ResidualClusters clusters;
   int image_index = 0;
-  for (const auto& [id, block] : pose_blocks_) clusters.image_of_block[block.data()] = image_index++;
+  for (const auto& [id, block] : pose_blocks_)
+    clusters.image_of_block[block.data()] = image_index++;
   // The marginalised points are tracks by themselves; a marker's corner,
   // seen in several images, is one too.
   if (use_markers_) {
     int corner_index = 0;
-    for (MarkerCorner& corner : *markers_) clusters.track_of_block[corner.xyz.data()] = corner_index++;
+    for (MarkerCorner& corner : *markers_)
+      clusters.track_of_block[corner.xyz.data()] = corner_index++;
   }
   clusters.residuals_per_dof = summary.num_residuals_reduced / dof;
   const auto start = std::chrono::steady_clock::now();
@@ -522,17 +550,20 @@ void BundleProblem::ComputeStdDevs(const ceres::Solver::Summary& summary, Calibr
   const MarginalCovariance marginal =
       ComputeMarginalCovariance(&problem_, points, others, wanted, scale, describe, &clusters,
                                 /*max_dense_size=*/1200, options_.num_threads);
-  LOG(INFO) << "bundle adjustment: covariance of " << others.size() << " pose and calibration blocks, "
-            << points.size() << " points marginalised, clustered by " << marginal.num_clusters << " images and "
+  LOG(INFO) << "bundle adjustment: covariance of " << others.size()
+            << " pose and calibration blocks, " << points.size()
+            << " points marginalised, clustered by " << marginal.num_clusters << " images and "
             << marginal.num_tracks << " tracks: "
-            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() << " s";
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+            << " s";
   StoreStdDevs(marginal, std_devs);
 }
 
 // Each camera's standard deviations, the larger of the noise's and the
 // clusters' estimates, and the correlations of its intrinsics with its
 // housing.
-void BundleProblem::StoreStdDevs(const MarginalCovariance& marginal, CalibrationStdDevs* std_devs) const {
+void BundleProblem::StoreStdDevs(const MarginalCovariance& marginal,
+                                 CalibrationStdDevs* std_devs) const {
   const auto larger = [](std::vector<double> by_noise, const std::vector<double>& by_clusters) {
     for (size_t i = 0; i < by_clusters.size() && i < by_noise.size(); ++i) {
       by_noise[i] = std::max(by_noise[i], by_clusters[i]);
@@ -545,13 +576,15 @@ void BundleProblem::StoreStdDevs(const MarginalCovariance& marginal, Calibration
     if (free_intrinsics) {
       std_devs->intrinsics_by_noise[id] = marginal.StdDevs(intrinsics_block);
       std_devs->intrinsics_by_clusters[id] = marginal.ClusteredStdDevs(intrinsics_block);
-      std_devs->intrinsics[id] = larger(std_devs->intrinsics_by_noise[id], std_devs->intrinsics_by_clusters[id]);
+      std_devs->intrinsics[id] =
+          larger(std_devs->intrinsics_by_noise[id], std_devs->intrinsics_by_clusters[id]);
     }
     if (!housings_.count(id) || !marginal.offset.count(housings_.at(id).data())) continue;
     const double* housing_block = housings_.at(id).data();
     std_devs->housing_by_noise[id] = marginal.StdDevs(housing_block);
     std_devs->housing_by_clusters[id] = marginal.ClusteredStdDevs(housing_block);
-    std_devs->housing[id] = larger(std_devs->housing_by_noise[id], std_devs->housing_by_clusters[id]);
+    std_devs->housing[id] =
+        larger(std_devs->housing_by_noise[id], std_devs->housing_by_clusters[id]);
     if (!free_intrinsics) continue;
     Eigen::MatrixXd& correlation = std_devs->intrinsics_housing_correlation[id];
     correlation.resize(marginal.size.at(intrinsics_block), marginal.size.at(housing_block));
@@ -580,8 +613,10 @@ void BundleProblem::WriteBack() {
 
 }  // namespace
 
-ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction, const BundleAdjustmentOptions& options,
-                                    const BundleAdjustmentScope& scope, std::vector<MarkerCorner>* markers,
+ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction,
+                                    const BundleAdjustmentOptions& options,
+                                    const BundleAdjustmentScope& scope,
+                                    std::vector<MarkerCorner>* markers,
                                     const MarkerScale& marker_scale, CalibrationStdDevs* std_devs) {
   options.Check();
   BundleProblem problem(reconstruction, options, scope, markers, marker_scale);

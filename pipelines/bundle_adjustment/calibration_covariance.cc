@@ -18,7 +18,8 @@ namespace {
 // Square roots of a diagonal stretch, negatives (round-off) as 0.
 std::vector<double> DiagonalStdDevs(const Eigen::MatrixXd& covariance, int start, int size) {
   std::vector<double> std_dev;
-  for (int i = 0; i < size; ++i) std_dev.push_back(std::sqrt(std::max(0.0, covariance(start + i, start + i))));
+  for (int i = 0; i < size; ++i)
+    std_dev.push_back(std::sqrt(std::max(0.0, covariance(start + i, start + i))));
   return std_dev;
 }
 
@@ -32,8 +33,10 @@ struct BlockClusters {
 };
 
 // Dense cluster indices of every residual block (see ResidualClusters).
-std::vector<BlockClusters> AssignClusters(ceres::Problem* problem, const std::vector<ceres::ResidualBlockId>& ids,
-                                          const std::vector<double*>& points, const std::vector<double>& squared_norms,
+std::vector<BlockClusters> AssignClusters(ceres::Problem* problem,
+                                          const std::vector<ceres::ResidualBlockId>& ids,
+                                          const std::vector<double*>& points,
+                                          const std::vector<double>& squared_norms,
                                           const ResidualClusters& clusters) {
   std::unordered_map<const double*, int> point_index;
   for (size_t p = 0; p < points.size(); ++p) point_index[points[p]] = static_cast<int>(p);
@@ -71,7 +74,8 @@ std::vector<BlockClusters> AssignClusters(ceres::Problem* problem, const std::ve
       }
       for (double* block : blocks) {
         if (b.track >= 0) break;
-        if (const auto it = clusters.track_of_block.find(block); it != clusters.track_of_block.end()) {
+        if (const auto it = clusters.track_of_block.find(block);
+            it != clusters.track_of_block.end()) {
           b.track = dense(listed_track_index, it->second, &num_tracks);
         }
       }
@@ -93,7 +97,8 @@ std::vector<BlockClusters> AssignClusters(ceres::Problem* problem, const std::ve
 // The clusters' summed effects and, from them, the two-way covariance.
 class ClusterEffects {
  public:
-  ClusterEffects(int size, const std::vector<BlockClusters>& blocks) : blocks_(blocks), both_(size, size) {
+  ClusterEffects(int size, const std::vector<BlockClusters>& blocks)
+      : blocks_(blocks), both_(size, size) {
     int num_images = 0, num_tracks = 0;
     std::unordered_map<int, int> blocks_of_both;
     for (const BlockClusters& b : blocks) {
@@ -151,7 +156,8 @@ class ClusterEffects {
       for (size_t j = 0; j < varying.size(); ++j) sub(i, j) = covariance(varying[i], varying[j]);
     }
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (sub + sub.transpose()));
-    sub = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+    sub = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
+          eig.eigenvectors().transpose();
     covariance.setZero();
     for (size_t i = 0; i < varying.size(); ++i) {
       for (size_t j = 0; j < varying.size(); ++j) covariance(varying[i], varying[j]) = sub(i, j);
@@ -172,18 +178,20 @@ class ClusterEffects {
 NumericalError RankDeficient(const std::string& name, const char* measure, double ratio) {
   std::ostringstream text;
   text << ratio;
-  return NumericalError("covariance: the views do not determine " + name + " (reduced system rank deficient: " +
-                        measure + " ratio " + text.str() + "); hold it fixed or add views");
+  return NumericalError("covariance: the views do not determine " + name +
+                        " (reduced system rank deficient: " + measure + " ratio " + text.str() +
+                        "); hold it fixed or add views");
 }
 
 // Rows of S^-1 at `wanted` by a dense eigen-decomposition of the scaled
 // system, whose smallest eigenvector names the parameter that dominates an
 // unobservable direction.
-Eigen::MatrixXd DenseInverseRows(const Eigen::SparseMatrix<double>& reduced, const Eigen::VectorXd& d_inv_sqrt,
-                                 const std::vector<int>& wanted,
+Eigen::MatrixXd DenseInverseRows(const Eigen::SparseMatrix<double>& reduced,
+                                 const Eigen::VectorXd& d_inv_sqrt, const std::vector<int>& wanted,
                                  const std::function<std::string(Eigen::Index)>& name_of) {
   const Eigen::MatrixXd s = Eigen::MatrixXd(reduced);
-  const Eigen::MatrixXd scaled = d_inv_sqrt.asDiagonal() * (0.5 * (s + s.transpose())) * d_inv_sqrt.asDiagonal();
+  const Eigen::MatrixXd scaled =
+      d_inv_sqrt.asDiagonal() * (0.5 * (s + s.transpose())) * d_inv_sqrt.asDiagonal();
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaled);
   const Eigen::VectorXd values = eig.eigenvalues();
   const Eigen::Index n = values.size();
@@ -195,8 +203,10 @@ Eigen::MatrixXd DenseInverseRows(const Eigen::SparseMatrix<double>& reduced, con
   Eigen::MatrixXd rows(wanted.size(), n);
   for (size_t k = 0; k < wanted.size(); ++k) {
     rows.row(static_cast<Eigen::Index>(k)) =
-        (eig.eigenvectors().row(wanted[k]) * values.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose())
-            .cwiseProduct(d_inv_sqrt.transpose()) * d_inv_sqrt(wanted[k]);
+        (eig.eigenvectors().row(wanted[k]) * values.cwiseInverse().asDiagonal() *
+         eig.eigenvectors().transpose())
+            .cwiseProduct(d_inv_sqrt.transpose()) *
+        d_inv_sqrt(wanted[k]);
   }
   return rows;
 }
@@ -205,11 +215,13 @@ Eigen::MatrixXd DenseInverseRows(const Eigen::SparseMatrix<double>& reduced, con
 // reducing AMD order): a survey's S couples each image with its
 // neighbours only, and its dense decomposition costs n^3. Rank deficiency
 // shows as a vanishing pivot; the parameter at that pivot is named.
-Eigen::MatrixXd SparseInverseRows(const Eigen::SparseMatrix<double>& reduced, const Eigen::VectorXd& d_inv_sqrt,
-                                  const std::vector<int>& wanted,
+Eigen::MatrixXd SparseInverseRows(const Eigen::SparseMatrix<double>& reduced,
+                                  const Eigen::VectorXd& d_inv_sqrt, const std::vector<int>& wanted,
                                   const std::function<std::string(Eigen::Index)>& name_of) {
-  const Eigen::SparseMatrix<double> symmetric = 0.5 * (reduced + Eigen::SparseMatrix<double>(reduced.transpose()));
-  const Eigen::SparseMatrix<double> scaled = d_inv_sqrt.asDiagonal() * symmetric * d_inv_sqrt.asDiagonal();
+  const Eigen::SparseMatrix<double> symmetric =
+      0.5 * (reduced + Eigen::SparseMatrix<double>(reduced.transpose()));
+  const Eigen::SparseMatrix<double> scaled =
+      d_inv_sqrt.asDiagonal() * symmetric * d_inv_sqrt.asDiagonal();
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(scaled);
   if (ldlt.info() != Eigen::Success) {
     // An exactly zero pivot stops the factorisation where it is; a shift
@@ -217,14 +229,18 @@ Eigen::MatrixXd SparseInverseRows(const Eigen::SparseMatrix<double>& reduced, co
     // pivot can be found and named (the shifted factor gives no numbers).
     ldlt.setShift(1e-15);
     ldlt.factorize(scaled);
-    if (ldlt.info() != Eigen::Success) throw NumericalError("covariance: the reduced system cannot be factorised");
+    if (ldlt.info() != Eigen::Success)
+      throw NumericalError("covariance: the reduced system cannot be factorised");
   }
   const Eigen::VectorXd pivots = ldlt.vectorD();
   Eigen::Index smallest;
   const double ratio = pivots.minCoeff(&smallest) / pivots.cwiseAbs().maxCoeff();
-  if (!(ratio > 1e-12)) throw RankDeficient(name_of(ldlt.permutationPinv().indices()(smallest)), "pivot", ratio);
-  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(scaled.rows(), static_cast<Eigen::Index>(wanted.size()));
-  for (size_t k = 0; k < wanted.size(); ++k) unit(wanted[k], static_cast<Eigen::Index>(k)) = d_inv_sqrt(wanted[k]);
+  if (!(ratio > 1e-12))
+    throw RankDeficient(name_of(ldlt.permutationPinv().indices()(smallest)), "pivot", ratio);
+  Eigen::MatrixXd unit =
+      Eigen::MatrixXd::Zero(scaled.rows(), static_cast<Eigen::Index>(wanted.size()));
+  for (size_t k = 0; k < wanted.size(); ++k)
+    unit(wanted[k], static_cast<Eigen::Index>(k)) = d_inv_sqrt(wanted[k]);
   const Eigen::MatrixXd solved = ldlt.solve(unit);
   return (d_inv_sqrt.asDiagonal() * solved).transpose();
 }
@@ -246,9 +262,9 @@ Eigen::VectorXd JacobiScaling(const Eigen::SparseMatrix<double>& reduced, int nu
 // rows in the result, and its tangent coordinates in the reduced system.
 struct WantedTangents {
   std::vector<Eigen::MatrixXd> plus;
-  std::vector<int> columns;      // in order; block a's start at first_row[a]
+  std::vector<int> columns;  // in order; block a's start at first_row[a]
   std::vector<int> first_row;
-  int total = 0;                 // ambient coordinates of all wanted blocks
+  int total = 0;  // ambient coordinates of all wanted blocks
 };
 
 WantedTangents TangentsOf(ceres::Problem* problem, const std::vector<const double*>& wanted,
@@ -279,8 +295,10 @@ WantedTangents TangentsOf(ceres::Problem* problem, const std::vector<const doubl
 // gradient w r (J_c' - H_cp H_pp^+ J_p'), w = rho' -- the points' share
 // removed as in the Schur complement. A cluster's effect S^-1 u_k is the
 // sum of its residuals' effects.
-Eigen::MatrixXd ClusteredCovariance(const PointSchurComplement& schur, const std::vector<const double*>& wanted,
-                                    const WantedTangents& tangents, const Eigen::MatrixXd& inverse_rows,
+Eigen::MatrixXd ClusteredCovariance(const PointSchurComplement& schur,
+                                    const std::vector<const double*>& wanted,
+                                    const WantedTangents& tangents,
+                                    const Eigen::MatrixXd& inverse_rows,
                                     const std::vector<BlockClusters>& block_clusters,
                                     const ResidualClusters& clusters, MarginalCovariance* result) {
   Eigen::MatrixXd gain(tangents.total, schur.num_columns());
@@ -292,8 +310,9 @@ Eigen::MatrixXd ClusteredCovariance(const PointSchurComplement& schur, const std
   weights.reserve(block_clusters.size());
   for (const BlockClusters& b : block_clusters) weights.push_back(b.weight);
   ClusterEffects effects(tangents.total, block_clusters);
-  schur.VisitReducedGradients(gain, weights,
-                              [&](size_t block, const Eigen::VectorXd& effect) { effects.Add(block, effect); });
+  schur.VisitReducedGradients(gain, weights, [&](size_t block, const Eigen::VectorXd& effect) {
+    effects.Add(block, effect);
+  });
   return effects.Covariance(clusters.residuals_per_dof, &result->num_clusters, &result->num_tracks);
 }
 
@@ -318,8 +337,8 @@ double MarginalCovariance::Correlation(const double* a, int i, const double* b, 
 MarginalCovariance ComputeMarginalCovariance(
     ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others,
     const std::vector<const double*>& wanted, double scale,
-    const std::function<std::string(const double*, int)>& describe, const ResidualClusters* clusters,
-    int max_dense_size, int num_threads) {
+    const std::function<std::string(const double*, int)>& describe,
+    const ResidualClusters* clusters, int max_dense_size, int num_threads) {
   const PointSchurComplement schur(problem, points, others, num_threads);
   const int nc = schur.num_columns();
   // Each residual block's clusters and the weight of its gradient: the
@@ -327,14 +346,16 @@ MarginalCovariance ComputeMarginalCovariance(
   // rho' J'r, is what balances).
   std::vector<BlockClusters> block_clusters;
   if (clusters) {
-    block_clusters = AssignClusters(problem, schur.residual_blocks(), points, schur.squared_norms(), *clusters);
+    block_clusters =
+        AssignClusters(problem, schur.residual_blocks(), points, schur.squared_norms(), *clusters);
   }
   const Eigen::VectorXd d_inv_sqrt = JacobiScaling(schur.reduced(), nc);
   const auto name_of = [&](Eigen::Index column) {
     for (const auto& [block, start] : schur.offset()) {
       const int size = problem->ParameterBlockTangentSize(block);
       if (column >= start && column < start + size) {
-        return describe(block, static_cast<int>(column) - start) + " [tangent " + std::to_string(column - start) + "]";
+        return describe(block, static_cast<int>(column) - start) + " [tangent " +
+               std::to_string(column - start) + "]";
       }
     }
     return "parameter " + std::to_string(column);
@@ -342,9 +363,10 @@ MarginalCovariance ComputeMarginalCovariance(
   MarginalCovariance result;
   const WantedTangents tangents = TangentsOf(problem, wanted, schur.offset(), &result);
   // The rows of S^-1 at the wanted coordinates.
-  const Eigen::MatrixXd inverse_rows = nc <= max_dense_size
-      ? DenseInverseRows(schur.reduced(), d_inv_sqrt, tangents.columns, name_of)
-      : SparseInverseRows(schur.reduced(), d_inv_sqrt, tangents.columns, name_of);
+  const Eigen::MatrixXd inverse_rows =
+      nc <= max_dense_size
+          ? DenseInverseRows(schur.reduced(), d_inv_sqrt, tangents.columns, name_of)
+          : SparseInverseRows(schur.reduced(), d_inv_sqrt, tangents.columns, name_of);
 
   // Each wanted block's tangent covariance mapped to its ambient
   // coordinates: C_ab = P_a C'_ab P_b^T.
@@ -354,13 +376,15 @@ MarginalCovariance ComputeMarginalCovariance(
       const Eigen::MatrixXd& pa = tangents.plus[a];
       const Eigen::MatrixXd& pb = tangents.plus[b];
       const int tb = schur.offset().at(wanted[b]);
-      result.covariance.block(result.offset[wanted[a]], result.offset[wanted[b]], pa.rows(), pb.rows()) =
-          scale * scale * pa * inverse_rows.block(tangents.first_row[a], tb, pa.cols(), pb.cols()) * pb.transpose();
+      result.covariance.block(result.offset[wanted[a]], result.offset[wanted[b]], pa.rows(),
+                              pb.rows()) =
+          scale * scale * pa * inverse_rows.block(tangents.first_row[a], tb, pa.cols(), pb.cols()) *
+          pb.transpose();
     }
   }
   if (clusters) {
-    result.clustered_covariance =
-        ClusteredCovariance(schur, wanted, tangents, inverse_rows, block_clusters, *clusters, &result);
+    result.clustered_covariance = ClusteredCovariance(schur, wanted, tangents, inverse_rows,
+                                                      block_clusters, *clusters, &result);
   }
   return result;
 }

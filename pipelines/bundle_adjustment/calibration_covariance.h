@@ -11,7 +11,6 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Core>
-
 #include <functional>
 #include <map>
 #include <string>
@@ -81,7 +80,7 @@ struct ResidualClusters {
 MarginalCovariance ComputeMarginalCovariance(
     ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others,
     const std::vector<const double*>& wanted, double scale,
-    const std::function<std::string(const double*, int)>& describe, const ResidualClusters* clusters = nullptr,
-    int max_dense_size = 1200, int num_threads = 1);
+    const std::function<std::string(const double*, int)>& describe,
+    const ResidualClusters* clusters = nullptr, int max_dense_size = 1200, int num_threads = 1);
 
 }  // namespace portcal

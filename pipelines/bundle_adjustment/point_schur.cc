@@ -42,8 +42,10 @@ Eigen::Matrix3d PseudoInverse(const Eigen::Matrix3d& information) {
 
 // Runs work(begin, end, thread) on `num_threads` threads over contiguous
 // ranges of [0, count); the first exception is rethrown after all ended.
-void ForEachRange(size_t count, int num_threads, const std::function<void(size_t, size_t, int)>& work) {
-  const size_t threads = std::max<size_t>(1, std::min<size_t>(static_cast<size_t>(num_threads), count));
+void ForEachRange(size_t count, int num_threads,
+                  const std::function<void(size_t, size_t, int)>& work) {
+  const size_t threads =
+      std::max<size_t>(1, std::min<size_t>(static_cast<size_t>(num_threads), count));
   if (threads == 1) return work(0, count, 0);
   std::vector<std::exception_ptr> errors(threads);
   std::vector<std::thread> running;
@@ -62,7 +64,8 @@ void ForEachRange(size_t count, int num_threads, const std::function<void(size_t
   }
 }
 
-void AddPair(int a, int b, const Eigen::MatrixXd& value, std::unordered_map<uint64_t, Eigen::MatrixXd>* pairs) {
+void AddPair(int a, int b, const Eigen::MatrixXd& value,
+             std::unordered_map<uint64_t, Eigen::MatrixXd>* pairs) {
   if (a > b) return AddPair(b, a, value.transpose(), pairs);
   const uint64_t key = (static_cast<uint64_t>(a) << 32) | static_cast<uint32_t>(b);
   const auto [it, inserted] = pairs->try_emplace(key);
@@ -75,7 +78,8 @@ void AddPair(int a, int b, const Eigen::MatrixXd& value, std::unordered_map<uint
 
 }  // namespace
 
-PointSchurComplement::PointSchurComplement(ceres::Problem* problem, const std::vector<double*>& points,
+PointSchurComplement::PointSchurComplement(ceres::Problem* problem,
+                                           const std::vector<double*>& points,
                                            const std::vector<double*>& others, int num_threads)
     : problem_(problem), num_threads_(std::max(1, num_threads)) {
   IndexBlocks(points, others);
@@ -85,7 +89,8 @@ PointSchurComplement::PointSchurComplement(ceres::Problem* problem, const std::v
   std::vector<PairBlocks> pairs(static_cast<size_t>(num_threads_));
   ForEachRange(points.size() + 1, num_threads_, [&](size_t begin, size_t end, int thread) {
     std::vector<Linearised> linearised;
-    for (size_t p = begin; p < end; ++p) Reduce(p, &linearised, &pairs[static_cast<size_t>(thread)]);
+    for (size_t p = begin; p < end; ++p)
+      Reduce(p, &linearised, &pairs[static_cast<size_t>(thread)]);
   });
   for (size_t t = 1; t < pairs.size(); ++t) {
     for (const auto& [key, value] : pairs[t]) {
@@ -97,10 +102,12 @@ PointSchurComplement::PointSchurComplement(ceres::Problem* problem, const std::v
   Assemble(pairs[0]);
 }
 
-void PointSchurComplement::IndexBlocks(const std::vector<double*>& points, const std::vector<double*>& others) {
+void PointSchurComplement::IndexBlocks(const std::vector<double*>& points,
+                                       const std::vector<double*>& others) {
   for (size_t p = 0; p < points.size(); ++p) {
-    PORTCAL_CHECK_MSG(problem_->ParameterBlockTangentSize(points[p]) == 3 && !problem_->GetManifold(points[p]),
-                      "a marginalised point must be a plain 3-vector");
+    PORTCAL_CHECK_MSG(
+        problem_->ParameterBlockTangentSize(points[p]) == 3 && !problem_->GetManifold(points[p]),
+        "a marginalised point must be a plain 3-vector");
     point_index_[points[p]] = static_cast<int>(p);
   }
   for (double* block : others) {
@@ -109,7 +116,8 @@ void PointSchurComplement::IndexBlocks(const std::vector<double*>& points, const
     const int ambient = problem_->ParameterBlockSize(block);
     Eigen::MatrixXd plus;
     if (const ceres::Manifold* manifold = problem_->GetManifold(block)) {
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> jacobian(ambient, tangent);
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> jacobian(ambient,
+                                                                                      tangent);
       manifold->PlusJacobian(block, jacobian.data());
       plus = jacobian;
     }
@@ -185,15 +193,18 @@ void PointSchurComplement::Linearise(size_t block, Linearised* out) const {
   out->residual.resize(rows);
   out->point.resize(0, 3);
   out->others.clear();
-  bool finite = cost->Evaluate(blocks.data(), out->residual.data(), jacobians.data()) && out->residual.allFinite();
+  bool finite = cost->Evaluate(blocks.data(), out->residual.data(), jacobians.data()) &&
+                out->residual.allFinite();
   for (size_t i = 0; i < blocks.size() && finite; ++i) {
     finite = ambient[i].allFinite();
     if (is_point[i]) out->point = ambient[i];
     if (other[i] < 0) continue;
     const Eigen::MatrixXd& plus = plus_[static_cast<size_t>(other[i])];
-    out->others.emplace_back(other[i], plus.size() ? Eigen::MatrixXd(ambient[i] * plus) : Eigen::MatrixXd(ambient[i]));
+    out->others.emplace_back(
+        other[i], plus.size() ? Eigen::MatrixXd(ambient[i] * plus) : Eigen::MatrixXd(ambient[i]));
   }
-  if (!finite) throw NumericalError("covariance: the residuals cannot be evaluated at the solution");
+  if (!finite)
+    throw NumericalError("covariance: the residuals cannot be evaluated at the solution");
 }
 
 // Linearises the residual blocks of `point` (num_points: those of no point)
@@ -212,7 +223,8 @@ void PointSchurComplement::AccumulatePoint(size_t point, std::vector<Linearised>
       auto it = std::find_if(local->point_other.begin(), local->point_other.end(),
                              [other = other](const auto& entry) { return entry.first == other; });
       if (it == local->point_other.end()) {
-        local->point_other.emplace_back(other, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, jacobian.cols()));
+        local->point_other.emplace_back(
+            other, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, jacobian.cols()));
         it = local->point_other.end() - 1;
       }
       it->second += block.point.transpose() * jacobian;
@@ -222,7 +234,8 @@ void PointSchurComplement::AccumulatePoint(size_t point, std::vector<Linearised>
 }
 
 // Adds the point's share of S: its residuals' J_c'J_c, less H_cp H_pp^+ H_pc.
-void PointSchurComplement::Reduce(size_t point, std::vector<Linearised>* linearised, PairBlocks* pairs) {
+void PointSchurComplement::Reduce(size_t point, std::vector<Linearised>* linearised,
+                                  PairBlocks* pairs) {
   PointBlocks local;
   AccumulatePoint(point, linearised, &local);
   const size_t begin = first_[point];
@@ -237,7 +250,8 @@ void PointSchurComplement::Reduce(size_t point, std::vector<Linearised>* lineari
     }
   }
   std::vector<Eigen::MatrixXd> response;  // H_pp^+ H_pc, the point's response to each block
-  for (const auto& [other, point_other] : local.point_other) response.emplace_back(local.pinv * point_other);
+  for (const auto& [other, point_other] : local.point_other)
+    response.emplace_back(local.pinv * point_other);
   for (size_t i = 0; i < local.point_other.size(); ++i) {
     for (size_t j = 0; j < local.point_other.size(); ++j) {
       if (local.point_other[j].first < local.point_other[i].first) continue;
@@ -254,14 +268,16 @@ void PointSchurComplement::VisitReducedGradients(
   // batch's are a few MB.
   constexpr size_t kBatch = 4096;
   const size_t count = first_.size() - 1;  // the points and the blocks of none
-  std::vector<std::vector<std::pair<size_t, Eigen::VectorXd>>> effects(static_cast<size_t>(num_threads_));
+  std::vector<std::vector<std::pair<size_t, Eigen::VectorXd>>> effects(
+      static_cast<size_t>(num_threads_));
   for (size_t batch = 0; batch < count; batch += kBatch) {
     const size_t size = std::min(kBatch, count - batch);
     ForEachRange(size, num_threads_, [&](size_t begin, size_t end, int thread) {
       std::vector<std::pair<size_t, Eigen::VectorXd>>& out = effects[static_cast<size_t>(thread)];
       out.clear();
       std::vector<Linearised> linearised;  // scratch, reused point after point
-      for (size_t p = batch + begin; p < batch + end; ++p) ReducedGradientsOf(p, gain, weights, &linearised, &out);
+      for (size_t p = batch + begin; p < batch + end; ++p)
+        ReducedGradientsOf(p, gain, weights, &linearised, &out);
     });
     for (auto& thread : effects) {
       for (const auto& [index, effect] : thread) visit(index, effect);
@@ -270,10 +286,10 @@ void PointSchurComplement::VisitReducedGradients(
   }
 }
 
-void PointSchurComplement::ReducedGradientsOf(size_t point, const Eigen::MatrixXd& gain,
-                                              const std::vector<double>& weights,
-                                              std::vector<Linearised>* linearised_scratch,
-                                              std::vector<std::pair<size_t, Eigen::VectorXd>>* out) const {
+void PointSchurComplement::ReducedGradientsOf(
+    size_t point, const Eigen::MatrixXd& gain, const std::vector<double>& weights,
+    std::vector<Linearised>* linearised_scratch,
+    std::vector<std::pair<size_t, Eigen::VectorXd>>* out) const {
   PointBlocks local;
   AccumulatePoint(point, linearised_scratch, &local);
   const std::vector<Linearised>& linearised = *linearised_scratch;
@@ -282,8 +298,9 @@ void PointSchurComplement::ReducedGradientsOf(size_t point, const Eigen::MatrixX
   // residual's pull on the point into the other blocks.
   Eigen::MatrixXd point_gain = Eigen::MatrixXd::Zero(rows, 3);
   for (const auto& [other, point_other] : local.point_other) {
-    point_gain += gain.middleCols(start_[static_cast<size_t>(other)], size_[static_cast<size_t>(other)]) *
-                  point_other.transpose();
+    point_gain +=
+        gain.middleCols(start_[static_cast<size_t>(other)], size_[static_cast<size_t>(other)]) *
+        point_other.transpose();
   }
   point_gain = point_gain * local.pinv;
   for (size_t k = 0; k < linearised.size(); ++k) {
@@ -292,10 +309,12 @@ void PointSchurComplement::ReducedGradientsOf(size_t point, const Eigen::MatrixX
     const Eigen::VectorXd weighted = weights[index] * block.residual;
     Eigen::VectorXd effect = Eigen::VectorXd::Zero(rows);
     for (const auto& [other, jacobian] : block.others) {
-      effect.noalias() += gain.middleCols(start_[static_cast<size_t>(other)], size_[static_cast<size_t>(other)]) *
-                          (jacobian.transpose() * weighted);
+      effect.noalias() +=
+          gain.middleCols(start_[static_cast<size_t>(other)], size_[static_cast<size_t>(other)]) *
+          (jacobian.transpose() * weighted);
     }
-    if (block.point.rows() > 0) effect.noalias() -= point_gain * (block.point.transpose() * weighted);
+    if (block.point.rows() > 0)
+      effect.noalias() -= point_gain * (block.point.transpose() * weighted);
     out->emplace_back(index, std::move(effect));
   }
 }

@@ -26,8 +26,8 @@ class PointSchurComplement {
   // columns are S's, in this order. Blocks in neither list are taken as
   // held. The points are shared among `num_threads` threads. Throws
   // NumericalError when a residual cannot be evaluated.
-  PointSchurComplement(ceres::Problem* problem, const std::vector<double*>& points, const std::vector<double*>& others,
-                       int num_threads = 1);
+  PointSchurComplement(ceres::Problem* problem, const std::vector<double*>& points,
+                       const std::vector<double*>& others, int num_threads = 1);
 
   int num_columns() const { return num_columns_; }
   // Tangent column of each other block's first coordinate.
@@ -43,8 +43,9 @@ class PointSchurComplement {
   // (J_c' - H_cp H_pp^+ J_p') weights[k] r_k, its weighted gradient with
   // the points' response removed, mapped by `gain` (rows x num_columns).
   // Computed on the threads, visited on the caller's, in point order.
-  void VisitReducedGradients(const Eigen::MatrixXd& gain, const std::vector<double>& weights,
-                             const std::function<void(size_t, const Eigen::VectorXd&)>& visit) const;
+  void VisitReducedGradients(
+      const Eigen::MatrixXd& gain, const std::vector<double>& weights,
+      const std::function<void(size_t, const Eigen::VectorXd&)>& visit) const;
 
  private:
   struct Linearised;
@@ -58,7 +59,8 @@ class PointSchurComplement {
   void Linearise(size_t block, Linearised* out) const;
   void AccumulatePoint(size_t point, std::vector<Linearised>* linearised, PointBlocks* local) const;
   void Reduce(size_t point, std::vector<Linearised>* linearised, PairBlocks* pairs);
-  void ReducedGradientsOf(size_t point, const Eigen::MatrixXd& gain, const std::vector<double>& weights,
+  void ReducedGradientsOf(size_t point, const Eigen::MatrixXd& gain,
+                          const std::vector<double>& weights,
                           std::vector<Linearised>* linearised_scratch,
                           std::vector<std::pair<size_t, Eigen::VectorXd>>* out) const;
 

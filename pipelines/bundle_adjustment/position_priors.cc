@@ -56,7 +56,6 @@ Eigen::Vector3d Apply(const Similarity3d& s, const Eigen::Vector3d& x) {
   return s.scale * (s.rotation * x) + s.translation;
 }
 
-
 }  // namespace
 
 Similarity3d FitSimilarity(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) {
@@ -73,13 +72,15 @@ int NumUsablePositionPriors(const Reconstruction& reconstruction) {
   return SpansPlane(pairs) ? static_cast<int>(pairs.size()) : 0;
 }
 
-std::optional<PositionPriorAlignment> AlignToPositionPriors(Reconstruction* r, double min_inlier_distance_m) {
+std::optional<PositionPriorAlignment> AlignToPositionPriors(Reconstruction* r,
+                                                            double min_inlier_distance_m) {
   const std::vector<CentreAndPrior> pairs = Collect(*r);
   if (!SpansPlane(pairs)) return std::nullopt;
   std::vector<char> use(pairs.size(), 1);
   Similarity3d sim = Fit(pairs, use);
   std::vector<double> errors(pairs.size());
-  for (size_t i = 0; i < pairs.size(); ++i) errors[i] = (Apply(sim, pairs[i].centre) - pairs[i].prior).norm();
+  for (size_t i = 0; i < pairs.size(); ++i)
+    errors[i] = (Apply(sim, pairs[i].centre) - pairs[i].prior).norm();
   std::vector<double> sorted = errors;
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
   const double limit = std::max(3.0 * 1.4826 * sorted[sorted.size() / 2], min_inlier_distance_m);
@@ -102,7 +103,8 @@ std::optional<PositionPriorAlignment> AlignToPositionPriors(Reconstruction* r, d
   // cam_from_new = (R_c R^T, s t_c - R_c R^T t).
   for (auto& [id, pose] : r->mutable_poses()) {
     const Eigen::Quaterniond rotation = pose.rotation * sim.rotation.conjugate();
-    pose = Rigid3d(rotation.normalized(), sim.scale * pose.translation - rotation * sim.translation);
+    pose =
+        Rigid3d(rotation.normalized(), sim.scale * pose.translation - rotation * sim.translation);
   }
   std::vector<point3D_t> ids;
   for (const auto& [id, point] : r->points()) ids.push_back(id);

@@ -25,7 +25,8 @@ size_t ReducedCameraSystemBlocks(const Reconstruction& reconstruction,
   size_t blocks = 0;
   for (auto& [image_id, of_image] : neighbours) {
     std::sort(of_image.begin(), of_image.end());
-    blocks += 1 + static_cast<size_t>(std::unique(of_image.begin(), of_image.end()) - of_image.begin());
+    blocks +=
+        1 + static_cast<size_t>(std::unique(of_image.begin(), of_image.end()) - of_image.begin());
   }
   return blocks;
 }

@@ -14,15 +14,16 @@ namespace portcal {
 void SelfCalibrationOptions::Check() const {
   marker_scale.Check();
   if (!(max_reproj_error_px > 0)) {
-    throw OptionError("--BundleAdjustment.max_reproj_error", std::to_string(max_reproj_error_px), "> 0 px");
+    throw OptionError("--BundleAdjustment.max_reproj_error", std::to_string(max_reproj_error_px),
+                      "> 0 px");
   }
   if (!(robust_function_tolerance > 0 && robust_function_tolerance < 1)) {
-    throw OptionError("--BundleAdjustment.robust_function_tolerance", std::to_string(robust_function_tolerance),
-                      "in (0, 1)");
+    throw OptionError("--BundleAdjustment.robust_function_tolerance",
+                      std::to_string(robust_function_tolerance), "in (0, 1)");
   }
   if (!(principal_point_test_sigmas >= 0)) {
-    throw OptionError("--BundleAdjustment.principal_point_test_sigmas", std::to_string(principal_point_test_sigmas),
-                      ">= 0 (0: no test)");
+    throw OptionError("--BundleAdjustment.principal_point_test_sigmas",
+                      std::to_string(principal_point_test_sigmas), ">= 0 (0: no test)");
   }
   // ba as the robust and the held solves take it (their two options are
   // checked where BundleAdjustmentOptions checks its own).
@@ -43,8 +44,9 @@ std::string FormatSigmas(double sigmas) {
 // Whether any camera's refined principal point lies more than `sigmas`
 // standard deviations (per axis) from the image centre; describes each
 // camera's offset in `offset`.
-bool PrincipalPointOffCentre(const std::map<camera_t, HousedCamera>& cameras, const CalibrationStdDevs& std_devs,
-                             double sigmas, std::ostringstream* offset) {
+bool PrincipalPointOffCentre(const std::map<camera_t, HousedCamera>& cameras,
+                             const CalibrationStdDevs& std_devs, double sigmas,
+                             std::ostringstream* offset) {
   bool significant = false;
   *offset << std::fixed << std::setprecision(2);
   for (const auto& [id, camera] : cameras) {
@@ -61,8 +63,8 @@ bool PrincipalPointOffCentre(const std::map<camera_t, HousedCamera>& cameras, co
       // No finite standard deviation: the data cannot tell, so not significant.
       const bool beyond = sigma > 0 && std::isfinite(sigma) && std::abs(delta) > sigmas * sigma;
       significant |= beyond;
-      *offset << (k ? ", " : "") << axis[k] << " " << std::showpos << delta << std::noshowpos << " px (sd "
-              << sigma << ")";
+      *offset << (k ? ", " : "") << axis[k] << " " << std::showpos << delta << std::noshowpos
+              << " px (sd " << sigma << ")";
     }
   }
   return significant;
@@ -77,12 +79,14 @@ bool PrincipalPointOffCentre(const std::map<camera_t, HousedCamera>& cameras, co
 constexpr double kMaxPrincipalPointStdDevFraction = 0.002;
 
 // The largest principal point standard deviation above that bound, or 0.
-double PoorPrincipalPointStdDev(const std::map<camera_t, HousedCamera>& cameras, const CalibrationStdDevs& std_devs) {
+double PoorPrincipalPointStdDev(const std::map<camera_t, HousedCamera>& cameras,
+                                const CalibrationStdDevs& std_devs) {
   double worst = 0;
   for (const auto& [id, camera] : cameras) {
     const auto sd = std_devs.intrinsics.find(id);
     if (sd == std_devs.intrinsics.end()) continue;
-    const double bound = kMaxPrincipalPointStdDevFraction * std::max(camera.camera.width, camera.camera.height);
+    const double bound =
+        kMaxPrincipalPointStdDevFraction * std::max(camera.camera.width, camera.camera.height);
     for (int idx : CameraModelPrincipalPointIdxs(camera.camera.model_id)) {
       const double sigma = sd->second[idx];
       if (!(sigma <= bound)) worst = std::max(worst, std::isfinite(sigma) ? sigma : HUGE_VAL);
@@ -103,21 +107,23 @@ void CentrePrincipalPoints(Reconstruction* r) {
 
 }  // namespace
 
-SelfCalibration::SelfCalibration(const SelfCalibrationOptions& options, std::string model_name, Reconstruction* r,
-                                 std::vector<MarkerCorner>* markers)
+SelfCalibration::SelfCalibration(const SelfCalibrationOptions& options, std::string model_name,
+                                 Reconstruction* r, std::vector<MarkerCorner>* markers)
     : options_(options),
       model_name_(std::move(model_name)),
       r_(*r),
       markers_(*markers),
       cameras_before_(r->cameras()),
       joint_(options.ba.refine_housing &&
-             (options.ba.refine_focal_length || options.ba.refine_principal_point || options.ba.refine_extra_params)) {}
+             (options.ba.refine_focal_length || options.ba.refine_principal_point ||
+              options.ba.refine_extra_params)) {}
 
 camera_t SelfCalibration::HousingAtBound() const {
   return options_.ba.refine_housing ? CameraWithHousingAtBound(r_.cameras()) : kInvalidCameraId;
 }
 
-SelfCalibrationOutcome SelfCalibration::Calibrate(bool intrinsics_first, CalibrationStdDevs* std_devs) {
+SelfCalibrationOutcome SelfCalibration::Calibrate(bool intrinsics_first,
+                                                  CalibrationStdDevs* std_devs) {
   SelfCalibrationOutcome outcome;
   // The staged solves only start the next: robust, to the robust tolerance.
   if (joint_ && intrinsics_first) {
@@ -159,15 +165,18 @@ void SelfCalibration::Solve(const BundleAdjustmentOptions& ba, CalibrationStdDev
     std::string why;
     if (ImplausibleIntrinsics(cameras_before_.at(id).camera, camera.camera, &why)) {
       throw NumericalError(model_name_ + ": refining camera " + std::to_string(id) +
-                           " gave implausible intrinsics (" + why + "): the reconstruction is likely "
-                           "wrong (mean reprojection error " + std::to_string(r_.MeanReprojectionError()) +
+                           " gave implausible intrinsics (" + why +
+                           "): the reconstruction is likely "
+                           "wrong (mean reprojection error " +
+                           std::to_string(r_.MeanReprojectionError()) +
                            " px); give the intrinsics (--ImageReader.camera_params) or more views");
     }
   }
   outcome->num_filtered += r_.DeleteObservationsBeyond(options_.max_reproj_error_px);
   const BundleAdjustmentOptions final_solve =
       options_.hold_weights ? ba.WithWeightsHeld(options_.held_trust_region_radius) : ba;
-  AdjustBundle(&r_, final_solve, BundleAdjustmentScope(), &markers_, options_.marker_scale, std_devs);
+  AdjustBundle(&r_, final_solve, BundleAdjustmentScope(), &markers_, options_.marker_scale,
+               std_devs);
 }
 
 void SelfCalibration::WarnIfPrincipalPointPoor(const CalibrationStdDevs& std_devs,
@@ -176,7 +185,8 @@ void SelfCalibration::WarnIfPrincipalPointPoor(const CalibrationStdDevs& std_dev
   if (!(sigma > 0)) return;
   std::ostringstream text;
   text << "the principal point is poorly determined (std dev " << std::setprecision(3) << sigma
-       << " px): the focal length, distortion and housing may have taken up its offset; give the in-air "
+       << " px): the focal length, distortion and housing may have taken up its offset; give the "
+          "in-air "
           "intrinsics (--ImageReader.camera_params), more views, or views nearer the image corners";
   outcome->warnings.push_back(text.str());
   LOG(WARNING) << "refractive_bundle_adjuster: " << outcome->warnings.back();
@@ -184,9 +194,11 @@ void SelfCalibration::WarnIfPrincipalPointPoor(const CalibrationStdDevs& std_dev
 
 // Holds the principal point at the image centre again (and solves) unless
 // it lies beyond the test's sigmas from it; returns the note.
-std::string SelfCalibration::TestPrincipalPoint(CalibrationStdDevs* std_devs, SelfCalibrationOutcome* outcome) {
+std::string SelfCalibration::TestPrincipalPoint(CalibrationStdDevs* std_devs,
+                                                SelfCalibrationOutcome* outcome) {
   std::ostringstream offset;
-  if (PrincipalPointOffCentre(r_.cameras(), *std_devs, options_.principal_point_test_sigmas, &offset)) {
+  if (PrincipalPointOffCentre(r_.cameras(), *std_devs, options_.principal_point_test_sigmas,
+                              &offset)) {
     outcome->principal_point_held = false;
     return "principal point refined: off the image centre by " + offset.str();
   }
@@ -196,8 +208,8 @@ std::string SelfCalibration::TestPrincipalPoint(CalibrationStdDevs* std_devs, Se
   *std_devs = CalibrationStdDevs();
   Solve(held, std_devs, outcome);
   outcome->principal_point_held = true;
-  return "principal point held at the image centre: refined, it was off by " + offset.str() + ", within " +
-         FormatSigmas(options_.principal_point_test_sigmas);
+  return "principal point held at the image centre: refined, it was off by " + offset.str() +
+         ", within " + FormatSigmas(options_.principal_point_test_sigmas);
 }
 
 // Moves the position of every housing at a bound of the adjustment (flat:
@@ -213,7 +225,8 @@ void MoveHousingsOffBound(const std::optional<Housing>& guess, Reconstruction* r
     for (int k : refinement.position) {
       camera.housing->params[static_cast<size_t>(k)] = from.params[static_cast<size_t>(k)];
     }
-    LOG(INFO) << "refractive_bundle_adjuster: camera " << id << ": housing started again off its bound, from the "
+    LOG(INFO) << "refractive_bundle_adjuster: camera " << id
+              << ": housing started again off its bound, from the "
               << "guess's " << refinement.position_name;
   }
   r->UpdateRays();

@@ -94,8 +94,10 @@ class SelfCalibration {
 
  private:
   BundleAdjustmentOptions Robust(const BundleAdjustmentOptions& ba) const;
-  void Solve(const BundleAdjustmentOptions& ba, CalibrationStdDevs* std_devs, SelfCalibrationOutcome* outcome);
-  void WarnIfPrincipalPointPoor(const CalibrationStdDevs& std_devs, SelfCalibrationOutcome* outcome) const;
+  void Solve(const BundleAdjustmentOptions& ba, CalibrationStdDevs* std_devs,
+             SelfCalibrationOutcome* outcome);
+  void WarnIfPrincipalPointPoor(const CalibrationStdDevs& std_devs,
+                                SelfCalibrationOutcome* outcome) const;
   std::string TestPrincipalPoint(CalibrationStdDevs* std_devs, SelfCalibrationOutcome* outcome);
 
   const SelfCalibrationOptions& options_;

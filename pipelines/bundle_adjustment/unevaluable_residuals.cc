@@ -15,7 +15,8 @@ bool EvaluableResidualBlock(const ceres::Problem& problem, ceres::ResidualBlockI
   Eigen::VectorXd residuals(num_residuals);
   std::vector<Eigen::VectorXd> jacobians;
   std::vector<double*> jacobian_ptrs;
-  for (const int32_t size : cost->parameter_block_sizes()) jacobians.emplace_back(num_residuals * size);
+  for (const int32_t size : cost->parameter_block_sizes())
+    jacobians.emplace_back(num_residuals * size);
   for (Eigen::VectorXd& jacobian : jacobians) jacobian_ptrs.push_back(jacobian.data());
   if (!cost->Evaluate(parameters.data(), residuals.data(), jacobian_ptrs.data())) return false;
   if (!residuals.allFinite()) return false;
@@ -37,8 +38,9 @@ std::vector<ceres::ResidualBlockId> UnevaluableResidualBlocks(const ceres::Probl
   return failing;
 }
 
-std::string DescribeUnevaluableResiduals(const ceres::Problem& problem,
-                                         const std::function<std::string(const std::vector<double*>&)>& describe) {
+std::string DescribeUnevaluableResiduals(
+    const ceres::Problem& problem,
+    const std::function<std::string(const std::vector<double*>&)>& describe) {
   const std::vector<ceres::ResidualBlockId> failing = UnevaluableResidualBlocks(problem);
   if (failing.empty()) return "";
   std::ostringstream out;

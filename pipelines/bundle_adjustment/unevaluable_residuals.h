@@ -24,7 +24,8 @@ std::vector<ceres::ResidualBlockId> UnevaluableResidualBlocks(const ceres::Probl
 // "; N residual(s) cannot be evaluated there, among them A, B, C", or empty
 // if all can: the first three named by `describe` from their parameter
 // blocks. For the message of a solve that failed.
-std::string DescribeUnevaluableResiduals(const ceres::Problem& problem,
-                                         const std::function<std::string(const std::vector<double*>&)>& describe);
+std::string DescribeUnevaluableResiduals(
+    const ceres::Problem& problem,
+    const std::function<std::string(const std::vector<double*>&)>& describe);
 
 }  // namespace portcal

@@ -13,7 +13,8 @@ namespace portcal {
 
 WeightsSettledCallback::WeightsSettledCallback(const ceres::Problem* problem,
                                                std::vector<ceres::ResidualBlockId> residual_blocks,
-                                               const ceres::LossFunction* loss, double max_unsettled_fraction)
+                                               const ceres::LossFunction* loss,
+                                               double max_unsettled_fraction)
     : problem_(problem),
       residual_blocks_(std::move(residual_blocks)),
       loss_(loss),
@@ -33,7 +34,8 @@ void WeightsSettledCallback::ComputeWeights(std::vector<double>* weights) const 
       problem_->GetParameterBlocksForResidualBlock(id, &blocks);
       residuals.resize(cost->num_residuals());
       if (!cost->Evaluate(blocks.data(), residuals.data(), nullptr)) continue;
-      const double squared_norm = Eigen::Map<const Eigen::VectorXd>(residuals.data(), residuals.size()).squaredNorm();
+      const double squared_norm =
+          Eigen::Map<const Eigen::VectorXd>(residuals.data(), residuals.size()).squaredNorm();
       if (!std::isfinite(squared_norm)) continue;
       double rho[3];
       loss_->Evaluate(squared_norm, rho);
@@ -46,8 +48,10 @@ void WeightsSettledCallback::ComputeWeights(std::vector<double>* weights) const 
   second.join();
 }
 
-ceres::CallbackReturnType WeightsSettledCallback::operator()(const ceres::IterationSummary& summary) {
-  if (summary.iteration > 0 && !summary.step_is_successful) return ceres::SOLVER_CONTINUE;  // same iterate
+ceres::CallbackReturnType WeightsSettledCallback::operator()(
+    const ceres::IterationSummary& summary) {
+  if (summary.iteration > 0 && !summary.step_is_successful)
+    return ceres::SOLVER_CONTINUE;  // same iterate
   ComputeWeights(&next_weights_);
   const bool first = weights_.empty();
   size_t num_unsettled = 0;
@@ -56,12 +60,14 @@ ceres::CallbackReturnType WeightsSettledCallback::operator()(const ceres::Iterat
   }
   weights_.swap(next_weights_);
   if (first) return ceres::SOLVER_CONTINUE;
-  last_unsettled_fraction_ = static_cast<double>(num_unsettled) / std::max<size_t>(1, weights_.size());
-  VLOG(2) << "bundle adjustment: iteration " << summary.iteration << ": " << num_unsettled << " of " << weights_.size()
-          << " weights changed by more than " << kSettledWeightChange;
+  last_unsettled_fraction_ =
+      static_cast<double>(num_unsettled) / std::max<size_t>(1, weights_.size());
+  VLOG(2) << "bundle adjustment: iteration " << summary.iteration << ": " << num_unsettled << " of "
+          << weights_.size() << " weights changed by more than " << kSettledWeightChange;
   if (last_unsettled_fraction_ <= max_unsettled_fraction_) {
-    VLOG(1) << "bundle adjustment: the robust weights settled after " << summary.iteration << " iterations ("
-            << num_unsettled << " of " << weights_.size() << " changed by more than " << kSettledWeightChange << ")";
+    VLOG(1) << "bundle adjustment: the robust weights settled after " << summary.iteration
+            << " iterations (" << num_unsettled << " of " << weights_.size()
+            << " changed by more than " << kSettledWeightChange << ")";
     return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
   }
   return ceres::SOLVER_CONTINUE;

@@ -24,7 +24,8 @@ namespace portcal {
 class WeightsSettledCallback : public ceres::IterationCallback {
  public:
   // `residual_blocks`: those under `loss` (the problem owns both).
-  WeightsSettledCallback(const ceres::Problem* problem, std::vector<ceres::ResidualBlockId> residual_blocks,
+  WeightsSettledCallback(const ceres::Problem* problem,
+                         std::vector<ceres::ResidualBlockId> residual_blocks,
                          const ceres::LossFunction* loss, double max_unsettled_fraction);
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override;
 

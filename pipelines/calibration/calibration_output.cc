@@ -5,13 +5,14 @@
 
 namespace portcal {
 
-void WriteCalibrationOutput(const CalibrationReport& report, const std::filesystem::path& dir, Database* database,
-                            camera_t camera_id, const std::function<void()>& write_beside) {
+void WriteCalibrationOutput(const CalibrationReport& report, const std::filesystem::path& dir,
+                            Database* database, camera_t camera_id,
+                            const std::function<void()>& write_beside) {
   // The last moment to honour a stop: a SIGINT during the report's pictures
   // would otherwise end in a complete output and exit 0.
   if (CancelFlag::Requested()) {
-    throw Cancelled("nothing was written (" + dir.string() + (database ? " and the database are" : " is") +
-                    " as it was)");
+    throw Cancelled("nothing was written (" + dir.string() +
+                    (database ? " and the database are" : " is") + " as it was)");
   }
   if (database == nullptr) {
     WriteCalibrationReport(report, dir);

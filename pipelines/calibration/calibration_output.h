@@ -17,7 +17,8 @@ namespace portcal {
 // it was.
 // `write_beside` (optional) writes further files into `dir` after the
 // reports and before the commit.
-void WriteCalibrationOutput(const CalibrationReport& report, const std::filesystem::path& dir, Database* database,
-                            camera_t camera_id, const std::function<void()>& write_beside = {});
+void WriteCalibrationOutput(const CalibrationReport& report, const std::filesystem::path& dir,
+                            Database* database, camera_t camera_id,
+                            const std::function<void()>& write_beside = {});
 
 }  // namespace portcal

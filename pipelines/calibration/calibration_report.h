@@ -26,11 +26,11 @@ namespace portcal {
 struct ProjectionUncertaintyGrid {
   std::string of;  // "intrinsics" or "housing": what is uncertain
   double working_distance_m = 0;
-  double pixel_sigma_px = 0;  // the corners' noise propagated (residual sigma)
+  double pixel_sigma_px = 0;       // the corners' noise propagated (residual sigma)
   std::vector<double> x_px, y_px;  // cell centres, COLMAP pixels: per column, per row
   // rows x cols (y_px.size() x x_px.size()); -1 where no ray.
   Eigen::MatrixXd at_working_distance_px, at_infinity_px;
-  bool determined = true;  // false: the views do not fix the unknowns (maps all -1)
+  bool determined = true;               // false: the views do not fix the unknowns (maps all -1)
   double Mean(bool at_infinity) const;  // over the cells with a ray
   double Max(bool at_infinity) const;
 };
@@ -75,14 +75,16 @@ struct CalibrationReport {
 
 // The report of a camera calibration (with the board warp when it was
 // estimated) and of a housing calibration, of the target `target`.
-CalibrationReport ReportOf(const CameraCalibrationResult& result, bool with_board_warp, const std::string& target);
+CalibrationReport ReportOf(const CameraCalibrationResult& result, bool with_board_warp,
+                           const std::string& target);
 CalibrationReport ReportOf(const HousingCalibrationResult& result, const std::string& target);
 
 // What a fitted board warp means for the calibration: the sag, whether it
 // is significant against its standard deviation, and how far the focal
 // length and principal point would move held flat (`flat`: the same views
 // calibrated with the board held flat), in pixels and standard deviations.
-std::string BoardWarpNote(const CameraCalibrationResult& warped, const CameraCalibrationResult& flat);
+std::string BoardWarpNote(const CameraCalibrationResult& warped,
+                          const CameraCalibrationResult& flat);
 
 // calibration.txt's text.
 std::string CalibrationReportText(const CalibrationReport& report);
@@ -95,9 +97,11 @@ void WriteCalibrationReport(const CalibrationReport& report, const std::filesyst
 // (camera 2 in the camera-1 frame), cam2_from_cam1 (rotation_wxyz,
 // translation) with standard deviations, and a block per camera; the
 // verdict first when given. Returns calibration.txt's text.
-std::string WriteStereoCalibrationReport(const StereoCalibrationResult& result, const HousedCamera& camera1,
-                                  const HousedCamera& camera2, const std::string& target_description,
-                                  const std::filesystem::path& dir, const CalibrationVerdict* verdict = nullptr);
+std::string WriteStereoCalibrationReport(const StereoCalibrationResult& result,
+                                         const HousedCamera& camera1, const HousedCamera& camera2,
+                                         const std::string& target_description,
+                                         const std::filesystem::path& dir,
+                                         const CalibrationVerdict* verdict = nullptr);
 
 // Reads the camera (and housing) of a calibration.yaml written by portcal or
 // calibmar, and portcal's standard deviations, board warp, target, notes and per-view table

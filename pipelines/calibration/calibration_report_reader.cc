@@ -18,7 +18,8 @@ namespace portcal {
 namespace {
 
 constexpr const char* kCalibrationFormats =
-    "portcal reads portcal's and calibmar's calibration.yaml (key 'model'), OpenCV's FileStorage YAML and ROS "
+    "portcal reads portcal's and calibmar's calibration.yaml (key 'model'), OpenCV's FileStorage "
+    "YAML and ROS "
     "camera_info YAML (key 'camera_matrix'), and mrcal's .cameramodel";
 
 // A camera from another tool's file: no standard deviations, views or
@@ -44,11 +45,14 @@ void ReadCalibmarComments(const fs::path& path, CalibrationReport* report) {
         report->target_description = value;
       } else if (key == "overall_rms" && report->overall_rms_px == 0) {
         report->overall_rms_px = std::stod(value);
-      } else if (key == "non_svp_est_std_dev" && report->housing && report->housing_std_dev.empty()) {
-        for (const std::string& token : SplitTokens(value, ", ")) report->housing_std_dev.push_back(std::stod(token));
+      } else if (key == "non_svp_est_std_dev" && report->housing &&
+                 report->housing_std_dev.empty()) {
+        for (const std::string& token : SplitTokens(value, ", "))
+          report->housing_std_dev.push_back(std::stod(token));
         if (report->housing_std_dev.size() != report->housing->params.size()) {
           throw InputError(path.string() + ": the comment non_svp_est_std_dev has " +
-                           std::to_string(report->housing_std_dev.size()) + " values, non_svp_parameters " +
+                           std::to_string(report->housing_std_dev.size()) +
+                           " values, non_svp_parameters " +
                            std::to_string(report->housing->params.size()));
         }
       }
@@ -60,26 +64,29 @@ void ReadCalibmarComments(const fs::path& path, CalibrationReport* report) {
 
 // A covariance under `key` (absent: empty): `size` rows of `size` finite
 // numbers, symmetric, its diagonal not negative.
-Eigen::MatrixXd ReadCovariance(const YAML::Node& root, const char* key, size_t size, const fs::path& path) {
+Eigen::MatrixXd ReadCovariance(const YAML::Node& root, const char* key, size_t size,
+                               const fs::path& path) {
   if (!root[key]) return Eigen::MatrixXd();
   const auto rows = root[key].as<std::vector<std::vector<double>>>();
   const Eigen::Index n = static_cast<Eigen::Index>(size);
   Eigen::MatrixXd covariance(n, n);
   if (rows.size() != size) {
-    throw InputError(path.string() + ": " + key + " has " + std::to_string(rows.size()) + " rows, not " +
-                     std::to_string(size));
+    throw InputError(path.string() + ": " + key + " has " + std::to_string(rows.size()) +
+                     " rows, not " + std::to_string(size));
   }
   for (size_t r = 0; r < size; ++r) {
     if (rows[r].size() != size) {
       throw InputError(path.string() + ": " + key + " row " + std::to_string(r) + " has " +
                        std::to_string(rows[r].size()) + " values, not " + std::to_string(size));
     }
-    for (size_t c = 0; c < size; ++c) covariance(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = rows[r][c];
+    for (size_t c = 0; c < size; ++c)
+      covariance(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = rows[r][c];
   }
   const double scale = std::max(1e-300, covariance.cwiseAbs().maxCoeff());
   if (!covariance.allFinite() || (covariance.diagonal().array() < 0).any() ||
       !((covariance - covariance.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * scale)) {
-    throw InputError(path.string() + ": " + key + " is not a covariance (finite, symmetric, diagonal >= 0)");
+    throw InputError(path.string() + ": " + key +
+                     " is not a covariance (finite, symmetric, diagonal >= 0)");
   }
   return covariance;
 }
@@ -92,7 +99,8 @@ namespace {
 // value of the wrong type) are turned into InputError by the caller.
 CalibrationReport ReadCalibrationReportUnguarded(const fs::path& path) {
   if (!fs::exists(path)) throw InputError(path.string() + ": no such file");
-  if (!fs::is_regular_file(path)) throw InputError(path.string() + ": not a file (" + kCalibrationFormats + ")");
+  if (!fs::is_regular_file(path))
+    throw InputError(path.string() + ": not a file (" + kCalibrationFormats + ")");
   if (path.extension() == ".cameramodel") return ReportOfCamera(ReadMrcalCameraModel(path).camera);
   if (IsOpenCvOrRosCameraYaml(path)) return ReportOfCamera(ReadOpenCvCameraYaml(path));
   YAML::Node root;
@@ -131,11 +139,12 @@ CalibrationReport ReadCalibrationReportUnguarded(const fs::path& path) {
     report.parameters_covariance =
         ReadCovariance(root, "parameters_covariance", report.camera.params.size(), path);
     if (report.housing) {
-      report.housing_covariance =
-          ReadCovariance(root, "non_svp_parameters_covariance", report.housing->params.size(), path);
+      report.housing_covariance = ReadCovariance(root, "non_svp_parameters_covariance",
+                                                 report.housing->params.size(), path);
     }
     if (root["overall_rms"]) report.overall_rms_px = root["overall_rms"].as<double>();
-    if (root["residual_sigma_px"]) report.residual_sigma_px = root["residual_sigma_px"].as<double>();
+    if (root["residual_sigma_px"])
+      report.residual_sigma_px = root["residual_sigma_px"].as<double>();
     if (root["num_points"]) report.num_points = root["num_points"].as<int>();
     if (root["per_view"]) {
       for (const YAML::Node& entry : root["per_view"]) {

@@ -1,5 +1,3 @@
-#include "pipelines/calibration/calibration_report.h"
-
 #include <cstdio>
 #include <iomanip>
 #include <sstream>
@@ -8,6 +6,7 @@
 #include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/string_utils.h"
+#include "pipelines/calibration/calibration_report.h"
 
 namespace fs = std::filesystem;
 
@@ -54,22 +53,29 @@ std::string StdDevText(const std::vector<double>& values, size_t i) {
 // other tools print other numbers for the same fit.
 std::string ErrorFiguresExplained(bool self_calibration) {
   return std::string(
-             "  RMS reprojection error: the root mean square of the distances (pixels) between the observed and "
-             "the reprojected points; the mean distance, which COLMAP's model_analyzer and portcal's mapper "
+             "  RMS reprojection error: the root mean square of the distances (pixels) between the "
+             "observed and "
+             "the reprojected points; the mean distance, which COLMAP's model_analyzer and "
+             "portcal's mapper "
              "print, is smaller.\n") +
-         (self_calibration
-              ? "  Residual sigma: the noise of one pixel coordinate of a keypoint at SIFT's finest scales that "
-                "the fit implies (coarser keypoints count less, by their scale), corrected for the free "
-                "parameters; the standard deviations are scaled by it.\n"
-              : "  Residual sigma: the noise of one pixel coordinate that the fit implies, sqrt(sum of squared "
-                "residuals / (2 x points - free parameters)); the standard deviations are scaled by it.\n");
+         (self_calibration ? "  Residual sigma: the noise of one pixel coordinate of a keypoint at "
+                             "SIFT's finest scales that "
+                             "the fit implies (coarser keypoints count less, by their scale), "
+                             "corrected for the free "
+                             "parameters; the standard deviations are scaled by it.\n"
+                           : "  Residual sigma: the noise of one pixel coordinate that the fit "
+                             "implies, sqrt(sum of squared "
+                             "residuals / (2 x points - free parameters)); the standard deviations "
+                             "are scaled by it.\n");
 }
 
 // The two estimates behind a std dev, when there are two.
-std::string StdDevSourcesText(const std::vector<double>& by_noise, const std::vector<double>& by_clusters, size_t i) {
+std::string StdDevSourcesText(const std::vector<double>& by_noise,
+                              const std::vector<double>& by_clusters, size_t i) {
   if (i >= by_noise.size() || i >= by_clusters.size() || by_noise[i] <= 0) return "";
   std::ostringstream out;
-  out << std::fixed << std::setprecision(6) << std::setw(17) << by_noise[i] << std::setw(17) << by_clusters[i];
+  out << std::fixed << std::setprecision(6) << std::setw(17) << by_noise[i] << std::setw(17)
+      << by_clusters[i];
   return out.str();
 }
 
@@ -79,7 +85,8 @@ std::string CovarianceYaml(const std::string& key, const Eigen::MatrixXd& covari
   std::string text = key + ":\n";
   for (Eigen::Index r = 0; r < covariance.rows(); ++r) {
     std::vector<double> row(static_cast<size_t>(covariance.cols()));
-    for (Eigen::Index c = 0; c < covariance.cols(); ++c) row[static_cast<size_t>(c)] = covariance(r, c);
+    for (Eigen::Index c = 0; c < covariance.cols(); ++c)
+      row[static_cast<size_t>(c)] = covariance(r, c);
     text += "- " + List(row) + "\n";
   }
   return text;
@@ -99,7 +106,8 @@ std::string MapRows(const Eigen::MatrixXd& map, const std::string& indent) {
 std::string UncertaintyYaml(const ProjectionUncertaintyGrid& grid) {
   std::ostringstream out;
   out << "projection_uncertainty:\n"
-      << "  definition: 'mrcal 2.2 projection_uncertainty, mean-frames, worstdirection-stdev (px); points at "
+      << "  definition: 'mrcal 2.2 projection_uncertainty, mean-frames, worstdirection-stdev (px); "
+         "points at "
          "depth working_distance_m and at infinity; -1: no ray'\n"
       << "  of: " << grid.of << "\n"
       << "  determined: " << (grid.determined ? "true" : "false") << "\n"
@@ -121,7 +129,8 @@ std::string Yaml(const CalibrationReport& r) {
   out << "model: " << r.camera.ModelName() << "\n"
       << "parameters: " << List(r.camera.params) << "\n"
       << "non_svp_model: " << (r.housing ? r.housing->ModelName() : "NONE") << "\n"
-      << "non_svp_parameters: " << List(r.housing ? r.housing->params : std::vector<double>{}) << "\n"
+      << "non_svp_parameters: " << List(r.housing ? r.housing->params : std::vector<double>{})
+      << "\n"
       << "width: " << r.camera.width << "\n"
       << "height: " << r.camera.height << "\n"
       << "parameter_names: [" << r.camera.ParamsInfo() << "]\n"
@@ -139,12 +148,15 @@ std::string Yaml(const CalibrationReport& r) {
       << CovarianceYaml("non_svp_parameters_covariance", r.housing_covariance);
   out << "overall_rms: " << Num(r.overall_rms_px) << "\n"
       << "residual_sigma_px: " << Num(r.residual_sigma_px) << "\n"
-      << "num_views: " << std::count_if(r.views.begin(), r.views.end(), [](const CalibratedView& v) { return !v.dropped; })
+      << "num_views: "
+      << std::count_if(r.views.begin(), r.views.end(),
+                       [](const CalibratedView& v) { return !v.dropped; })
       << "\nnum_points: " << r.num_points << "\n"
       << "target: " << SingleQuoted(r.target_description) << "\n";
   if (r.board_warp) {
     out << "board_warp: " << List({r.board_warp->x(), r.board_warp->y()}) << "\n"
-        << "board_warp_std_dev: " << List({r.board_warp_std_dev->x(), r.board_warp_std_dev->y()}) << "\n";
+        << "board_warp_std_dev: " << List({r.board_warp_std_dev->x(), r.board_warp_std_dev->y()})
+        << "\n";
   }
   if (!r.warnings.empty()) {
     out << "warnings:\n";
@@ -159,10 +171,10 @@ std::string Yaml(const CalibrationReport& r) {
   out << "per_view:\n";
   for (const CalibratedView& v : r.views) {
     const Eigen::Vector4d q = QuaternionToWxyz(v.cam_from_target.rotation);
-    out << "- image: " << YamlQuoted(v.image_name) << "\n  rms: " << Num(v.rms_px) << "\n  points: " << v.num_points
-        << "\n  outlier: " << (v.outlier ? "true" : "false") << "\n  dropped: " << (v.dropped ? "true" : "false")
-        << "\n  cam_from_" << r.pose_frame << ":\n    rotation_wxyz: " << List({q[0], q[1], q[2], q[3]})
-        << "\n    translation: "
+    out << "- image: " << YamlQuoted(v.image_name) << "\n  rms: " << Num(v.rms_px)
+        << "\n  points: " << v.num_points << "\n  outlier: " << (v.outlier ? "true" : "false")
+        << "\n  dropped: " << (v.dropped ? "true" : "false") << "\n  cam_from_" << r.pose_frame
+        << ":\n    rotation_wxyz: " << List({q[0], q[1], q[2], q[3]}) << "\n    translation: "
         << List({v.cam_from_target.translation.x(), v.cam_from_target.translation.y(),
                  v.cam_from_target.translation.z()})
         << "\n";
@@ -176,9 +188,8 @@ std::string Text(const CalibrationReport& r) {
   out << "portcal calibration\n===================\n\n";
   if (r.verdict) out << VerdictText(*r.verdict) << "\n";
   for (const std::string& warning : r.warnings) out << "WARNING: " << warning << "\n\n";
-  out
-      << "Camera model " << r.camera.ModelName() << ", " << r.camera.width << " x " << r.camera.height
-      << " px\nTarget: " << r.target_description << "\n\n";
+  out << "Camera model " << r.camera.ModelName() << ", " << r.camera.width << " x "
+      << r.camera.height << " px\nTarget: " << r.target_description << "\n\n";
   const std::vector<std::string> names = SplitTokens(r.camera.ParamsInfo(), ", ");
   out << "  parameter          value          std dev"
       << (r.parameters_std_dev_by_clusters.empty() && r.housing_std_dev_by_clusters.empty()
@@ -188,7 +199,8 @@ std::string Text(const CalibrationReport& r) {
   for (size_t i = 0; i < r.camera.params.size(); ++i) {
     out << "  " << std::left << std::setw(10) << names[i] << std::right << std::setw(17)
         << std::setprecision(6) << r.camera.params[i] << StdDevText(r.parameters_std_dev, i)
-        << StdDevSourcesText(r.parameters_std_dev_by_noise, r.parameters_std_dev_by_clusters, i) << "\n";
+        << StdDevSourcesText(r.parameters_std_dev_by_noise, r.parameters_std_dev_by_clusters, i)
+        << "\n";
   }
   if (r.housing) {
     const std::vector<std::string> housing_names = SplitTokens(r.housing->ParamsInfo(), ", ");
@@ -202,22 +214,25 @@ std::string Text(const CalibrationReport& r) {
           << (i < r.housing_std_dev.size() && r.housing_std_dev[i] == 0 && constant
                   ? std::string("       (constant)")
                   : StdDevText(r.housing_std_dev, i) +
-                        StdDevSourcesText(r.housing_std_dev_by_noise, r.housing_std_dev_by_clusters, i))
+                        StdDevSourcesText(r.housing_std_dev_by_noise, r.housing_std_dev_by_clusters,
+                                          i))
           << "\n";
     }
     out << "  In words: " << r.housing->InWords() << ".\n";
   }
   if (r.board_warp) {
-    out << std::setprecision(3) << "\nBoard warp (parabolic sag): x " << r.board_warp->x() * 1000 << " +- "
-        << r.board_warp_std_dev->x() * 1000 << " mm, y " << r.board_warp->y() * 1000 << " +- "
-        << r.board_warp_std_dev->y() * 1000 << " mm\n";
+    out << std::setprecision(3) << "\nBoard warp (parabolic sag): x " << r.board_warp->x() * 1000
+        << " +- " << r.board_warp_std_dev->x() * 1000 << " mm, y " << r.board_warp->y() * 1000
+        << " +- " << r.board_warp_std_dev->y() * 1000 << " mm\n";
   }
   for (const std::string& note : r.notes) out << "\nNote: " << note << "\n";
   if (r.projection_uncertainty && r.projection_uncertainty->determined) {
     const ProjectionUncertaintyGrid& u = *r.projection_uncertainty;
-    out << std::setprecision(3) << "\nProjection uncertainty of the " << u.of << " (mrcal's mean-frames, worst "
+    out << std::setprecision(3) << "\nProjection uncertainty of the " << u.of
+        << " (mrcal's mean-frames, worst "
         << "direction, 1 sigma): mean " << u.Mean(false) << ", max " << u.Max(false) << " px at "
-        << u.working_distance_m << " m; mean " << u.Mean(true) << ", max " << u.Max(true) << " px at infinity\n";
+        << u.working_distance_m << " m; mean " << u.Mean(true) << ", max " << u.Max(true)
+        << " px at infinity\n";
   }
   out << std::setprecision(4) << "\nRMS reprojection error " << r.overall_rms_px << " px over "
       << r.num_points << " points (residual sigma " << r.residual_sigma_px << " px)\n"
@@ -226,13 +241,16 @@ std::string Text(const CalibrationReport& r) {
   for (const CalibratedView& v : r.views) {
     out << "  " << std::left << std::setw(36) << v.image_name << std::right << std::setw(10)
         << v.rms_px << std::setw(8) << v.num_points
-        << (v.dropped ? "  dropped (outlier)" : v.outlier ? "  outlier" : "") << "\n";
+        << (v.dropped   ? "  dropped (outlier)"
+            : v.outlier ? "  outlier"
+                        : "")
+        << "\n";
   }
   return out.str();
 }
 
-std::string CameraBlock(const std::string& key, const Camera& camera, const std::vector<double>& std_dev,
-                        const std::optional<Housing>& housing) {
+std::string CameraBlock(const std::string& key, const Camera& camera,
+                        const std::vector<double>& std_dev, const std::optional<Housing>& housing) {
   std::ostringstream out;
   out << key << ":\n  model: " << camera.ModelName() << "\n  parameters: " << List(camera.params)
       << "\n  parameters_std_dev: " << StdDevList(std_dev)
@@ -259,9 +277,10 @@ double ProjectionUncertaintyGrid::Max(bool at_infinity) const {
   return map.size() > 0 ? map.maxCoeff() : -1;
 }
 
-std::string WriteStereoCalibrationReport(const StereoCalibrationResult& r, const HousedCamera& camera1,
-                                  const HousedCamera& camera2, const std::string& target_description,
-                                  const fs::path& dir, const CalibrationVerdict* verdict) {
+std::string WriteStereoCalibrationReport(const StereoCalibrationResult& r,
+                                         const HousedCamera& camera1, const HousedCamera& camera2,
+                                         const std::string& target_description, const fs::path& dir,
+                                         const CalibrationVerdict* verdict) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (!fs::is_directory(dir)) throw InputError(dir.string() + ": cannot create output directory");
@@ -274,47 +293,59 @@ std::string WriteStereoCalibrationReport(const StereoCalibrationResult& r, const
        << List({rotation(0, 0), rotation(0, 1), rotation(0, 2), rotation(1, 0), rotation(1, 1),
                 rotation(1, 2), rotation(2, 0), rotation(2, 1), rotation(2, 2)})
        << "\ncam_to_world_translation: "
-       << List({cam1_from_cam2.translation.x(), cam1_from_cam2.translation.y(), cam1_from_cam2.translation.z()})
-       << "\ncam2_from_cam1:\n  rotation_wxyz: " << List({q[0], q[1], q[2], q[3]}) << "\n  translation: "
-       << List({r.cam2_from_cam1.translation.x(), r.cam2_from_cam1.translation.y(), r.cam2_from_cam1.translation.z()})
-       << "\ncam2_from_cam1_std_dev:\n  rotation_deg: "
-       << StdDevList({r.rotation_std_dev_deg.x(), r.rotation_std_dev_deg.y(), r.rotation_std_dev_deg.z()})
+       << List({cam1_from_cam2.translation.x(), cam1_from_cam2.translation.y(),
+                cam1_from_cam2.translation.z()})
+       << "\ncam2_from_cam1:\n  rotation_wxyz: " << List({q[0], q[1], q[2], q[3]})
        << "\n  translation: "
-       << StdDevList({r.translation_std_dev.x(), r.translation_std_dev.y(), r.translation_std_dev.z()})
+       << List({r.cam2_from_cam1.translation.x(), r.cam2_from_cam1.translation.y(),
+                r.cam2_from_cam1.translation.z()})
+       << "\ncam2_from_cam1_std_dev:\n  rotation_deg: "
+       << StdDevList(
+              {r.rotation_std_dev_deg.x(), r.rotation_std_dev_deg.y(), r.rotation_std_dev_deg.z()})
+       << "\n  translation: "
+       << StdDevList(
+              {r.translation_std_dev.x(), r.translation_std_dev.y(), r.translation_std_dev.z()})
        << "\nbaseline: " << Num(r.cam2_from_cam1.translation.norm()) << "\n"
        << CameraBlock("camera1", r.camera1, r.camera1_std_dev, camera1.housing)
        << CameraBlock("camera2", r.camera2, r.camera2_std_dev, camera2.housing)
-       << "overall_rms: " << Num(r.overall_rms_px) << "\nresidual_sigma_px: " << Num(r.residual_sigma_px)
-       << "\nnum_views: " << r.views1.size() << "\nnum_points: " << r.num_points << "\ntarget: '"
-       << target_description << "'\nper_view:\n";
+       << "overall_rms: " << Num(r.overall_rms_px)
+       << "\nresidual_sigma_px: " << Num(r.residual_sigma_px) << "\nnum_views: " << r.views1.size()
+       << "\nnum_points: " << r.num_points << "\ntarget: '" << target_description
+       << "'\nper_view:\n";
   for (size_t f = 0; f < r.views1.size(); ++f) {
-    yaml << "- image1: " << YamlQuoted(r.views1[f].image_name) << "\n  rms1: " << Num(r.views1[f].rms_px)
-         << "\n  image2: " << YamlQuoted(r.views2[f].image_name) << "\n  rms2: " << Num(r.views2[f].rms_px) << "\n";
+    yaml << "- image1: " << YamlQuoted(r.views1[f].image_name)
+         << "\n  rms1: " << Num(r.views1[f].rms_px)
+         << "\n  image2: " << YamlQuoted(r.views2[f].image_name)
+         << "\n  rms2: " << Num(r.views2[f].rms_px) << "\n";
   }
   std::ostringstream text;
   if (verdict) yaml << VerdictYaml(*verdict);
-  text << "portcal stereo calibration\n==========================\n\n" << (verdict ? VerdictText(*verdict) + "\n" : "");
-  text << std::fixed << "Target: "
-       << target_description << "\n\ncam2_from_cam1 (camera 2 from camera 1)\n" << std::setprecision(6)
-       << "  rotation (w, x, y, z)   " << q[0] << " " << q[1] << " " << q[2] << " " << q[3]
-       << "\n  translation (m)         " << r.cam2_from_cam1.translation.transpose()
+  text << "portcal stereo calibration\n==========================\n\n"
+       << (verdict ? VerdictText(*verdict) + "\n" : "");
+  text << std::fixed << "Target: " << target_description
+       << "\n\ncam2_from_cam1 (camera 2 from camera 1)\n"
+       << std::setprecision(6) << "  rotation (w, x, y, z)   " << q[0] << " " << q[1] << " " << q[2]
+       << " " << q[3] << "\n  translation (m)         " << r.cam2_from_cam1.translation.transpose()
        << "\n  baseline (m)            " << r.cam2_from_cam1.translation.norm() << std::scientific
-       << std::setprecision(2) << "\n  rotation std dev (deg)  " << r.rotation_std_dev_deg.transpose()
-       << "\n  translation std dev (m) " << r.translation_std_dev.transpose() << std::fixed << "\n\n";
+       << std::setprecision(2) << "\n  rotation std dev (deg)  "
+       << r.rotation_std_dev_deg.transpose() << "\n  translation std dev (m) "
+       << r.translation_std_dev.transpose() << std::fixed << "\n\n";
   for (const auto& [name, camera, std_dev] :
-       {std::tuple{"camera 1", &r.camera1, &r.camera1_std_dev}, std::tuple{"camera 2", &r.camera2, &r.camera2_std_dev}}) {
+       {std::tuple{"camera 1", &r.camera1, &r.camera1_std_dev},
+        std::tuple{"camera 2", &r.camera2, &r.camera2_std_dev}}) {
     text << name << " " << camera->ModelName() << ": ";
     for (double p : camera->params) text << std::setprecision(6) << p << " ";
     text << (std_dev->empty() || (*std_dev)[0] == 0 ? "(fixed)" : "(refined)") << "\n";
   }
-  text << std::setprecision(4) << "\nRMS reprojection error " << r.overall_rms_px << " px over " << r.num_points
-       << " points\n\n  frame  image 1 rms  image 2 rms\n";
+  text << std::setprecision(4) << "\nRMS reprojection error " << r.overall_rms_px << " px over "
+       << r.num_points << " points\n\n  frame  image 1 rms  image 2 rms\n";
   for (size_t f = 0; f < r.views1.size(); ++f) {
-    text << "  " << std::left << std::setw(24) << r.views1[f].image_name << std::right << std::setw(8)
-         << r.views1[f].rms_px << std::setw(10) << r.views2[f].rms_px << "\n";
+    text << "  " << std::left << std::setw(24) << r.views1[f].image_name << std::right
+         << std::setw(8) << r.views1[f].rms_px << std::setw(10) << r.views2[f].rms_px << "\n";
   }
   const std::string yaml_text = yaml.str(), text_text = text.str();
-  WriteFileAtomically(dir / "calibration.yaml", false, [&](std::ostream& out) { out << yaml_text; });
+  WriteFileAtomically(dir / "calibration.yaml", false,
+                      [&](std::ostream& out) { out << yaml_text; });
   WriteFileAtomically(dir / "calibration.txt", false, [&](std::ostream& out) { out << text_text; });
   return text_text;
 }

@@ -69,7 +69,8 @@ Eigen::MatrixXi CoverageCounts(int width, int height, const std::vector<Eigen::V
 // The image's corners ("top-left", "top-right", "bottom-left",
 // "bottom-right") of a 3 x 3 split where no pixel falls: the verdict's
 // coverage rule and the live goal's limits name them.
-std::vector<std::string> EmptyImageCorners(int width, int height, const std::vector<Eigen::Vector2d>& pixels);
+std::vector<std::string> EmptyImageCorners(int width, int height,
+                                           const std::vector<Eigen::Vector2d>& pixels);
 
 // "a", "a and b", "a, b and c".
 std::string JoinedWords(const std::vector<std::string>& words);
@@ -78,28 +79,33 @@ std::string JoinedWords(const std::vector<std::string>& words);
 // parameters: FAIL; others: CHECK), RMS, outlier views, number of views,
 // coverage of `pixels` (the observations, COLMAP pixels), the projection
 // uncertainty when computed, and a housing whose lens was taken as exact.
-CalibrationVerdict JudgeCalibration(const CalibrationReport& report, const std::vector<Eigen::Vector2d>& pixels,
+CalibrationVerdict JudgeCalibration(const CalibrationReport& report,
+                                    const std::vector<Eigen::Vector2d>& pixels,
                                     const VerdictRules& rules = VerdictRules());
 // The same, the pixels those of a target calibration's `views`.
-CalibrationVerdict JudgeCalibration(const CalibrationReport& report, const std::vector<CalibrationView>& views,
+CalibrationVerdict JudgeCalibration(const CalibrationReport& report,
+                                    const std::vector<CalibrationView>& views,
                                     const VerdictRules& rules = VerdictRules());
 
 // The same, the pixels those of camera `camera_id`'s observations of the
 // model's points (a self-calibration's).
-CalibrationVerdict JudgeCalibration(const CalibrationReport& report, const SparseModel& model, camera_t camera_id,
-                                    const VerdictRules& rules = VerdictRules());
+CalibrationVerdict JudgeCalibration(const CalibrationReport& report, const SparseModel& model,
+                                    camera_t camera_id, const VerdictRules& rules = VerdictRules());
 
 // Judges a stereo calibration of the frames' views: RMS, frames and their
 // outliers, each camera's coverage, and whether the rig is determined.
-CalibrationVerdict JudgeStereo(const StereoCalibrationResult& result, const std::vector<CalibrationView>& views1,
-                               const std::vector<CalibrationView>& views2, const VerdictRules& rules = VerdictRules());
+CalibrationVerdict JudgeStereo(const StereoCalibrationResult& result,
+                               const std::vector<CalibrationView>& views1,
+                               const std::vector<CalibrationView>& views2,
+                               const VerdictRules& rules = VerdictRules());
 
 // Judges a held-out evaluation of `input` (its RMS, when it has one, is
 // the fit's own): the held-out RMS against the thresholds and against the
 // fit's, the residual pattern, the views not evaluated, and with `folds`
 // the cross-validation's held-out against training RMS.
 CalibrationVerdict JudgeHeldOut(const HeldOutEvaluation& evaluation, const CalibrationReport& input,
-                                const std::vector<FoldEvaluation>& folds, double cross_validation_rms_px,
+                                const std::vector<FoldEvaluation>& folds,
+                                double cross_validation_rms_px,
                                 const VerdictRules& rules = VerdictRules());
 
 // calibration.txt's verdict block and calibration.yaml's `verdict:` key

@@ -19,13 +19,16 @@ namespace portcal {
 
 void CameraCalibrationSettings::Check() const {
   if (!(outlier_view_factor > 1)) {
-    throw OptionError("--Calibration.outlier_view_factor", std::to_string(outlier_view_factor), "> 1");
+    throw OptionError("--Calibration.outlier_view_factor", std::to_string(outlier_view_factor),
+                      "> 1");
   }
   if (min_points_per_view < 4) {
-    throw OptionError("--Calibration.min_points_per_view", std::to_string(min_points_per_view), ">= 4");
+    throw OptionError("--Calibration.min_points_per_view", std::to_string(min_points_per_view),
+                      ">= 4");
   }
   if (max_num_iterations < 1) {
-    throw OptionError("--Calibration.max_num_iterations", std::to_string(max_num_iterations), ">= 1");
+    throw OptionError("--Calibration.max_num_iterations", std::to_string(max_num_iterations),
+                      ">= 1");
   }
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
 }
@@ -88,9 +91,10 @@ void AddBoardResiduals(const std::vector<const CalibrationView*>& views, int mod
     for (size_t v = 0; v < views.size(); ++v) {
       for (size_t i = 0; i < views[v]->pixels.size(); ++i) {
         const Eigen::Vector3d& p = views[v]->points_in_target[i];
-        problem->AddResidualBlock(
-            BoardReprojectionError<Model>::Create(p, BoardWarpUv(p, board_extent), views[v]->pixels[i]), nullptr,
-            s->poses[v].data(), s->intrinsics.data(), s->warp.data());
+        problem->AddResidualBlock(BoardReprojectionError<Model>::Create(
+                                      p, BoardWarpUv(p, board_extent), views[v]->pixels[i]),
+                                  nullptr, s->poses[v].data(), s->intrinsics.data(),
+                                  s->warp.data());
       }
     }
   });
@@ -109,7 +113,8 @@ void ComputeViewRms(const std::vector<const CalibrationView*>& views, int model_
         const Eigen::Quaterniond q(s->poses[v][3], s->poses[v][0], s->poses[v][1], s->poses[v][2]);
         Eigen::Vector3d p = views[v]->points_in_target[i];
         p.z() += BoardSag(s->warp.data(), BoardWarpUv(p, board_extent));
-        const Eigen::Vector3d in_cam = q * p + Eigen::Vector3d(s->poses[v][4], s->poses[v][5], s->poses[v][6]);
+        const Eigen::Vector3d in_cam =
+            q * p + Eigen::Vector3d(s->poses[v][4], s->poses[v][5], s->poses[v][6]);
         double x = 0, y = 0;
         if (!Model::ImgFromCam(s->intrinsics.data(), in_cam.x(), in_cam.y(), in_cam.z(), &x, &y)) {
           throw NumericalError(views[v]->image_name + ": a target point ends behind the camera");
@@ -127,8 +132,9 @@ void ComputeViewRms(const std::vector<const CalibrationView*>& views, int model_
 
 // Covariance of the parameters, scaled by the residual variance: the
 // observations' noise is estimated from the fit, not assumed to be 1 px.
-void ComputeParamsCovariance(const std::vector<int>& fixed, const CameraCalibrationSettings& settings,
-                             ceres::Problem* problem, Solution* s) {
+void ComputeParamsCovariance(const std::vector<int>& fixed,
+                             const CameraCalibrationSettings& settings, ceres::Problem* problem,
+                             Solution* s) {
   const int num_params = static_cast<int>(s->intrinsics.size());
   const double dof = s->num_residuals - s->num_free;
   const double variance = dof > 0 ? s->sum_squares / dof : 0;
@@ -157,8 +163,9 @@ void ComputeParamsCovariance(const std::vector<int>& fixed, const CameraCalibrat
     for (int i = 0; i < num_params; ++i) {
       if (std::find(fixed.begin(), fixed.end(), i) == fixed.end()) s->params_std_dev[i] = -1.0;
     }
-    LOG(WARNING) << "camera calibration: the covariance is rank deficient (a parameter the views do "
-                    "not determine); standard deviations undetermined";
+    LOG(WARNING)
+        << "camera calibration: the covariance is rank deficient (a parameter the views do "
+           "not determine); standard deviations undetermined";
   }
 }
 
@@ -181,9 +188,11 @@ Solution Solve(const std::vector<const CalibrationView*>& views, const Camera& c
   }
   if (!settings.estimate_board_warp) problem.SetParameterBlockConstant(s.warp.data());
 
-  SolveCalibration(&problem, settings.max_num_iterations, settings.num_threads, "camera calibration");
+  SolveCalibration(&problem, settings.max_num_iterations, settings.num_threads,
+                   "camera calibration");
   for (double p : s.intrinsics) {
-    if (!std::isfinite(p)) throw NumericalError("camera calibration produced a non-finite parameter");
+    if (!std::isfinite(p))
+      throw NumericalError("camera calibration produced a non-finite parameter");
   }
   ComputeViewRms(views, camera.model_id, board_extent, &s);
   s.num_free = (num_params - static_cast<int>(fixed.size())) + 6 * static_cast<int>(views.size()) +
@@ -216,7 +225,8 @@ std::vector<const CalibrationView*> UsableViews(const std::vector<CalibrationVie
 // wanted, the pinhole part of *camera.
 std::vector<std::array<double, 7>> StartFromZhang(const std::vector<const CalibrationView*>& views,
                                                   const std::vector<int>& fixed,
-                                                  const CameraCalibrationSettings& settings, Camera* camera) {
+                                                  const CameraCalibrationSettings& settings,
+                                                  Camera* camera) {
   std::vector<PlanarView> planar;
   for (const CalibrationView* view : views) {
     PlanarView p;
@@ -226,7 +236,8 @@ std::vector<std::array<double, 7>> StartFromZhang(const std::vector<const Calibr
   }
   const auto pinhole = InitializePinholeFromPlanarViews(planar, static_cast<int>(camera->width),
                                                         static_cast<int>(camera->height));
-  if (!pinhole) throw NumericalError("Zhang initialisation failed: the views are too alike or too few");
+  if (!pinhole)
+    throw NumericalError("Zhang initialisation failed: the views are too alike or too few");
   if (settings.initialize_from_data) {
     const std::vector<int> focal = CameraModelFocalLengthIdxs(camera->model_id);
     const std::vector<int> principal = CameraModelPrincipalPointIdxs(camera->model_id);
@@ -263,9 +274,10 @@ struct DroppedViews {
 // Solves, and while outliers are dropped (up to 4 rounds), drops the views
 // whose RMS exceeds outlier_view_factor x the median of the kept views and
 // solves again. *camera and *poses hold the last solution.
-Solution SolveDroppingOutliers(const std::vector<const CalibrationView*>& views, const std::vector<int>& fixed,
-                               const Eigen::Vector4d& extent, const CameraCalibrationSettings& settings,
-                               Camera* camera, std::vector<std::array<double, 7>>* poses, DroppedViews* out) {
+Solution SolveDroppingOutliers(const std::vector<const CalibrationView*>& views,
+                               const std::vector<int>& fixed, const Eigen::Vector4d& extent,
+                               const CameraCalibrationSettings& settings, Camera* camera,
+                               std::vector<std::array<double, 7>>* poses, DroppedViews* out) {
   out->dropped.assign(views.size(), false);
   out->rms_px.assign(views.size(), 0.0);
   Solution solution;
@@ -278,7 +290,8 @@ Solution SolveDroppingOutliers(const std::vector<const CalibrationView*>& views,
         kept_poses.push_back((*poses)[v]);
       }
     }
-    if (kept.size() < 2) throw NumericalError("camera calibration: fewer than 2 views left after dropping outliers");
+    if (kept.size() < 2)
+      throw NumericalError("camera calibration: fewer than 2 views left after dropping outliers");
     solution = Solve(kept, *camera, kept_poses, fixed, extent, settings);
     const double median = MedianViewRms(solution.view_rms);
     bool any_new = false;
@@ -286,7 +299,8 @@ Solution SolveDroppingOutliers(const std::vector<const CalibrationView*>& views,
     for (size_t v = 0; v < views.size(); ++v) {
       if (out->dropped[v]) continue;
       (*poses)[v] = solution.poses[k];
-      if (settings.drop_outlier_views && solution.view_rms[k] > settings.outlier_view_factor * median) {
+      if (settings.drop_outlier_views &&
+          solution.view_rms[k] > settings.outlier_view_factor * median) {
         out->dropped[v] = true;
         out->rms_px[v] = solution.view_rms[k];
         any_new = true;
@@ -301,9 +315,11 @@ Solution SolveDroppingOutliers(const std::vector<const CalibrationView*>& views,
   return solution;
 }
 
-CameraCalibrationResult ResultOf(const std::vector<const CalibrationView*>& views, const Camera& camera,
-                                 const Solution& solution, const std::vector<std::array<double, 7>>& poses,
-                                 const DroppedViews& dropped, const CameraCalibrationSettings& settings) {
+CameraCalibrationResult ResultOf(const std::vector<const CalibrationView*>& views,
+                                 const Camera& camera, const Solution& solution,
+                                 const std::vector<std::array<double, 7>>& poses,
+                                 const DroppedViews& dropped,
+                                 const CameraCalibrationSettings& settings) {
   CameraCalibrationResult result;
   result.camera = camera;
   result.params_std_dev = solution.params_std_dev;
@@ -349,7 +365,8 @@ CameraCalibrationResult CalibrateCamera(const std::vector<CalibrationView>& all_
   Camera camera = initial;
   std::vector<std::array<double, 7>> poses = StartFromZhang(views, fixed, settings, &camera);
   DroppedViews dropped;
-  const Solution solution = SolveDroppingOutliers(views, fixed, extent, settings, &camera, &poses, &dropped);
+  const Solution solution =
+      SolveDroppingOutliers(views, fixed, extent, settings, &camera, &poses, &dropped);
   return ResultOf(views, camera, solution, poses, dropped, settings);
 }
 

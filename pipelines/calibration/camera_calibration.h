@@ -58,8 +58,8 @@ struct CameraCalibrationResult {
   Eigen::MatrixXd params_covariance;
   Eigen::Vector2d board_warp = Eigen::Vector2d::Zero();  // metres
   Eigen::Vector2d board_warp_std_dev = Eigen::Vector2d::Zero();
-  double overall_rms_px = 0;       // over all points of the kept views
-  double residual_sigma_px = 0;    // sqrt(sum r^2 / (2N - free parameters))
+  double overall_rms_px = 0;     // over all points of the kept views
+  double residual_sigma_px = 0;  // sqrt(sum r^2 / (2N - free parameters))
   int num_points = 0;
   std::vector<CalibratedView> views;
 };

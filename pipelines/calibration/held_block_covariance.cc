@@ -38,7 +38,8 @@ class Freed {
 }  // namespace
 
 Eigen::MatrixXd HeldBlockCovarianceContribution(ceres::Problem* problem, double* held,
-                                                const Eigen::MatrixXd& held_covariance, double* of) {
+                                                const Eigen::MatrixXd& held_covariance,
+                                                double* of) {
   PORTCAL_CHECK(problem->IsParameterBlockConstant(held) && !problem->IsParameterBlockConstant(of));
   const int held_size = problem->ParameterBlockSize(held);
   PORTCAL_CHECK(held_covariance.rows() == held_size && held_covariance.cols() == held_size);
@@ -58,19 +59,22 @@ Eigen::MatrixXd HeldBlockCovarianceContribution(ceres::Problem* problem, double*
   {
     const Freed freed(problem, held);  // without a manifold: the held block's ambient columns
     if (!problem->Evaluate(options, nullptr, nullptr, nullptr, &crs)) {
-      throw NumericalError("propagating the held parameters' covariance: the Jacobian could not be evaluated");
+      throw NumericalError(
+          "propagating the held parameters' covariance: the Jacobian could not be evaluated");
     }
   }
   const Eigen::MatrixXd jacobian = Dense(crs);
   const Eigen::MatrixXd free_part = jacobian.leftCols(free_columns);
   const Eigen::LDLT<Eigen::MatrixXd> information(free_part.transpose() * free_part);
   if (information.info() != Eigen::Success || !(information.vectorD().minCoeff() > 0)) {
-    throw NumericalError("propagating the held parameters' covariance: the free parameters are undetermined");
+    throw NumericalError(
+        "propagating the held parameters' covariance: the free parameters are undetermined");
   }
   // dx/dtheta, the rows of `of` only.
   const int of_size = problem->ParameterBlockTangentSize(of);
   const Eigen::MatrixXd sensitivity =
-      -information.solve(free_part.transpose() * jacobian.rightCols(held_size)).middleRows(of_column, of_size);
+      -information.solve(free_part.transpose() * jacobian.rightCols(held_size))
+           .middleRows(of_column, of_size);
   const Eigen::MatrixXd tangent = sensitivity * held_covariance * sensitivity.transpose();
   const ceres::Manifold* manifold = problem->GetManifold(of);
   if (manifold == nullptr) return 0.5 * (tangent + tangent.transpose());

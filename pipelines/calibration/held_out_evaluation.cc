@@ -15,7 +15,8 @@ constexpr int kGridCols = 16, kGridRows = 9;
 // Each cell's mean residual and the RMS of those means.
 void ResidualPattern(const std::vector<CalibrationView>& views, const HousedCamera& camera,
                      HeldOutEvaluation* evaluation) {
-  Eigen::MatrixXd sum_x = Eigen::MatrixXd::Zero(kGridRows, kGridCols), sum_y = sum_x, sum_squares_xy = sum_x;
+  Eigen::MatrixXd sum_x = Eigen::MatrixXd::Zero(kGridRows, kGridCols), sum_y = sum_x,
+                  sum_squares_xy = sum_x;
   Eigen::MatrixXi count = Eigen::MatrixXi::Zero(kGridRows, kGridCols);
   const double width = camera.camera.width, height = camera.camera.height;
   for (size_t v = 0; v < views.size(); ++v) {
@@ -25,8 +26,10 @@ void ResidualPattern(const std::vector<CalibrationView>& views, const HousedCame
       const auto predicted = camera.Project(view.cam_from_target * views[v].points_in_target[i]);
       if (!predicted) continue;
       const Eigen::Vector2d& observed = views[v].pixels[i];
-      const int c = std::clamp(static_cast<int>(observed.x() / width * kGridCols), 0, kGridCols - 1);
-      const int r = std::clamp(static_cast<int>(observed.y() / height * kGridRows), 0, kGridRows - 1);
+      const int c =
+          std::clamp(static_cast<int>(observed.x() / width * kGridCols), 0, kGridCols - 1);
+      const int r =
+          std::clamp(static_cast<int>(observed.y() / height * kGridRows), 0, kGridRows - 1);
       const Eigen::Vector2d residual = observed - *predicted;
       sum_x(r, c) += residual.x();
       sum_y(r, c) += residual.y();
@@ -35,7 +38,8 @@ void ResidualPattern(const std::vector<CalibrationView>& views, const HousedCame
     }
   }
   evaluation->cell_points = count;
-  evaluation->mean_residual_x.setConstant(kGridRows, kGridCols, std::numeric_limits<double>::quiet_NaN());
+  evaluation->mean_residual_x.setConstant(kGridRows, kGridCols,
+                                          std::numeric_limits<double>::quiet_NaN());
   evaluation->mean_residual_y = evaluation->mean_residual_x;
   double sum_squares = 0, floor_squares = 0;
   int cells = 0;
@@ -50,7 +54,8 @@ void ResidualPattern(const std::vector<CalibrationView>& views, const HousedCame
       // about it (both axes, s from the cell's own scatter, so a pattern
       // does not raise its own yardstick) has a squared length of s^2 / n.
       const int n = count(r, c);
-      const double scatter = std::max(0.0, sum_squares_xy(r, c) - n * (mx * mx + my * my)) / (n - 1);
+      const double scatter =
+          std::max(0.0, sum_squares_xy(r, c) - n * (mx * mx + my * my)) / (n - 1);
       floor_squares += scatter / n;
       ++cells;
     }
@@ -61,19 +66,21 @@ void ResidualPattern(const std::vector<CalibrationView>& views, const HousedCame
 
 }  // namespace
 
-std::vector<CalibrationView> WithBoardSag(const std::vector<CalibrationView>& views, const Eigen::Vector2d& warp) {
+std::vector<CalibrationView> WithBoardSag(const std::vector<CalibrationView>& views,
+                                          const Eigen::Vector2d& warp) {
   // The extent over these views: a board seen whole in any of them spans
   // it, as it did in the calibration.
   const Eigen::Vector4d extent = BoardExtent(views);
   std::vector<CalibrationView> sagged = views;
   for (CalibrationView& view : sagged) {
-    for (Eigen::Vector3d& point : view.points_in_target) point.z() += BoardSag(warp.data(), BoardWarpUv(point, extent));
+    for (Eigen::Vector3d& point : view.points_in_target)
+      point.z() += BoardSag(warp.data(), BoardWarpUv(point, extent));
   }
   return sagged;
 }
 
-HeldOutEvaluation EvaluateHeldOut(const std::vector<CalibrationView>& views, const HousedCamera& camera,
-                                  int num_threads) {
+HeldOutEvaluation EvaluateHeldOut(const std::vector<CalibrationView>& views,
+                                  const HousedCamera& camera, int num_threads) {
   HeldOutEvaluation evaluation;
   double sum_squares = 0;
   for (const CalibrationView& view : views) {
@@ -95,8 +102,9 @@ HeldOutEvaluation EvaluateHeldOut(const std::vector<CalibrationView>& views, con
     evaluation.views.push_back(result);
   }
   if (evaluation.num_points == 0) {
-    throw NumericalError("held-out evaluation: no view could be evaluated (no pose fits any of the " +
-                         std::to_string(views.size()) + " views with this calibration)");
+    throw NumericalError(
+        "held-out evaluation: no view could be evaluated (no pose fits any of the " +
+        std::to_string(views.size()) + " views with this calibration)");
   }
   evaluation.rms_px = std::sqrt(sum_squares / evaluation.num_points);
   ResidualPattern(views, camera, &evaluation);

@@ -48,11 +48,12 @@ struct HeldOutEvaluation {
 // the sag `warp` (mrcal's parabolic warp, colmap_ext/cost/board_warp.h)
 // over the views' extent: a calibration that fitted its board's warp is
 // judged on the same board, warped alike, not on a flat one.
-std::vector<CalibrationView> WithBoardSag(const std::vector<CalibrationView>& views, const Eigen::Vector2d& warp);
+std::vector<CalibrationView> WithBoardSag(const std::vector<CalibrationView>& views,
+                                          const Eigen::Vector2d& warp);
 
 // Throws NumericalError when no view can be evaluated.
-HeldOutEvaluation EvaluateHeldOut(const std::vector<CalibrationView>& views, const HousedCamera& camera,
-                                  int num_threads);
+HeldOutEvaluation EvaluateHeldOut(const std::vector<CalibrationView>& views,
+                                  const HousedCamera& camera, int num_threads);
 
 // One fold of a cross-validation: calibrated on the other folds' views,
 // evaluated on this one's.
@@ -66,7 +67,8 @@ struct FoldEvaluation {
 
 // Fits a calibration to views (a camera or a housing calibration) and
 // returns it with its own RMS.
-using CalibrationMethod = std::function<HousedCamera(const std::vector<CalibrationView>& views, double* rms_px)>;
+using CalibrationMethod =
+    std::function<HousedCamera(const std::vector<CalibrationView>& views, double* rms_px)>;
 
 // Views go to folds in turn (view i to fold i mod K), so that a capture's
 // beginning and end are both in every fold. Throws OptionError for K < 2

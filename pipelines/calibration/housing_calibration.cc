@@ -24,7 +24,8 @@ namespace portcal {
 
 void HousingCalibrationSettings::Check() const {
   if (max_num_iterations < 1) {
-    throw OptionError("--Calibration.max_num_iterations", std::to_string(max_num_iterations), ">= 1");
+    throw OptionError("--Calibration.max_num_iterations", std::to_string(max_num_iterations),
+                      ">= 1");
   }
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
 }
@@ -46,7 +47,8 @@ std::vector<Pose> InitialPoses(const std::vector<CalibrationView>& views, const 
       rays.push_back(ray->head<2>());
     }
     const std::optional<Rigid3d> pose = PoseFromNormalizedPlanarView({plane, rays});
-    if (!pose) throw NumericalError(view.image_name + ": no homography from the target to the image");
+    if (!pose)
+      throw NumericalError(view.image_name + ": no homography from the target to the image");
     poses.push_back(ToPose(*pose));
   }
   return poses;
@@ -86,9 +88,9 @@ Eigen::Vector3d EstimateAxis(const std::vector<CalibrationView>& views, const Ca
 
 struct State {
   std::vector<double> intrinsics;
-  Housing housing;  // its params are the port block
-  std::vector<Pose> poses;         // the underwater views'
-  std::vector<Pose> in_air_poses;  // the in-air views'
+  Housing housing;                             // its params are the port block
+  std::vector<Pose> poses;                     // the underwater views'
+  std::vector<Pose> in_air_poses;              // the in-air views'
   std::array<double, 2> warp = {0, 0};         // the underwater board's
   std::array<double, 2> in_air_warp = {0, 0};  // a different in-air board's
   // 1 / residual variance of each set (px^-2): the joint solve's weights.
@@ -122,7 +124,8 @@ struct JointProblem {
 };
 
 // The board's extent over both sets when they share a warp.
-Eigen::Vector4d SharedBoardExtent(const std::vector<CalibrationView>& views, const InAirViews* in_air) {
+Eigen::Vector4d SharedBoardExtent(const std::vector<CalibrationView>& views,
+                                  const InAirViews* in_air) {
   Eigen::Vector4d extent = BoardExtent(views);
   if (in_air != nullptr && in_air->share_board_warp) {
     for (const CalibrationView& view : in_air->views) ExtendBoardExtent(view, &extent);
@@ -184,18 +187,21 @@ void AddAirResiduals(const Inputs& in, State* state, JointProblem* jp) {
 // `poses_only`; the intrinsics and the warp as `in` says, in the exact
 // solve only (the virtual-camera error back-projects through the
 // intrinsics, which is ill-conditioned far from the solution).
-void SetBlocks(const Inputs& in, bool exact, bool poses_only, State* state, ceres::Problem* problem) {
+void SetBlocks(const Inputs& in, bool exact, bool poses_only, State* state,
+               ceres::Problem* problem) {
   for (Pose& pose : state->poses) problem->SetManifold(pose.data(), PoseManifold());
   for (Pose& pose : state->in_air_poses) {
     if (problem->HasParameterBlock(pose.data())) problem->SetManifold(pose.data(), PoseManifold());
   }
   const bool intrinsics_free = exact && !poses_only && in.RefinesIntrinsics();
-  const std::vector<int> fixed = in.in_air != nullptr ? in.in_air->fixed_params : std::vector<int>{};
+  const std::vector<int> fixed =
+      in.in_air != nullptr ? in.in_air->fixed_params : std::vector<int>{};
   if (!intrinsics_free || fixed.size() == state->intrinsics.size()) {
     problem->SetParameterBlockConstant(state->intrinsics.data());
   } else if (!fixed.empty()) {
-    problem->SetManifold(state->intrinsics.data(),
-                         new ceres::SubsetManifold(static_cast<int>(state->intrinsics.size()), fixed));
+    problem->SetManifold(
+        state->intrinsics.data(),
+        new ceres::SubsetManifold(static_cast<int>(state->intrinsics.size()), fixed));
   }
   if (poses_only) {
     problem->SetParameterBlockConstant(state->housing.params.data());
@@ -240,7 +246,8 @@ State BestStart(const Inputs& in, const State& state, const Eigen::Vector3d& axi
 }
 
 // Sum of squared residuals (unweighted) over `ids`; per view when asked.
-double SumSquares(ceres::Problem* problem, const std::vector<std::vector<ceres::ResidualBlockId>>& ids,
+double SumSquares(ceres::Problem* problem,
+                  const std::vector<std::vector<ceres::ResidualBlockId>>& ids,
                   std::vector<double>* per_view_rms = nullptr) {
   double total = 0;
   for (const auto& view_ids : ids) {
@@ -250,7 +257,8 @@ double SumSquares(ceres::Problem* problem, const std::vector<std::vector<ceres::
     double cost = 0;
     problem->Evaluate(options, &cost, nullptr, nullptr, nullptr);
     total += 2 * cost;
-    if (per_view_rms != nullptr) per_view_rms->push_back(std::sqrt(2 * cost / std::max<size_t>(1, view_ids.size())));
+    if (per_view_rms != nullptr)
+      per_view_rms->push_back(std::sqrt(2 * cost / std::max<size_t>(1, view_ids.size())));
   }
   return total;
 }
@@ -264,12 +272,15 @@ int NumPoints(const std::vector<CalibrationView>& views) {
 // Each set's residual variance (px^2), its own poses (and the housing, for
 // the underwater set) taken from its degrees of freedom.
 void WeighBySetVariance(const Inputs& in, JointProblem* jp, State* state) {
-  const double water = SumSquares(&jp->problem, jp->water_ids) /
-                       std::max(1.0, 2.0 * NumPoints(in.views) - 6.0 * in.views.size() -
-                                         static_cast<double>(state->housing.Refinement().Refined().size()));
-  const double air = SumSquares(&jp->problem, jp->air_ids) /
-                     std::max(1.0, 2.0 * NumPoints(in.in_air->views) - 6.0 * in.in_air->views.size());
-  if (!(water > 0) || !(air > 0)) throw NumericalError("housing calibration: a residual variance of zero");
+  const double water =
+      SumSquares(&jp->problem, jp->water_ids) /
+      std::max(1.0, 2.0 * NumPoints(in.views) - 6.0 * in.views.size() -
+                        static_cast<double>(state->housing.Refinement().Refined().size()));
+  const double air =
+      SumSquares(&jp->problem, jp->air_ids) /
+      std::max(1.0, 2.0 * NumPoints(in.in_air->views) - 6.0 * in.in_air->views.size());
+  if (!(water > 0) || !(air > 0))
+    throw NumericalError("housing calibration: a residual variance of zero");
   state->water_weight = 1 / water;
   state->air_weight = 1 / air;
   LOG(INFO) << "housing calibration: residual sigma " << std::sqrt(water) << " px under water, "
@@ -281,7 +292,8 @@ std::unique_ptr<JointProblem> SolveExactly(const Inputs& in, State* state) {
   AddWaterResiduals<PortErrorKind::kReprojection>(in, state, jp.get());
   if (in.in_air != nullptr) AddAirResiduals(in, state, jp.get());
   SetBlocks(in, true, false, state, &jp->problem);
-  SolveCalibration(&jp->problem, in.settings.max_num_iterations, in.settings.num_threads, "housing calibration");
+  SolveCalibration(&jp->problem, in.settings.max_num_iterations, in.settings.num_threads,
+                   "housing calibration");
   return jp;
 }
 
@@ -294,7 +306,8 @@ std::unique_ptr<JointProblem> SolveJointly(const Inputs& in, State* state) {
     JointProblem jp;
     AddWaterResiduals<PortErrorKind::kVirtualCamera>(in, state, &jp);
     SetBlocks(in, false, false, state, &jp.problem);
-    SolveCalibration(&jp.problem, in.settings.max_num_iterations, in.settings.num_threads, "housing calibration");
+    SolveCalibration(&jp.problem, in.settings.max_num_iterations, in.settings.num_threads,
+                     "housing calibration");
   }
   std::unique_ptr<JointProblem> jp = SolveExactly(in, state);
   if (in.in_air == nullptr) return jp;
@@ -308,16 +321,19 @@ std::unique_ptr<JointProblem> SolveJointly(const Inputs& in, State* state) {
 int NumFreeParameters(const Inputs& in, const State& state) {
   const HousingRefinement refinement = state.housing.Refinement();
   int num_free = 6 * static_cast<int>(state.poses.size() + state.in_air_poses.size()) +
-                 (refinement.orientation.empty() ? 0 : 2) + static_cast<int>(refinement.position.size());
+                 (refinement.orientation.empty() ? 0 : 2) +
+                 static_cast<int>(refinement.position.size());
   if (in.RefinesIntrinsics()) {
     num_free += static_cast<int>(state.intrinsics.size()) -
                 static_cast<int>(in.in_air != nullptr ? in.in_air->fixed_params.size() : 0);
   }
-  if (in.settings.estimate_board_warp) num_free += (in.in_air != nullptr && !in.in_air->share_board_warp) ? 4 : 2;
+  if (in.settings.estimate_board_warp)
+    num_free += (in.in_air != nullptr && !in.in_air->share_board_warp) ? 4 : 2;
   return num_free;
 }
 
-Eigen::MatrixXd CovarianceOf(ceres::Covariance* covariance, const double* block, int size, double variance) {
+Eigen::MatrixXd CovarianceOf(ceres::Covariance* covariance, const double* block, int size,
+                             double variance) {
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> c(size, size);
   covariance->GetCovarianceBlock(block, block, c.data());
   return c * variance;
@@ -338,9 +354,11 @@ void FillStdDevs(const Inputs& in, double variance, State* state, ceres::Problem
   ceres::Covariance covariance(CalibrationCovarianceOptions(in.settings.num_threads));
   double* port = state->housing.params.data();
   std::vector<std::pair<const double*, const double*>> blocks = {{port, port}};
-  if (in.RefinesIntrinsics()) blocks.emplace_back(state->intrinsics.data(), state->intrinsics.data());
+  if (in.RefinesIntrinsics())
+    blocks.emplace_back(state->intrinsics.data(), state->intrinsics.data());
   if (in.settings.estimate_board_warp) blocks.emplace_back(state->warp.data(), state->warp.data());
-  const bool own_air_warp = in.settings.estimate_board_warp && in.in_air != nullptr && !in.in_air->share_board_warp;
+  const bool own_air_warp =
+      in.settings.estimate_board_warp && in.in_air != nullptr && !in.in_air->share_board_warp;
   if (own_air_warp) blocks.emplace_back(state->in_air_warp.data(), state->in_air_warp.data());
   const int m = static_cast<int>(state->housing.params.size());
   const int n = static_cast<int>(state->intrinsics.size());
@@ -353,7 +371,8 @@ void FillStdDevs(const Inputs& in, double variance, State* state, ceres::Problem
     LOG(WARNING) << "housing calibration: the covariance is rank deficient (parameters not "
                     "separable from these views); standard deviations undetermined";
     for (int k : refined) result->housing_std_dev[static_cast<size_t>(k)] = -1;
-    if (in.RefinesIntrinsics()) std::fill(result->camera_std_dev.begin(), result->camera_std_dev.end(), -1.0);
+    if (in.RefinesIntrinsics())
+      std::fill(result->camera_std_dev.begin(), result->camera_std_dev.end(), -1.0);
     return;
   }
   result->housing_covariance = CovarianceOf(&covariance, port, m, variance);
@@ -361,30 +380,35 @@ void FillStdDevs(const Inputs& in, double variance, State* state, ceres::Problem
     // The held lens's own error, carried into the port (first order). If
     // that cannot be done, the report says the lens was taken as exact.
     try {
-      result->housing_covariance +=
-          HeldBlockCovarianceContribution(problem, state->intrinsics.data(), *in.lens_covariance, port);
+      result->housing_covariance += HeldBlockCovarianceContribution(
+          problem, state->intrinsics.data(), *in.lens_covariance, port);
       result->lens_covariance_propagated = true;
     } catch (const NumericalError& e) {
-      LOG(WARNING) << "housing calibration: the lens's covariance not propagated (" << e.what() << ")";
+      LOG(WARNING) << "housing calibration: the lens's covariance not propagated (" << e.what()
+                   << ")";
     }
   }
   const std::vector<double> housing = StdDevsOf(result->housing_covariance);
-  for (int k : refined) result->housing_std_dev[static_cast<size_t>(k)] = housing[static_cast<size_t>(k)];
+  for (int k : refined)
+    result->housing_std_dev[static_cast<size_t>(k)] = housing[static_cast<size_t>(k)];
   if (in.RefinesIntrinsics()) {
     result->camera_covariance = CovarianceOf(&covariance, state->intrinsics.data(), n, variance);
     result->camera_std_dev = StdDevsOf(result->camera_covariance);
   }
   if (in.settings.estimate_board_warp) {
-    const std::vector<double> warp = StdDevsOf(CovarianceOf(&covariance, state->warp.data(), 2, variance));
+    const std::vector<double> warp =
+        StdDevsOf(CovarianceOf(&covariance, state->warp.data(), 2, variance));
     result->board_warp_std_dev = Eigen::Vector2d(warp[0], warp[1]);
   }
   if (own_air_warp) {
-    const std::vector<double> warp = StdDevsOf(CovarianceOf(&covariance, state->in_air_warp.data(), 2, variance));
+    const std::vector<double> warp =
+        StdDevsOf(CovarianceOf(&covariance, state->in_air_warp.data(), 2, variance));
     result->in_air_board_warp_std_dev = Eigen::Vector2d(warp[0], warp[1]);
   }
 }
 
-std::vector<CalibratedView> ViewsOf(const std::vector<CalibrationView>& views, const std::vector<Pose>& poses,
+std::vector<CalibratedView> ViewsOf(const std::vector<CalibrationView>& views,
+                                    const std::vector<Pose>& poses,
                                     const std::vector<double>& rms) {
   std::vector<CalibratedView> out;
   for (size_t v = 0; v < views.size(); ++v) {
@@ -400,7 +424,8 @@ std::vector<CalibratedView> ViewsOf(const std::vector<CalibrationView>& views, c
 
 // The result at the solution: RMS and residual sigma of each set, the
 // standard deviations, the per-view tables.
-HousingCalibrationResult ResultOf(const Inputs& in, const Camera& camera, State* state, JointProblem* jp) {
+HousingCalibrationResult ResultOf(const Inputs& in, const Camera& camera, State* state,
+                                  JointProblem* jp) {
   HousingCalibrationResult result;
   std::vector<double> water_rms, air_rms;
   const double water = SumSquares(&jp->problem, jp->water_ids, &water_rms);
@@ -409,7 +434,8 @@ HousingCalibrationResult ResultOf(const Inputs& in, const Camera& camera, State*
   const int num_air_points = in.in_air != nullptr ? NumPoints(in.in_air->views) : 0;
   const double dof = 2.0 * (num_points + num_air_points) - NumFreeParameters(in, *state);
   // Weighted: ~1 when each set's weight is its residual variance.
-  const double variance = dof > 0 ? (state->water_weight * water + state->air_weight * air) / dof : 0;
+  const double variance =
+      dof > 0 ? (state->water_weight * water + state->air_weight * air) / dof : 0;
   FillStdDevs(in, variance, state, &jp->problem, &result);
   result.housing = state->housing;
   result.camera = camera;
@@ -435,7 +461,8 @@ HousingCalibrationResult ResultOf(const Inputs& in, const Camera& camera, State*
 
 HousingCalibrationResult CalibrateHousing(const std::vector<CalibrationView>& views,
                                           const Camera& camera, const Housing& housing,
-                                          const HousingCalibrationSettings& settings, const InAirViews* in_air,
+                                          const HousingCalibrationSettings& settings,
+                                          const InAirViews* in_air,
                                           const Eigen::MatrixXd* lens_covariance) {
   settings.Check();
   camera.Validate("camera");
@@ -443,11 +470,12 @@ HousingCalibrationResult CalibrateHousing(const std::vector<CalibrationView>& vi
   const Eigen::Index n = static_cast<Eigen::Index>(camera.params.size());
   if (lens_covariance != nullptr && (lens_covariance->rows() != n || lens_covariance->cols() != n ||
                                      !lens_covariance->allFinite())) {
-    throw InputError("housing calibration: the lens covariance is not " + std::to_string(n) + " x " +
-                     std::to_string(n) + " finite numbers (" + camera.ModelName() + ")");
+    throw InputError("housing calibration: the lens covariance is not " + std::to_string(n) +
+                     " x " + std::to_string(n) + " finite numbers (" + camera.ModelName() + ")");
   }
   if (views.size() < 2) throw NumericalError("housing calibration needs at least 2 views");
-  if (in_air != nullptr && in_air->views.empty()) throw NumericalError("housing calibration: no in-air views");
+  if (in_air != nullptr && in_air->views.empty())
+    throw NumericalError("housing calibration: no in-air views");
   const Inputs in{views,
                   in_air,
                   camera.model_id,
@@ -465,8 +493,9 @@ HousingCalibrationResult CalibrateHousing(const std::vector<CalibrationView>& vi
   if (settings.initialize_from_data) {
     state = BestStart(in, state, axis);
     LOG(INFO) << "housing_calibrator: axis from the views " << axis.transpose() << ", start "
-              << Eigen::Map<const Eigen::VectorXd>(state.housing.params.data(),
-                                                   static_cast<Eigen::Index>(state.housing.params.size()))
+              << Eigen::Map<const Eigen::VectorXd>(
+                     state.housing.params.data(),
+                     static_cast<Eigen::Index>(state.housing.params.size()))
                      .transpose();
   }
   const std::unique_ptr<JointProblem> jp = SolveJointly(in, &state);

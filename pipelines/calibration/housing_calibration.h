@@ -34,7 +34,7 @@
 namespace portcal {
 
 struct HousingCalibrationSettings {
-  bool refine_intrinsics = false;  // jointly with the housing
+  bool refine_intrinsics = false;    // jointly with the housing
   bool initialize_from_data = true;  // else start from the given parameters
   // mrcal's board sag (board_warp.h): the underwater views' own, and the
   // in-air views' own unless InAirViews::share_board_warp.

@@ -47,14 +47,16 @@ Rigid3d MedianPose(const std::vector<Rigid3d>& poses) {
       weights += 1 / norm;
     }
     step /= weights;
-    rotation = (rotation * Eigen::Quaterniond(Eigen::AngleAxisd(step.norm(), step.norm() > 0 ? step.normalized()
-                                                                                          : Eigen::Vector3d::UnitX())))
+    rotation = (rotation *
+                Eigen::Quaterniond(Eigen::AngleAxisd(
+                    step.norm(), step.norm() > 0 ? step.normalized() : Eigen::Vector3d::UnitX())))
                    .normalized();
     if (step.norm() < 1e-12) break;
   }
   // Translation: geometric median.
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
-  for (const Rigid3d& pose : poses) translation += pose.translation / static_cast<double>(poses.size());
+  for (const Rigid3d& pose : poses)
+    translation += pose.translation / static_cast<double>(poses.size());
   for (int iter = 0; iter < 200; ++iter) {
     Eigen::Vector3d numerator = Eigen::Vector3d::Zero();
     double weights = 0;
@@ -102,9 +104,10 @@ struct FrameCandidates {
 double Disagreement(const Rigid3d& candidate, const FrameCandidates& frame) {
   double best = std::numeric_limits<double>::infinity();
   for (const Rigid3d* other : {&frame.as_is, &frame.turned}) {
-    const double rotation = candidate.rotation.angularDistance(other->rotation) * 180 / M_PI / kAgreementDeg;
-    const double position =
-        (candidate.translation - other->translation).norm() / (kAgreementDistance * frame.board_distance);
+    const double rotation =
+        candidate.rotation.angularDistance(other->rotation) * 180 / M_PI / kAgreementDeg;
+    const double position = (candidate.translation - other->translation).norm() /
+                            (kAgreementDistance * frame.board_distance);
     best = std::min(best, std::max(rotation, position));
   }
   return best;
@@ -177,7 +180,8 @@ StereoStart StartStereo(const std::vector<StereoFrame>& frames, const HousedCame
     const double turned = consensus.rotation.angularDistance(candidates[f].turned.rotation);
     if (turned < as_is) {
       start.used[f].cam2 = flipped[f];
-      LOG(INFO) << frames[f].cam2.image_name << ": board numbered from the other end; turned by 180 deg";
+      LOG(INFO) << frames[f].cam2.image_name
+                << ": board numbered from the other end; turned by 180 deg";
     }
     chosen.push_back(turned < as_is ? candidates[f].turned : candidates[f].as_is);
   }
@@ -187,9 +191,11 @@ StereoStart StartStereo(const std::vector<StereoFrame>& frames, const HousedCame
 
 // Standard deviations of the relative pose (and of the intrinsics when
 // refined) from the covariance scaled by the residual variance.
-void ComputeStereoStdDevs(ceres::Problem* problem, const double* cam2_from_cam1, const std::vector<double>& intrinsics1,
+void ComputeStereoStdDevs(ceres::Problem* problem, const double* cam2_from_cam1,
+                          const std::vector<double>& intrinsics1,
                           const std::vector<double>& intrinsics2, double variance,
-                          const StereoCalibrationSettings& settings, StereoCalibrationResult* result) {
+                          const StereoCalibrationSettings& settings,
+                          StereoCalibrationResult* result) {
   ceres::Covariance covariance(CalibrationCovarianceOptions(settings.num_threads));
   std::vector<std::pair<const double*, const double*>> blocks = {{cam2_from_cam1, cam2_from_cam1}};
   if (settings.refine_intrinsics) {
@@ -199,7 +205,8 @@ void ComputeStereoStdDevs(ceres::Problem* problem, const double* cam2_from_cam1,
   result->camera1_std_dev.assign(intrinsics1.size(), 0.0);
   result->camera2_std_dev.assign(intrinsics2.size(), 0.0);
   if (!covariance.Compute(blocks, problem)) {
-    LOG(WARNING) << "stereo calibration: rank-deficient covariance; standard deviations undetermined";
+    LOG(WARNING)
+        << "stereo calibration: rank-deficient covariance; standard deviations undetermined";
     result->rotation_std_dev_deg.setConstant(-1);
     result->translation_std_dev.setConstant(-1);
     return;
@@ -210,7 +217,8 @@ void ComputeStereoStdDevs(ceres::Problem* problem, const double* cam2_from_cam1,
   // quaternion of delta being (cos|delta|, sin|delta| delta/|delta|): the
   // tangent vector is half the rotation vector.
   for (int i = 0; i < 3; ++i) {
-    result->rotation_std_dev_deg[i] = 2 * std::sqrt(std::max(0.0, c[7 * i] * variance)) * 180 / M_PI;
+    result->rotation_std_dev_deg[i] =
+        2 * std::sqrt(std::max(0.0, c[7 * i] * variance)) * 180 / M_PI;
     result->translation_std_dev[i] = std::sqrt(std::max(0.0, c[7 * (i + 3)] * variance));
   }
   if (!settings.refine_intrinsics) return;
@@ -225,8 +233,10 @@ void ComputeStereoStdDevs(ceres::Problem* problem, const double* cam2_from_cam1,
 
 // Each frame's two views at the solution: poses and RMS.
 void AddStereoViews(const std::vector<StereoFrame>& used, const std::vector<PoseBlock>& poses1,
-                    const HousedCamera& camera1, const HousedCamera& camera2, StereoCalibrationResult* result) {
-  const HousedCamera final1{result->camera1, camera1.housing}, final2{result->camera2, camera2.housing};
+                    const HousedCamera& camera1, const HousedCamera& camera2,
+                    StereoCalibrationResult* result) {
+  const HousedCamera final1{result->camera1, camera1.housing},
+      final2{result->camera2, camera2.housing};
   for (size_t f = 0; f < used.size(); ++f) {
     const Rigid3d cam1_from_target = FromPose(poses1[f]);
     const Rigid3d cam2_from_target = result->cam2_from_cam1 * cam1_from_target;
@@ -241,10 +251,12 @@ void AddStereoViews(const std::vector<StereoFrame>& used, const std::vector<Pose
 
 }  // namespace
 
-StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames, const HousedCamera& camera1,
-                                        const HousedCamera& camera2, const StereoCalibrationSettings& settings) {
+StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames,
+                                        const HousedCamera& camera1, const HousedCamera& camera2,
+                                        const StereoCalibrationSettings& settings) {
   settings.Check();
-  if (frames.size() < 2) throw NumericalError("stereo calibration needs at least 2 frames seen by both cameras");
+  if (frames.size() < 2)
+    throw NumericalError("stereo calibration needs at least 2 frames seen by both cameras");
   StereoStart start = StartStereo(frames, camera1, camera2, settings.num_threads);
   StereoCalibrationResult result;
   result.median_cam2_from_cam1 = start.median_cam2_from_cam1;
@@ -256,8 +268,10 @@ StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames, 
   int num_points = 0;
   for (size_t f = 0; f < frames.size(); ++f) {
     const StereoFrame& frame = start.used[f];
-    AddRigView(frame.cam1, camera1, start.poses1[f].data(), identity.data(), intrinsics1.data(), &problem);
-    AddRigView(frame.cam2, camera2, start.poses1[f].data(), cam2_from_cam1.data(), intrinsics2.data(), &problem);
+    AddRigView(frame.cam1, camera1, start.poses1[f].data(), identity.data(), intrinsics1.data(),
+               &problem);
+    AddRigView(frame.cam2, camera2, start.poses1[f].data(), cam2_from_cam1.data(),
+               intrinsics2.data(), &problem);
     problem.SetManifold(start.poses1[f].data(), PoseManifold());
     num_points += static_cast<int>(frame.cam1.pixels.size() + frame.cam2.pixels.size());
   }
@@ -267,15 +281,16 @@ StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames, 
     problem.SetParameterBlockConstant(intrinsics1.data());
     problem.SetParameterBlockConstant(intrinsics2.data());
   }
-  const ceres::Solver::Summary summary =
-      SolveCalibration(&problem, settings.max_num_iterations, settings.num_threads, "stereo calibration");
+  const ceres::Solver::Summary summary = SolveCalibration(
+      &problem, settings.max_num_iterations, settings.num_threads, "stereo calibration");
 
   const double sum_squares = 2 * summary.final_cost;
-  const int num_free = 6 * static_cast<int>(frames.size()) + 6 +
-                       (settings.refine_intrinsics ? static_cast<int>(intrinsics1.size() + intrinsics2.size()) : 0);
+  const int num_free =
+      6 * static_cast<int>(frames.size()) + 6 +
+      (settings.refine_intrinsics ? static_cast<int>(intrinsics1.size() + intrinsics2.size()) : 0);
   const double dof = 2.0 * num_points - num_free;
-  ComputeStereoStdDevs(&problem, cam2_from_cam1.data(), intrinsics1, intrinsics2, dof > 0 ? sum_squares / dof : 0,
-                       settings, &result);
+  ComputeStereoStdDevs(&problem, cam2_from_cam1.data(), intrinsics1, intrinsics2,
+                       dof > 0 ? sum_squares / dof : 0, settings, &result);
   result.cam2_from_cam1 = FromPose(cam2_from_cam1);
   result.camera1 = camera1.camera;
   result.camera1.params = intrinsics1;

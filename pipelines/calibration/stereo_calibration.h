@@ -33,7 +33,7 @@ struct StereoCalibrationSettings {
 
 struct StereoCalibrationResult {
   Rigid3d cam2_from_cam1;
-  Rigid3d median_cam2_from_cam1;  // the robust initial value
+  Rigid3d median_cam2_from_cam1;                                   // the robust initial value
   Eigen::Vector3d rotation_std_dev_deg = Eigen::Vector3d::Zero();  // about cam2's axes
   Eigen::Vector3d translation_std_dev = Eigen::Vector3d::Zero();   // metres
   Camera camera1, camera2;
@@ -44,8 +44,9 @@ struct StereoCalibrationResult {
   std::vector<CalibratedView> views1, views2;  // per frame
 };
 
-StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames, const HousedCamera& camera1,
-                                        const HousedCamera& camera2, const StereoCalibrationSettings& settings);
+StereoCalibrationResult CalibrateStereo(const std::vector<StereoFrame>& frames,
+                                        const HousedCamera& camera1, const HousedCamera& camera2,
+                                        const StereoCalibrationSettings& settings);
 
 // Geodesic L1 median of rotations and geometric median of translations of
 // a set of poses (Weiszfeld iterations).

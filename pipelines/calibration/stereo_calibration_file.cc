@@ -19,18 +19,21 @@ YAML::Node Load(const fs::path& path) {
   }
 }
 
-const YAML::Node Required(const YAML::Node& node, const std::string& key, const std::string& context) {
+const YAML::Node Required(const YAML::Node& node, const std::string& key,
+                          const std::string& context) {
   if (!node.IsMap() || !node[key]) throw InputError(context + ": no key '" + key + "'");
   return node[key];
 }
 
-HousedCamera ReadCamera(const YAML::Node& root, const std::string& key, camera_t id, const std::string& file) {
+HousedCamera ReadCamera(const YAML::Node& root, const std::string& key, camera_t id,
+                        const std::string& file) {
   const std::string context = file + ": " + key;
   const YAML::Node block = Required(root, key, file);
   HousedCamera camera;
   camera.camera.camera_id = id;
   try {
-    camera.camera.model_id = CameraModelNameToId(Required(block, "model", context).as<std::string>());
+    camera.camera.model_id =
+        CameraModelNameToId(Required(block, "model", context).as<std::string>());
   } catch (const InputError& e) {
     throw InputError(context + ".model: " + e.what());
   }
@@ -39,9 +42,10 @@ HousedCamera ReadCamera(const YAML::Node& root, const std::string& key, camera_t
   camera.camera.height = Required(block, "height", context).as<uint64_t>();
   camera.camera.Validate(context);
   if (block["non_svp_model"] && block["non_svp_model"].as<std::string>() != "NONE") {
-    camera.housing = Housing::FromName(block["non_svp_model"].as<std::string>(),
-                                       Required(block, "non_svp_parameters", context).as<std::vector<double>>(),
-                                       context + ".non_svp_parameters");
+    camera.housing =
+        Housing::FromName(block["non_svp_model"].as<std::string>(),
+                          Required(block, "non_svp_parameters", context).as<std::vector<double>>(),
+                          context + ".non_svp_parameters");
     camera.housing->ValidateInput(context + ".non_svp_parameters");
   }
   return camera;
@@ -52,13 +56,15 @@ Rigid3d ReadPose(const YAML::Node& root, const std::string& file) {
   const YAML::Node block = Required(root, "cam2_from_cam1", file);
   const std::vector<double> q = Required(block, "rotation_wxyz", context).as<std::vector<double>>();
   const std::vector<double> t = Required(block, "translation", context).as<std::vector<double>>();
-  if (q.size() != 4 || t.size() != 3) throw InputError(context + ": rotation_wxyz needs 4 values, translation 3");
+  if (q.size() != 4 || t.size() != 3)
+    throw InputError(context + ": rotation_wxyz needs 4 values, translation 3");
   const Eigen::Vector4d wxyz(q[0], q[1], q[2], q[3]);
   const Eigen::Vector3d translation(t[0], t[1], t[2]);
   if (!wxyz.allFinite() || !(wxyz.norm() > 1e-6) || !translation.allFinite()) {
     throw InputError(context + ": not a rotation and translation (non-finite or zero quaternion)");
   }
-  if (!(translation.norm() > 0)) throw InputError(context + ": the two cameras are in one place (zero baseline)");
+  if (!(translation.norm() > 0))
+    throw InputError(context + ": the two cameras are in one place (zero baseline)");
   return Rigid3d(QuaternionFromWxyz(wxyz.normalized()), translation);
 }
 

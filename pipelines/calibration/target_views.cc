@@ -36,11 +36,13 @@ TargetViews ReadTargetViewsIfAny(Database* database) {
       // otherwise surface as a solver that "did not converge".
       const std::string where = database->path() + ": image " + image.name + ", target point " +
                                 std::to_string(o.point_id) + " of portcal_target_observations";
-      if (!o.xy.allFinite() || !o.point_in_target.allFinite()) throw InputError(where + " is not a finite number");
+      if (!o.xy.allFinite() || !o.point_in_target.allFinite())
+        throw InputError(where + " is not a finite number");
       if (camera && !NearTheImage(o.xy, *camera)) {
-        throw InputError(where + " is at (" + std::to_string(o.xy.x()) + ", " + std::to_string(o.xy.y()) +
-                         "), far outside the " + std::to_string(camera->width) + "x" +
-                         std::to_string(camera->height) + " image");
+        throw InputError(where + " is at (" + std::to_string(o.xy.x()) + ", " +
+                         std::to_string(o.xy.y()) + "), far outside the " +
+                         std::to_string(camera->width) + "x" + std::to_string(camera->height) +
+                         " image");
       }
       view.points_in_target.push_back(o.point_in_target);
       view.pixels.push_back(o.xy);
@@ -61,7 +63,8 @@ camera_t ChooseCamera(const TargetViews& views, int camera_id, const std::string
   }
   if (views.by_camera.size() > 1) {
     throw InputError(database_path + ": " + std::to_string(views.by_camera.size()) +
-                     " cameras have target observations; choose one with " + option + " (or "
+                     " cameras have target observations; choose one with " + option +
+                     " (or "
                      "extract with --ImageReader.single_camera 1)");
   }
   return views.by_camera.begin()->first;

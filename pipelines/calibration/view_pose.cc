@@ -11,8 +11,8 @@
 
 namespace portcal {
 
-ceres::Solver::Summary SolveCalibration(ceres::Problem* problem, int max_num_iterations, int num_threads,
-                                        const std::string& what) {
+ceres::Solver::Summary SolveCalibration(ceres::Problem* problem, int max_num_iterations,
+                                        int num_threads, const std::string& what) {
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_SCHUR;
   options.logging_type = ceres::SILENT;
@@ -42,8 +42,9 @@ ceres::Covariance::Options CalibrationCovarianceOptions(int num_threads) {
   return options;
 }
 
-void AddRigView(const CalibrationView& view, const HousedCamera& rig_camera, double* cam1_from_target,
-             double* camk_from_cam1, double* intrinsics, ceres::Problem* problem) {
+void AddRigView(const CalibrationView& view, const HousedCamera& rig_camera,
+                double* cam1_from_target, double* camk_from_cam1, double* intrinsics,
+                ceres::Problem* problem) {
   VisitCameraModel(rig_camera.camera.model_id, [&](auto camera_tag) {
     using CameraModel = decltype(camera_tag);
     const auto add = [&](auto make) {
@@ -69,7 +70,8 @@ void AddRigView(const CalibrationView& view, const HousedCamera& rig_camera, dou
 
 // cam_from_target of one camera and view: homography on the undistorted
 // rays, then a pose-only solve through lens and port.
-Rigid3d EstimateViewPose(const CalibrationView& view, const HousedCamera& rig_camera, int num_threads) {
+Rigid3d EstimateViewPose(const CalibrationView& view, const HousedCamera& rig_camera,
+                         int num_threads) {
   PlanarView planar;
   for (size_t i = 0; i < view.pixels.size(); ++i) {
     const auto ray = rig_camera.camera.CamFromImg(view.pixels[i]);
@@ -97,7 +99,8 @@ Rigid3d EstimateViewPose(const CalibrationView& view, const HousedCamera& rig_ca
   return FromPose(p);
 }
 
-double ViewRms(const CalibrationView& view, const HousedCamera& rig_camera, const Rigid3d& cam_from_target) {
+double ViewRms(const CalibrationView& view, const HousedCamera& rig_camera,
+               const Rigid3d& cam_from_target) {
   double sum = 0;
   for (size_t i = 0; i < view.pixels.size(); ++i) {
     const auto pixel = rig_camera.Project(cam_from_target * view.points_in_target[i]);
@@ -106,8 +109,8 @@ double ViewRms(const CalibrationView& view, const HousedCamera& rig_camera, cons
   return std::sqrt(sum / std::max<size_t>(1, view.pixels.size()));
 }
 
-
-double HeldOutRms(const std::vector<CalibrationView>& views, const HousedCamera& camera, int num_threads) {
+double HeldOutRms(const std::vector<CalibrationView>& views, const HousedCamera& camera,
+                  int num_threads) {
   double sum = 0;
   size_t count = 0;
   for (const CalibrationView& view : views) {

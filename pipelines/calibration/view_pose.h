@@ -18,8 +18,8 @@ namespace portcal {
 
 // Solves a calibration problem: Schur complement, tight tolerances, silent.
 // Throws NumericalError("<what> did not converge: ...").
-ceres::Solver::Summary SolveCalibration(ceres::Problem* problem, int max_num_iterations, int num_threads,
-                                        const std::string& what);
+ceres::Solver::Summary SolveCalibration(ceres::Problem* problem, int max_num_iterations,
+                                        int num_threads, const std::string& what);
 
 // Dense SVD covariance (small problems; reports rank deficiency).
 ceres::Covariance::Options CalibrationCovarianceOptions(int num_threads);
@@ -34,10 +34,12 @@ void AddRigView(const CalibrationView& view, const HousedCamera& camera, double*
 Rigid3d EstimateViewPose(const CalibrationView& view, const HousedCamera& camera, int num_threads);
 
 // RMS (px) of a view at a pose, through lens and housing.
-double ViewRms(const CalibrationView& view, const HousedCamera& camera, const Rigid3d& cam_from_target);
+double ViewRms(const CalibrationView& view, const HousedCamera& camera,
+               const Rigid3d& cam_from_target);
 
 // Held-out error of a calibration: each view's pose estimated alone (pose
 // only, everything else fixed), RMS over all points of all views.
-double HeldOutRms(const std::vector<CalibrationView>& views, const HousedCamera& camera, int num_threads);
+double HeldOutRms(const std::vector<CalibrationView>& views, const HousedCamera& camera,
+                  int num_threads);
 
 }  // namespace portcal

@@ -56,8 +56,8 @@ std::optional<Rigid3d> PoseFromNormalizedPlanarView(const PlanarView& view) {
   return Rigid3d(Eigen::Quaterniond(rotation), scale * m.col(2));
 }
 
-std::optional<PinholeEstimate> InitializePinholeFromPlanarViews(const std::vector<PlanarView>& views,
-                                                                int width, int height) {
+std::optional<PinholeEstimate> InitializePinholeFromPlanarViews(
+    const std::vector<PlanarView>& views, int width, int height) {
   std::vector<Eigen::Matrix3d> homographies;
   for (const PlanarView& view : views) {
     const auto h = EstimateHomography(view.target_xy, view.pixels);
@@ -109,7 +109,8 @@ std::optional<PinholeEstimate> InitializePinholeFromPlanarViews(const std::vecto
     for (Eigen::Vector2d& p : normalized.pixels) {
       p = Eigen::Vector2d((p.x() - estimate.cx) / estimate.fx, (p.y() - estimate.cy) / estimate.fy);
     }
-    estimate.cam_from_target.push_back(PoseFromNormalizedPlanarView(normalized).value_or(Rigid3d()));
+    estimate.cam_from_target.push_back(
+        PoseFromNormalizedPlanarView(normalized).value_or(Rigid3d()));
   }
   return estimate;
 }

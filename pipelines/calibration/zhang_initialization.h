@@ -35,7 +35,7 @@ struct PinholeEstimate {
 // Needs >= 3 views in general position (2 with the principal point fixed at
 // the image centre, which is what it falls back to). nullopt when the
 // conic is not positive definite (views too alike, or too few).
-std::optional<PinholeEstimate> InitializePinholeFromPlanarViews(const std::vector<PlanarView>& views,
-                                                                int width, int height);
+std::optional<PinholeEstimate> InitializePinholeFromPlanarViews(
+    const std::vector<PlanarView>& views, int width, int height);
 
 }  // namespace portcal

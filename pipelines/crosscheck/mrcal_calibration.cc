@@ -46,7 +46,8 @@ BoardGrid InferBoardGrid(const std::vector<CalibrationView>& views) {
       ys.insert(std::round(p.y() * 1e9) / 1e9);
     }
   }
-  if (xs.size() < 2 || ys.size() < 2) throw InputError("target observations: fewer than 2x2 corners");
+  if (xs.size() < 2 || ys.size() < 2)
+    throw InputError("target observations: fewer than 2x2 corners");
   double spacing = std::numeric_limits<double>::max();
   for (const std::set<double>* values : {&xs, &ys}) {
     for (auto it = std::next(values->begin()); it != values->end(); ++it) {
@@ -62,7 +63,8 @@ BoardGrid InferBoardGrid(const std::vector<CalibrationView>& views) {
 }
 
 MrcalBoardSolve MrcalBoardSolveOf(const std::vector<CalibrationView>& views,
-                                  const std::vector<Rigid3d>& cam_from_target, const BoardGrid& grid,
+                                  const std::vector<Rigid3d>& cam_from_target,
+                                  const BoardGrid& grid,
                                   std::vector<std::vector<int>>* pool_to_point) {
   PORTCAL_CHECK(views.size() == cam_from_target.size());
   const int per_board = grid.width_n * grid.height_n;
@@ -73,7 +75,8 @@ MrcalBoardSolve MrcalBoardSolveOf(const std::vector<CalibrationView>& views,
   solve.observations.assign(views.size() * per_board * 3, 0.0);
   if (pool_to_point) pool_to_point->assign(views.size(), std::vector<int>(per_board, -1));
   // mrcal's board frame starts at the first corner.
-  const Rigid3d target_from_board(Eigen::Quaterniond::Identity(), Eigen::Vector3d(grid.origin.x(), grid.origin.y(), 0));
+  const Rigid3d target_from_board(Eigen::Quaterniond::Identity(),
+                                  Eigen::Vector3d(grid.origin.x(), grid.origin.y(), 0));
   for (size_t f = 0; f < views.size(); ++f) {
     const CalibrationView& view = views[f];
     double* block = &solve.observations[f * per_board * 3];
@@ -119,13 +122,15 @@ struct MrcalProblem {
 // One board observation per view, a dense (H, W) block of the pool each;
 // corners the detector did not report are marked as outliers (weight < 0),
 // which mrcal respects.
-void AddBoardObservations(const std::vector<CalibrationView>& views, const std::vector<Rigid3d>& seed_cam_from_target,
-                          MrcalProblem* problem) {
-  const MrcalBoardSolve solve = MrcalBoardSolveOf(views, seed_cam_from_target, problem->grid, &problem->pool_to_point);
+void AddBoardObservations(const std::vector<CalibrationView>& views,
+                          const std::vector<Rigid3d>& seed_cam_from_target, MrcalProblem* problem) {
+  const MrcalBoardSolve solve =
+      MrcalBoardSolveOf(views, seed_cam_from_target, problem->grid, &problem->pool_to_point);
   const int num_frames = problem->num_frames;
   problem->pool.resize(static_cast<size_t>(num_frames) * problem->per_board);
   for (size_t k = 0; k < problem->pool.size(); ++k) {
-    problem->pool[k] = {{solve.observations[3 * k], solve.observations[3 * k + 1], solve.observations[3 * k + 2]}};
+    problem->pool[k] = {
+        {solve.observations[3 * k], solve.observations[3 * k + 1], solve.observations[3 * k + 2]}};
   }
   problem->observations.resize(num_frames);
   problem->frames.resize(num_frames);
@@ -149,12 +154,13 @@ void AddBoardObservations(const std::vector<CalibrationView>& views, const std::
 // the regularisation terms; `x` gets the measurements.
 Eigen::MatrixXd MrcalJtJ(MrcalProblem* pr, std::vector<double>* x) {
   const int num_frames = pr->num_frames;
-  const int num_state = mrcal_num_states(1, 0, num_frames, 0, 0, num_frames, pr->selections, &pr->lensmodel);
-  const int num_meas = mrcal_num_measurements(num_frames, 0, pr->grid.width_n, pr->grid.height_n, 1, 0,
-                                              num_frames, 0, 0, pr->selections, &pr->lensmodel);
-  const int num_nonzero = _mrcal_num_j_nonzero(num_frames, 0, pr->grid.width_n, pr->grid.height_n, 1, 0,
-                                               num_frames, 0, 0, pr->observations.data(), nullptr,
-                                               pr->selections, &pr->lensmodel);
+  const int num_state =
+      mrcal_num_states(1, 0, num_frames, 0, 0, num_frames, pr->selections, &pr->lensmodel);
+  const int num_meas = mrcal_num_measurements(num_frames, 0, pr->grid.width_n, pr->grid.height_n, 1,
+                                              0, num_frames, 0, 0, pr->selections, &pr->lensmodel);
+  const int num_nonzero =
+      _mrcal_num_j_nonzero(num_frames, 0, pr->grid.width_n, pr->grid.height_n, 1, 0, num_frames, 0,
+                           0, pr->observations.data(), nullptr, pr->selections, &pr->lensmodel);
   std::vector<double> b_packed(num_state), jt_x(num_nonzero);
   x->assign(num_meas, 0.0);
   std::vector<int> jt_p(num_meas + 1), jt_i(num_nonzero);
@@ -171,13 +177,13 @@ Eigen::MatrixXd MrcalJtJ(MrcalProblem* pr, std::vector<double>* x) {
   jt.dtype = CHOLMOD_DOUBLE;
   jt.sorted = 1;
   jt.packed = 1;
-  if (!mrcal_optimizer_callback(b_packed.data(), num_state * static_cast<int>(sizeof(double)),
-                                x->data(), num_meas * static_cast<int>(sizeof(double)),
-                                reinterpret_cast<cholmod_sparse_struct*>(&jt), pr->intrinsics.data(),
-                                nullptr, pr->frames.data(), nullptr, &pr->warp, 1, 0, num_frames, 0, 0,
-                                pr->observations.data(), nullptr, num_frames, 0, pr->pool.data(),
-                                &pr->lensmodel, pr->imagersize, pr->selections, &pr->constants, pr->grid.spacing,
-                                pr->grid.width_n, pr->grid.height_n, false)) {
+  if (!mrcal_optimizer_callback(
+          b_packed.data(), num_state * static_cast<int>(sizeof(double)), x->data(),
+          num_meas * static_cast<int>(sizeof(double)),
+          reinterpret_cast<cholmod_sparse_struct*>(&jt), pr->intrinsics.data(), nullptr,
+          pr->frames.data(), nullptr, &pr->warp, 1, 0, num_frames, 0, 0, pr->observations.data(),
+          nullptr, num_frames, 0, pr->pool.data(), &pr->lensmodel, pr->imagersize, pr->selections,
+          &pr->constants, pr->grid.spacing, pr->grid.width_n, pr->grid.height_n, false)) {
     throw NumericalError("mrcal_optimizer_callback failed (its message is above)");
   }
   Eigen::MatrixXd jtj = Eigen::MatrixXd::Zero(num_state, num_state);
@@ -194,7 +200,8 @@ Eigen::MatrixXd MrcalJtJ(MrcalProblem* pr, std::vector<double>* x) {
 // Covariance as mrcal's uncertainty model has it: Var(b) = s^2 (J^T J)^-1
 // over the packed state, s^2 the residual variance of the inlier corners;
 // then unpacked to units.
-void FillMrcalCovariance(MrcalProblem* pr, bool estimate_board_warp, MrcalCalibrationResult* result) {
+void FillMrcalCovariance(MrcalProblem* pr, bool estimate_board_warp,
+                         MrcalCalibrationResult* result) {
   std::vector<double> x;
   const Eigen::MatrixXd jtj = MrcalJtJ(pr, &x);
   const int num_state = static_cast<int>(jtj.rows());
@@ -214,7 +221,8 @@ void FillMrcalCovariance(MrcalProblem* pr, bool estimate_board_warp, MrcalCalibr
   result->residual_sigma_px = std::sqrt(variance);
 
   std::vector<double> unpack(num_state, 1.0);
-  mrcal_unpack_solver_state_vector(unpack.data(), 1, 0, num_frames, 0, 0, pr->selections, &pr->lensmodel);
+  mrcal_unpack_solver_state_vector(unpack.data(), 1, 0, num_frames, 0, 0, pr->selections,
+                                   &pr->lensmodel);
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(jtj);
   result->params_covariance = Eigen::MatrixXd::Zero(num_intrinsics, num_intrinsics);
   result->params_std_dev.assign(num_intrinsics, 0.0);
@@ -227,15 +235,17 @@ void FillMrcalCovariance(MrcalProblem* pr, bool estimate_board_warp, MrcalCalibr
                                               &pr->lensmodel);
   for (int a = 0; a < num_intrinsics; ++a) {
     for (int b = 0; b < num_intrinsics; ++b) {
-      result->params_covariance(a, b) = inverse(i0 + a, i0 + b) * unpack[i0 + a] * unpack[i0 + b] * variance;
+      result->params_covariance(a, b) =
+          inverse(i0 + a, i0 + b) * unpack[i0 + a] * unpack[i0 + b] * variance;
     }
     result->params_std_dev[a] = std::sqrt(std::max(0.0, result->params_covariance(a, a)));
   }
   if (estimate_board_warp) {
-    const int w0 = mrcal_state_index_calobject_warp(1, 0, num_frames, 0, 0, num_frames, pr->selections,
-                                                    &pr->lensmodel);
+    const int w0 = mrcal_state_index_calobject_warp(1, 0, num_frames, 0, 0, num_frames,
+                                                    pr->selections, &pr->lensmodel);
     for (int a = 0; a < 2; ++a) {
-      result->board_warp_std_dev[a] = std::sqrt(std::max(0.0, inverse(w0 + a, w0 + a) * variance)) * unpack[w0 + a];
+      result->board_warp_std_dev[a] =
+          std::sqrt(std::max(0.0, inverse(w0 + a, w0 + a) * variance)) * unpack[w0 + a];
     }
   }
 }
@@ -252,7 +262,8 @@ MrcalCalibrationResult CalibrateWithMrcal(const std::vector<CalibrationView>& vi
   pr.grid = InferBoardGrid(views);
   const MrcalLens seed_lens = MrcalLensFromCamera(seed);
   PORTCAL_CHECK(mrcal_lensmodel_from_name(&pr.lensmodel, seed_lens.lensmodel.c_str()));
-  PORTCAL_CHECK(mrcal_lensmodel_num_params(&pr.lensmodel) == static_cast<int>(seed_lens.intrinsics.size()));
+  PORTCAL_CHECK(mrcal_lensmodel_num_params(&pr.lensmodel) ==
+                static_cast<int>(seed_lens.intrinsics.size()));
   pr.num_frames = static_cast<int>(views.size());
   pr.per_board = pr.grid.width_n * pr.grid.height_n;
   AddBoardObservations(views, seed_cam_from_target, &pr);
@@ -268,10 +279,10 @@ MrcalCalibrationResult CalibrateWithMrcal(const std::vector<CalibrationView>& vi
   pr.selections.do_apply_outlier_rejection = options.reject_outliers;
 
   const mrcal_stats_t stats = mrcal_optimize(
-      nullptr, 0, nullptr, 0, pr.intrinsics.data(), nullptr, pr.frames.data(), nullptr, &pr.warp, 1, 0,
-      pr.num_frames, 0, 0, pr.observations.data(), nullptr, pr.num_frames, 0, pr.pool.data(), &pr.lensmodel,
-      pr.imagersize, pr.selections, &pr.constants, pr.grid.spacing, pr.grid.width_n, pr.grid.height_n,
-      options.verbose, false);
+      nullptr, 0, nullptr, 0, pr.intrinsics.data(), nullptr, pr.frames.data(), nullptr, &pr.warp, 1,
+      0, pr.num_frames, 0, 0, pr.observations.data(), nullptr, pr.num_frames, 0, pr.pool.data(),
+      &pr.lensmodel, pr.imagersize, pr.selections, &pr.constants, pr.grid.spacing, pr.grid.width_n,
+      pr.grid.height_n, options.verbose, false);
   if (!std::isfinite(stats.rms_reproj_error__pixels) || stats.rms_reproj_error__pixels < 0) {
     throw NumericalError("mrcal_optimize failed (its message is above)");
   }

@@ -50,12 +50,13 @@ BoardGrid InferBoardGrid(const std::vector<CalibrationView>& views);
 // index of the view's point, -1 where the view has none. Throws InputError
 // for a point off the grid.
 MrcalBoardSolve MrcalBoardSolveOf(const std::vector<CalibrationView>& views,
-                                  const std::vector<Rigid3d>& cam_from_target, const BoardGrid& grid,
+                                  const std::vector<Rigid3d>& cam_from_target,
+                                  const BoardGrid& grid,
                                   std::vector<std::vector<int>>* pool_to_point = nullptr);
 
 struct MrcalCalibrationResult {
-  std::string lensmodel;  // e.g. LENSMODEL_OPENCV4
-  Camera camera;          // mrcal's solution as the equivalent COLMAP camera
+  std::string lensmodel;               // e.g. LENSMODEL_OPENCV4
+  Camera camera;                       // mrcal's solution as the equivalent COLMAP camera
   std::vector<double> params_std_dev;  // in camera.params' order
   Eigen::MatrixXd params_covariance;
   Eigen::Vector2d board_warp = Eigen::Vector2d::Zero();  // metres (x2, y2)

@@ -13,7 +13,8 @@ namespace {
 // mrcal holds parameters by group only (the core fx, fy, cx, cy; the
 // distortions): which groups portcal held, or why_not where a held set is
 // not a union of groups.
-bool MrcalSelectionsOf(const CameraCalibrationSettings& settings, MrcalBoardSolve* solve, std::string* why_not) {
+bool MrcalSelectionsOf(const CameraCalibrationSettings& settings, MrcalBoardSolve* solve,
+                       std::string* why_not) {
   const std::set<std::string> fixed(settings.fixed_params.begin(), settings.fixed_params.end());
   std::set<std::string> rest = fixed;
   if (fixed.count("focal") && fixed.count("principal_point")) {
@@ -35,10 +36,9 @@ bool MrcalSelectionsOf(const CameraCalibrationSettings& settings, MrcalBoardSolv
 
 }  // namespace
 
-std::optional<MrcalBoardSolve> MrcalBoardSolveOfCalibration(const std::vector<CalibrationView>& views,
-                                                            const CameraCalibrationResult& result,
-                                                            const CameraCalibrationSettings& settings,
-                                                            std::string* why_not) {
+std::optional<MrcalBoardSolve> MrcalBoardSolveOfCalibration(
+    const std::vector<CalibrationView>& views, const CameraCalibrationResult& result,
+    const CameraCalibrationSettings& settings, std::string* why_not) {
   PORTCAL_CHECK(why_not != nullptr);
   MrcalBoardSolve selections;
   if (!MrcalSelectionsOf(settings, &selections, why_not)) return std::nullopt;
@@ -80,13 +80,15 @@ std::filesystem::path WriteCalibrationCameraModel(const std::vector<CalibrationV
     return {};
   }
   std::string why_not;
-  const std::optional<MrcalBoardSolve> solve = MrcalBoardSolveOfCalibration(views, result, settings, &why_not);
+  const std::optional<MrcalBoardSolve> solve =
+      MrcalBoardSolveOfCalibration(views, result, settings, &why_not);
   if (!solve) {
-    LOG(WARNING) << "camera.cameramodel carries no optimization_inputs (mrcal's uncertainty tools will "
-                 << "refuse it): " << why_not;
+    LOG(WARNING)
+        << "camera.cameramodel carries no optimization_inputs (mrcal's uncertainty tools will "
+        << "refuse it): " << why_not;
   } else if (!MrcalExtraFreedom(model).empty()) {
-    LOG(INFO) << "camera.cameramodel: mrcal's tools evaluate " << model << " as " << MrcalLensModelFor(model)
-              << ", which also frees " << MrcalExtraFreedom(model)
+    LOG(INFO) << "camera.cameramodel: mrcal's tools evaluate " << model << " as "
+              << MrcalLensModelFor(model) << ", which also frees " << MrcalExtraFreedom(model)
               << "; their uncertainties are those of that larger model";
   }
   const std::filesystem::path path = dir / "camera.cameramodel";

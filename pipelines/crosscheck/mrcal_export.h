@@ -19,10 +19,9 @@ namespace portcal {
 // mrcal sees it; the dropped views are left out. Empty, with `why_not`
 // set, where mrcal cannot express it: a lens model mrcal lacks, a target
 // that is not one square grid, parameters held that mrcal would free.
-std::optional<MrcalBoardSolve> MrcalBoardSolveOfCalibration(const std::vector<CalibrationView>& views,
-                                                            const CameraCalibrationResult& result,
-                                                            const CameraCalibrationSettings& settings,
-                                                            std::string* why_not);
+std::optional<MrcalBoardSolve> MrcalBoardSolveOfCalibration(
+    const std::vector<CalibrationView>& views, const CameraCalibrationResult& result,
+    const CameraCalibrationSettings& settings, std::string* why_not);
 
 // Writes `dir`/camera.cameramodel with the optimization_inputs where mrcal
 // can express the solve, without them (and a log line saying why) where it

@@ -12,7 +12,8 @@ namespace {
 // are a chessboard's inner corners: mrgingham's, or portcal's own).
 std::string ChessboardDescription(const MrcalBoardSolve& solve) {
   std::ostringstream out;
-  out << "chessboard " << solve.width_n << "x" << solve.height_n << " inner corners, square " << solve.spacing << " m";
+  out << "chessboard " << solve.width_n << "x" << solve.height_n << " inner corners, square "
+      << solve.spacing << " m";
   return out.str();
 }
 
@@ -25,12 +26,14 @@ InAirViews InAirViewsOfMrcalSolve(const MrcalBoardSolve& solve, const Camera& ca
   const int per_board = solve.width_n * solve.height_n;
   for (size_t f = 0; f < solve.frames_rt_toref.size(); ++f) {
     CalibrationView view;
-    view.image_name = f < solve.image_paths.size() ? solve.image_paths[f] : "frame " + std::to_string(f);
+    view.image_name =
+        f < solve.image_paths.size() ? solve.image_paths[f] : "frame " + std::to_string(f);
     for (int k = 0; k < per_board; ++k) {
       const double* corner = &solve.observations[(f * per_board + k) * 3];
       if (!(corner[2] > 0)) continue;
       // mrcal's board frame: corner (row, col) at (col, row) x spacing, z = 0.
-      view.points_in_target.emplace_back((k % solve.width_n) * solve.spacing, (k / solve.width_n) * solve.spacing, 0);
+      view.points_in_target.emplace_back((k % solve.width_n) * solve.spacing,
+                                         (k / solve.width_n) * solve.spacing, 0);
       view.pixels.emplace_back(corner[0] + 0.5, corner[1] + 0.5);  // mrcal's pixels -> COLMAP's
     }
     if (view.pixels.size() >= 4) in_air.views.push_back(std::move(view));
@@ -43,7 +46,8 @@ InAirViews InAirViewsOfMrcalSolve(const MrcalBoardSolve& solve, const Camera& ca
   PORTCAL_CHECK(CameraModelFocalLengthIdxs(camera.model_id).size() == 2);
   const int num_core = 4;
   for (int i = 0; i < static_cast<int>(camera.params.size()); ++i) {
-    if ((i < num_core && !solve.intrinsics_core_estimated) || (i >= num_core && !solve.intrinsics_distortions_estimated)) {
+    if ((i < num_core && !solve.intrinsics_core_estimated) ||
+        (i >= num_core && !solve.intrinsics_distortions_estimated)) {
       in_air.fixed_params.push_back(i);
     }
   }

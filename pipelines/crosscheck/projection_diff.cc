@@ -64,9 +64,11 @@ Eigen::Matrix3d FitRotation(const std::vector<std::optional<Eigen::Vector3d>>& r
                             const std::vector<double>& weights) {
   Eigen::Matrix3d correlation = Eigen::Matrix3d::Zero();
   for (size_t k = 0; k < rays_a.size(); ++k) {
-    if (rays_a[k] && rays_b[k] && weights[k] > 0) correlation += weights[k] * *rays_b[k] * rays_a[k]->transpose();
+    if (rays_a[k] && rays_b[k] && weights[k] > 0)
+      correlation += weights[k] * *rays_b[k] * rays_a[k]->transpose();
   }
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(correlation, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(correlation,
+                                              Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d fix = Eigen::Matrix3d::Identity();
   fix(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
   Eigen::Matrix3d rotation = svd.matrixU() * fix * svd.matrixV().transpose();
@@ -104,7 +106,8 @@ Eigen::Matrix3d FitRotation(const std::vector<std::optional<Eigen::Vector3d>>& r
       if (!delta.allFinite()) break;
       const Eigen::Matrix3d candidate =
           (delta.norm() > 0 ? Eigen::AngleAxisd(delta.norm(), delta.normalized()).toRotationMatrix()
-                            : Eigen::Matrix3d::Identity()) * rotation;
+                            : Eigen::Matrix3d::Identity()) *
+          rotation;
       const double next = cost(candidate);
       if (next < current) {
         improved = current - next > 1e-15 * current;
@@ -141,9 +144,7 @@ Evaluation Evaluate(const Camera& a, const Camera& b, const Grid& grid,
 
 // Central-difference step for parameter i: a hundredth of its standard
 // deviation (the map is smooth on that scale; round-off is far below).
-double Step(const Eigen::MatrixXd& covariance, int i) {
-  return 1e-2 * std::sqrt(covariance(i, i));
-}
+double Step(const Eigen::MatrixXd& covariance, int i) { return 1e-2 * std::sqrt(covariance(i, i)); }
 
 using GridJacobian = Eigen::Matrix<double, 2, Eigen::Dynamic>;
 
@@ -185,9 +186,8 @@ std::vector<double> ProjectionStdDev(const CalibratedLens& lens, const Grid& gri
   for (size_t k = 0; k < n; ++k) {
     if (!rays[k] || !jacobians[k].allFinite()) continue;
     const Eigen::Matrix2d c = jacobians[k] * lens.covariance * jacobians[k].transpose();
-    sigma[k] = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(c)
-                                           .eigenvalues()
-                                           .maxCoeff()));
+    sigma[k] = std::sqrt(
+        std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(c).eigenvalues().maxCoeff()));
   }
   return sigma;
 }
@@ -199,7 +199,9 @@ void AddPredictedVariance(const CalibratedLens& lens, bool lens_is_a, const Came
                           std::vector<double>* variance) {
   const size_t n = grid.pixels.size();
   const std::vector<GridJacobian> jacobians = GridJacobians(lens, n, [&](const Camera& camera) {
-    return (lens_is_a ? Evaluate(camera, other, grid, weights) : Evaluate(other, camera, grid, weights)).diff;
+    return (lens_is_a ? Evaluate(camera, other, grid, weights)
+                      : Evaluate(other, camera, grid, weights))
+        .diff;
   });
   for (size_t k = 0; k < n; ++k) {
     (*variance)[k] += (jacobians[k] * lens.covariance * jacobians[k].transpose()).trace();
@@ -207,12 +209,13 @@ void AddPredictedVariance(const CalibratedLens& lens, bool lens_is_a, const Came
 }
 
 double Percentile(std::vector<double> values, double fraction) {
-  values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
-               values.end());
+  values.erase(
+      std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
+      values.end());
   if (values.empty()) return kNaN;
   std::sort(values.begin(), values.end());
-  const size_t index = std::min(values.size() - 1,
-                                static_cast<size_t>(std::ceil(fraction * values.size())) - 1);
+  const size_t index =
+      std::min(values.size() - 1, static_cast<size_t>(std::ceil(fraction * values.size())) - 1);
   return values[index];
 }
 
@@ -236,9 +239,8 @@ std::vector<double> FitWeights(const CalibratedLens& a, const CalibratedLens& b,
       weights[k] = std::isfinite(s) && s > 0 ? 1.0 / (s * s) : 0.0;
     }
   } else {
-    const double radius = options.focus_radius < 0
-                              ? std::min(a.camera.width, a.camera.height) / 6.0
-                              : options.focus_radius;
+    const double radius = options.focus_radius < 0 ? std::min(a.camera.width, a.camera.height) / 6.0
+                                                   : options.focus_radius;
     const Eigen::Vector2d centre(a.camera.width / 2.0, a.camera.height / 2.0);
     for (size_t k = 0; k < n; ++k) weights[k] = (grid.pixels[k] - centre).norm() <= radius;
   }
@@ -340,8 +342,8 @@ void WriteProjectionDiffHeatMap(const ProjectionDiff& diff, int width, int heigh
     }
   }
   std::ostringstream heading;
-  heading << std::setprecision(3) << title << ": mean " << diff.mean_px << ", p95 " << diff.p95_px << ", max "
-          << diff.max_px << " px (lines: mean, p95)";
+  heading << std::setprecision(3) << title << ": mean " << diff.mean_px << ", p95 " << diff.p95_px
+          << ", max " << diff.max_px << " px (lines: mean, p95)";
   HeatMapStyle style;
   style.title = heading.str();
   style.unit = "px";

@@ -31,9 +31,9 @@ struct CalibratedLens {
 };
 
 struct ProjectionDiffOptions {
-  int gridn_width = 60;       // grid points across; rows follow the aspect ratio
-  double focus_radius = -1;   // px; < 0: mrcal's default (see above)
-  void Check() const;         // throws OptionError
+  int gridn_width = 60;      // grid points across; rows follow the aspect ratio
+  double focus_radius = -1;  // px; < 0: mrcal's default (see above)
+  void Check() const;        // throws OptionError
 };
 
 struct ProjectionDiff {
@@ -44,7 +44,7 @@ struct ProjectionDiff {
   Eigen::Matrix3d b_from_a = Eigen::Matrix3d::Identity();
   double mean_px = 0, p95_px = 0, max_px = 0;
   double predicted_mean_px = 0, predicted_p95_px = 0;  // 0 without covariances
-  std::string worst_region;   // e.g. "top-left corner" (of a 3 x 3 split)
+  std::string worst_region;                            // e.g. "top-left corner" (of a 3 x 3 split)
   double worst_region_mean_px = 0;
 };
 

@@ -31,8 +31,9 @@ TargetDetection FromChessboard(const ChessboardDetection& d, const TargetDetecto
   for (size_t i = 0; i < d.corners.size(); ++i) {
     if (!d.corners[i]) continue;
     const int c = static_cast<int>(i) % cols, r = static_cast<int>(i) / cols;
-    detection.points.push_back({static_cast<int64_t>(i), *d.corners[i],
-                                Eigen::Vector3d(c * options.square_size_m, r * options.square_size_m, 0.0)});
+    detection.points.push_back(
+        {static_cast<int64_t>(i), *d.corners[i],
+         Eigen::Vector3d(c * options.square_size_m, r * options.square_size_m, 0.0)});
   }
   return detection;
 }
@@ -43,14 +44,16 @@ void TargetDetectorOptions::Check() const {
   if (type != "chessboard" && type != "aruco_grid" && type != "charuco") {
     throw OptionError("--Target.type", type, "chessboard, aruco_grid or charuco");
   }
-  if (!(square_size_m > 0)) throw OptionError("--Target.square_size", std::to_string(square_size_m), "> 0 m");
+  if (!(square_size_m > 0))
+    throw OptionError("--Target.square_size", std::to_string(square_size_m), "> 0 m");
   // A board's squares and markers are millimetres to decimetres: a metre or
   // more is a size in millimetres given as metres.
   for (const auto& [option, size] : {std::pair("--Target.square_size", square_size_m),
                                      std::pair("--Target.marker_size", markers.marker_size_m)}) {
     if (size >= 1) {
-      throw OptionError(option, FormatShortest(size),
-                        "metres (" + FormatShortest(size) + " mm is " + FormatShortest(size / 1000) + " m)");
+      throw OptionError(
+          option, FormatShortest(size),
+          "metres (" + FormatShortest(size) + " mm is " + FormatShortest(size / 1000) + " m)");
     }
   }
   if (type == "chessboard") {
@@ -62,7 +65,8 @@ void TargetDetectorOptions::Check() const {
 
 TargetDetection DetectTarget(const cv::Mat& gray, const TargetDetectorOptions& options) {
   options.Check();
-  if (options.type == "chessboard") return FromChessboard(DetectChessboard(gray, ChessboardOptions(options)), options);
+  if (options.type == "chessboard")
+    return FromChessboard(DetectChessboard(gray, ChessboardOptions(options)), options);
   const MarkerBoardDetection d = DetectMarkerBoard(gray, MarkerOptions(options));
   TargetDetection detection;
   detection.found = d.found;
@@ -79,8 +83,9 @@ std::vector<BoardPoint> TargetLayout(const TargetDetectorOptions& options) {
   std::vector<BoardPoint> points;
   for (int r = 0; r < options.chessboard.rows; ++r) {
     for (int c = 0; c < options.chessboard.cols; ++c) {
-      points.push_back({static_cast<int64_t>(r) * options.chessboard.cols + c, Eigen::Vector2d::Zero(),
-                        Eigen::Vector3d(c * options.square_size_m, r * options.square_size_m, 0.0)});
+      points.push_back(
+          {static_cast<int64_t>(r) * options.chessboard.cols + c, Eigen::Vector2d::Zero(),
+           Eigen::Vector3d(c * options.square_size_m, r * options.square_size_m, 0.0)});
     }
   }
   return points;

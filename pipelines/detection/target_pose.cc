@@ -5,7 +5,8 @@
 
 namespace portcal {
 
-std::optional<TargetPose> EstimateTargetPose(const TargetDetection& detection, const HousedCamera& camera) {
+std::optional<TargetPose> EstimateTargetPose(const TargetDetection& detection,
+                                             const HousedCamera& camera) {
   if (!detection.found || detection.points.size() < 4) return std::nullopt;
   CalibrationView view;
   view.image_name = "frame";

@@ -19,6 +19,7 @@ struct TargetPose {
 // A homography on the rays through the lens, then a pose-only solve through
 // lens and housing (view_pose.h). nullopt without a found target, with
 // fewer than 4 points, or where no pose fits.
-std::optional<TargetPose> EstimateTargetPose(const TargetDetection& detection, const HousedCamera& camera);
+std::optional<TargetPose> EstimateTargetPose(const TargetDetection& detection,
+                                             const HousedCamera& camera);
 
 }  // namespace portcal

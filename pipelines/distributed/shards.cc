@@ -10,14 +10,16 @@ namespace portcal {
 
 void Shard::Check() const {
   if (count < 1 || index < 0 || index >= count) {
-    throw InputError("shard " + std::to_string(index) + " of " + std::to_string(count) + ": not a shard");
+    throw InputError("shard " + std::to_string(index) + " of " + std::to_string(count) +
+                     ": not a shard");
   }
 }
 
 Shard ThisRanksShard() { return Shard{MpiWorld::Rank(), MpiWorld::Size()}; }
 
 std::filesystem::path ShardDatabasePath(const std::string& database_path, const Shard& shard) {
-  return database_path + ".shard-" + std::to_string(shard.index) + "-of-" + std::to_string(shard.count);
+  return database_path + ".shard-" + std::to_string(shard.index) + "-of-" +
+         std::to_string(shard.count);
 }
 
 void RemoveShardDatabase(const std::filesystem::path& path) {
@@ -37,7 +39,8 @@ void RunOnEveryRank(const std::string& stage, const std::function<void()>& work,
   if (MpiWorld::AllSucceeded(error == nullptr)) return;
   clean_up();
   if (error) std::rethrow_exception(error);
-  throw std::runtime_error(stage + ": another rank of the MPI job failed (its error is above); rank " +
+  throw std::runtime_error(stage +
+                           ": another rank of the MPI job failed (its error is above); rank " +
                            std::to_string(MpiWorld::Rank()) + " stopped too, nothing was written");
 }
 

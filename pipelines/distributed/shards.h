@@ -40,6 +40,7 @@ void RemoveShardDatabase(const std::filesystem::path& path);
 // Runs `work` on every rank. If it failed on any rank, every rank runs
 // `clean_up` and throws: its own error, or one saying another rank failed
 // (whose error that rank reports). Every rank must call it together.
-void RunOnEveryRank(const std::string& stage, const std::function<void()>& work, const std::function<void()>& clean_up);
+void RunOnEveryRank(const std::string& stage, const std::function<void()>& work,
+                    const std::function<void()>& clean_up);
 
 }  // namespace portcal

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
 #include <opencv2/core.hpp>
 #include <opencv2/flann.hpp>
 
@@ -28,7 +27,8 @@ void DescriptorMatchingOptions::Check() const {
     throw OptionError("--SiftMatching.kdtree_num_trees", std::to_string(kdtree_num_trees), ">= 1");
   }
   if (kdtree_num_checks < 1) {
-    throw OptionError("--SiftMatching.kdtree_num_checks", std::to_string(kdtree_num_checks), ">= 1");
+    throw OptionError("--SiftMatching.kdtree_num_checks", std::to_string(kdtree_num_checks),
+                      ">= 1");
   }
 }
 
@@ -46,13 +46,17 @@ namespace {
 // The two nearest rows of `data` for each row of `queries`, by k-d trees.
 // FLANN's L2 distances are squared; for unit vectors dot = 1 - d^2 / 2.
 void NearestKdTree(const UnitDescriptors& data, const UnitDescriptors& queries,
-                   const DescriptorMatchingOptions& options, std::vector<NearestDescriptors>* nearest) {
-  const cv::Mat data_mat(static_cast<int>(data.rows()), 128, CV_32F, const_cast<float*>(data.data()));
-  const cv::Mat query_mat(static_cast<int>(queries.rows()), 128, CV_32F, const_cast<float*>(queries.data()));
+                   const DescriptorMatchingOptions& options,
+                   std::vector<NearestDescriptors>* nearest) {
+  const cv::Mat data_mat(static_cast<int>(data.rows()), 128, CV_32F,
+                         const_cast<float*>(data.data()));
+  const cv::Mat query_mat(static_cast<int>(queries.rows()), 128, CV_32F,
+                          const_cast<float*>(queries.data()));
   const int k = data.rows() > 1 ? 2 : 1;
   cv::flann::Index index(data_mat, cv::flann::KDTreeIndexParams(options.kdtree_num_trees));
   cv::Mat indices, distances;
-  index.knnSearch(query_mat, indices, distances, k, cv::flann::SearchParams(options.kdtree_num_checks));
+  index.knnSearch(query_mat, indices, distances, k,
+                  cv::flann::SearchParams(options.kdtree_num_checks));
   for (int q = 0; q < query_mat.rows; ++q) {
     NearestDescriptors& n = (*nearest)[static_cast<size_t>(q)];
     n.index = indices.at<int>(q, 0);

@@ -30,7 +30,7 @@ struct DescriptorMatchingOptions {
   std::string method = "brute_force";  // brute_force | kdtree
   int kdtree_num_trees = 4;
   int kdtree_num_checks = 128;  // leaves visited per query
-  void Check() const;  // throws OptionError naming --SiftMatching.*
+  void Check() const;           // throws OptionError naming --SiftMatching.*
 };
 
 // Descriptors as unit float rows (uint8 / 512, renormalised).

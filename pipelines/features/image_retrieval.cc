@@ -69,7 +69,8 @@ void ImageRetrievalIndex::Add(const std::vector<int>& words) {
 void ImageRetrievalIndex::Finalize() {
   const int n = static_cast<int>(counts_.size());
   Eigen::VectorXf document_frequency = Eigen::VectorXf::Zero(num_words_);
-  for (const Eigen::VectorXf& c : counts_) document_frequency += (c.array() > 0).cast<float>().matrix();
+  for (const Eigen::VectorXf& c : counts_)
+    document_frequency += (c.array() > 0).cast<float>().matrix();
   const Eigen::VectorXf idf =
       (static_cast<float>(n) / document_frequency.array().max(1.0f)).log().matrix();
   histograms_.resize(num_words_, n);

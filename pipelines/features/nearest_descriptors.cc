@@ -64,8 +64,8 @@ PORTCAL_AVX2 inline __m128 HorizontalSum4(__m256 a, __m256 b, __m256 c, __m256 d
 // (not above the current second best), which after the first few columns
 // is almost every time.
 template <int R, int C>
-PORTCAL_AVX2 inline void Tile(const float* a, const float* b, int row0, int col0, NearestDescriptors* nearest1,
-                              NearestDescriptors* nearest2) {
+PORTCAL_AVX2 inline void Tile(const float* a, const float* b, int row0, int col0,
+                              NearestDescriptors* nearest1, NearestDescriptors* nearest2) {
   __m256 acc[R][C];
   for (int r = 0; r < R; ++r) {
     for (int c = 0; c < C; ++c) acc[r][c] = _mm256_setzero_ps();
@@ -107,22 +107,32 @@ template <int R>
 PORTCAL_AVX2 inline void EdgeTile(int cols, const float* a, const float* b, int row0, int col0,
                                   NearestDescriptors* nearest1, NearestDescriptors* nearest2) {
   switch (cols) {
-    case 1: Tile<R, 1>(a, b, row0, col0, nearest1, nearest2); break;
-    case 2: Tile<R, 2>(a, b, row0, col0, nearest1, nearest2); break;
-    case 3: Tile<R, 3>(a, b, row0, col0, nearest1, nearest2); break;
-    default: Tile<R, 4>(a, b, row0, col0, nearest1, nearest2); break;
+    case 1:
+      Tile<R, 1>(a, b, row0, col0, nearest1, nearest2);
+      break;
+    case 2:
+      Tile<R, 2>(a, b, row0, col0, nearest1, nearest2);
+      break;
+    case 3:
+      Tile<R, 3>(a, b, row0, col0, nearest1, nearest2);
+      break;
+    default:
+      Tile<R, 4>(a, b, row0, col0, nearest1, nearest2);
+      break;
   }
 }
 
 template <int R>
 PORTCAL_AVX2 void RowsAgainstChunk(const float* a, int row0, const float* b, Eigen::Index col_begin,
-                                   Eigen::Index col_end, NearestDescriptors* nearest1, NearestDescriptors* nearest2) {
+                                   Eigen::Index col_end, NearestDescriptors* nearest1,
+                                   NearestDescriptors* nearest2) {
   Eigen::Index c = col_begin;
   for (; c + kTileCols <= col_end; c += kTileCols) {
     Tile<R, kTileCols>(a, b + c * kDims, row0, static_cast<int>(c), nearest1, nearest2);
   }
   if (c < col_end) {
-    EdgeTile<R>(static_cast<int>(col_end - c), a, b + c * kDims, row0, static_cast<int>(c), nearest1, nearest2);
+    EdgeTile<R>(static_cast<int>(col_end - c), a, b + c * kDims, row0, static_cast<int>(c),
+                nearest1, nearest2);
   }
 }
 
@@ -132,10 +142,15 @@ PORTCAL_AVX2 void NearestAvx2(const float* a, Eigen::Index n1, const float* b, E
     const Eigen::Index col_end = std::min(n2, col_begin + kChunkCols);
     Eigen::Index r = 0;
     for (; r + kTileRows <= n1; r += kTileRows) {
-      RowsAgainstChunk<kTileRows>(a + r * kDims, static_cast<int>(r), b, col_begin, col_end, nearest1, nearest2);
+      RowsAgainstChunk<kTileRows>(a + r * kDims, static_cast<int>(r), b, col_begin, col_end,
+                                  nearest1, nearest2);
     }
-    if (n1 - r == 2) RowsAgainstChunk<2>(a + r * kDims, static_cast<int>(r), b, col_begin, col_end, nearest1, nearest2);
-    if (n1 - r == 1) RowsAgainstChunk<1>(a + r * kDims, static_cast<int>(r), b, col_begin, col_end, nearest1, nearest2);
+    if (n1 - r == 2)
+      RowsAgainstChunk<2>(a + r * kDims, static_cast<int>(r), b, col_begin, col_end, nearest1,
+                          nearest2);
+    if (n1 - r == 1)
+      RowsAgainstChunk<1>(a + r * kDims, static_cast<int>(r), b, col_begin, col_end, nearest1,
+                          nearest2);
   }
 }
 
@@ -148,7 +163,8 @@ bool CpuHasAvx2() {
 
 }  // namespace
 
-void FindNearestDescriptorsPortable(const UnitDescriptorRows& descriptors1, const UnitDescriptorRows& descriptors2,
+void FindNearestDescriptorsPortable(const UnitDescriptorRows& descriptors1,
+                                    const UnitDescriptorRows& descriptors2,
                                     std::vector<NearestDescriptors>* nearest1,
                                     std::vector<NearestDescriptors>* nearest2) {
   const Eigen::Index n1 = descriptors1.rows(), n2 = descriptors2.rows();
@@ -171,21 +187,25 @@ void FindNearestDescriptorsPortable(const UnitDescriptorRows& descriptors1, cons
   }
 }
 
-bool FindNearestDescriptorsAvx2(const UnitDescriptorRows& descriptors1, const UnitDescriptorRows& descriptors2,
-                                std::vector<NearestDescriptors>* nearest1, std::vector<NearestDescriptors>* nearest2) {
+bool FindNearestDescriptorsAvx2(const UnitDescriptorRows& descriptors1,
+                                const UnitDescriptorRows& descriptors2,
+                                std::vector<NearestDescriptors>* nearest1,
+                                std::vector<NearestDescriptors>* nearest2) {
 #ifdef PORTCAL_HAVE_AVX2_KERNEL
   if (!CpuHasAvx2()) return false;
   Reset(descriptors1.rows(), descriptors2.rows(), nearest1, nearest2);
-  NearestAvx2(descriptors1.data(), descriptors1.rows(), descriptors2.data(), descriptors2.rows(), nearest1->data(),
-              nearest2->data());
+  NearestAvx2(descriptors1.data(), descriptors1.rows(), descriptors2.data(), descriptors2.rows(),
+              nearest1->data(), nearest2->data());
   return true;
 #else
   return false;
 #endif
 }
 
-void FindNearestDescriptors(const UnitDescriptorRows& descriptors1, const UnitDescriptorRows& descriptors2,
-                            std::vector<NearestDescriptors>* nearest1, std::vector<NearestDescriptors>* nearest2) {
+void FindNearestDescriptors(const UnitDescriptorRows& descriptors1,
+                            const UnitDescriptorRows& descriptors2,
+                            std::vector<NearestDescriptors>* nearest1,
+                            std::vector<NearestDescriptors>* nearest2) {
   if (!FindNearestDescriptorsAvx2(descriptors1, descriptors2, nearest1, nearest2)) {
     FindNearestDescriptorsPortable(descriptors1, descriptors2, nearest1, nearest2);
   }

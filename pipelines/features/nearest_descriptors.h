@@ -18,9 +18,8 @@
 // (the first one wins).
 #pragma once
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 namespace portcal {
 
@@ -34,15 +33,20 @@ using UnitDescriptorRows = Eigen::Matrix<float, Eigen::Dynamic, 128, Eigen::RowM
 // nearest1[i]: the best two rows of descriptors2 for row i of descriptors1;
 // nearest2[j]: the best two rows of descriptors1 for row j of descriptors2.
 // Resizes and overwrites both. Uses the AVX2 kernel where the CPU has it.
-void FindNearestDescriptors(const UnitDescriptorRows& descriptors1, const UnitDescriptorRows& descriptors2,
-                            std::vector<NearestDescriptors>* nearest1, std::vector<NearestDescriptors>* nearest2);
+void FindNearestDescriptors(const UnitDescriptorRows& descriptors1,
+                            const UnitDescriptorRows& descriptors2,
+                            std::vector<NearestDescriptors>* nearest1,
+                            std::vector<NearestDescriptors>* nearest2);
 
 // The two implementations, for tests and benchmarks. The AVX2 one returns
 // false, touching nothing, where the CPU lacks AVX2 or FMA.
-void FindNearestDescriptorsPortable(const UnitDescriptorRows& descriptors1, const UnitDescriptorRows& descriptors2,
+void FindNearestDescriptorsPortable(const UnitDescriptorRows& descriptors1,
+                                    const UnitDescriptorRows& descriptors2,
                                     std::vector<NearestDescriptors>* nearest1,
                                     std::vector<NearestDescriptors>* nearest2);
-bool FindNearestDescriptorsAvx2(const UnitDescriptorRows& descriptors1, const UnitDescriptorRows& descriptors2,
-                                std::vector<NearestDescriptors>* nearest1, std::vector<NearestDescriptors>* nearest2);
+bool FindNearestDescriptorsAvx2(const UnitDescriptorRows& descriptors1,
+                                const UnitDescriptorRows& descriptors2,
+                                std::vector<NearestDescriptors>* nearest1,
+                                std::vector<NearestDescriptors>* nearest2);
 
 }  // namespace portcal

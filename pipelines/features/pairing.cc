@@ -13,31 +13,37 @@ namespace portcal {
 
 std::string PairingModeName(PairingMode mode) {
   switch (mode) {
-    case PairingMode::kExhaustive: return "exhaustive";
-    case PairingMode::kSequential: return "sequential";
-    case PairingMode::kSpatial: return "spatial";
+    case PairingMode::kExhaustive:
+      return "exhaustive";
+    case PairingMode::kSequential:
+      return "sequential";
+    case PairingMode::kSpatial:
+      return "spatial";
   }
   return "unknown";
 }
 
 void SequentialPairingOptions::Check() const {
-  if (overlap < 1) throw OptionError("--SequentialMatching.overlap", std::to_string(overlap), ">= 1");
+  if (overlap < 1)
+    throw OptionError("--SequentialMatching.overlap", std::to_string(overlap), ">= 1");
   if (loop_detection_period < 1) {
-    throw OptionError("--SequentialMatching.loop_detection_period", std::to_string(loop_detection_period),
-                      ">= 1");
+    throw OptionError("--SequentialMatching.loop_detection_period",
+                      std::to_string(loop_detection_period), ">= 1");
   }
   if (loop_detection_num_images < 1) {
     throw OptionError("--SequentialMatching.loop_detection_num_images",
                       std::to_string(loop_detection_num_images), ">= 1");
   }
   if (vocabulary_size < 2) {
-    throw OptionError("--SequentialMatching.vocabulary_size", std::to_string(vocabulary_size), ">= 2");
+    throw OptionError("--SequentialMatching.vocabulary_size", std::to_string(vocabulary_size),
+                      ">= 2");
   }
 }
 
 void SpatialPairingOptions::Check() const {
   if (max_num_neighbors < 1) {
-    throw OptionError("--SpatialMatching.max_num_neighbors", std::to_string(max_num_neighbors), ">= 1");
+    throw OptionError("--SpatialMatching.max_num_neighbors", std::to_string(max_num_neighbors),
+                      ">= 1");
   }
   if (!(max_distance_m > 0)) {
     throw OptionError("--SpatialMatching.max_distance", std::to_string(max_distance_m), "> 0 m");
@@ -52,7 +58,8 @@ ImagePairs ExhaustivePairs(const std::vector<image_t>& images) {
   return pairs;
 }
 
-ImagePairs SequentialPairs(const std::vector<image_t>& images, const SequentialPairingOptions& options) {
+ImagePairs SequentialPairs(const std::vector<image_t>& images,
+                           const SequentialPairingOptions& options) {
   ImagePairs pairs;
   const size_t n = images.size();
   for (size_t i = 0; i < n; ++i) {
@@ -82,14 +89,16 @@ ImagePairs SpatialPairs(const std::vector<std::pair<image_t, Eigen::Vector3d>>& 
       if (distance <= options.max_distance_m) nearest.emplace_back(distance, j);
     }
     const size_t k = std::min(nearest.size(), static_cast<size_t>(options.max_num_neighbors));
-    std::partial_sort(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(k), nearest.end());
-    for (size_t n = 0; n < k; ++n) pairs.emplace_back(positions[i].first, positions[nearest[n].second].first);
+    std::partial_sort(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(k),
+                      nearest.end());
+    for (size_t n = 0; n < k; ++n)
+      pairs.emplace_back(positions[i].first, positions[nearest[n].second].first);
   }
   return pairs;
 }
 
-ImagePairs LoopPairs(Database* database, const std::vector<image_t>& images, const SequentialPairingOptions& options,
-                     ProgressSink& progress) {
+ImagePairs LoopPairs(Database* database, const std::vector<image_t>& images,
+                     const SequentialPairingOptions& options, ProgressSink& progress) {
   // Vocabulary from the descriptors of up to 200 images spread over the
   // sequence; then each image's words, one image in memory at a time.
   const size_t stride = std::max<size_t>(1, images.size() / 200);
@@ -121,8 +130,9 @@ ImagePairs LoopPairs(Database* database, const std::vector<image_t>& images, con
 }
 
 ImagePairs CandidatePairs(const PairingChoice& choice, const std::vector<DatabaseImage>& images,
-                          const std::vector<image_t>& ids, const std::string& database_path, const std::string& stage,
-                          Database* database, ProgressSink& progress, int64_t* num_loop_pairs) {
+                          const std::vector<image_t>& ids, const std::string& database_path,
+                          const std::string& stage, Database* database, ProgressSink& progress,
+                          int64_t* num_loop_pairs) {
   ImagePairs candidates;
   if (choice.mode == PairingMode::kExhaustive) {
     candidates = ExhaustivePairs(ids);
@@ -131,11 +141,13 @@ ImagePairs CandidatePairs(const PairingChoice& choice, const std::vector<Databas
   } else {
     std::vector<std::pair<image_t, Eigen::Vector3d>> positions;
     for (const DatabaseImage& image : images) {
-      if (const auto position = image.PriorPosition()) positions.emplace_back(image.image_id, *position);
+      if (const auto position = image.PriorPosition())
+        positions.emplace_back(image.image_id, *position);
     }
     if (positions.size() < 2) {
-      throw InputError(database_path + ": " + std::to_string(positions.size()) +
-                       " image(s) with a position prior; spatial matching needs them (run pose_prior_importer)");
+      throw InputError(
+          database_path + ": " + std::to_string(positions.size()) +
+          " image(s) with a position prior; spatial matching needs them (run pose_prior_importer)");
     }
     if (positions.size() < images.size()) {
       LOG(WARNING) << stage << ": " << images.size() - positions.size()

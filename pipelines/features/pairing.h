@@ -48,7 +48,8 @@ using ImagePairs = std::vector<std::pair<image_t, image_t>>;
 
 // Candidate pairs (image_id1, image_id2) for images sorted by name.
 ImagePairs ExhaustivePairs(const std::vector<image_t>& images);
-ImagePairs SequentialPairs(const std::vector<image_t>& images, const SequentialPairingOptions& options);
+ImagePairs SequentialPairs(const std::vector<image_t>& images,
+                           const SequentialPairingOptions& options);
 
 // Images without a position have no spatial pairs.
 ImagePairs SpatialPairs(const std::vector<std::pair<image_t, Eigen::Vector3d>>& positions,
@@ -57,8 +58,8 @@ ImagePairs SpatialPairs(const std::vector<std::pair<image_t, Eigen::Vector3d>>& 
 // Pairs between every `loop_detection_period`-th image and its most similar
 // images outside the sequential window (a vocabulary trained on this
 // database's descriptors).
-ImagePairs LoopPairs(Database* database, const std::vector<image_t>& images, const SequentialPairingOptions& options,
-                     ProgressSink& progress);
+ImagePairs LoopPairs(Database* database, const std::vector<image_t>& images,
+                     const SequentialPairingOptions& options, ProgressSink& progress);
 
 // The candidate pairs of `mode` over `images` (`ids` their ids in name
 // order), and, sequential with loop detection, the loop candidates (their
@@ -70,7 +71,8 @@ struct PairingChoice {
   const SpatialPairingOptions& spatial;
 };
 ImagePairs CandidatePairs(const PairingChoice& choice, const std::vector<DatabaseImage>& images,
-                          const std::vector<image_t>& ids, const std::string& database_path, const std::string& stage,
-                          Database* database, ProgressSink& progress, int64_t* num_loop_pairs);
+                          const std::vector<image_t>& ids, const std::string& database_path,
+                          const std::string& stage, Database* database, ProgressSink& progress,
+                          int64_t* num_loop_pairs);
 
 }  // namespace portcal

@@ -26,14 +26,15 @@ struct SampsonError {
     const Eigen::Quaternion<T> rotation(q[3], q[0], q[1], q[2]);
     const Eigen::Matrix<T, 3, 1> translation(t[0], t[1], t[2]);
     Eigen::Matrix<T, 3, 3> cross;
-    cross << T(0), -translation.z(), translation.y(), translation.z(), T(0), -translation.x(), -translation.y(),
-        translation.x(), T(0);
+    cross << T(0), -translation.z(), translation.y(), translation.z(), T(0), -translation.x(),
+        -translation.y(), translation.x(), T(0);
     const Eigen::Matrix<T, 3, 3> E = cross * rotation.toRotationMatrix();
     const Eigen::Matrix<T, 3, 1> p1(T(x1_.x()), T(x1_.y()), T(1));
     const Eigen::Matrix<T, 3, 1> p2(T(x2_.x()), T(x2_.y()), T(1));
     const Eigen::Matrix<T, 3, 1> e_p1 = E * p1;
     const Eigen::Matrix<T, 3, 1> et_p2 = E.transpose() * p2;
-    const T denominator = e_p1.x() * e_p1.x() + e_p1.y() * e_p1.y() + et_p2.x() * et_p2.x() + et_p2.y() * et_p2.y();
+    const T denominator =
+        e_p1.x() * e_p1.x() + e_p1.y() * e_p1.y() + et_p2.x() * et_p2.x() + et_p2.y() * et_p2.y();
     // A match on the epipoles' line through both centres has no epipolar
     // distance to measure: fail rather than divide by zero.
     if (!(denominator > T(0))) return false;
@@ -48,9 +49,10 @@ struct SampsonError {
 }  // namespace
 
 std::optional<Rigid3d> RefineRelativePose(const std::vector<Eigen::Vector2d>& points1,
-                                          const std::vector<Eigen::Vector2d>& points2, const Rigid3d& cam2_from_cam1,
-                                          double loss_scale) {
-  if (points1.size() != points2.size() || points1.size() < 5 || !(loss_scale >= 0)) return std::nullopt;
+                                          const std::vector<Eigen::Vector2d>& points2,
+                                          const Rigid3d& cam2_from_cam1, double loss_scale) {
+  if (points1.size() != points2.size() || points1.size() < 5 || !(loss_scale >= 0))
+    return std::nullopt;
   const double norm = cam2_from_cam1.translation.norm();
   if (!(norm > 0) || !std::isfinite(norm)) return std::nullopt;
   const Eigen::Quaterniond start = cam2_from_cam1.rotation.normalized();
@@ -60,11 +62,12 @@ std::optional<Rigid3d> RefineRelativePose(const std::vector<Eigen::Vector2d>& po
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
-  const std::unique_ptr<ceres::LossFunction> loss(loss_scale > 0 ? new ceres::CauchyLoss(loss_scale) : nullptr);
+  const std::unique_ptr<ceres::LossFunction> loss(loss_scale > 0 ? new ceres::CauchyLoss(loss_scale)
+                                                                 : nullptr);
   for (size_t i = 0; i < points1.size(); ++i) {
-    problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<SampsonError, 1, 4, 3>(new SampsonError(points1[i], points2[i])), loss.get(), q,
-        t.data());
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SampsonError, 1, 4, 3>(
+                                 new SampsonError(points1[i], points2[i])),
+                             loss.get(), q, t.data());
   }
   problem.SetManifold(q, new ceres::EigenQuaternionManifold());
   problem.SetManifold(t.data(), new ceres::SphereManifold<3>());

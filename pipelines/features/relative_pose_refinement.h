@@ -25,7 +25,7 @@ namespace portcal {
 // nullopt when there are fewer than 5 matches or the solve fails (the
 // caller keeps its start).
 std::optional<Rigid3d> RefineRelativePose(const std::vector<Eigen::Vector2d>& points1,
-                                          const std::vector<Eigen::Vector2d>& points2, const Rigid3d& cam2_from_cam1,
-                                          double loss_scale);
+                                          const std::vector<Eigen::Vector2d>& points2,
+                                          const Rigid3d& cam2_from_cam1, double loss_scale);
 
 }  // namespace portcal

@@ -15,7 +15,8 @@ constexpr double kUpsamplingShift = 0.25;
 
 void SiftExtractionOptions::Check() const {
   if (max_num_features < 1) {
-    throw OptionError("--SiftExtraction.max_num_features", std::to_string(max_num_features), ">= 1");
+    throw OptionError("--SiftExtraction.max_num_features", std::to_string(max_num_features),
+                      ">= 1");
   }
   if (max_image_size < 16) {
     throw OptionError("--SiftExtraction.max_image_size", std::to_string(max_image_size), ">= 16");
@@ -24,7 +25,8 @@ void SiftExtractionOptions::Check() const {
     throw OptionError("--SiftExtraction.first_octave", std::to_string(first_octave), "-1 ... 4");
   }
   if (octave_resolution < 1 || octave_resolution > 10) {
-    throw OptionError("--SiftExtraction.octave_resolution", std::to_string(octave_resolution), "1 ... 10");
+    throw OptionError("--SiftExtraction.octave_resolution", std::to_string(octave_resolution),
+                      "1 ... 10");
   }
   if (!(peak_threshold > 0)) {
     throw OptionError("--SiftExtraction.peak_threshold", std::to_string(peak_threshold), "> 0");
@@ -49,7 +51,8 @@ SiftFeatures ExtractSift(const cv::Mat& gray, const SiftExtractionOptions& optio
   // One scale factor for the image: max_image_size, then first_octave.
   double scale = 1.0;  // original pixels per working pixel
   const int max_side = std::max(gray.cols, gray.rows);
-  if (max_side > options.max_image_size) scale = static_cast<double>(max_side) / options.max_image_size;
+  if (max_side > options.max_image_size)
+    scale = static_cast<double>(max_side) / options.max_image_size;
   scale *= std::pow(2.0, options.first_octave + 1);
   cv::Mat work = gray;
   if (scale != 1.0) {
@@ -63,8 +66,9 @@ SiftFeatures ExtractSift(const cv::Mat& gray, const SiftExtractionOptions& optio
   // OpenCV's contrastThreshold is divided by the number of layers and
   // halved inside; COLMAP's peak_threshold is the final threshold.
   const double contrast_threshold = 2.0 * options.peak_threshold * options.octave_resolution;
-  cv::Ptr<cv::SIFT> sift = cv::SIFT::create(options.max_num_features, options.octave_resolution,
-                                            contrast_threshold, options.edge_threshold, options.sigma);
+  cv::Ptr<cv::SIFT> sift =
+      cv::SIFT::create(options.max_num_features, options.octave_resolution, contrast_threshold,
+                       options.edge_threshold, options.sigma);
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;
   sift->detectAndCompute(work, cv::noArray(), keypoints, descriptors);
@@ -105,7 +109,8 @@ SiftFeatures ExtractSift(const cv::Mat& gray, const SiftExtractionOptions& optio
     // scale COLMAP stores; angle in degrees.
     const float feature_scale = static_cast<float>(0.5 * k.size * 0.5 * (sx + sy));
     const float orientation = static_cast<float>(k.angle * M_PI / 180.0);
-    features.keypoints.push_back(FeatureKeypoint::FromScaleOrientation(x, y, feature_scale, orientation));
+    features.keypoints.push_back(
+        FeatureKeypoint::FromScaleOrientation(x, y, feature_scale, orientation));
     QuantizeRootSift(descriptors.ptr<float>(static_cast<int>(i)),
                      features.descriptors.data() + 128 * static_cast<Eigen::Index>(i));
   }

@@ -11,7 +11,8 @@
 namespace portcal {
 
 void TwoViewVerificationOptions::Check() const {
-  if (!(max_error > 0)) throw OptionError("--TwoViewGeometry.max_error", std::to_string(max_error), "> 0 px");
+  if (!(max_error > 0))
+    throw OptionError("--TwoViewGeometry.max_error", std::to_string(max_error), "> 0 px");
   if (!(confidence > 0 && confidence < 1)) {
     throw OptionError("--TwoViewGeometry.confidence", std::to_string(confidence), "in (0, 1)");
   }
@@ -23,7 +24,8 @@ void TwoViewVerificationOptions::Check() const {
     throw OptionError("--TwoViewGeometry.min_num_inliers", std::to_string(min_num_inliers), ">= 8");
   }
   if (!(min_inlier_ratio >= 0 && min_inlier_ratio <= 1)) {
-    throw OptionError("--TwoViewGeometry.min_inlier_ratio", std::to_string(min_inlier_ratio), "in [0, 1]");
+    throw OptionError("--TwoViewGeometry.min_inlier_ratio", std::to_string(min_inlier_ratio),
+                      "in [0, 1]");
   }
 }
 
@@ -34,7 +36,8 @@ FeatureMatches Inliers(const FeatureMatches& matches, const std::vector<int>& in
   FeatureMatches inliers;
   if (mask.empty()) return inliers;
   for (size_t k = 0; k < indices.size(); ++k) {
-    if (mask.at<uchar>(static_cast<int>(k))) inliers.push_back(matches[static_cast<size_t>(indices[k])]);
+    if (mask.at<uchar>(static_cast<int>(k)))
+      inliers.push_back(matches[static_cast<size_t>(indices[k])]);
   }
   return inliers;
 }
@@ -47,8 +50,9 @@ struct MatchedPoints {
   std::vector<int> ray_index;  // match index of each normalised pair
 };
 
-MatchedPoints PointsOfMatches(const Camera& camera1, const FeatureKeypoints& keypoints1, const Camera& camera2,
-                              const FeatureKeypoints& keypoints2, const FeatureMatches& matches) {
+MatchedPoints PointsOfMatches(const Camera& camera1, const FeatureKeypoints& keypoints1,
+                              const Camera& camera2, const FeatureKeypoints& keypoints2,
+                              const FeatureMatches& matches) {
   MatchedPoints out;
   for (size_t m = 0; m < matches.size(); ++m) {
     const FeatureKeypoint& k1 = keypoints1.at(matches[m].point2D_idx1);
@@ -67,7 +71,8 @@ MatchedPoints PointsOfMatches(const Camera& camera1, const FeatureKeypoints& key
 }
 
 // The same restricted to F's inliers (`f_mask` over all matches).
-MatchedPoints FInliersOf(const MatchedPoints& all, const cv::Mat& f_mask, std::vector<int>* f_index) {
+MatchedPoints FInliersOf(const MatchedPoints& all, const cv::Mat& f_mask,
+                         std::vector<int>* f_index) {
   MatchedPoints out;
   for (size_t k = 0; k < all.pixels1.size(); ++k) {
     if (!f_mask.at<uchar>(static_cast<int>(k))) continue;
@@ -90,8 +95,8 @@ MatchedPoints FInliersOf(const MatchedPoints& all, const cv::Mat& f_mask, std::v
 // (relative_pose_refinement.h) under a Cauchy loss of a quarter of the
 // inlier threshold (1 px at the default 4), the scale of a true match's
 // noise, not of the chance matches the threshold lets in.
-std::optional<Rigid3d> PoseFromEssential(const cv::Mat& E, const MatchedPoints& e_points, const cv::Mat& e_mask,
-                                         double threshold) {
+std::optional<Rigid3d> PoseFromEssential(const cv::Mat& E, const MatchedPoints& e_points,
+                                         const cv::Mat& e_mask, double threshold) {
   std::vector<cv::Point2d> in1, in2;
   std::vector<Eigen::Vector2d> points1, points2;
   for (size_t k = 0; k < e_points.ray_index.size(); ++k) {
@@ -132,15 +137,16 @@ TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& key
   // iterations where the 5-point solver on the raw matches would need
   // thousands.
   cv::Mat f_mask, e_mask, h_mask;
-  const cv::Mat F = cv::findFundamentalMat(points.pixels1, points.pixels2, cv::USAC_DEFAULT, options.max_error,
-                                           options.confidence, options.max_num_trials, f_mask);
+  const cv::Mat F =
+      cv::findFundamentalMat(points.pixels1, points.pixels2, cv::USAC_DEFAULT, options.max_error,
+                             options.confidence, options.max_num_trials, f_mask);
   const FeatureMatches f_inliers = F.rows == 3 ? Inliers(matches, all, f_mask) : FeatureMatches();
   // E's inliers are a subset of F's, so with fewer than the minimum here
   // neither model can pass COLMAP's rules below: the pair is degenerate
   // whatever E and H say, and their RANSAC (up to max_num_trials each on a
   // pair of unrelated images) is skipped.
-  const double min_inliers = std::max<double>(options.min_num_inliers,
-                                              options.min_inlier_ratio * matches.size());
+  const double min_inliers =
+      std::max<double>(options.min_num_inliers, options.min_inlier_ratio * matches.size());
   if (static_cast<double>(f_inliers.size()) < min_inliers) {
     if (F.rows == 3) cv::cv2eigen(F, geometry.F);
     return geometry;
@@ -152,13 +158,17 @@ TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& key
   if (static_cast<int>(f_points.rays1.size()) >= options.min_num_inliers) {
     cv::theRNG() = cv::RNG(GeneratorState(options.random_seed));
     E = cv::findEssentialMat(f_points.rays1, f_points.rays2, cv::Mat::eye(3, 3, CV_64F), cv::RANSAC,
-                             options.confidence, options.max_error / focal, options.max_num_trials, e_mask);
+                             options.confidence, options.max_error / focal, options.max_num_trials,
+                             e_mask);
   }
   cv::theRNG() = cv::RNG(GeneratorState(options.random_seed));
-  const cv::Mat H = cv::findHomography(f_points.pixels1, f_points.pixels2, cv::RANSAC, options.max_error, h_mask,
-                                       options.max_num_trials, options.confidence);
-  const FeatureMatches e_inliers = E.rows == 3 ? Inliers(matches, f_points.ray_index, e_mask) : FeatureMatches();
-  const FeatureMatches h_inliers = H.rows == 3 ? Inliers(matches, f_index, h_mask) : FeatureMatches();
+  const cv::Mat H =
+      cv::findHomography(f_points.pixels1, f_points.pixels2, cv::RANSAC, options.max_error, h_mask,
+                         options.max_num_trials, options.confidence);
+  const FeatureMatches e_inliers =
+      E.rows == 3 ? Inliers(matches, f_points.ray_index, e_mask) : FeatureMatches();
+  const FeatureMatches h_inliers =
+      H.rows == 3 ? Inliers(matches, f_index, h_mask) : FeatureMatches();
   const double nf = static_cast<double>(f_inliers.size());
   const double ne = static_cast<double>(e_inliers.size());
   const double nh = static_cast<double>(h_inliers.size());
@@ -167,13 +177,16 @@ TwoViewGeometry VerifyTwoView(const Camera& camera1, const FeatureKeypoints& key
   if (E.rows == 3) cv::cv2eigen(E, geometry.E);
   if (H.rows == 3) cv::cv2eigen(H, geometry.H);
   if (ne >= min_inliers && nf > 0 && ne / nf >= options.min_E_F_inlier_ratio) {
-    geometry.config = nh / ne > options.max_H_inlier_ratio ? TwoViewGeometryConfig::kPlanarOrPanoramic
-                                                           : TwoViewGeometryConfig::kCalibrated;
+    geometry.config = nh / ne > options.max_H_inlier_ratio
+                          ? TwoViewGeometryConfig::kPlanarOrPanoramic
+                          : TwoViewGeometryConfig::kCalibrated;
     geometry.inlier_matches = e_inliers;
-    if (const auto pose = PoseFromEssential(E, f_points, e_mask, options.max_error / focal)) geometry.cam2_from_cam1 = *pose;
+    if (const auto pose = PoseFromEssential(E, f_points, e_mask, options.max_error / focal))
+      geometry.cam2_from_cam1 = *pose;
   } else if (nf >= min_inliers) {
-    geometry.config = nh / nf > options.max_H_inlier_ratio ? TwoViewGeometryConfig::kPlanarOrPanoramic
-                                                           : TwoViewGeometryConfig::kUncalibrated;
+    geometry.config = nh / nf > options.max_H_inlier_ratio
+                          ? TwoViewGeometryConfig::kPlanarOrPanoramic
+                          : TwoViewGeometryConfig::kUncalibrated;
     geometry.inlier_matches = f_inliers;
     geometry.E.setZero();
   }

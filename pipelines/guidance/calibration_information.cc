@@ -67,7 +67,8 @@ CalibrationInformation& CalibrationInformation::operator+=(const CalibrationInfo
   return *this;
 }
 
-CalibrationInformation CalibrationInformation::operator+(const CalibrationInformation& other) const {
+CalibrationInformation CalibrationInformation::operator+(
+    const CalibrationInformation& other) const {
   CalibrationInformation sum = *this;
   sum += other;
   return sum;
@@ -81,9 +82,11 @@ Eigen::MatrixXd CalibrationInformation::MeanFrameGain(const Eigen::Vector3d& p) 
 Eigen::Matrix3d CalibrationInformation::MeanFrameNoise(const Eigen::Vector3d& p) const {
   if (num_views == 0) return Eigen::Matrix3d::Zero();
   const Eigen::Matrix3d a = -2 * Cross(p);
-  const Eigen::Matrix3d rotation_part = a * p_rr * a.transpose() + a * p_rr_t + (a * p_rr_t).transpose() + t_p_rr_t;
+  const Eigen::Matrix3d rotation_part =
+      a * p_rr * a.transpose() + a * p_rr_t + (a * p_rr_t).transpose() + t_p_rr_t;
   const Eigen::Matrix3d cross_part = a * p_rt + t_p_rt;
-  return (rotation_part + cross_part + cross_part.transpose() + p_tt) / (static_cast<double>(num_views) * num_views);
+  return (rotation_part + cross_part + cross_part.transpose() + p_tt) /
+         (static_cast<double>(num_views) * num_views);
 }
 
 }  // namespace portcal

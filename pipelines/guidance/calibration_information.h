@@ -30,14 +30,14 @@ struct CalibrationInformation {
   int num_views = 0;  // views whose pose the points fix
   // Sums over views; K = B^-1 C^T split into its rotation (r) and
   // translation (t) rows, T_i = 2 [t_i]x, P = B^-1 in 3x3 blocks.
-  Eigen::MatrixXd k_rotation;     // 3 x p: sum K_r
-  Eigen::MatrixXd k_offset;       // 3 x p: sum (T_i K_r + K_t)
-  Eigen::Matrix3d p_rr = Eigen::Matrix3d::Zero();    // sum P_rr
-  Eigen::Matrix3d p_rr_t = Eigen::Matrix3d::Zero();  // sum P_rr T_i^T
+  Eigen::MatrixXd k_rotation;                          // 3 x p: sum K_r
+  Eigen::MatrixXd k_offset;                            // 3 x p: sum (T_i K_r + K_t)
+  Eigen::Matrix3d p_rr = Eigen::Matrix3d::Zero();      // sum P_rr
+  Eigen::Matrix3d p_rr_t = Eigen::Matrix3d::Zero();    // sum P_rr T_i^T
   Eigen::Matrix3d t_p_rr_t = Eigen::Matrix3d::Zero();  // sum T_i P_rr T_i^T
-  Eigen::Matrix3d p_rt = Eigen::Matrix3d::Zero();    // sum P_rt
-  Eigen::Matrix3d t_p_rt = Eigen::Matrix3d::Zero();  // sum T_i P_rt
-  Eigen::Matrix3d p_tt = Eigen::Matrix3d::Zero();    // sum P_tt
+  Eigen::Matrix3d p_rt = Eigen::Matrix3d::Zero();      // sum P_rt
+  Eigen::Matrix3d t_p_rt = Eigen::Matrix3d::Zero();    // sum T_i P_rt
+  Eigen::Matrix3d p_tt = Eigen::Matrix3d::Zero();      // sum P_tt
 
   // No views, `num_unknowns` unknowns.
   static CalibrationInformation Zero(int num_unknowns);
@@ -45,8 +45,10 @@ struct CalibrationInformation {
   // unknowns-unknowns (p x p) and unknowns-pose (p x 6) information blocks
   // and its target-to-camera translation. An empty result (no views) when
   // the pose block is singular: the points do not fix the pose.
-  static CalibrationInformation OfView(const Eigen::MatrixXd& pose_pose, const Eigen::MatrixXd& unknowns_unknowns,
-                                       const Eigen::MatrixXd& unknowns_pose, const Eigen::Vector3d& translation);
+  static CalibrationInformation OfView(const Eigen::MatrixXd& pose_pose,
+                                       const Eigen::MatrixXd& unknowns_unknowns,
+                                       const Eigen::MatrixXd& unknowns_pose,
+                                       const Eigen::Vector3d& translation);
 
   int NumUnknowns() const { return static_cast<int>(reduced.rows()); }
   CalibrationInformation& operator+=(const CalibrationInformation& other);

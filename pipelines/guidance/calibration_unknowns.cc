@@ -18,7 +18,8 @@ namespace portcal {
 
 void CalibrationUnknowns::Check() const {
   if (housing_calibration && !camera.housing) {
-    throw InputError("next-pose guidance: a housing calibration needs the housing's model and constants");
+    throw InputError(
+        "next-pose guidance: a housing calibration needs the housing's model and constants");
   }
   if (camera.housing && board_warp) {
     throw InputError("next-pose guidance: behind a housing the board is held flat (no board warp)");
@@ -26,8 +27,8 @@ void CalibrationUnknowns::Check() const {
   camera.camera.Validate("next-pose guidance: camera");
   for (int index : fixed_intrinsics) {
     if (index < 0 || index >= static_cast<int>(camera.camera.params.size())) {
-      throw InputError("next-pose guidance: held intrinsic " + std::to_string(index) + " is not a parameter of " +
-                       camera.camera.ModelName());
+      throw InputError("next-pose guidance: held intrinsic " + std::to_string(index) +
+                       " is not a parameter of " + camera.camera.ModelName());
     }
   }
 }
@@ -48,9 +49,12 @@ namespace {
 class PointProblem {
  public:
   PointProblem(const CalibrationUnknowns& unknowns, const Rigid3d& cam_from_target)
-      : unknowns_(unknowns), pose_(ToPose(cam_from_target)), intrinsics_(unknowns.camera.camera.params) {
+      : unknowns_(unknowns),
+        pose_(ToPose(cam_from_target)),
+        intrinsics_(unknowns.camera.camera.params) {
     if (unknowns.camera.housing) housing_ = unknowns.camera.housing->params;
-    if (unknowns.board_warp) warp_ = {unknowns.board_warp->value.x(), unknowns.board_warp->value.y()};
+    if (unknowns.board_warp)
+      warp_ = {unknowns.board_warp->value.x(), unknowns.board_warp->value.y()};
   }
 
   // Adds the points that project; returns their indices. Target points
@@ -68,14 +72,16 @@ class PointProblem {
           const Eigen::Vector2d uv = on_board && unknowns_.board_warp
                                          ? BoardWarpUv(points[i], unknowns_.board_warp->extent)
                                          : Eigen::Vector2d(1, 1);
-          problem_.AddResidualBlock(BoardReprojectionError<CameraModel>::Create(points[i], uv, Eigen::Vector2d::Zero()),
-                                    nullptr, pose_.data(), intrinsics_.data(), warp_.data());
+          problem_.AddResidualBlock(
+              BoardReprojectionError<CameraModel>::Create(points[i], uv, Eigen::Vector2d::Zero()),
+              nullptr, pose_.data(), intrinsics_.data(), warp_.data());
           continue;
         }
         VisitHousingModel(unknowns_.camera.housing->model_id, [&](auto port_tag) {
-          using Functor = BoardThroughPortError<CameraModel, decltype(port_tag), PortErrorKind::kReprojection>;
-          problem_.AddResidualBlock(Functor::Create(points[i], Eigen::Vector2d::Zero()), nullptr, pose_.data(),
-                                    intrinsics_.data(), housing_.data());
+          using Functor =
+              BoardThroughPortError<CameraModel, decltype(port_tag), PortErrorKind::kReprojection>;
+          problem_.AddResidualBlock(Functor::Create(points[i], Eigen::Vector2d::Zero()), nullptr,
+                                    pose_.data(), intrinsics_.data(), housing_.data());
         });
       }
     });
@@ -116,7 +122,8 @@ class PointProblem {
     const int n = static_cast<int>(intrinsics_.size());
     if (static_cast<int>(unknowns_.fixed_intrinsics.size()) >= n) return nullptr;
     if (!unknowns_.fixed_intrinsics.empty()) {
-      problem_.SetManifold(intrinsics_.data(), new ceres::SubsetManifold(n, unknowns_.fixed_intrinsics));
+      problem_.SetManifold(intrinsics_.data(),
+                           new ceres::SubsetManifold(n, unknowns_.fixed_intrinsics));
     }
     return intrinsics_.data();
   }
@@ -142,9 +149,9 @@ CalibrationInformation ViewInformation(const CalibrationUnknowns& unknowns,
   PORTCAL_CHECK(jacobian.cols() == 6 + p);
   const Eigen::MatrixXd pose_columns = jacobian.leftCols(6);
   const Eigen::MatrixXd unknown_columns = jacobian.rightCols(p);
-  return CalibrationInformation::OfView(pose_columns.transpose() * pose_columns,
-                                        unknown_columns.transpose() * unknown_columns,
-                                        unknown_columns.transpose() * pose_columns, cam_from_target.translation);
+  return CalibrationInformation::OfView(
+      pose_columns.transpose() * pose_columns, unknown_columns.transpose() * unknown_columns,
+      unknown_columns.transpose() * pose_columns, cam_from_target.translation);
 }
 
 ProjectionJacobians ProjectionJacobian(const CalibrationUnknowns& unknowns,

@@ -27,9 +27,10 @@ std::string LiveEstimate::Summary() const {
   out << "camera 1, " << CameraSummary() << "\ncamera 2, " << camera2->CameraSummary() << "\nrig: ";
   if (rig && rig->solved) {
     const double sigma = rig->translation_std_dev.norm();
-    out << std::setprecision(4) << "baseline " << 1000 * rig->cam2_from_cam1.translation.norm() << " mm ± "
-        << std::setprecision(2) << 1000 * sigma << " mm, rotation σ " << rig->rotation_std_dev_deg.maxCoeff()
-        << " deg, RMS " << std::setprecision(3) << rig->rms_px << " px";
+    out << std::setprecision(4) << "baseline " << 1000 * rig->cam2_from_cam1.translation.norm()
+        << " mm ± " << std::setprecision(2) << 1000 * sigma << " mm, rotation σ "
+        << rig->rotation_std_dev_deg.maxCoeff() << " deg, RMS " << std::setprecision(3)
+        << rig->rms_px << " px";
   } else {
     out << (rig ? rig->status : std::string("not estimated"));
   }
@@ -66,7 +67,8 @@ std::string LiveEstimate::CameraSummary() const {
 LiveEstimator::LiveEstimator(const LiveEstimatorOptions& options, const TargetShape& target)
     : options_(options), target_(target) {
   options.Check();
-  if (!options.HousingCalibration()) fixed_indices_ = FixedParamIndices(options.camera, options.fixed_params);
+  if (!options.HousingCalibration())
+    fixed_indices_ = FixedParamIndices(options.camera, options.fixed_params);
 }
 
 CalibrationUnknowns LiveEstimator::Unknowns(const HousedCamera& camera) const {
@@ -89,7 +91,8 @@ void TakeSolve(const Result& result, const std::string& names, const std::vector
   estimate->std_devs = std_devs;
   estimate->rms_px = result.overall_rms_px;
   estimate->pixel_sigma_px = result.residual_sigma_px;
-  for (const CalibratedView& view : result.views) estimate->view_poses.push_back(view.cam_from_target);
+  for (const CalibratedView& view : result.views)
+    estimate->view_poses.push_back(view.cam_from_target);
 }
 
 }  // namespace
@@ -97,7 +100,8 @@ void TakeSolve(const Result& result, const std::string& names, const std::vector
 void LiveEstimator::Solve(const std::vector<CalibrationView>& views, LiveEstimate* estimate) const {
   const int needed = options_.MinViews() - static_cast<int>(views.size());
   if (needed > 0) {
-    estimate->status = std::to_string(needed) + " more view" + (needed == 1 ? "" : "s") + " before the first estimate";
+    estimate->status = std::to_string(needed) + " more view" + (needed == 1 ? "" : "s") +
+                       " before the first estimate";
     return;
   }
   try {
@@ -108,16 +112,20 @@ void LiveEstimator::Solve(const std::vector<CalibrationView>& views, LiveEstimat
       const HousingCalibrationResult result =
           CalibrateHousing(views, estimate->camera.camera, *estimate->camera.housing, settings);
       estimate->camera.housing = result.housing;
-      TakeSolve(result, result.housing.ParamsInfo(), result.housing.params, result.housing_std_dev, estimate);
-      if (const auto why = result.housing.Implausibility()) estimate->status = "implausible housing: " + *why;
+      TakeSolve(result, result.housing.ParamsInfo(), result.housing.params, result.housing_std_dev,
+                estimate);
+      if (const auto why = result.housing.Implausibility())
+        estimate->status = "implausible housing: " + *why;
     } else {
       CameraCalibrationSettings settings;
       settings.fixed_params = options_.fixed_params;
       settings.estimate_board_warp = options_.estimate_board_warp;
       settings.num_threads = options_.num_threads;
-      const CameraCalibrationResult result = CalibrateCamera(views, estimate->camera.camera, settings);
+      const CameraCalibrationResult result =
+          CalibrateCamera(views, estimate->camera.camera, settings);
       estimate->camera.camera = result.camera;
-      TakeSolve(result, result.camera.ParamsInfo(), result.camera.params, result.params_std_dev, estimate);
+      TakeSolve(result, result.camera.ParamsInfo(), result.camera.params, result.params_std_dev,
+                estimate);
     }
     estimate->solved = true;
   } catch (const NumericalError& e) {
@@ -131,30 +139,34 @@ LiveEstimate LiveEstimator::EstimateCamera(const std::vector<CalibrationView>& v
                                            const LiveEstimate* previous) const {
   LiveEstimate estimate;
   estimate.num_views = static_cast<int>(views.size());
-  estimate.camera = previous && previous->solved ? previous->camera : HousedCamera{options_.camera, options_.housing};
+  estimate.camera = previous && previous->solved ? previous->camera
+                                                 : HousedCamera{options_.camera, options_.housing};
   Solve(views, &estimate);
   const CalibrationUnknowns unknowns = Unknowns(estimate.camera);
   const int p = unknowns.NumUnknowns();
   estimate.information = CalibrationInformation::Zero(p);
   if (estimate.solved && estimate.view_poses.size() == views.size()) {
     for (size_t v = 0; v < views.size(); ++v) {
-      estimate.information += ViewInformation(unknowns, views[v].points_in_target, estimate.view_poses[v]);
+      estimate.information +=
+          ViewInformation(unknowns, views[v].points_in_target, estimate.view_poses[v]);
     }
   }
   if (!estimate.solved) estimate.pixel_sigma_px = options_.prior_pixel_sigma_px;
   NextPoseOptions guidance = options_.guidance;
   guidance.uncertainty.pixel_sigma_px = std::max(0.02, estimate.pixel_sigma_px);
-  estimate.uncertainty = ProjectionUncertaintyModel(unknowns, guidance.Uncertainty()).Evaluate(estimate.information);
+  estimate.uncertainty =
+      ProjectionUncertaintyModel(unknowns, guidance.Uncertainty()).Evaluate(estimate.information);
   return estimate;
 }
 
-LiveEstimate LiveEstimator::Estimate(const std::vector<CalibrationView>& views, const LiveEstimate* previous) const {
+LiveEstimate LiveEstimator::Estimate(const std::vector<CalibrationView>& views,
+                                     const LiveEstimate* previous) const {
   LiveEstimate estimate = EstimateCamera(views, previous);
   NextPoseOptions guidance = options_.guidance;
   guidance.uncertainty.pixel_sigma_px = std::max(0.02, estimate.pixel_sigma_px);
   try {
-    estimate.next =
-        SuggestPoses(Unknowns(estimate.camera), target_, estimate.information, estimate.num_views, 1, guidance)[0];
+    estimate.next = SuggestPoses(Unknowns(estimate.camera), target_, estimate.information,
+                                 estimate.num_views, 1, guidance)[0];
   } catch (const NumericalError& e) {
     estimate.suggestion_error = e.what();
   }
@@ -163,8 +175,9 @@ LiveEstimate LiveEstimator::Estimate(const std::vector<CalibrationView>& views, 
 
 namespace {
 
-LiveRig SolveRig(const std::vector<CalibrationView>& views1, const std::vector<CalibrationView>& views2,
-                 const LiveEstimate& camera1, const LiveEstimate& camera2, int num_threads) {
+LiveRig SolveRig(const std::vector<CalibrationView>& views1,
+                 const std::vector<CalibrationView>& views2, const LiveEstimate& camera1,
+                 const LiveEstimate& camera2, int num_threads) {
   LiveRig rig;
   if (!camera1.solved || !camera2.solved) {
     rig.status = "the relative pose once both cameras are estimated";
@@ -175,7 +188,8 @@ LiveRig SolveRig(const std::vector<CalibrationView>& views1, const std::vector<C
   StereoCalibrationSettings settings;
   settings.num_threads = num_threads;
   try {
-    const StereoCalibrationResult result = CalibrateStereo(frames, camera1.camera, camera2.camera, settings);
+    const StereoCalibrationResult result =
+        CalibrateStereo(frames, camera1.camera, camera2.camera, settings);
     rig.solved = true;
     rig.cam2_from_cam1 = result.cam2_from_cam1;
     rig.rotation_std_dev_deg = result.rotation_std_dev_deg;
@@ -192,23 +206,26 @@ LiveRig SolveRig(const std::vector<CalibrationView>& views1, const std::vector<C
 }  // namespace
 
 LiveEstimate EstimateRig(const LiveEstimator& camera1, const LiveEstimator& camera2,
-                         const std::vector<CalibrationView>& views1, const std::vector<CalibrationView>& views2,
-                         const LiveEstimate* previous) {
-  if (views1.size() != views2.size()) throw std::logic_error("EstimateRig: views1 and views2 differ in number");
+                         const std::vector<CalibrationView>& views1,
+                         const std::vector<CalibrationView>& views2, const LiveEstimate* previous) {
+  if (views1.size() != views2.size())
+    throw std::logic_error("EstimateRig: views1 and views2 differ in number");
   LiveEstimate estimate = camera1.EstimateCamera(views1, previous);
-  LiveEstimate estimate2 = camera2.EstimateCamera(views2, previous ? previous->camera2.get() : nullptr);
+  LiveEstimate estimate2 =
+      camera2.EstimateCamera(views2, previous ? previous->camera2.get() : nullptr);
   estimate.rig = SolveRig(views1, views2, estimate, estimate2, camera1.num_threads());
   NextPoseOptions guidance = camera1.guidance();
-  guidance.uncertainty.pixel_sigma_px = std::max({0.02, estimate.pixel_sigma_px, estimate2.pixel_sigma_px});
+  guidance.uncertainty.pixel_sigma_px =
+      std::max({0.02, estimate.pixel_sigma_px, estimate2.pixel_sigma_px});
   try {
     if (estimate.rig->solved) {
       const RigUnknowns rig{camera1.Unknowns(estimate.camera), camera2.Unknowns(estimate2.camera),
                             estimate.rig->cam2_from_cam1};
-      estimate.next = SuggestRigPose(rig, camera1.target(), estimate.information, estimate2.information,
-                                     estimate.num_views, guidance);
+      estimate.next = SuggestRigPose(rig, camera1.target(), estimate.information,
+                                     estimate2.information, estimate.num_views, guidance);
     } else {
-      estimate.next = SuggestPoses(camera1.Unknowns(estimate.camera), camera1.target(), estimate.information,
-                                   estimate.num_views, 1, guidance)[0];
+      estimate.next = SuggestPoses(camera1.Unknowns(estimate.camera), camera1.target(),
+                                   estimate.information, estimate.num_views, 1, guidance)[0];
     }
   } catch (const NumericalError& e) {
     estimate.suggestion_error = e.what();
@@ -221,8 +238,9 @@ LiveEstimate EstimateRig(const LiveEstimator& camera1, const LiveEstimator& came
   return estimate;
 }
 
-double RigGain(const LiveEstimator& camera1, const LiveEstimator& camera2, const LiveEstimate& estimate,
-               const CalibrationView& view1, const CalibrationView& view2) {
+double RigGain(const LiveEstimator& camera1, const LiveEstimator& camera2,
+               const LiveEstimate& estimate, const CalibrationView& view1,
+               const CalibrationView& view2) {
   const double gain1 = camera1.Gain(estimate, view1);
   return estimate.camera2 ? std::max(gain1, camera2.Gain(*estimate.camera2, view2)) : gain1;
 }

@@ -51,19 +51,19 @@ struct LiveRig {
 
 struct LiveEstimate {
   int num_views = 0;
-  bool solved = false;   // a calibration of the kept views
-  std::string status;    // why not solved, or a warning about the solve
-  HousedCamera camera;   // the estimate (the start before a solve)
-  std::vector<std::string> names;    // the estimated parameters
+  bool solved = false;             // a calibration of the kept views
+  std::string status;              // why not solved, or a warning about the solve
+  HousedCamera camera;             // the estimate (the start before a solve)
+  std::vector<std::string> names;  // the estimated parameters
   std::vector<double> values;
-  std::vector<double> std_devs;      // -1 undetermined
+  std::vector<double> std_devs;  // -1 undetermined
   double rms_px = 0;
-  double pixel_sigma_px = 0;         // the residuals' (or the prior)
-  std::vector<Rigid3d> view_poses;   // cam_from_target of each kept view
+  double pixel_sigma_px = 0;           // the residuals' (or the prior)
+  std::vector<Rigid3d> view_poses;     // cam_from_target of each kept view
   CalibrationInformation information;  // the kept views', unit pixel variance
   ProjectionUncertainty uncertainty;
   std::optional<PoseSuggestion> next;
-  std::string suggestion_error;      // why there is no suggestion
+  std::string suggestion_error;  // why there is no suggestion
   // A stereo rig (this is camera 1's estimate): camera 2's, whose `next` is
   // the same suggestion as camera 2 sees it, and the relative pose.
   std::shared_ptr<const LiveEstimate> camera2;
@@ -82,9 +82,11 @@ class LiveEstimator {
   // Solves the kept views (from the previous estimate's camera), then the
   // information, the uncertainty and the next pose. Never throws for a
   // failed solve: the estimate says why.
-  LiveEstimate Estimate(const std::vector<CalibrationView>& views, const LiveEstimate* previous) const;
+  LiveEstimate Estimate(const std::vector<CalibrationView>& views,
+                        const LiveEstimate* previous) const;
   // The same without the suggestion.
-  LiveEstimate EstimateCamera(const std::vector<CalibrationView>& views, const LiveEstimate* previous) const;
+  LiveEstimate EstimateCamera(const std::vector<CalibrationView>& views,
+                              const LiveEstimate* previous) const;
 
   // How much a view would lower the expected uncertainty (relative, 0..1;
   // 1 while the unknowns are undetermined and the view adds information).
@@ -108,13 +110,14 @@ class LiveEstimator {
 // then the rig's next pose (SuggestRigPose; camera 1's opening before the
 // relative pose is known).
 LiveEstimate EstimateRig(const LiveEstimator& camera1, const LiveEstimator& camera2,
-                         const std::vector<CalibrationView>& views1, const std::vector<CalibrationView>& views2,
-                         const LiveEstimate* previous);
+                         const std::vector<CalibrationView>& views1,
+                         const std::vector<CalibrationView>& views2, const LiveEstimate* previous);
 
 // How much a kept pair would lower the worse camera's uncertainty: the
 // larger of the two cameras' gains.
-double RigGain(const LiveEstimator& camera1, const LiveEstimator& camera2, const LiveEstimate& estimate,
-               const CalibrationView& view1, const CalibrationView& view2);
+double RigGain(const LiveEstimator& camera1, const LiveEstimator& camera2,
+               const LiveEstimate& estimate, const CalibrationView& view1,
+               const CalibrationView& view2);
 
 // The target as guidance sees it: every point the detector options'
 // target has.

@@ -14,13 +14,13 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-bool InView(const CalibrationUnknowns& unknowns, const TargetShape& target, const Rigid3d& cam_from_target,
-            double margin) {
+bool InView(const CalibrationUnknowns& unknowns, const TargetShape& target,
+            const Rigid3d& cam_from_target, double margin) {
   const Camera& camera = unknowns.camera.camera;
   for (const Eigen::Vector3d& corner : target.outline) {
     const auto pixel = unknowns.camera.Project(cam_from_target * corner);
-    if (!pixel || pixel->x() < margin || pixel->y() < margin || pixel->x() > camera.width - margin ||
-        pixel->y() > camera.height - margin) {
+    if (!pixel || pixel->x() < margin || pixel->y() < margin ||
+        pixel->x() > camera.width - margin || pixel->y() > camera.height - margin) {
       return false;
     }
   }
@@ -50,16 +50,19 @@ ViewSamplingOptions SamplingOptions(const NextPoseOptions& options) {
 // tilted about the horizontal and the vertical axis by min(tilt_max, 40 deg).
 std::vector<Eigen::Quaterniond> OpeningRotations(const NextPoseOptions& options) {
   const double tilt = std::min(options.tilt_max_deg, 40.0) * kDeg;
-  return {Eigen::Quaterniond::Identity(), Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX())),
+  return {Eigen::Quaterniond::Identity(),
+          Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX())),
           Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitY()))};
 }
 
 }  // namespace
 
 void NextPoseOptions::Check() const {
-  if (!(distance_min_m > 0)) throw OptionError("--Live.distance_range", std::to_string(distance_min_m), "> 0 m");
+  if (!(distance_min_m > 0))
+    throw OptionError("--Live.distance_range", std::to_string(distance_min_m), "> 0 m");
   if (!(distance_max_m >= distance_min_m)) {
-    throw OptionError("--Live.distance_range", std::to_string(distance_max_m), ">= the minimum distance");
+    throw OptionError("--Live.distance_range", std::to_string(distance_max_m),
+                      ">= the minimum distance");
   }
   if (!(tilt_max_deg >= 0 && tilt_max_deg <= 80)) {
     throw OptionError("--Live.max_tilt_deg", std::to_string(tilt_max_deg), "[0, 80]");
@@ -67,7 +70,8 @@ void NextPoseOptions::Check() const {
   if (!(roll_max_deg >= 0 && roll_max_deg <= 180)) {
     throw OptionError("--Live.max_roll_deg", std::to_string(roll_max_deg), "[0, 180]");
   }
-  if (!(border_margin_px >= 0)) throw OptionError("--Live.margin_px", std::to_string(border_margin_px), ">= 0");
+  if (!(border_margin_px >= 0))
+    throw OptionError("--Live.margin_px", std::to_string(border_margin_px), ">= 0");
   // Each candidate is a covariance evaluation (milliseconds): 10^5 already
   // takes minutes per suggestion.
   if (num_candidates < 1 || num_candidates > 100000) {
@@ -78,7 +82,8 @@ void NextPoseOptions::Check() const {
 
 ProjectionUncertaintyOptions NextPoseOptions::Uncertainty() const {
   ProjectionUncertaintyOptions result = uncertainty;
-  if (result.working_distance_m <= 0) result.working_distance_m = 0.5 * (distance_min_m + distance_max_m);
+  if (result.working_distance_m <= 0)
+    result.working_distance_m = 0.5 * (distance_min_m + distance_max_m);
   return result;
 }
 
@@ -97,7 +102,8 @@ TargetShape TargetShape::FromPoints(const std::vector<Eigen::Vector3d>& points) 
   return shape;
 }
 
-std::vector<PoseSuggestion> OpeningPoses(const CalibrationUnknowns& unknowns, const TargetShape& target,
+std::vector<PoseSuggestion> OpeningPoses(const CalibrationUnknowns& unknowns,
+                                         const TargetShape& target,
                                          const NextPoseOptions& options) {
   const std::vector<Eigen::Quaterniond> rotations = OpeningRotations(options);
   const char* const whys[] = {"opening 1/3: facing the camera, filling the image",
@@ -109,7 +115,8 @@ std::vector<PoseSuggestion> OpeningPoses(const CalibrationUnknowns& unknowns, co
     const std::string why = whys[turn];
     const int steps = 60;
     for (int k = 0; k <= steps; ++k) {
-      const double d = options.distance_min_m + (options.distance_max_m - options.distance_min_m) * k / steps;
+      const double d =
+          options.distance_min_m + (options.distance_max_m - options.distance_min_m) * k / steps;
       const Rigid3d pose = Centred(target, rotation, d);
       if (!InView(unknowns, target, pose, options.border_margin_px)) continue;
       PoseSuggestion suggestion;
@@ -121,16 +128,18 @@ std::vector<PoseSuggestion> OpeningPoses(const CalibrationUnknowns& unknowns, co
     }
   }
   if (poses.size() < rotations.size()) {
-    throw NumericalError("next-pose guidance: the target does not fit in the image within --Live.distance_range [" +
-                         std::to_string(options.distance_min_m) + ", " + std::to_string(options.distance_max_m) +
-                         "] m; allow a larger distance");
+    throw NumericalError(
+        "next-pose guidance: the target does not fit in the image within --Live.distance_range [" +
+        std::to_string(options.distance_min_m) + ", " + std::to_string(options.distance_max_m) +
+        "] m; allow a larger distance");
   }
   return poses;
 }
 
-std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, const TargetShape& target,
-                                         const CalibrationInformation& information, int num_kept, int count,
-                                         const NextPoseOptions& options) {
+std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns,
+                                         const TargetShape& target,
+                                         const CalibrationInformation& information, int num_kept,
+                                         int count, const NextPoseOptions& options) {
   options.Check();
   unknowns.Check();
   const ProjectionUncertaintyModel model(unknowns, options.Uncertainty());
@@ -158,8 +167,9 @@ std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, co
     for (int c = 0; c < options.num_candidates; ++c) {
       Rigid3d pose;
       try {
-        pose = SampleTargetView(unknowns.camera.camera, unknowns.camera.HousingOrNull(), target.outline,
-                                target.center, -Eigen::Vector3d::UnitZ(), sampling, &rng);
+        pose = SampleTargetView(unknowns.camera.camera, unknowns.camera.HousingOrNull(),
+                                target.outline, target.center, -Eigen::Vector3d::UnitZ(), sampling,
+                                &rng);
       } catch (const NumericalError&) {
         break;  // no pose fits: handled below
       }
@@ -176,9 +186,11 @@ std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, co
       }
     }
     if (!best_information) {
-      throw NumericalError("next-pose guidance: no pose keeps the whole target in view within --Live.distance_range [" +
-                           std::to_string(options.distance_min_m) + ", " + std::to_string(options.distance_max_m) +
-                           "] m and --Live.max_tilt_deg " + std::to_string(options.tilt_max_deg));
+      throw NumericalError(
+          "next-pose guidance: no pose keeps the whole target in view within --Live.distance_range "
+          "[" +
+          std::to_string(options.distance_min_m) + ", " + std::to_string(options.distance_max_m) +
+          "] m and --Live.max_tilt_deg " + std::to_string(options.tilt_max_deg));
     }
     best.why = "most lowers the expected projection uncertainty";
     current += *best_information;
@@ -189,7 +201,8 @@ std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, co
 
 namespace {
 
-bool InBothViews(const RigUnknowns& rig, const TargetShape& target, const Rigid3d& cam1_from_target, double margin) {
+bool InBothViews(const RigUnknowns& rig, const TargetShape& target, const Rigid3d& cam1_from_target,
+                 double margin) {
   return InView(rig.camera1, target, cam1_from_target, margin) &&
          InView(rig.camera2, target, rig.cam2_from_cam1 * cam1_from_target, margin);
 }
@@ -203,7 +216,8 @@ std::optional<Rigid3d> RigOpeningPose(const RigUnknowns& rig, const TargetShape&
   const Eigen::Vector3d shift(0.5 * centre2_in_cam1.x(), 0.5 * centre2_in_cam1.y(), 0);
   const int steps = 60;
   for (int k = 0; k <= steps; ++k) {
-    const double d = options.distance_min_m + (options.distance_max_m - options.distance_min_m) * k / steps;
+    const double d =
+        options.distance_min_m + (options.distance_max_m - options.distance_min_m) * k / steps;
     Rigid3d pose = Centred(target, rotation, d);
     pose.translation += shift;
     if (InBothViews(rig, target, pose, options.border_margin_px)) return pose;
@@ -214,7 +228,8 @@ std::optional<Rigid3d> RigOpeningPose(const RigUnknowns& rig, const TargetShape&
 // The worse camera's expected uncertainty with these informations;
 // undetermined counts as infinitely uncertain, ties going to the most
 // information added.
-double RigScore(const ProjectionUncertainty& after1, const ProjectionUncertainty& after2, double added_trace) {
+double RigScore(const ProjectionUncertainty& after1, const ProjectionUncertainty& after2,
+                double added_trace) {
   if (!after1.determined || !after2.determined) return 1e12 / (1.0 + added_trace);
   return std::max(after1.mean_px, after2.mean_px);
 }
@@ -222,8 +237,9 @@ double RigScore(const ProjectionUncertainty& after1, const ProjectionUncertainty
 }  // namespace
 
 PoseSuggestion SuggestRigPose(const RigUnknowns& rig, const TargetShape& target,
-                              const CalibrationInformation& information1, const CalibrationInformation& information2,
-                              int num_kept, const NextPoseOptions& options) {
+                              const CalibrationInformation& information1,
+                              const CalibrationInformation& information2, int num_kept,
+                              const NextPoseOptions& options) {
   options.Check();
   rig.camera1.Check();
   rig.camera2.Check();
@@ -235,7 +251,8 @@ PoseSuggestion SuggestRigPose(const RigUnknowns& rig, const TargetShape& target,
   PoseSuggestion best;
   best.before = worse(model1.Evaluate(information1), model2.Evaluate(information2));
   const char* openings[] = {"opening 1/3: facing the rig, between the cameras",
-                            "opening 2/3: tilted about the horizontal axis", "opening 3/3: tilted about the vertical axis"};
+                            "opening 2/3: tilted about the horizontal axis",
+                            "opening 3/3: tilted about the vertical axis"};
   if (num_kept < 3) {
     if (const auto pose = RigOpeningPose(rig, target, num_kept, options)) {
       best.cam_from_target = *pose;
@@ -249,14 +266,16 @@ PoseSuggestion SuggestRigPose(const RigUnknowns& rig, const TargetShape& target,
   for (int c = 0; c < (best.opening ? 0 : options.num_candidates); ++c) {
     Rigid3d pose;
     try {
-      pose = SampleTargetView(rig.camera1.camera.camera, rig.camera1.camera.HousingOrNull(), target.outline,
-                              target.center, -Eigen::Vector3d::UnitZ(), sampling, &rng);
+      pose = SampleTargetView(rig.camera1.camera.camera, rig.camera1.camera.HousingOrNull(),
+                              target.outline, target.center, -Eigen::Vector3d::UnitZ(), sampling,
+                              &rng);
     } catch (const NumericalError&) {
       break;
     }
     if (!InBothViews(rig, target, pose, options.border_margin_px)) continue;
     const CalibrationInformation added1 = ViewInformation(rig.camera1, target.points, pose);
-    const CalibrationInformation added2 = ViewInformation(rig.camera2, target.points, rig.cam2_from_cam1 * pose);
+    const CalibrationInformation added2 =
+        ViewInformation(rig.camera2, target.points, rig.cam2_from_cam1 * pose);
     const ProjectionUncertainty after1 = model1.Evaluate(information1 + added1);
     const ProjectionUncertainty after2 = model2.Evaluate(information2 + added2);
     const double score = RigScore(after1, after2, added1.reduced.trace() + added2.reduced.trace());
@@ -268,15 +287,18 @@ PoseSuggestion SuggestRigPose(const RigUnknowns& rig, const TargetShape& target,
     }
   }
   if (best.why.empty()) {
-    throw NumericalError("next-pose guidance: no pose keeps the whole target in both cameras' views within "
-                         "--Live.distance_range [" + std::to_string(options.distance_min_m) + ", " +
-                         std::to_string(options.distance_max_m) + "] m and --Live.max_tilt_deg " +
-                         std::to_string(options.tilt_max_deg));
+    throw NumericalError(
+        "next-pose guidance: no pose keeps the whole target in both cameras' views within "
+        "--Live.distance_range [" +
+        std::to_string(options.distance_min_m) + ", " + std::to_string(options.distance_max_m) +
+        "] m and --Live.max_tilt_deg " + std::to_string(options.tilt_max_deg));
   }
   if (best.opening) {
-    best.after = worse(model1.Evaluate(information1 + ViewInformation(rig.camera1, target.points, best.cam_from_target)),
-                       model2.Evaluate(information2 + ViewInformation(rig.camera2, target.points,
-                                                                      rig.cam2_from_cam1 * best.cam_from_target)));
+    best.after = worse(
+        model1.Evaluate(information1 +
+                        ViewInformation(rig.camera1, target.points, best.cam_from_target)),
+        model2.Evaluate(information2 + ViewInformation(rig.camera2, target.points,
+                                                       rig.cam2_from_cam1 * best.cam_from_target)));
   }
   return best;
 }
@@ -300,7 +322,8 @@ PoseDistance DistanceToSuggestion(const CalibrationUnknowns& unknowns, const Tar
       distance.outline_px += (*a - *b).norm();
       ++count;
     }
-    distance.outline_px = count > 0 ? distance.outline_px / count : std::numeric_limits<double>::infinity();
+    distance.outline_px =
+        count > 0 ? distance.outline_px / count : std::numeric_limits<double>::infinity();
     distance.rotation_deg = cam_from_target.rotation.angularDistance(aim.rotation) / kDeg;
     distance.translation_m = (cam_from_target * target.center - aim * target.center).norm();
     if (distance.outline_px < best.outline_px) best = distance;

@@ -43,7 +43,7 @@ struct TargetShape {
 
 struct PoseSuggestion {
   Rigid3d cam_from_target;
-  std::string why;               // "opening 2/3: tilted about the horizontal axis", ...
+  std::string why;  // "opening 2/3: tilted about the horizontal axis", ...
   bool opening = false;
   ProjectionUncertainty before;  // with the kept views
   ProjectionUncertainty after;   // with the suggested view added
@@ -54,17 +54,18 @@ struct PoseSuggestion {
 // focal length and principal point need tilted views before distortion
 // repays views near the image's corners). Each at the nearest distance in
 // range that keeps the target inside the image.
-std::vector<PoseSuggestion> OpeningPoses(const CalibrationUnknowns& unknowns, const TargetShape& target,
-                                         const NextPoseOptions& options);
+std::vector<PoseSuggestion> OpeningPoses(const CalibrationUnknowns& unknowns,
+                                         const TargetShape& target, const NextPoseOptions& options);
 
 // The next `count` poses: the opening poses not yet taken (`num_kept` views
 // kept), then greedily the best candidate, each added to the information
 // before the next is chosen. `information`: the kept views' (unit pixel
 // variance). Throws NumericalError when no pose keeps
 // the target in view within the options.
-std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns, const TargetShape& target,
-                                         const CalibrationInformation& information, int num_kept, int count,
-                                         const NextPoseOptions& options);
+std::vector<PoseSuggestion> SuggestPoses(const CalibrationUnknowns& unknowns,
+                                         const TargetShape& target,
+                                         const CalibrationInformation& information, int num_kept,
+                                         int count, const NextPoseOptions& options);
 
 // A stereo rig's guidance: both cameras' unknowns and the rig's relative
 // pose (its own uncertainty is not scored: the views that fix the two
@@ -82,8 +83,9 @@ struct RigUnknowns {
 // the worse camera's. Throws NumericalError when no pose keeps the target
 // in both views within the options.
 PoseSuggestion SuggestRigPose(const RigUnknowns& rig, const TargetShape& target,
-                              const CalibrationInformation& information1, const CalibrationInformation& information2,
-                              int num_kept, const NextPoseOptions& options);
+                              const CalibrationInformation& information1,
+                              const CalibrationInformation& information2, int num_kept,
+                              const NextPoseOptions& options);
 
 // How far the target is from a suggested pose: the mean distance (px) of
 // its outline's corners in the image, the rotation (deg) between the poses

@@ -19,12 +19,13 @@ std::vector<cv::Point2f> TargetOutlinePixels(const HousedCamera& camera, const T
 
 // Draws the outline (and the points, when `with_points`) in `color` onto a
 // BGR image.
-void DrawTargetAt(const HousedCamera& camera, const TargetShape& target, const Rigid3d& cam_from_target,
-                  const cv::Scalar& color, bool with_points, cv::Mat* bgr);
+void DrawTargetAt(const HousedCamera& camera, const TargetShape& target,
+                  const Rigid3d& cam_from_target, const cv::Scalar& color, bool with_points,
+                  cv::Mat* bgr);
 
 // An image of the camera's size: the target filled at the pose, and a
 // caption.
-cv::Mat PosePreview(const HousedCamera& camera, const TargetShape& target, const Rigid3d& cam_from_target,
-                    const std::string& caption);
+cv::Mat PosePreview(const HousedCamera& camera, const TargetShape& target,
+                    const Rigid3d& cam_from_target, const std::string& caption);
 
 }  // namespace portcal

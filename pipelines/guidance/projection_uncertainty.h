@@ -53,7 +53,8 @@ Eigen::VectorXd UncertaintyGridRows(double image_height, int grid_rows);
 // information (the kept views', plus a candidate's) is scored.
 class ProjectionUncertaintyModel {
  public:
-  ProjectionUncertaintyModel(const CalibrationUnknowns& unknowns, const ProjectionUncertaintyOptions& options);
+  ProjectionUncertaintyModel(const CalibrationUnknowns& unknowns,
+                             const ProjectionUncertaintyOptions& options);
 
   // `information`: NumUnknowns() unknowns, unit pixel variance (it is
   // scaled by pixel_sigma_px^2 here).

@@ -18,7 +18,8 @@ void ImageReaderOptions::Check() const {
     throw OptionError("--ImageReader.camera_model", camera_model, "one of " + CameraModelNames());
   }
   if (!camera_params.empty()) {
-    const std::vector<double> params = ParseDoubleList(camera_params, "--ImageReader.camera_params");
+    const std::vector<double> params =
+        ParseDoubleList(camera_params, "--ImageReader.camera_params");
     const int expected = CameraModelNumParams(CameraModelNameToId(camera_model));
     if (static_cast<int>(params.size()) != expected) {
       throw OptionError("--ImageReader.camera_params", camera_params,
@@ -34,8 +35,8 @@ void ImageReaderOptions::Check() const {
 
 std::string ImageSizeProblem(int width, int height) {
   if (width >= kMinImageSide && height >= kMinImageSide) return "";
-  return std::to_string(width) + "x" + std::to_string(height) + " pixels, under " + std::to_string(kMinImageSide) +
-         " a side";
+  return std::to_string(width) + "x" + std::to_string(height) + " pixels, under " +
+         std::to_string(kMinImageSide) + " a side";
 }
 
 std::vector<std::string> ListImages(const fs::path& dir) {
@@ -44,7 +45,8 @@ std::vector<std::string> ListImages(const fs::path& dir) {
   for (const auto& entry : fs::recursive_directory_iterator(dir)) {
     if (!entry.is_regular_file()) continue;
     std::string ext = entry.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
     if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".tif" || ext == ".tiff" ||
         ext == ".bmp") {
       // Lexically: a symlinked image keeps its link's name (fs::relative would
@@ -52,7 +54,8 @@ std::vector<std::string> ListImages(const fs::path& dir) {
       std::string name = entry.path().lexically_relative(dir).generic_string();
       const std::string problem = ImageNameProblem(name);
       if (!problem.empty()) {
-        LOG(WARNING) << dir.string() << ": skipping image '" << ShownImageName(name) << "', whose name " << problem;
+        LOG(WARNING) << dir.string() << ": skipping image '" << ShownImageName(name)
+                     << "', whose name " << problem;
         continue;
       }
       names.push_back(std::move(name));
@@ -67,7 +70,8 @@ namespace {
 
 Camera NewCamera(const ImageReaderOptions& options, int width, int height) {
   Camera camera = Camera::FromModelName(
-      options.camera_model, options.default_focal_length_factor * std::max(width, height), width, height);
+      options.camera_model, options.default_focal_length_factor * std::max(width, height), width,
+      height);
   if (!options.camera_params.empty()) {
     camera.params = ParseDoubleList(options.camera_params, "--ImageReader.camera_params");
     camera.has_prior_focal_length = true;
@@ -77,10 +81,11 @@ Camera NewCamera(const ImageReaderOptions& options, int width, int height) {
 
 // How the existing image's camera differs from what the options would give
 // it in this import, or "" where it does not.
-std::string ImportDifference(const Camera& camera, const ImageReaderOptions& options, const std::string& folder,
-                             const SharedCameras& shared) {
+std::string ImportDifference(const Camera& camera, const ImageReaderOptions& options,
+                             const std::string& folder, const SharedCameras& shared) {
   if (camera.ModelName() != options.camera_model) {
-    return "its camera is " + camera.ModelName() + ", --ImageReader.camera_model asks for " + options.camera_model;
+    return "its camera is " + camera.ModelName() + ", --ImageReader.camera_model asks for " +
+           options.camera_model;
   }
   const bool sharing = options.single_camera || options.single_camera_per_folder;
   const auto it = shared.by_folder.find(folder);
@@ -90,7 +95,8 @@ std::string ImportDifference(const Camera& camera, const ImageReaderOptions& opt
   }
   if (!sharing && shared.given.count(camera.camera_id)) {
     return "it shares camera " + std::to_string(camera.camera_id) +
-           " with another image, the options ask for one camera per image (--ImageReader.single_camera 0)";
+           " with another image, the options ask for one camera per image "
+           "(--ImageReader.single_camera 0)";
   }
   return "";
 }
@@ -102,9 +108,11 @@ std::string ImportDifference(const Camera& camera, const ImageReaderOptions& opt
 std::optional<camera_t> ExistingSharedCamera(Database* database, const ImageReaderOptions& options,
                                              const std::string& folder, int width, int height) {
   for (const DatabaseImage& image : database->ReadAllImages()) {
-    if (!options.single_camera && fs::path(image.name).parent_path().generic_string() != folder) continue;
+    if (!options.single_camera && fs::path(image.name).parent_path().generic_string() != folder)
+      continue;
     const std::optional<Camera> camera = database->ReadCamera(image.camera_id);
-    if (camera && camera->ModelName() == options.camera_model && camera->width == static_cast<uint64_t>(width) &&
+    if (camera && camera->ModelName() == options.camera_model &&
+        camera->width == static_cast<uint64_t>(width) &&
         camera->height == static_cast<uint64_t>(height)) {
       return image.camera_id;
     }
@@ -114,11 +122,13 @@ std::optional<camera_t> ExistingSharedCamera(Database* database, const ImageRead
 
 // The camera a new (or re-imported) image gets: its folder's shared one, or
 // a new one.
-camera_t CameraForImport(Database* database, const ImageReaderOptions& options, const std::string& name,
-                         const std::string& folder, int width, int height, SharedCameras* shared) {
+camera_t CameraForImport(Database* database, const ImageReaderOptions& options,
+                         const std::string& name, const std::string& folder, int width, int height,
+                         SharedCameras* shared) {
   const bool sharing = options.single_camera || options.single_camera_per_folder;
   if (sharing && !shared->by_folder.count(folder) && !options.overwrite) {
-    if (const std::optional<camera_t> existing = ExistingSharedCamera(database, options, folder, width, height)) {
+    if (const std::optional<camera_t> existing =
+            ExistingSharedCamera(database, options, folder, width, height)) {
       shared->by_folder.emplace(folder, *existing);
     }
   }
@@ -141,8 +151,8 @@ camera_t CameraForImport(Database* database, const ImageReaderOptions& options, 
 
 }  // namespace
 
-image_t ImportImage(Database* database, const ImageReaderOptions& options,
-                    const std::string& name, int width, int height, SharedCameras* shared) {
+image_t ImportImage(Database* database, const ImageReaderOptions& options, const std::string& name,
+                    int width, int height, SharedCameras* shared) {
   const bool sharing = options.single_camera || options.single_camera_per_folder;
   const std::string folder =
       options.single_camera ? std::string() : fs::path(name).parent_path().generic_string();
@@ -154,7 +164,8 @@ image_t ImportImage(Database* database, const ImageReaderOptions& options,
                        " pixels, but its camera in the database is " +
                        std::to_string(camera->width) + "x" + std::to_string(camera->height));
     }
-    const std::string difference = camera ? ImportDifference(*camera, options, folder, *shared) : "";
+    const std::string difference =
+        camera ? ImportDifference(*camera, options, folder, *shared) : "";
     if (difference.empty()) {
       if (sharing) shared->by_folder.emplace(folder, existing->camera_id);
       shared->given.insert(existing->camera_id);
@@ -162,9 +173,11 @@ image_t ImportImage(Database* database, const ImageReaderOptions& options,
     }
     if (!options.overwrite) {
       throw InputError(name + ": imported before, and " + difference +
-                       "; rerun with --ImageReader.overwrite 1 to import its camera again, or use a new database");
+                       "; rerun with --ImageReader.overwrite 1 to import its camera again, or use "
+                       "a new database");
     }
-    const camera_t camera_id = CameraForImport(database, options, name, folder, width, height, shared);
+    const camera_t camera_id =
+        CameraForImport(database, options, name, folder, width, height, shared);
     database->UpdateImageCamera(existing->image_id, camera_id);
     database->DeleteCameraIfUnused(existing->camera_id);
     shared->given.insert(camera_id);

@@ -52,7 +52,7 @@ struct SharedCameras {
 // not match its shared or existing camera, and, without options.overwrite,
 // when the image is in the database with a camera other than the options
 // would give it (another model, or shared otherwise).
-image_t ImportImage(Database* database, const ImageReaderOptions& options,
-                    const std::string& name, int width, int height, SharedCameras* shared);
+image_t ImportImage(Database* database, const ImageReaderOptions& options, const std::string& name,
+                    int width, int height, SharedCameras* shared);
 
 }  // namespace portcal

@@ -10,8 +10,9 @@ FramePairSource::FramePairSource(const FrameSourceOptions& first, const FrameSou
                                  double tolerance_s)
     : first_(std::make_unique<FrameSource>(first)), second_(std::make_unique<FrameSource>(second)) {
   if (first_->live() != second_->live()) {
-    throw InputError("--source2 " + second.source + ": " + (second_->live() ? "a live source" : "a recording") +
-                     ", but --source " + first.source + " is " + (first_->live() ? "live" : "a recording") +
+    throw InputError("--source2 " + second.source + ": " +
+                     (second_->live() ? "a live source" : "a recording") + ", but --source " +
+                     first.source + " is " + (first_->live() ? "live" : "a recording") +
                      "; a stereo pair needs two of the same kind (their times must compare)");
   }
   tolerance_s_ = tolerance_s > 0 ? tolerance_s : 0.5 / std::min(first_->fps(), second_->fps());

@@ -23,7 +23,8 @@ class FramePairSource {
   // `tolerance_s` <= 0: half the frame interval of the slower source.
   // Throws InputError naming the source that cannot be opened, or when one
   // source is live and the other recorded (their clocks do not compare).
-  FramePairSource(const FrameSourceOptions& first, const FrameSourceOptions& second, double tolerance_s);
+  FramePairSource(const FrameSourceOptions& first, const FrameSourceOptions& second,
+                  double tolerance_s);
 
   // kEnd when either source ends, kStalled when either stalls.
   FrameStatus Next(FramePair* pair);

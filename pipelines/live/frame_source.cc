@@ -27,9 +27,11 @@ bool AllDigits(const std::string& text) {
 }  // namespace
 
 void FrameSourceOptions::Check() const {
-  if (source.empty()) throw OptionError("--source", "''", "a device, video file, folder, URL or GStreamer pipeline");
+  if (source.empty())
+    throw OptionError("--source", "''", "a device, video file, folder, URL or GStreamer pipeline");
   if (!(folder_fps > 0)) throw OptionError("--Live.fps", std::to_string(folder_fps), "> 0");
-  if (!(stall_seconds > 0)) throw OptionError("--Live.stall_seconds", std::to_string(stall_seconds), "> 0 s");
+  if (!(stall_seconds > 0))
+    throw OptionError("--Live.stall_seconds", std::to_string(stall_seconds), "> 0 s");
 }
 
 SourceKind ClassifySource(const std::string& source) {
@@ -68,7 +70,9 @@ FrameSource::FrameSource(const FrameSourceOptions& options) : options_(options) 
     return;
   }
   if (kind_ == SourceKind::kDevice && !AllDigits(source) && !fs::exists(source, error)) {
-    throw InputError(source + ": no such video device (is the camera plugged in? `v4l2-ctl --list-devices` lists them)");
+    throw InputError(
+        source +
+        ": no such video device (is the camera plugged in? `v4l2-ctl --list-devices` lists them)");
   }
   if (kind_ == SourceKind::kFile && !fs::exists(source, error)) {
     throw InputError(source + ": no such file, folder or device");
@@ -77,7 +81,8 @@ FrameSource::FrameSource(const FrameSourceOptions& options) : options_(options) 
   if (kind_ == SourceKind::kDevice) {
     if (AllDigits(source)) {
       // /dev/video0 .. /dev/video9999: a longer number is no device index.
-      if (source.size() > 4) throw InputError(source + ": no such video device index (0 to 9999, /dev/videoN)");
+      if (source.size() > 4)
+        throw InputError(source + ": no such video device index (0 to 9999, /dev/videoN)");
       capture->open(std::stoi(source), cv::CAP_V4L2);
     } else {
       capture->open(source, cv::CAP_V4L2);
@@ -86,16 +91,19 @@ FrameSource::FrameSource(const FrameSourceOptions& options) : options_(options) 
     capture->open(source, cv::CAP_GSTREAMER);
   } else if (kind_ == SourceKind::kNetwork) {
     const int timeout_ms = static_cast<int>(1000 * options.stall_seconds);
-    capture->open(source, cv::CAP_FFMPEG, {cv::CAP_PROP_OPEN_TIMEOUT_MSEC, timeout_ms, cv::CAP_PROP_READ_TIMEOUT_MSEC, timeout_ms});
+    capture->open(
+        source, cv::CAP_FFMPEG,
+        {cv::CAP_PROP_OPEN_TIMEOUT_MSEC, timeout_ms, cv::CAP_PROP_READ_TIMEOUT_MSEC, timeout_ms});
   } else {
     capture->open(source, cv::CAP_ANY);
   }
   if (!capture->isOpened()) {
     throw InputError(source + ": OpenCV cannot open it as a " +
-                     (kind_ == SourceKind::kDevice     ? std::string("V4L2 device")
-                      : kind_ == SourceKind::kPipeline ? std::string("GStreamer pipeline (it must end in appsink)")
-                      : kind_ == SourceKind::kNetwork  ? std::string("network stream")
-                                                       : std::string("video file")));
+                     (kind_ == SourceKind::kDevice ? std::string("V4L2 device")
+                      : kind_ == SourceKind::kPipeline
+                          ? std::string("GStreamer pipeline (it must end in appsink)")
+                      : kind_ == SourceKind::kNetwork ? std::string("network stream")
+                                                      : std::string("video file")));
   }
   fps_ = capture->get(cv::CAP_PROP_FPS);
   if (!(fps_ > 0 && fps_ < 1000)) fps_ = options.folder_fps;
@@ -140,12 +148,17 @@ FrameSource::~FrameSource() {
 std::string FrameSource::Describe() const {
   const std::string rate = std::to_string(static_cast<int>(std::lround(fps_)));
   switch (kind_) {
-    case SourceKind::kDevice: return "V4L2 device " + options_.source;
-    case SourceKind::kPipeline: return "GStreamer pipeline '" + options_.source + "'";
-    case SourceKind::kNetwork: return "network stream " + options_.source;
+    case SourceKind::kDevice:
+      return "V4L2 device " + options_.source;
+    case SourceKind::kPipeline:
+      return "GStreamer pipeline '" + options_.source + "'";
+    case SourceKind::kNetwork:
+      return "network stream " + options_.source;
     case SourceKind::kFolder:
-      return "folder " + options_.source + " (" + std::to_string(folder_images_.size()) + " images at " + rate + " fps)";
-    case SourceKind::kFile: break;
+      return "folder " + options_.source + " (" + std::to_string(folder_images_.size()) +
+             " images at " + rate + " fps)";
+    case SourceKind::kFile:
+      break;
   }
   return "video file " + options_.source + " (" + rate + " fps)";
 }
@@ -174,7 +187,8 @@ FrameStatus FrameSource::NextRecorded(Frame* frame) {
   frame->arrival_wall_s = WallSeconds();
   if (kind_ == SourceKind::kFolder) {
     if (next_index_ >= static_cast<int64_t>(folder_images_.size())) return FrameStatus::kEnd;
-    const fs::path path = fs::path(options_.source) / folder_images_[static_cast<size_t>(next_index_)];
+    const fs::path path =
+        fs::path(options_.source) / folder_images_[static_cast<size_t>(next_index_)];
     frame->image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
     if (frame->image.empty()) LOG(WARNING) << path.string() << ": cannot read the image; skipped";
   } else if (!capture_->read(frame->image) || frame->image.empty()) {
@@ -187,9 +201,9 @@ FrameStatus FrameSource::NextRecorded(Frame* frame) {
 FrameStatus FrameSource::NextLive(Frame* frame) {
   std::unique_lock<std::mutex> lock(shared_->mutex);
   const int64_t seen = next_index_;
-  const bool arrived = shared_->changed.wait_for(lock, std::chrono::duration<double>(options_.stall_seconds), [&] {
-    return shared_->count > seen || shared_->ended;
-  });
+  const bool arrived =
+      shared_->changed.wait_for(lock, std::chrono::duration<double>(options_.stall_seconds),
+                                [&] { return shared_->count > seen || shared_->ended; });
   if (shared_->count > seen) {
     frame->image = shared_->newest;
     frame->time_s = shared_->newest_wall_s - shared_->start_wall_s;

@@ -12,8 +12,8 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
-#include <vector>
 #include <string>
+#include <vector>
 
 namespace portcal {
 
@@ -22,18 +22,18 @@ struct FrameSourceOptions {
   // rtsp:// (or http://, udp://) URL, or a GStreamer pipeline ending in
   // appsink.
   std::string source;
-  double folder_fps = 10;     // a folder's frame rate (a file's is its own), > 0
-  bool realtime = true;       // files and folders: pace to the frame rate
-  double stall_seconds = 5;   // a live source without a frame this long is stalled, > 0
-  void Check() const;         // throws OptionError naming the --Live. option
+  double folder_fps = 10;    // a folder's frame rate (a file's is its own), > 0
+  bool realtime = true;      // files and folders: pace to the frame rate
+  double stall_seconds = 5;  // a live source without a frame this long is stalled, > 0
+  void Check() const;        // throws OptionError naming the --Live. option
 };
 
 enum class SourceKind { kDevice, kFile, kFolder, kNetwork, kPipeline };
 
 struct Frame {
-  cv::Mat image;       // as decoded (gray or BGR)
-  double time_s = 0;   // media time (files, folders) or since the start (live)
-  int64_t index = 0;   // frame number in the source
+  cv::Mat image;              // as decoded (gray or BGR)
+  double time_s = 0;          // media time (files, folders) or since the start (live)
+  int64_t index = 0;          // frame number in the source
   double arrival_wall_s = 0;  // when it was read (steady clock, s): pairs live sources
 };
 
@@ -54,7 +54,10 @@ class FrameSource {
   FrameStatus Next(Frame* frame);
 
   SourceKind kind() const { return kind_; }
-  bool live() const { return kind_ == SourceKind::kDevice || kind_ == SourceKind::kNetwork || kind_ == SourceKind::kPipeline; }
+  bool live() const {
+    return kind_ == SourceKind::kDevice || kind_ == SourceKind::kNetwork ||
+           kind_ == SourceKind::kPipeline;
+  }
   double fps() const { return fps_; }
   // "V4L2 device /dev/video0", "video file run.avi (10 fps)", ...
   std::string Describe() const;
@@ -69,7 +72,7 @@ class FrameSource {
   double fps_ = 0;
   std::vector<std::string> folder_images_;
   std::unique_ptr<cv::VideoCapture> capture_;  // a recorded file
-  std::shared_ptr<Shared> shared_;       // live source
+  std::shared_ptr<Shared> shared_;             // live source
   int64_t next_index_ = 0;
   double start_wall_s_ = -1;
 };

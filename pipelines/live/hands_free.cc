@@ -10,9 +10,12 @@ namespace portcal {
 
 void HandsFreeOptions::Check() const {
   if (!(still_px > 0)) throw OptionError("--Live.still_px", std::to_string(still_px), "> 0 px");
-  if (!(still_seconds > 0)) throw OptionError("--Live.still_seconds", std::to_string(still_seconds), "> 0 s");
-  if (!(novelty_fraction >= 0)) throw OptionError("--Live.novelty", std::to_string(novelty_fraction), ">= 0");
-  if (!(min_gain >= 0 && min_gain < 1)) throw OptionError("--Live.min_gain", std::to_string(min_gain), "[0, 1)");
+  if (!(still_seconds > 0))
+    throw OptionError("--Live.still_seconds", std::to_string(still_seconds), "> 0 s");
+  if (!(novelty_fraction >= 0))
+    throw OptionError("--Live.novelty", std::to_string(novelty_fraction), ">= 0");
+  if (!(min_gain >= 0 && min_gain < 1))
+    throw OptionError("--Live.min_gain", std::to_string(min_gain), "[0, 1)");
 }
 
 double MeanCornerShift(const CornerMap& a, const CornerMap& b) {
@@ -24,7 +27,8 @@ double MeanCornerShift(const CornerMap& a, const CornerMap& b) {
     sum += (pixel - it->second).norm();
     ++shared;
   }
-  if (shared == 0 || 2 * shared < std::min(a.size(), b.size())) return std::numeric_limits<double>::infinity();
+  if (shared == 0 || 2 * shared < std::min(a.size(), b.size()))
+    return std::numeric_limits<double>::infinity();
   return sum / static_cast<double>(shared);
 }
 
@@ -33,10 +37,14 @@ double CornerSharpness(const cv::Mat& gray, const CornerMap& corners) {
   double sum = 0;
   int count = 0;
   for (const auto& [id, pixel] : corners) {
-    const int x = static_cast<int>(std::lround(pixel.x() - 0.5)), y = static_cast<int>(std::lround(pixel.y() - 0.5));
-    if (x - half - 1 < 0 || y - half - 1 < 0 || x + half + 1 >= gray.cols || y + half + 1 >= gray.rows) continue;
+    const int x = static_cast<int>(std::lround(pixel.x() - 0.5)),
+              y = static_cast<int>(std::lround(pixel.y() - 0.5));
+    if (x - half - 1 < 0 || y - half - 1 < 0 || x + half + 1 >= gray.cols ||
+        y + half + 1 >= gray.rows)
+      continue;
     cv::Mat laplacian;
-    cv::Laplacian(gray(cv::Rect(x - half - 1, y - half - 1, 2 * half + 3, 2 * half + 3)), laplacian, CV_32F);
+    cv::Laplacian(gray(cv::Rect(x - half - 1, y - half - 1, 2 * half + 3, 2 * half + 3)), laplacian,
+                  CV_32F);
     const cv::Mat inner = laplacian(cv::Rect(1, 1, 2 * half + 1, 2 * half + 1));
     sum += inner.dot(inner) / inner.total();
     ++count;
@@ -44,7 +52,8 @@ double CornerSharpness(const cv::Mat& gray, const CornerMap& corners) {
   return count > 0 ? sum / count : 0;
 }
 
-StillnessTracker::State StillnessTracker::Update(double time_s, const CornerMap& corners, double sharpness) {
+StillnessTracker::State StillnessTracker::Update(double time_s, const CornerMap& corners,
+                                                 double sharpness) {
   State state;
   const double lasted = anchor_.empty() ? 0 : last_time_s_ - anchor_time_s_;
   if (corners.empty()) {
@@ -70,7 +79,8 @@ StillnessTracker::State StillnessTracker::Update(double time_s, const CornerMap&
       ++shared;
     }
     // A spell is the same corners held still: most of them seen throughout.
-    if (10 * shared < 9 * std::max(anchor_.size(), corners.size())) motion = std::numeric_limits<double>::infinity();
+    if (10 * shared < 9 * std::max(anchor_.size(), corners.size()))
+      motion = std::numeric_limits<double>::infinity();
   }
   last_time_s_ = time_s;
   if (!(motion <= options_.still_px)) {
@@ -88,7 +98,8 @@ StillnessTracker::State StillnessTracker::Update(double time_s, const CornerMap&
   }
   for (auto& [id, sum] : anchor_) {
     const auto it = corners.find(id);
-    sum += it != corners.end() ? it->second : sum / spell_frames_;  // a corner not seen stays where it was
+    sum += it != corners.end() ? it->second
+                               : sum / spell_frames_;  // a corner not seen stays where it was
   }
   ++spell_frames_;
   state.sharpest = sharpness > best_sharpness_;

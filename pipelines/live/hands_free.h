@@ -15,12 +15,13 @@
 namespace portcal {
 
 struct HandsFreeOptions {
-  bool enabled = true;            // else frames are kept only on request
-  double still_px = 3;            // every corner within this of its mean over the spell, > 0
-  double still_seconds = 0.7;     // for this long, > 0
-  double novelty_fraction = 0.04; // mean corner shift from every kept view, of the image diagonal, >= 0
-  double min_gain = 0.01;         // relative drop of the expected uncertainty, [0, 1)
-  void Check() const;             // throws OptionError naming the --Live. option
+  bool enabled = true;         // else frames are kept only on request
+  double still_px = 3;         // every corner within this of its mean over the spell, > 0
+  double still_seconds = 0.7;  // for this long, > 0
+  double novelty_fraction =
+      0.04;                // mean corner shift from every kept view, of the image diagonal, >= 0
+  double min_gain = 0.01;  // relative drop of the expected uncertainty, [0, 1)
+  void Check() const;      // throws OptionError naming the --Live. option
 };
 
 using CornerMap = std::map<int, Eigen::Vector2d>;  // point id -> pixel
@@ -38,11 +39,11 @@ class StillnessTracker {
   explicit StillnessTracker(const HandsFreeOptions& options) : options_(options) {}
 
   struct State {
-    bool still = false;       // held for still_seconds
-    bool sharpest = false;    // this frame is the spell's sharpest so far
-    bool new_spell = false;   // this frame begins a spell (or the target is not seen)
-    double held_s = 0;        // how long the spell has lasted
-    double motion_px = 0;     // largest corner shift since the spell began
+    bool still = false;      // held for still_seconds
+    bool sharpest = false;   // this frame is the spell's sharpest so far
+    bool new_spell = false;  // this frame begins a spell (or the target is not seen)
+    double held_s = 0;       // how long the spell has lasted
+    double motion_px = 0;    // largest corner shift since the spell began
     // The spell this frame ended, by motion or by losing the target: how
     // long it had lasted and the motion that ended it (infinite: lost).
     double ended_held_s = 0;

@@ -13,13 +13,14 @@ namespace portcal {
 
 void LiveGoalOptions::Check() const {
   if (!(target_uncertainty_px > 0)) {
-    throw OptionError("--Live.target_uncertainty_px", std::to_string(target_uncertainty_px), "> 0 px");
+    throw OptionError("--Live.target_uncertainty_px", std::to_string(target_uncertainty_px),
+                      "> 0 px");
   }
 }
 
 namespace {
 
-constexpr double kWantedTiltDeg = 30;       // views tilted at least this (a board's depth range)
+constexpr double kWantedTiltDeg = 30;         // views tilted at least this (a board's depth range)
 constexpr double kWantedDistanceRatio = 1.4;  // farthest / nearest kept view
 
 // Image corners (of a 3 x 3 split) that no kept view's corner falls in.
@@ -39,20 +40,23 @@ std::string LiveGoal::Summary() const {
   if (!determined) {
     text << "goal " << target_px << " px: no uncertainty yet";
   } else if (met) {
-    text << "enough: expected projection uncertainty " << mean_px << " px <= " << target_px << " px (Finish)";
+    text << "enough: expected projection uncertainty " << mean_px << " px <= " << target_px
+         << " px (Finish)";
   } else {
     text << "expected projection uncertainty " << mean_px << " px, goal " << target_px << " px ("
          << std::setprecision(0) << 100 * progress << " %)";
   }
-  if (!limits.empty()) text << (met ? "; could still improve: " : "; still limiting: ") << JoinedWords(limits);
+  if (!limits.empty())
+    text << (met ? "; could still improve: " : "; still limiting: ") << JoinedWords(limits);
   return text.str();
 }
 
-LiveGoal EvaluateGoal(const LiveEstimate& estimate, const std::vector<CornerMap>& kept_corners, cv::Size image,
-                      double target_px) {
+LiveGoal EvaluateGoal(const LiveEstimate& estimate, const std::vector<CornerMap>& kept_corners,
+                      cv::Size image, double target_px) {
   LiveGoal goal;
   goal.target_px = target_px;
-  goal.determined = estimate.solved && estimate.uncertainty.determined && estimate.uncertainty.mean_px > 0;
+  goal.determined =
+      estimate.solved && estimate.uncertainty.determined && estimate.uncertainty.mean_px > 0;
   if (goal.determined) {
     goal.mean_px = estimate.uncertainty.mean_px;
     goal.max_px = estimate.uncertainty.max_px;
@@ -62,7 +66,8 @@ LiveGoal EvaluateGoal(const LiveEstimate& estimate, const std::vector<CornerMap>
   if (image.area() > 0) {
     const std::vector<std::string> empty = EmptyImageCorners(kept_corners, image);
     if (!empty.empty()) {
-      goal.limits.push_back("the image's " + JoinedWords(empty) + " corner" + (empty.size() > 1 ? "s have" : " has") +
+      goal.limits.push_back("the image's " + JoinedWords(empty) + " corner" +
+                            (empty.size() > 1 ? "s have" : " has") +
                             " no points (bring the target there)");
     }
   }
@@ -71,7 +76,8 @@ LiveGoal EvaluateGoal(const LiveEstimate& estimate, const std::vector<CornerMap>
     // The board's normal against its line of sight.
     const Eigen::Vector3d normal = pose.rotation * Eigen::Vector3d::UnitZ();
     const Eigen::Vector3d sight = pose.translation.normalized();
-    max_tilt = std::max(max_tilt, std::acos(std::min(1.0, std::abs(normal.dot(sight)))) * 180 / M_PI);
+    max_tilt =
+        std::max(max_tilt, std::acos(std::min(1.0, std::abs(normal.dot(sight)))) * 180 / M_PI);
     nearest = std::min(nearest, pose.translation.norm());
     farthest = std::max(farthest, pose.translation.norm());
   }
@@ -79,12 +85,14 @@ LiveGoal EvaluateGoal(const LiveEstimate& estimate, const std::vector<CornerMap>
     std::ostringstream text;
     text << std::fixed << std::setprecision(0);
     if (max_tilt < kWantedTiltDeg) {
-      text << "tilts up to " << max_tilt << " deg (tilt the target " << kWantedTiltDeg << "-45 deg, both ways)";
+      text << "tilts up to " << max_tilt << " deg (tilt the target " << kWantedTiltDeg
+           << "-45 deg, both ways)";
       goal.limits.push_back(text.str());
       text.str("");
     }
     if (farthest < kWantedDistanceRatio * nearest) {
-      text << std::setprecision(2) << "distances " << nearest << "-" << farthest << " m only (hold it nearer and farther)";
+      text << std::setprecision(2) << "distances " << nearest << "-" << farthest
+           << " m only (hold it nearer and farther)";
       goal.limits.push_back(text.str());
     }
   }

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "pipelines/live/hands_free.h"
 #include "pipelines/guidance/live_estimator.h"
+#include "pipelines/live/hands_free.h"
 
 namespace portcal {
 
@@ -37,8 +37,8 @@ struct LiveGoal {
 
 // One camera's goal from its estimate and the kept views' corners
 // (`image`: the frames' size).
-LiveGoal EvaluateGoal(const LiveEstimate& estimate, const std::vector<CornerMap>& kept_corners, cv::Size image,
-                      double target_px);
+LiveGoal EvaluateGoal(const LiveEstimate& estimate, const std::vector<CornerMap>& kept_corners,
+                      cv::Size image, double target_px);
 
 // A rig's: met when both cameras' are; the worse camera's figures, each
 // camera's limits (camera 2's prefixed).

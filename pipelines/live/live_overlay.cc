@@ -12,7 +12,8 @@ namespace portcal {
 namespace {
 
 double ScaleFor(const cv::Size& size, int max_width) {
-  return size.width > max_width && max_width > 0 ? static_cast<double>(max_width) / size.width : 1.0;
+  return size.width > max_width && max_width > 0 ? static_cast<double>(max_width) / size.width
+                                                 : 1.0;
 }
 
 cv::Mat ScaledBgr(const cv::Mat& gray, double scale) {
@@ -27,27 +28,31 @@ void Caption(const std::string& text, int line, cv::Mat* bgr) {
   const double size = std::max(0.4, bgr->cols / 1100.0);
   const cv::Point at(10, static_cast<int>((line + 1) * 26 * size / 0.6));
   cv::putText(*bgr, text, at, cv::FONT_HERSHEY_SIMPLEX, size, cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
-  cv::putText(*bgr, text, at, cv::FONT_HERSHEY_SIMPLEX, size, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  cv::putText(*bgr, text, at, cv::FONT_HERSHEY_SIMPLEX, size, cv::Scalar(255, 255, 255), 1,
+              cv::LINE_AA);
 }
-
 
 cv::Mat DrawOneOverlay(const LiveSnapshot& snapshot, const TargetShape& target, int max_width) {
   const double scale = ScaleFor(snapshot.frame.size(), max_width);
   cv::Mat bgr = ScaledBgr(snapshot.frame, scale);
-  const cv::Scalar color = snapshot.hold.still   ? cv::Scalar(0, 220, 0)
+  const cv::Scalar color = snapshot.hold.still        ? cv::Scalar(0, 220, 0)
                            : snapshot.hold.held_s > 0 ? cv::Scalar(0, 220, 255)
                                                       : cv::Scalar(0, 0, 255);
   for (const auto& [id, pixel] : snapshot.corners) {
-    cv::circle(bgr, cv::Point(cvRound((pixel.x() - 0.5) * scale * 16), cvRound((pixel.y() - 0.5) * scale * 16)),
-               4 * 16, color, 1, cv::LINE_AA, 4);
+    cv::circle(
+        bgr,
+        cv::Point(cvRound((pixel.x() - 0.5) * scale * 16), cvRound((pixel.y() - 0.5) * scale * 16)),
+        4 * 16, color, 1, cv::LINE_AA, 4);
   }
   const LiveEstimate* estimate = snapshot.estimate.get();
   if (estimate && estimate->next) {
     const std::vector<cv::Point2f> outline =
         TargetOutlinePixels(estimate->camera, target, estimate->next->cam_from_target);
     std::vector<cv::Point> polygon;
-    for (const cv::Point2f& p : outline) polygon.emplace_back(cvRound(p.x * scale * 16), cvRound(p.y * scale * 16));
-    if (!polygon.empty()) cv::polylines(bgr, polygon, true, cv::Scalar(0, 140, 255), 2, cv::LINE_AA, 4);
+    for (const cv::Point2f& p : outline)
+      polygon.emplace_back(cvRound(p.x * scale * 16), cvRound(p.y * scale * 16));
+    if (!polygon.empty())
+      cv::polylines(bgr, polygon, true, cv::Scalar(0, 140, 255), 2, cv::LINE_AA, 4);
   }
   std::ostringstream line;
   line << std::fixed << std::setprecision(1) << snapshot.fps << " fps  ";
@@ -63,11 +68,11 @@ cv::Mat DrawOneOverlay(const LiveSnapshot& snapshot, const TargetShape& target, 
     // pose of the frame rests on a guessed focal length, and it said "59
     // deg, 41 cm" while the board filled the outline.
     std::ostringstream away;
-    away << std::fixed << std::setprecision(0) << "to the suggested pose: " << snapshot.to_suggestion->outline_px
-         << " px";
+    away << std::fixed << std::setprecision(0)
+         << "to the suggested pose: " << snapshot.to_suggestion->outline_px << " px";
     if (estimate->solved) {
-      away << ", " << snapshot.to_suggestion->rotation_deg << " deg, " << 100 * snapshot.to_suggestion->translation_m
-           << " cm";
+      away << ", " << snapshot.to_suggestion->rotation_deg << " deg, "
+           << 100 * snapshot.to_suggestion->translation_m << " cm";
     }
     Caption(away.str(), 1, &bgr);
   }
@@ -132,8 +137,8 @@ cv::Mat DrawOneUncertainty(const LiveSnapshot& snapshot, int max_width) {
   // unreadable on the page), the goal as a white iso-line.
   HeatMapStyle style;
   std::ostringstream title;
-  title << std::setprecision(3) << "expected projection uncertainty: mean " << estimate->uncertainty.mean_px
-        << " px, max " << estimate->uncertainty.max_px << " px";
+  title << std::setprecision(3) << "expected projection uncertainty: mean "
+        << estimate->uncertainty.mean_px << " px, max " << estimate->uncertainty.max_px << " px";
   style.title = title.str();
   style.unit = "px";
   if (snapshot.goal.target_px > 0) style.contour_levels = {snapshot.goal.target_px};
@@ -141,7 +146,8 @@ cv::Mat DrawOneUncertainty(const LiveSnapshot& snapshot, int max_width) {
   const int height = snapshot.frame.empty() ? size.height : snapshot.frame.rows;
   cv::Mat picture = HeatMapPicture(estimate->uncertainty.map_px, width, height, style);
   if (picture.cols > max_width && max_width > 0) {
-    cv::resize(picture, picture, cv::Size(max_width, std::max(1, picture.rows * max_width / picture.cols)), 0, 0,
+    cv::resize(picture, picture,
+               cv::Size(max_width, std::max(1, picture.rows * max_width / picture.cols)), 0, 0,
                cv::INTER_AREA);
   }
   return picture;
@@ -166,9 +172,11 @@ LiveSnapshot SecondCamera(const LiveSnapshot& snapshot) {
 cv::Mat PerCamera(const LiveSnapshot& snapshot, int max_width,
                   const std::function<cv::Mat(const LiveSnapshot&, int)>& draw) {
   if (snapshot.frame2.empty()) return draw(snapshot, max_width);
-  cv::Mat first = draw(snapshot, max_width / 2), second = draw(SecondCamera(snapshot), max_width / 2);
+  cv::Mat first = draw(snapshot, max_width / 2),
+          second = draw(SecondCamera(snapshot), max_width / 2);
   if (second.rows != first.rows) {
-    cv::resize(second, second, cv::Size(second.cols * first.rows / std::max(1, second.rows), first.rows));
+    cv::resize(second, second,
+               cv::Size(second.cols * first.rows / std::max(1, second.rows), first.rows));
   }
   cv::Mat joined;
   cv::hconcat(first, second, joined);
@@ -178,8 +186,9 @@ cv::Mat PerCamera(const LiveSnapshot& snapshot, int max_width,
 }  // namespace
 
 cv::Mat DrawLiveOverlay(const LiveSnapshot& snapshot, const TargetShape& target, int max_width) {
-  return PerCamera(snapshot, max_width,
-                   [&target](const LiveSnapshot& s, int width) { return DrawOneOverlay(s, target, width); });
+  return PerCamera(snapshot, max_width, [&target](const LiveSnapshot& s, int width) {
+    return DrawOneOverlay(s, target, width);
+  });
 }
 
 cv::Mat DrawCoverage(const LiveSnapshot& snapshot, int max_width) {

@@ -44,7 +44,9 @@ nlohmann::json EstimateJson(const LiveEstimate& estimate) {
   json["rms_px"] = estimate.rms_px;
   nlohmann::json params = nlohmann::json::array();
   for (size_t k = 0; k < estimate.names.size(); ++k) {
-    params.push_back({{"name", estimate.names[k]}, {"value", estimate.values[k]}, {"std_dev", estimate.std_devs[k]}});
+    params.push_back({{"name", estimate.names[k]},
+                      {"value", estimate.values[k]},
+                      {"std_dev", estimate.std_devs[k]}});
   }
   json["params"] = params;
   json["uncertainty"] = {{"determined", estimate.uncertainty.determined},
@@ -52,10 +54,11 @@ nlohmann::json EstimateJson(const LiveEstimate& estimate) {
                          {"max_px", estimate.uncertainty.max_px}};
   if (estimate.next) {
     const Rigid3d& p = estimate.next->cam_from_target;
-    json["next"] = {{"why", estimate.next->why},
-                    {"rotation_wxyz", {p.rotation.w(), p.rotation.x(), p.rotation.y(), p.rotation.z()}},
-                    {"translation", {p.translation.x(), p.translation.y(), p.translation.z()}},
-                    {"distance_m", p.translation.norm()}};
+    json["next"] = {
+        {"why", estimate.next->why},
+        {"rotation_wxyz", {p.rotation.w(), p.rotation.x(), p.rotation.y(), p.rotation.z()}},
+        {"translation", {p.translation.x(), p.translation.y(), p.translation.z()}},
+        {"distance_m", p.translation.norm()}};
   } else {
     json["next"] = nullptr;
     json["suggestion_error"] = estimate.suggestion_error;
@@ -130,8 +133,10 @@ std::string NewNonce() {
 
 std::string ContentSecurityPolicy(const std::string& nonce) {
   const std::string inline_allowed = nonce.empty() ? "" : " 'nonce-" + nonce + "'";
-  return "default-src 'none'; script-src 'self'" + inline_allowed + "; style-src 'self'" + inline_allowed +
-         "; img-src 'self'; connect-src 'self'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
+  return "default-src 'none'; script-src 'self'" + inline_allowed + "; style-src 'self'" +
+         inline_allowed +
+         "; img-src 'self'; connect-src 'self'; base-uri 'none'; form-action 'none'; "
+         "frame-ancestors 'none'";
 }
 
 // Viewers of the stream at once: each holds a server thread.
@@ -175,7 +180,8 @@ void LiveServer::Impl::EncodeLoop() {
     }
     seen = snapshot.frames_processed;
     if (WallSeconds() - last_viewer_s.load() > 2) continue;
-    auto bytes = std::make_shared<const std::vector<uint8_t>>(EncodeOverlayJpeg(snapshot, session->target(), options));
+    auto bytes = std::make_shared<const std::vector<uint8_t>>(
+        EncodeOverlayJpeg(snapshot, session->target(), options));
     const double latency_ms = 1000 * (WallSeconds() - snapshot.arrival_wall_s);
     const std::lock_guard<std::mutex> lock(mutex);
     jpeg = bytes;
@@ -197,10 +203,12 @@ bool LiveServer::Impl::StreamPart(int64_t* sent, httplib::DataSink& sink) {
     part = jpeg;
     *sent = jpeg_count;
   }
-  const std::string header = "--frame\r\nContent-Type: image/jpeg\r\nContent-Length: " +
-                             std::to_string(part->size()) + "\r\n\r\n";
+  const std::string header =
+      "--frame\r\nContent-Type: image/jpeg\r\nContent-Length: " + std::to_string(part->size()) +
+      "\r\n\r\n";
   return sink.write(header.data(), header.size()) &&
-         sink.write(reinterpret_cast<const char*>(part->data()), part->size()) && sink.write("\r\n", 2);
+         sink.write(reinterpret_cast<const char*>(part->data()), part->size()) &&
+         sink.write("\r\n", 2);
 }
 
 nlohmann::json LiveServer::Impl::State() const {
@@ -223,14 +231,21 @@ nlohmann::json LiveServer::Impl::State() const {
     state["latency_ms"] = latency_count > 0 ? latency_sum_ms / latency_count : 0.0;
   }
   nlohmann::json kept = nlohmann::json::array();
-  for (const KeptView& view : snapshot.kept) kept.push_back({{"name", view.name}, {"points", view.view.pixels.size()}});
+  for (const KeptView& view : snapshot.kept)
+    kept.push_back({{"name", view.name}, {"points", view.view.pixels.size()}});
   state["kept"] = kept;
   state["coverage"] = CoverageFraction(snapshot);
   const LiveGoal& goal = snapshot.goal;
-  state["goal"] = {{"target_px", goal.target_px}, {"determined", goal.determined}, {"mean_px", goal.mean_px},
-                   {"max_px", goal.max_px},         {"met", goal.met},               {"progress", goal.progress},
-                   {"limits", goal.limits},         {"summary", goal.Summary()}};
-  state["estimate"] = snapshot.estimate ? EstimateJson(*snapshot.estimate) : nlohmann::json(nullptr);
+  state["goal"] = {{"target_px", goal.target_px},
+                   {"determined", goal.determined},
+                   {"mean_px", goal.mean_px},
+                   {"max_px", goal.max_px},
+                   {"met", goal.met},
+                   {"progress", goal.progress},
+                   {"limits", goal.limits},
+                   {"summary", goal.Summary()}};
+  state["estimate"] =
+      snapshot.estimate ? EstimateJson(*snapshot.estimate) : nlohmann::json(nullptr);
   if (snapshot.to_suggestion) {
     state["to_suggestion"] = {{"outline_px", snapshot.to_suggestion->outline_px},
                               {"rotation_deg", snapshot.to_suggestion->rotation_deg},
@@ -257,7 +272,9 @@ void LiveServer::Impl::Routes() {
     if (++stream_clients > kMaxStreamClients) {
       --stream_clients;
       response.status = 503;
-      response.set_content("too many viewers of the stream (" + std::to_string(kMaxStreamClients) + ")", "text/plain");
+      response.set_content(
+          "too many viewers of the stream (" + std::to_string(kMaxStreamClients) + ")",
+          "text/plain");
       return;
     }
     last_viewer_s = WallSeconds();
@@ -268,15 +285,18 @@ void LiveServer::Impl::Routes() {
         [this](bool) { --stream_clients; });
   });
   server.Get("/coverage.jpg", [this](const httplib::Request&, httplib::Response& response) {
-    Reply(&response, Jpeg(DrawCoverage(session->Snapshot(), options.max_width / 2), 85), "image/jpeg");
+    Reply(&response, Jpeg(DrawCoverage(session->Snapshot(), options.max_width / 2), 85),
+          "image/jpeg");
   });
   server.Get("/uncertainty.jpg", [this](const httplib::Request&, httplib::Response& response) {
-    Reply(&response, Jpeg(DrawUncertainty(session->Snapshot(), options.max_width / 2), 85), "image/jpeg");
+    Reply(&response, Jpeg(DrawUncertainty(session->Snapshot(), options.max_width / 2), 85),
+          "image/jpeg");
   });
   server.Get("/thumbnail", [this](const httplib::Request& request, httplib::Response& response) {
     const std::string name = request.get_param_value("name");
     for (const KeptView& view : session->Snapshot().kept) {
-      if (view.name == name && !view.thumbnail.empty()) return Reply(&response, Jpeg(view.thumbnail, 85), "image/jpeg");
+      if (view.name == name && !view.thumbnail.empty())
+        return Reply(&response, Jpeg(view.thumbnail, 85), "image/jpeg");
     }
     response.status = 404;
   });
@@ -286,19 +306,24 @@ void LiveServer::Impl::Routes() {
       {"/undo", [this](const httplib::Request&) { session->Undo(); }},
       {"/calibrate", [this](const httplib::Request&) { session->CalibrateNow(); }},
       {"/finish", [this](const httplib::Request&) { session->Finish(); }},
-      {"/remove", [this](const httplib::Request& request) { session->Remove(request.get_param_value("name")); }},
+      {"/remove",
+       [this](const httplib::Request& request) {
+         session->Remove(request.get_param_value("name"));
+       }},
   };
   for (const auto& [path, action] : commands) {
-    server.Post(path, [action = action](const httplib::Request& request, httplib::Response& response) {
-      action(request);
-      response.set_content("{\"ok\": true}", "application/json");
-    });
+    server.Post(path,
+                [action = action](const httplib::Request& request, httplib::Response& response) {
+                  action(request);
+                  response.set_content("{\"ok\": true}", "application/json");
+                });
   }
   // A POST with neither Content-Length nor Transfer-Encoding has no body
   // (RFC 9112, 6.3), but httplib 0.11 reads one until the client closes,
   // which a client waiting for the answer never does (`curl -X POST` hung).
   // The commands take no body: answer those before httplib reads.
-  server.set_pre_routing_handler([this, commands](const httplib::Request& request, httplib::Response& response) {
+  server.set_pre_routing_handler([this, commands](const httplib::Request& request,
+                                                  httplib::Response& response) {
     const std::optional<std::string> refused = RefuseLiveRequest(
         {request.method, request.get_header_value("Host"), request.get_header_value("Origin"),
          request.get_header_value("Sec-Fetch-Site"), request.get_header_value("Cookie"),
@@ -321,7 +346,8 @@ void LiveServer::Impl::Routes() {
   });
 }
 
-LiveServer::LiveServer(LiveSession* session, const LivePageOptions& options) : impl_(std::make_unique<Impl>()) {
+LiveServer::LiveServer(LiveSession* session, const LivePageOptions& options)
+    : impl_(std::make_unique<Impl>()) {
   options.Check();
   impl_->session = session;
   impl_->options = options;
@@ -353,9 +379,10 @@ LiveServer::LiveServer(LiveSession* session, const LivePageOptions& options) : i
   });
   impl_->port = port == 0 ? impl_->server.bind_to_any_port(impl_->host) : port;
   if (impl_->port <= 0 || (port != 0 && !impl_->server.bind_to_port(impl_->host, port))) {
-    throw InputError("--Live.address " + options.address + ": cannot listen there (" +
-                     (port != 0 ? "is the port in use? try another, or 0 for a free one" : "no free port") +
-                     "; is the address one of this machine's?)");
+    throw InputError(
+        "--Live.address " + options.address + ": cannot listen there (" +
+        (port != 0 ? "is the port in use? try another, or 0 for a free one" : "no free port") +
+        "; is the address one of this machine's?)");
   }
   impl_->listener = std::thread([impl = impl_.get()] { impl->server.listen_after_bind(); });
   // Serving before the constructor returns: a stop() before the listen
@@ -366,8 +393,9 @@ LiveServer::LiveServer(LiveSession* session, const LivePageOptions& options) : i
   impl_->encoder = std::thread([impl = impl_.get()] { impl->EncodeLoop(); });
   LOG(INFO) << "live: the page is at " << url();
   if (impl_->host == "0.0.0.0" && options.token.empty()) {
-    LOG(WARNING) << "live: serving on every network of this machine without a password: anyone who reaches "
-                 << "port " << impl_->port << " can end the session or remove views (set --Live.token)";
+    LOG(WARNING)
+        << "live: serving on every network of this machine without a password: anyone who reaches "
+        << "port " << impl_->port << " can end the session or remove views (set --Live.token)";
   }
 }
 

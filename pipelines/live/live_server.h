@@ -28,16 +28,16 @@ struct LivePageOptions {
   // host:port; 127.0.0.1 for this machine only, 0.0.0.0 to be seen from the
   // vehicle's network; port 0 takes a free one.
   std::string address = "127.0.0.1:8080";
-  bool headless = false;   // no page: state and suggestions on stderr only
-  int max_width = 1280;    // frames on the page are scaled down to this width
-  int jpeg_quality = 80;   // [10, 100]
-  std::string output_path; // shown on the page when the session ends
+  bool headless = false;    // no page: state and suggestions on stderr only
+  int max_width = 1280;     // frames on the page are scaled down to this width
+  int jpeg_quality = 80;    // [10, 100]
+  std::string output_path;  // shown on the page when the session ends
   // Required of every request when set (16-128 of [A-Za-z0-9_-]): the page
   // has no other password, which matters on a vehicle's shared network
   // (0.0.0.0). The printed address carries it; the page keeps it in a
   // cookie.
   std::string token;
-  void Check() const;      // throws OptionError naming the --Live. option
+  void Check() const;  // throws OptionError naming the --Live. option
 };
 
 // The JPEG encoder of the overlay, as the server runs it: drawing and

@@ -42,10 +42,11 @@ cv::Mat Thumbnail(const std::vector<cv::Mat>& images) {
   std::vector<cv::Mat> parts;
   for (const cv::Mat& image : images) {
     cv::Mat small;
-    cv::resize(image, small, cv::Size(160, std::max(1, 160 * image.rows / std::max(1, image.cols))), 0, 0,
-               cv::INTER_AREA);
+    cv::resize(image, small, cv::Size(160, std::max(1, 160 * image.rows / std::max(1, image.cols))),
+               0, 0, cv::INTER_AREA);
     if (small.channels() == 1) cv::cvtColor(small, small, cv::COLOR_GRAY2BGR);
-    if (!parts.empty() && small.rows != parts[0].rows) cv::resize(small, small, cv::Size(160, parts[0].rows));
+    if (!parts.empty() && small.rows != parts[0].rows)
+      cv::resize(small, small, cv::Size(160, parts[0].rows));
     parts.push_back(small);
   }
   cv::Mat joined;
@@ -70,26 +71,46 @@ void LiveSessionOptions::Check() const {
   goal.Check();
   if (max_views < 0) throw OptionError("--Live.max_views", std::to_string(max_views), ">= 0");
   if (!(pair_tolerance_s >= 0)) {
-    throw OptionError("--Live.pair_tolerance", std::to_string(pair_tolerance_s), ">= 0 s (0: the frames' own order)");
+    throw OptionError("--Live.pair_tolerance", std::to_string(pair_tolerance_s),
+                      ">= 0 s (0: the frames' own order)");
   }
-  if (Stereo() && source2 == source.source) throw OptionError("--source2", source2, "a source other than --source");
+  if (Stereo() && source2 == source.source)
+    throw OptionError("--source2", source2, "a source other than --source");
 }
 
 struct LiveSession::Pending {
   std::future<LiveEstimate> result;
 };
 
-LiveSession::LiveSession(const LiveSessionOptions& options, KeptFrameStore* store, std::vector<KeptView> existing)
-    : options_(options), store_(store), target_(ShapeOfTarget(options.detector)), kept_(std::move(existing)) {
+LiveSession::LiveSession(const LiveSessionOptions& options, KeptFrameStore* store,
+                         std::vector<KeptView> existing)
+    : options_(options),
+      store_(store),
+      target_(ShapeOfTarget(options.detector)),
+      kept_(std::move(existing)) {
   options.Check();
-  channels_.push_back(
-      Channel{options.source.source, options.estimator, nullptr, StillnessTracker(options.hands_free), cv::Size(), -1, {}, {}, {}});
+  channels_.push_back(Channel{options.source.source,
+                              options.estimator,
+                              nullptr,
+                              StillnessTracker(options.hands_free),
+                              cv::Size(),
+                              -1,
+                              {},
+                              {},
+                              {}});
   if (options.Stereo()) {
     LiveEstimatorOptions estimator2 = options.estimator;
     estimator2.camera = options.camera2;
     estimator2.housing = options.housing2;
-    channels_.push_back(
-        Channel{options.source2, estimator2, nullptr, StillnessTracker(options.hands_free), cv::Size(), -1, {}, {}, {}});
+    channels_.push_back(Channel{options.source2,
+                                estimator2,
+                                nullptr,
+                                StillnessTracker(options.hands_free),
+                                cv::Size(),
+                                -1,
+                                {},
+                                {},
+                                {}});
   }
   snapshot_.kept = kept_;
 }
@@ -108,11 +129,12 @@ void LiveSession::SetFinalStatus(const std::string& text) {
   snapshot_.final_status = text;
 }
 
-bool LiveSession::WaitForFrame(int64_t frames_processed, double timeout_s, LiveSnapshot* snapshot) const {
+bool LiveSession::WaitForFrame(int64_t frames_processed, double timeout_s,
+                               LiveSnapshot* snapshot) const {
   std::unique_lock<std::mutex> lock(mutex_);
-  const bool processed = frame_processed_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
-    return snapshot_.frames_processed > frames_processed || ended_;
-  });
+  const bool processed = frame_processed_.wait_for(
+      lock, std::chrono::duration<double>(timeout_s),
+      [&] { return snapshot_.frames_processed > frames_processed || ended_; });
   if (!processed || snapshot_.frames_processed <= frames_processed) return false;
   *snapshot = snapshot_;
   return true;
@@ -151,15 +173,17 @@ void LiveSession::StartEstimate() {
   pending_ = std::make_unique<Pending>();
   const LiveEstimator* camera1 = channels_[0].estimator.get();
   const LiveEstimator* camera2 = options_.Stereo() ? channels_[1].estimator.get() : nullptr;
-  pending_->result = std::async(std::launch::async, [camera1, camera2, views, views2, previous = estimate_] {
-    return camera2 ? EstimateRig(*camera1, *camera2, views, views2, previous.get())
-                   : camera1->Estimate(views, previous.get());
-  });
+  pending_->result =
+      std::async(std::launch::async, [camera1, camera2, views, views2, previous = estimate_] {
+        return camera2 ? EstimateRig(*camera1, *camera2, views, views2, previous.get())
+                       : camera1->Estimate(views, previous.get());
+      });
 }
 
 void LiveSession::CollectEstimate(bool wait) {
   if (!pending_) return;
-  if (!wait && pending_->result.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+  if (!wait && pending_->result.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+    return;
   estimate_ = std::make_shared<const LiveEstimate>(pending_->result.get());
   pending_.reset();
   std::istringstream lines(estimate_->Summary());  // a rig's: a line per camera and one for the rig
@@ -191,7 +215,8 @@ void LiveSession::UpdateGoal() {
   const double target = options_.goal.target_uncertainty_px;
   LiveGoal goal = EvaluateGoal(*estimate_, corners1, channels_[0].size, target);
   if (estimate_->camera2) {
-    goal = CombineGoals(goal, EvaluateGoal(*estimate_->camera2, corners2, channels_[1].size, target));
+    goal =
+        CombineGoals(goal, EvaluateGoal(*estimate_->camera2, corners2, channels_[1].size, target));
   }
   {
     const std::lock_guard<std::mutex> lock(mutex_);
@@ -226,8 +251,8 @@ bool LiveSession::TryKeep(const std::vector<Sight>& sights, bool requested) {
     detections.push_back(DetectTarget(sights[c].gray, precise));
     if (!detections.back().found) {
       const std::string camera = sights.size() > 1 ? " of camera " + std::to_string(c + 1) : "";
-      Note("held still, frame " + std::to_string(sights[c].frame->index) + camera + " not kept: the precise fit failed (" +
-               detections.back().reason + ")",
+      Note("held still, frame " + std::to_string(sights[c].frame->index) + camera +
+               " not kept: the precise fit failed (" + detections.back().reason + ")",
            true);
       RememberRefused(sights);
       return false;
@@ -239,9 +264,9 @@ bool LiveSession::TryKeep(const std::vector<Sight>& sights, bool requested) {
     const double gain = Gain(views);
     if (gain < options_.hands_free.min_gain) {
       std::ostringstream text;
-      text << "held still, not kept: this view would lower the uncertainty by only " << std::setprecision(2)
-           << 100 * gain << " % (--Live.min_gain " << 100 * options_.hands_free.min_gain
-           << " %); move the target (see the suggestion)";
+      text << "held still, not kept: this view would lower the uncertainty by only "
+           << std::setprecision(2) << 100 * gain << " % (--Live.min_gain "
+           << 100 * options_.hands_free.min_gain << " %); move the target (see the suggestion)";
       Note(text.str(), false);
       RememberRefused(sights);
       return false;
@@ -257,7 +282,8 @@ bool LiveSession::TryKeep(const std::vector<Sight>& sights, bool requested) {
     Note(std::string("frame not stored (it can be captured again): ") + e.what(), true);
     return false;
   }
-  KeptView kept{name, sights[0].frame->time_s, views[0], Corners(detections[0]), Thumbnail(images), {}, {}};
+  KeptView kept{
+      name, sights[0].frame->time_s, views[0], Corners(detections[0]), Thumbnail(images), {}, {}};
   kept.view.image_name = name;
   if (sights.size() > 1) {
     kept.view2 = views[1];
@@ -271,7 +297,8 @@ bool LiveSession::TryKeep(const std::vector<Sight>& sights, bool requested) {
     snapshot_.kept = kept_;
   }
   Note("kept " + name + " (frame " + std::to_string(sights[0].frame->index) + ", " +
-           std::to_string(detections[0].points.size()) + " corners)" + (requested ? ", on request" : ""),
+           std::to_string(detections[0].points.size()) + " corners)" +
+           (requested ? ", on request" : ""),
        false);
   StartEstimate();
   return true;
@@ -283,7 +310,8 @@ void LiveSession::Process(std::vector<Sight>& sights, double arrival_wall_s) {
   // A rig's second image on the other core.
   std::future<TargetDetection> second;
   if (sights.size() > 1) {
-    second = std::async(std::launch::async, [&quick, gray = sights[1].gray] { return DetectTarget(gray, quick); });
+    second = std::async(std::launch::async,
+                        [&quick, gray = sights[1].gray] { return DetectTarget(gray, quick); });
   }
   const TargetDetection detection = DetectTarget(sights[0].gray, quick);
   bool seen = detection.found;
@@ -295,13 +323,15 @@ void LiveSession::Process(std::vector<Sight>& sights, double arrival_wall_s) {
   }
   const double time_s = sights[0].frame->time_s;
   frame_time_s_ = time_s;
-  const StillnessTracker::State hold = Hold(sights, time_s, detection.found ? "" : detection.reason);
+  const StillnessTracker::State hold =
+      Hold(sights, time_s, detection.found ? "" : detection.reason);
   std::optional<PoseDistance> to_suggestion;
   if (detection.found && estimate_ && estimate_->next) {
     if (const auto pose = EstimateTargetPose(detection, estimate_->camera)) {
       const LiveEstimator& estimator = *channels_[0].estimator;
-      to_suggestion = DistanceToSuggestion(estimator.Unknowns(estimate_->camera), estimator.target(),
-                                           pose->cam_from_target, estimate_->next->cam_from_target);
+      to_suggestion =
+          DistanceToSuggestion(estimator.Unknowns(estimate_->camera), estimator.target(),
+                               pose->cam_from_target, estimate_->next->cam_from_target);
     }
   }
   ++summary_.frames;
@@ -346,7 +376,8 @@ void LiveSession::ApplyRequests() {
   if (names.empty()) return;
   bool changed = false;
   for (const std::string& name : names) {
-    const auto it = std::find_if(kept_.begin(), kept_.end(), [&](const KeptView& k) { return k.name == name; });
+    const auto it =
+        std::find_if(kept_.begin(), kept_.end(), [&](const KeptView& k) { return k.name == name; });
     if (it == kept_.end()) continue;
     try {
       store_->Remove(name);
@@ -381,11 +412,13 @@ void LiveSession::PrintStatus(double time_s) {
   }
   line << "; " << kept_.size() << " kept";
   if (s.goal.determined) {
-    line << "; goal " << (s.goal.met ? "met" : std::to_string(static_cast<int>(100 * s.goal.progress)) + " %");
+    line << "; goal "
+         << (s.goal.met ? "met" : std::to_string(static_cast<int>(100 * s.goal.progress)) + " %");
   }
   if (estimate_ && estimate_->next) {
     line << "; next: " << estimate_->next->why;
-    if (s.to_suggestion) line << ", " << std::setprecision(0) << s.to_suggestion->outline_px << " px away";
+    if (s.to_suggestion)
+      line << ", " << std::setprecision(0) << s.to_suggestion->outline_px << " px away";
   }
   LOG(INFO) << line.str();
 }
@@ -395,18 +428,20 @@ bool LiveSession::CheckSize(Channel* channel, const cv::Mat& gray, const Frame& 
     channel->size = gray.size();
     LiveEstimatorOptions& estimator = channel->estimator_options;
     if (estimator.camera.width == 0) {
-      estimator.camera = Camera::FromModelName(estimator.camera.ModelName(), 1.2 * std::max(gray.cols, gray.rows),
-                                               gray.cols, gray.rows);
+      estimator.camera = Camera::FromModelName(
+          estimator.camera.ModelName(), 1.2 * std::max(gray.cols, gray.rows), gray.cols, gray.rows);
     } else if (static_cast<int>(estimator.camera.width) != gray.cols ||
                static_cast<int>(estimator.camera.height) != gray.rows) {
       throw InputError(channel->source + ": frames are " + std::to_string(gray.cols) + "x" +
                        std::to_string(gray.rows) + ", the camera (--input_calibration) is " +
-                       std::to_string(estimator.camera.width) + "x" + std::to_string(estimator.camera.height));
+                       std::to_string(estimator.camera.width) + "x" +
+                       std::to_string(estimator.camera.height));
     }
     channel->estimator = std::make_unique<LiveEstimator>(estimator, target_);
     // The opening suggestion (or the continued session's estimate), once
     // every camera is sized.
-    if (std::all_of(channels_.begin(), channels_.end(), [](const Channel& c) { return c.estimator != nullptr; })) {
+    if (std::all_of(channels_.begin(), channels_.end(),
+                    [](const Channel& c) { return c.estimator != nullptr; })) {
       StartEstimate();
     }
     return true;
@@ -415,14 +450,16 @@ bool LiveSession::CheckSize(Channel* channel, const cv::Mat& gray, const Frame& 
     channel->other_size_since_s = -1;
     return true;
   }
-  const std::string sizes = std::to_string(gray.cols) + "x" + std::to_string(gray.rows) + " instead of " +
-                            std::to_string(channel->size.width) + "x" + std::to_string(channel->size.height);
+  const std::string sizes = std::to_string(gray.cols) + "x" + std::to_string(gray.rows) +
+                            " instead of " + std::to_string(channel->size.width) + "x" +
+                            std::to_string(channel->size.height);
   // In the source's time, not the wall's: a recorded file read as fast as
   // it decodes (--Live.realtime 0) spends seconds of video in a fraction of
   // one, and a resolution that changed for good must fail there too.
   if (channel->other_size_since_s < 0) {
     channel->other_size_since_s = frame.time_s;
-    Note(channel->source + ": frame " + std::to_string(frame.index) + " is " + sizes + "; skipped", true);
+    Note(channel->source + ": frame " + std::to_string(frame.index) + " is " + sizes + "; skipped",
+         true);
   } else if (frame.time_s - channel->other_size_since_s > options_.source.stall_seconds) {
     throw InputError(channel->source + ": the frames changed size to " + sizes + " for " +
                      std::to_string(static_cast<int>(options_.source.stall_seconds)) +
@@ -443,7 +480,9 @@ class LiveSession::Frames {
     second.source = options.source2;
     pairs_ = std::make_unique<FramePairSource>(options.source, second, options.pair_tolerance_s);
   }
-  FrameStatus Next(FramePair* pair) { return pairs_ ? pairs_->Next(pair) : single_->Next(&pair->first); }
+  FrameStatus Next(FramePair* pair) {
+    return pairs_ ? pairs_->Next(pair) : single_->Next(&pair->first);
+  }
   std::string Describe() const { return pairs_ ? pairs_->Describe() : single_->Describe(); }
   // A recorded source read as fast as it decodes: nothing waits on the
   // wall, so the session waits for each estimate and its result is the same
@@ -487,8 +526,8 @@ LiveSummary LiveSession::Run() {
       break;
     }
     if (status == FrameStatus::kStalled) {
-      Note(source.Describe() + ": no frame for " + std::to_string(static_cast<int>(options_.source.stall_seconds)) +
-               " s (stalled?)",
+      Note(source.Describe() + ": no frame for " +
+               std::to_string(static_cast<int>(options_.source.stall_seconds)) + " s (stalled?)",
            true);
       if (++stalls >= 3) {
         summary_.end_reason = "the source stalled";
@@ -523,9 +562,9 @@ LiveSummary LiveSession::Run() {
   summary_.kept_views = kept_;
   summary_.seconds = WallSeconds() - start;
   summary_.estimate = estimate_;
-  LOG(INFO) << "live: " << summary_.end_reason << "; " << summary_.frames << " frames in " << std::fixed
-            << std::setprecision(1) << summary_.seconds << " s, target in " << summary_.frames_with_target << ", "
-            << summary_.kept << " views kept";
+  LOG(INFO) << "live: " << summary_.end_reason << "; " << summary_.frames << " frames in "
+            << std::fixed << std::setprecision(1) << summary_.seconds << " s, target in "
+            << summary_.frames_with_target << ", " << summary_.kept << " views kept";
   return summary_;
 }
 

@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "pipelines/detection/target_detector.h"
+#include "pipelines/guidance/live_estimator.h"
 #include "pipelines/live/frame_source.h"
 #include "pipelines/live/hands_free.h"
-#include "pipelines/guidance/live_estimator.h"
 #include "pipelines/live/live_goal.h"
 
 namespace portcal {
@@ -38,7 +38,8 @@ class KeptFrameStore {
   virtual ~KeptFrameStore() = default;
   // One image per camera (a rig's pair, in camera order) with its target;
   // returns the view's name (a pair's: the name its two images share).
-  virtual std::string Store(const std::vector<cv::Mat>& images, const std::vector<TargetDetection>& detections) = 0;
+  virtual std::string Store(const std::vector<cv::Mat>& images,
+                            const std::vector<TargetDetection>& detections) = 0;
   virtual void Remove(const std::string& name) = 0;
 };
 
@@ -48,8 +49,8 @@ struct LiveSessionOptions {
   HandsFreeOptions hands_free;
   LiveEstimatorOptions estimator;
   LiveGoalOptions goal;
-  int max_views = 0;              // finish after this many kept views (0: when the source ends)
-  double status_interval_s = 2;   // a status line on stderr this often (<= 0: never)
+  int max_views = 0;             // finish after this many kept views (0: when the source ends)
+  double status_interval_s = 2;  // a status line on stderr this often (<= 0: never)
   // A stereo rig: camera 2's source (empty: one camera; the other source
   // options are shared), frames paired by time within pair_tolerance_s
   // (<= 0: half a frame interval), and camera 2's start (its model, or its
@@ -59,7 +60,7 @@ struct LiveSessionOptions {
   Camera camera2;
   std::optional<Housing> housing2;
   bool Stereo() const { return !source2.empty(); }
-  void Check() const;             // throws OptionError naming the option
+  void Check() const;  // throws OptionError naming the option
 };
 
 // One kept view as the session holds it.
@@ -68,7 +69,7 @@ struct KeptView {
   double time_s = 0;
   CalibrationView view;  // the precise corners
   CornerMap corners;
-  cv::Mat thumbnail;     // BGR, 160 px wide (empty for a continued session's views)
+  cv::Mat thumbnail;  // BGR, 160 px wide (empty for a continued session's views)
   // A rig's camera 2 (empty for one camera).
   CalibrationView view2;
   CornerMap corners2;
@@ -76,23 +77,24 @@ struct KeptView {
 
 // What a viewer shows (a copy, taken under the session's lock).
 struct LiveSnapshot {
-  cv::Mat frame;             // the newest frame, gray
+  cv::Mat frame;  // the newest frame, gray
   double time_s = 0;
   int64_t frame_index = 0;
   int64_t frames_processed = 0;  // counts every processed frame (WaitForFrame)
   double arrival_wall_s = 0;     // when the frame was read (steady clock, s)
-  double fps = 0;            // frames processed per second, recently
-  bool target_seen = false;  // by every camera
-  CornerMap corners;         // quick corners of the newest frame
-  cv::Mat frame2;            // a rig's camera 2 (empty for one camera)
+  double fps = 0;                // frames processed per second, recently
+  bool target_seen = false;      // by every camera
+  CornerMap corners;             // quick corners of the newest frame
+  cv::Mat frame2;                // a rig's camera 2 (empty for one camera)
   CornerMap corners2;
   StillnessTracker::State hold;
   std::vector<KeptView> kept;
   std::shared_ptr<const LiveEstimate> estimate;
   std::optional<PoseDistance> to_suggestion;  // the current pose vs the suggestion
-  LiveGoal goal;             // of the newest estimate
-  std::string message;       // the last warning or event, for the page
-  std::string final_status;  // after the session: the final calibration's progress, then its outcome
+  LiveGoal goal;                              // of the newest estimate
+  std::string message;                        // the last warning or event, for the page
+  std::string
+      final_status;  // after the session: the final calibration's progress, then its outcome
 };
 
 // What the session said (kept, refused and why), at a frame's media time.
@@ -103,11 +105,11 @@ struct LiveNote {
 };
 
 struct LiveSummary {
-  int64_t frames = 0;             // processed
+  int64_t frames = 0;  // processed
   int64_t frames_with_target = 0;
   int kept = 0;
   double seconds = 0;
-  std::string end_reason;         // "the source ended", "finish requested", ...
+  std::string end_reason;            // "the source ended", "finish requested", ...
   std::vector<KeptView> kept_views;  // in the order kept
   std::vector<LiveNote> notes;       // in the order said
   std::shared_ptr<const LiveEstimate> estimate;
@@ -116,7 +118,8 @@ struct LiveSummary {
 class LiveSession {
  public:
   // `existing`: views already kept in this database (a continued session).
-  LiveSession(const LiveSessionOptions& options, KeptFrameStore* store, std::vector<KeptView> existing = {});
+  LiveSession(const LiveSessionOptions& options, KeptFrameStore* store,
+              std::vector<KeptView> existing = {});
   ~LiveSession();
 
   // Until the source ends, max_views are kept, Finish() or Ctrl-C
@@ -156,7 +159,8 @@ class LiveSession {
     std::unique_ptr<LiveEstimator> estimator;
     StillnessTracker tracker;
     cv::Size size;
-    double other_size_since_s = -1;  // the source's time (Frame::time_s) frames of another size began
+    double other_size_since_s =
+        -1;  // the source's time (Frame::time_s) frames of another size began
     Frame sharpest;
     cv::Mat sharpest_gray;
     CornerMap sharpest_corners;
@@ -170,7 +174,8 @@ class LiveSession {
   std::string NotNovel(const std::vector<Sight>& sights) const;
   // Hands-free: the spells' states combined; the sharpest frames kept;
   // a pose held and not kept, said.
-  StillnessTracker::State Hold(const std::vector<Sight>& sights, double time_s, const std::string& lost_reason);
+  StillnessTracker::State Hold(const std::vector<Sight>& sights, double time_s,
+                               const std::string& lost_reason);
   std::vector<Sight> SharpestSights() const;
   bool TryKeep(const std::vector<Sight>& sights, bool requested);
   double Gain(const std::vector<CalibrationView>& views) const;

@@ -2,12 +2,12 @@
 // combined (and the sharpest moment of each kept), the spells that ended
 // before they were tried said with what broke them, and whether a view
 // repeats a kept (or refused) one. live_session.cc runs the loop.
-#include "pipelines/live/live_session.h"
-
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+
+#include "pipelines/live/live_session.h"
 
 namespace portcal {
 
@@ -24,17 +24,20 @@ void LiveSession::RememberRefused(const std::vector<Sight>& sights) {
 std::string LiveSession::NotNovel(const std::vector<Sight>& sights) const {
   const cv::Mat& image = sights[0].frame->image;
   const double novelty_px =
-      options_.hands_free.novelty_fraction * std::hypot(static_cast<double>(image.cols), static_cast<double>(image.rows));
+      options_.hands_free.novelty_fraction *
+      std::hypot(static_cast<double>(image.cols), static_cast<double>(image.rows));
   for (const std::vector<KeptView>* seen : {&kept_, &rejected_}) {
     for (const KeptView& kept : *seen) {
       const double shift = MeanCornerShift(sights[0].corners, kept.corners);
       bool same = shift < novelty_px;
-      if (sights.size() > 1) same = same && MeanCornerShift(sights[1].corners, kept.corners2) < novelty_px;
+      if (sights.size() > 1)
+        same = same && MeanCornerShift(sights[1].corners, kept.corners2) < novelty_px;
       if (!same) continue;
       if (seen == &rejected_) return "refused before";
       std::ostringstream why;
-      why << std::fixed << std::setprecision(0) << "too close to the kept view " << kept.name << " (corners " << shift
-          << " px from it on average, under " << novelty_px << " px: --Live.novelty)";
+      why << std::fixed << std::setprecision(0) << "too close to the kept view " << kept.name
+          << " (corners " << shift << " px from it on average, under " << novelty_px
+          << " px: --Live.novelty)";
       return why.str();
     }
   }
@@ -62,8 +65,8 @@ StillnessTracker::State LiveSession::Hold(const std::vector<Sight>& sights, doub
   }
   // Every camera's frame of one moment, so that a rig's pair stays a pair
   // (camera 1 chooses it; a spell begun anew by either camera restarts it).
-  const bool all_seen =
-      std::all_of(sights.begin(), sights.end(), [](const Sight& sight) { return !sight.corners.empty(); });
+  const bool all_seen = std::all_of(sights.begin(), sights.end(),
+                                    [](const Sight& sight) { return !sight.corners.empty(); });
   if (all_seen && (sharpest || hold.new_spell)) {
     for (size_t c = 0; c < sights.size(); ++c) {
       Channel& channel = channels_[c];
@@ -77,14 +80,16 @@ StillnessTracker::State LiveSession::Hold(const std::vector<Sight>& sights, doub
   if (!hold.new_spell) return hold;
   // A spell held for half the time asked, ended before it was tried: the
   // person meant to hold this pose; say what broke it.
-  if (options_.hands_free.enabled && !spell_tried_ && hold.ended_held_s >= 0.5 * options_.hands_free.still_seconds) {
+  if (options_.hands_free.enabled && !spell_tried_ &&
+      hold.ended_held_s >= 0.5 * options_.hands_free.still_seconds) {
     std::ostringstream why;
     why << std::fixed << std::setprecision(1) << "held " << hold.ended_held_s << " s of "
         << options_.hands_free.still_seconds << " s (--Live.still_seconds), not kept: ";
     if (std::isinf(hold.ended_motion_px)) {
       why << "the target was lost" << (lost_reason.empty() ? "" : " (" + lost_reason + ")");
     } else {
-      why << "it moved by " << hold.ended_motion_px << " px (--Live.still_px " << options_.hands_free.still_px << ")";
+      why << "it moved by " << hold.ended_motion_px << " px (--Live.still_px "
+          << options_.hands_free.still_px << ")";
     }
     Note(why.str(), false);
   }
@@ -94,7 +99,8 @@ StillnessTracker::State LiveSession::Hold(const std::vector<Sight>& sights, doub
 
 std::vector<LiveSession::Sight> LiveSession::SharpestSights() const {
   std::vector<Sight> sights;
-  for (const Channel& channel : channels_) sights.push_back({&channel.sharpest, channel.sharpest_gray, channel.sharpest_corners});
+  for (const Channel& channel : channels_)
+    sights.push_back({&channel.sharpest, channel.sharpest_gray, channel.sharpest_corners});
   return sights;
 }
 

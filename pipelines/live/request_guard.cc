@@ -20,7 +20,8 @@ bool SplitHost(const std::string& header, std::string* host, int* port) {
 }
 
 bool IsIpLiteralOrLocalhost(const std::string& host) {
-  static const std::regex ipv4(R"(^(25[0-5]|2[0-4][0-9]|1?[0-9]?[0-9])(\.(25[0-5]|2[0-4][0-9]|1?[0-9]?[0-9])){3}$)");
+  static const std::regex ipv4(
+      R"(^(25[0-5]|2[0-4][0-9]|1?[0-9]?[0-9])(\.(25[0-5]|2[0-4][0-9]|1?[0-9]?[0-9])){3}$)");
   if (host == "localhost" || std::regex_match(host, ipv4)) return true;
   return host.size() > 2 && host.front() == '[' && host.back() == ']';
 }
@@ -39,7 +40,8 @@ std::string CookieValue(const std::string& cookies, const std::string& name) {
 
 }  // namespace
 
-std::optional<std::string> RefuseLiveRequest(const LiveRequest& request, int port, const std::string& token) {
+std::optional<std::string> RefuseLiveRequest(const LiveRequest& request, int port,
+                                             const std::string& token) {
   std::string host;
   int host_port = -1;
   if (!SplitHost(request.host, &host, &host_port) || !IsIpLiteralOrLocalhost(host)) {
@@ -51,11 +53,13 @@ std::optional<std::string> RefuseLiveRequest(const LiveRequest& request, int por
     if (!request.origin.empty() && request.origin != "http://" + request.host) {
       return "a command from another page (Origin " + request.origin + ")";
     }
-    if (!request.sec_fetch_site.empty() && request.sec_fetch_site != "same-origin" && request.sec_fetch_site != "none") {
+    if (!request.sec_fetch_site.empty() && request.sec_fetch_site != "same-origin" &&
+        request.sec_fetch_site != "none") {
       return "a command from another site (Sec-Fetch-Site " + request.sec_fetch_site + ")";
     }
   }
-  if (!token.empty() && request.token_param != token && CookieValue(request.cookie, kCookieName) != token) {
+  if (!token.empty() && request.token_param != token &&
+      CookieValue(request.cookie, kCookieName) != token) {
     return "no valid token (open the address portcal printed, with its ?token=)";
   }
   return std::nullopt;

@@ -25,7 +25,8 @@ struct LiveRequest {
 // sent, of http://<Host>, and a Sec-Fetch-Site, where sent, of same-origin
 // or none. With a `token`, the request carries it (?token= or the cookie
 // the page set).
-std::optional<std::string> RefuseLiveRequest(const LiveRequest& request, int port, const std::string& token);
+std::optional<std::string> RefuseLiveRequest(const LiveRequest& request, int port,
+                                             const std::string& token);
 
 // The cookie that carries `token` for the page's later requests.
 std::string LiveTokenCookie(const std::string& token);

@@ -11,14 +11,22 @@ namespace {
 const std::vector<std::pair<std::string, cv::aruco::PREDEFINED_DICTIONARY_NAME>>& Table() {
   using namespace cv::aruco;
   static const std::vector<std::pair<std::string, PREDEFINED_DICTIONARY_NAME>> kTable = {
-      {"DICT_4X4_50", DICT_4X4_50},       {"DICT_4X4_100", DICT_4X4_100},
-      {"DICT_4X4_250", DICT_4X4_250},     {"DICT_4X4_1000", DICT_4X4_1000},
-      {"DICT_5X5_50", DICT_5X5_50},       {"DICT_5X5_100", DICT_5X5_100},
-      {"DICT_5X5_250", DICT_5X5_250},     {"DICT_5X5_1000", DICT_5X5_1000},
-      {"DICT_6X6_50", DICT_6X6_50},       {"DICT_6X6_100", DICT_6X6_100},
-      {"DICT_6X6_250", DICT_6X6_250},     {"DICT_6X6_1000", DICT_6X6_1000},
-      {"DICT_7X7_50", DICT_7X7_50},       {"DICT_7X7_100", DICT_7X7_100},
-      {"DICT_7X7_250", DICT_7X7_250},     {"DICT_7X7_1000", DICT_7X7_1000},
+      {"DICT_4X4_50", DICT_4X4_50},
+      {"DICT_4X4_100", DICT_4X4_100},
+      {"DICT_4X4_250", DICT_4X4_250},
+      {"DICT_4X4_1000", DICT_4X4_1000},
+      {"DICT_5X5_50", DICT_5X5_50},
+      {"DICT_5X5_100", DICT_5X5_100},
+      {"DICT_5X5_250", DICT_5X5_250},
+      {"DICT_5X5_1000", DICT_5X5_1000},
+      {"DICT_6X6_50", DICT_6X6_50},
+      {"DICT_6X6_100", DICT_6X6_100},
+      {"DICT_6X6_250", DICT_6X6_250},
+      {"DICT_6X6_1000", DICT_6X6_1000},
+      {"DICT_7X7_50", DICT_7X7_50},
+      {"DICT_7X7_100", DICT_7X7_100},
+      {"DICT_7X7_250", DICT_7X7_250},
+      {"DICT_7X7_1000", DICT_7X7_1000},
       {"DICT_ARUCO_ORIGINAL", DICT_ARUCO_ORIGINAL},
       {"DICT_APRILTAG_16h5", DICT_APRILTAG_16h5},
       {"DICT_APRILTAG_25h9", DICT_APRILTAG_25h9},
@@ -53,8 +61,8 @@ void CheckArucoDictionaryOption(const std::string& option, const std::string& na
   throw OptionError(option, name, "an ArUco dictionary: " + names);
 }
 
-std::vector<uint8_t> ArucoMarkerModules(const cv::aruco::Dictionary& dictionary,
-                                        int marker_id, int* modules_per_side) {
+std::vector<uint8_t> ArucoMarkerModules(const cv::aruco::Dictionary& dictionary, int marker_id,
+                                        int* modules_per_side) {
   if (marker_id < 0 || marker_id >= dictionary.bytesList.rows) {
     throw InputError("ArUco marker id " + std::to_string(marker_id) +
                      " is not in the dictionary (it has " +

@@ -19,7 +19,7 @@ void CheckArucoDictionaryOption(const std::string& option, const std::string& na
 // (bits + 2)^2 entries: 1 white, 0 black. Row 0 is the top edge (top-left to
 // top-right corner) of the printed marker. Throws InputError for an id the
 // dictionary does not have.
-std::vector<uint8_t> ArucoMarkerModules(const cv::aruco::Dictionary& dictionary,
-                                        int marker_id, int* modules_per_side);
+std::vector<uint8_t> ArucoMarkerModules(const cv::aruco::Dictionary& dictionary, int marker_id,
+                                        int* modules_per_side);
 
 }  // namespace portcal

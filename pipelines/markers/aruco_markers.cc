@@ -7,7 +7,8 @@
 
 namespace portcal {
 
-std::vector<MarkerDetection> DetectArucoMarkers(const cv::Mat& gray, const std::string& dictionary) {
+std::vector<MarkerDetection> DetectArucoMarkers(const cv::Mat& gray,
+                                                const std::string& dictionary) {
   const cv::Ptr<cv::aruco::Dictionary> dict = ArucoDictionaryByName(dictionary);
   cv::Ptr<cv::aruco::DetectorParameters> parameters = cv::aruco::DetectorParameters::create();
   parameters->cornerRefinementMethod = cv::aruco::CORNER_REFINE_SUBPIX;
@@ -25,7 +26,8 @@ std::vector<MarkerDetection> DetectArucoMarkers(const cv::Mat& gray, const std::
     for (int c = 0; c < 4; ++c) quad[c] = cv::Point2d(corners[m][c].x, corners[m][c].y);
     // Edge-line corners where the edges allow (see marker_edge_crossings.h).
     RefineMarkerCornersByCrossings(gray, refinement, &quad);
-    for (int c = 0; c < 4; ++c) detection.corners[c] = Eigen::Vector2d(quad[c].x + 0.5, quad[c].y + 0.5);
+    for (int c = 0; c < 4; ++c)
+      detection.corners[c] = Eigen::Vector2d(quad[c].x + 0.5, quad[c].y + 0.5);
     markers.push_back(detection);
   }
   return markers;

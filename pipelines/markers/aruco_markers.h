@@ -4,9 +4,8 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <opencv2/core.hpp>
-
 #include <array>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 

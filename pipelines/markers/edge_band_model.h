@@ -33,8 +33,8 @@ struct EdgeBandModel {
 
   // Gauss-Newton's normal equations at `q` over the pixels `use` marks;
   // returns the cost.
-  double Linearise(const std::vector<BandPixel>& band, const std::vector<char>& use, const Params& q, Normal* jtj,
-                   Params* jtr) const {
+  double Linearise(const std::vector<BandPixel>& band, const std::vector<char>& use,
+                   const Params& q, Normal* jtj, Params* jtr) const {
     const double w = std::exp(-q[7]) / std::sqrt(2.0);
     const double width_x = w * n.x(), width_y = w * n.y();
     jtj->setZero();

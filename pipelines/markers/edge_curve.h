@@ -44,8 +44,10 @@ struct EdgeCurve {
   }
 };
 
-inline std::optional<Eigen::Vector2d> IntersectLines(const Eigen::Vector2d& pa, const Eigen::Vector2d& da,
-                                              const Eigen::Vector2d& pb, const Eigen::Vector2d& db) {
+inline std::optional<Eigen::Vector2d> IntersectLines(const Eigen::Vector2d& pa,
+                                                     const Eigen::Vector2d& da,
+                                                     const Eigen::Vector2d& pb,
+                                                     const Eigen::Vector2d& db) {
   Eigen::Matrix2d A;
   A << da, -db;
   if (std::abs(A.determinant()) < 1e-6) return std::nullopt;
@@ -56,7 +58,7 @@ inline std::optional<Eigen::Vector2d> IntersectLines(const Eigen::Vector2d& pa, 
 // Where the end of `before` meets the start of `after`: tangent lines at
 // the current estimates, intersected, a few times over.
 inline std::optional<Eigen::Vector2d> IntersectCurves(const EdgeCurve& before, double before_length,
-                                               const EdgeCurve& after) {
+                                                      const EdgeCurve& after) {
   double t1 = before_length, t2 = 0;
   std::optional<Eigen::Vector2d> x;
   for (int iteration = 0; iteration < 5; ++iteration) {

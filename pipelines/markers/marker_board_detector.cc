@@ -1,15 +1,15 @@
 #include "pipelines/markers/marker_board_detector.h"
 
+#include <map>
 #include <opencv2/aruco.hpp>
 #include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
-#include <map>
 
 #include "colmap_ext/util/error.h"
-#include "pipelines/target/coarse_level.h"
 #include "pipelines/markers/aruco.h"
 #include "pipelines/markers/marker_edge_crossings.h"
 #include "pipelines/markers/marker_edge_refinement.h"
+#include "pipelines/target/coarse_level.h"
 
 namespace portcal {
 
@@ -24,13 +24,15 @@ void MarkerBoardOptions::Check() const {
   if (type == "charuco" && (squares_x < 3 || squares_y < 3)) {
     throw OptionError("--Target.squares_x/squares_y", std::to_string(squares_x), ">= 3 each");
   }
-  if (!(marker_size_m > 0)) throw OptionError("--Target.marker_size", std::to_string(marker_size_m), "> 0 m");
+  if (!(marker_size_m > 0))
+    throw OptionError("--Target.marker_size", std::to_string(marker_size_m), "> 0 m");
   if (type == "charuco" && !(square_size_m > marker_size_m)) {
     throw OptionError("--Target.square_size", std::to_string(square_size_m), "> marker_size");
   }
   if (min_points < 4) throw OptionError("--Target.min_points", std::to_string(min_points), ">= 4");
   if (coarse_max_image_size < 0) {
-    throw OptionError("--Target.coarse_max_image_size", std::to_string(coarse_max_image_size), ">= 0");
+    throw OptionError("--Target.coarse_max_image_size", std::to_string(coarse_max_image_size),
+                      ">= 0");
   }
   refinement.Check();
 }
@@ -44,10 +46,9 @@ cv::Ptr<cv::aruco::Board> MakeBoard(const MarkerBoardOptions& options,
                                     const cv::Ptr<cv::aruco::Dictionary>& dictionary,
                                     cv::Ptr<cv::aruco::CharucoBoard>* charuco) {
   if (options.type == "aruco_grid") {
-    return cv::aruco::GridBoard::create(options.markers_x, options.markers_y,
-                                        static_cast<float>(options.marker_size_m),
-                                        static_cast<float>(options.marker_separation_m), dictionary,
-                                        options.first_marker);
+    return cv::aruco::GridBoard::create(
+        options.markers_x, options.markers_y, static_cast<float>(options.marker_size_m),
+        static_cast<float>(options.marker_separation_m), dictionary, options.first_marker);
   }
   *charuco = cv::aruco::CharucoBoard::create(options.squares_x, options.squares_y,
                                              static_cast<float>(options.square_size_m),
@@ -79,7 +80,8 @@ bool RefineMarker(const cv::Mat& gray, const MarkerBoardOptions& options, int bi
                           ? RefineMarkerCorners(gray, edge_options, &quad)
                           : RefineMarkerCornersByCrossings(gray, edge_options, &quad);
   if (!fitted) return false;
-  for (int k = 0; k < 4; ++k) (*corners)[k] = cv::Point2f(static_cast<float>(quad[k].x), static_cast<float>(quad[k].y));
+  for (int k = 0; k < 4; ++k)
+    (*corners)[k] = cv::Point2f(static_cast<float>(quad[k].x), static_cast<float>(quad[k].y));
   return true;
 }
 
@@ -87,10 +89,12 @@ bool RefineMarker(const cv::Mat& gray, const MarkerBoardOptions& options, int bi
 // (quick) on the coarse level without one, the corners then brought back
 // to full-resolution pixels.
 void DetectMarkersOnLevel(const cv::Mat& gray, const MarkerBoardOptions& options,
-                          const cv::Ptr<cv::aruco::Dictionary>& dictionary, const cv::Ptr<cv::aruco::Board>& board,
+                          const cv::Ptr<cv::aruco::Dictionary>& dictionary,
+                          const cv::Ptr<cv::aruco::Board>& board,
                           std::vector<std::vector<cv::Point2f>>* corners, std::vector<int>* ids) {
-  const auto [scale, level] =
-      options.precise_fit ? std::pair<double, cv::Mat>(1.0, gray) : CoarseLevel(gray, options.coarse_max_image_size);
+  const auto [scale, level] = options.precise_fit
+                                  ? std::pair<double, cv::Mat>(1.0, gray)
+                                  : CoarseLevel(gray, options.coarse_max_image_size);
   cv::Ptr<cv::aruco::DetectorParameters> parameters = cv::aruco::DetectorParameters::create();
   // Line fits to the contour: sub-pixel without cornerSubPix's habit of
   // jumping to a neighbouring marker. Quick: the crossings start from the
@@ -103,14 +107,16 @@ void DetectMarkersOnLevel(const cv::Mat& gray, const MarkerBoardOptions& options
   if (scale == 1.0) return;
   for (auto& marker : *corners) {
     for (cv::Point2f& p : marker) {
-      p = cv::Point2f(static_cast<float>((p.x + 0.5) / scale - 0.5), static_cast<float>((p.y + 0.5) / scale - 0.5));
+      p = cv::Point2f(static_cast<float>((p.x + 0.5) / scale - 0.5),
+                      static_cast<float>((p.y + 0.5) / scale - 0.5));
     }
   }
 }
 
 BoardMarkers DetectBoardMarkers(const cv::Mat& gray, const MarkerBoardOptions& options,
                                 const cv::Ptr<cv::aruco::Dictionary>& dictionary,
-                                const cv::Ptr<cv::aruco::Board>& board, MarkerBoardDetection* detection) {
+                                const cv::Ptr<cv::aruco::Board>& board,
+                                MarkerBoardDetection* detection) {
   std::vector<std::vector<cv::Point2f>> corners;
   std::vector<int> ids;
   DetectMarkersOnLevel(gray, options, dictionary, board, &corners, &ids);
@@ -161,11 +167,13 @@ cv::Mat MarkersHomography(const BoardMarkers& markers, const cv::aruco::Board& b
 
 // The chessboard corners between the markers, interpolated by OpenCV and
 // refined on the two-edge pattern.
-void AddCharucoCorners(const cv::Mat& gray, const MarkerBoardOptions& options, const BoardMarkers& markers,
-                       const cv::Ptr<cv::aruco::CharucoBoard>& charuco, MarkerBoardDetection* detection) {
+void AddCharucoCorners(const cv::Mat& gray, const MarkerBoardOptions& options,
+                       const BoardMarkers& markers, const cv::Ptr<cv::aruco::CharucoBoard>& charuco,
+                       MarkerBoardDetection* detection) {
   std::vector<cv::Point2f> charuco_corners;
   std::vector<int> charuco_ids;
-  cv::aruco::interpolateCornersCharuco(markers.corners, markers.ids, gray, charuco, charuco_corners, charuco_ids);
+  cv::aruco::interpolateCornersCharuco(markers.corners, markers.ids, gray, charuco, charuco_corners,
+                                       charuco_ids);
   if (!options.precise_fit && !charuco_corners.empty()) {
     cv::cornerSubPix(gray, charuco_corners, cv::Size(2, 2), cv::Size(-1, -1),
                      cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 10, 0.01));
@@ -174,8 +182,9 @@ void AddCharucoCorners(const cv::Mat& gray, const MarkerBoardOptions& options, c
   const auto to_image = [&](double x, double y) {
     const cv::Mat h = homography;
     const double w = h.at<double>(2, 0) * x + h.at<double>(2, 1) * y + h.at<double>(2, 2);
-    return Eigen::Vector2d((h.at<double>(0, 0) * x + h.at<double>(0, 1) * y + h.at<double>(0, 2)) / w,
-                           (h.at<double>(1, 0) * x + h.at<double>(1, 1) * y + h.at<double>(1, 2)) / w);
+    return Eigen::Vector2d(
+        (h.at<double>(0, 0) * x + h.at<double>(0, 1) * y + h.at<double>(0, 2)) / w,
+        (h.at<double>(1, 0) * x + h.at<double>(1, 1) * y + h.at<double>(1, 2)) / w);
   };
   for (size_t i = 0; i < charuco_ids.size(); ++i) {
     const cv::Point3f& p = charuco->chessboardCorners[charuco_ids[i]];
@@ -186,10 +195,12 @@ void AddCharucoCorners(const cv::Mat& gray, const MarkerBoardOptions& options, c
       const Eigen::Vector2d dy = to_image(p.x, p.y + s) - to_image(p.x, p.y);
       // Stay inside the white margin around the neighbouring markers:
       // their modules are not part of the corner's two-edge pattern.
-      const double margin = 0.5 * (options.square_size_m - options.marker_size_m) / options.square_size_m;
+      const double margin =
+          0.5 * (options.square_size_m - options.marker_size_m) / options.square_size_m;
       const double fraction = std::min(options.refinement.window_fraction, 0.9 * margin);
-      const double half = std::clamp(fraction * std::min(dx.norm(), dy.norm()),
-                                     options.refinement.min_window_px, options.refinement.max_window_px);
+      const double half =
+          std::clamp(fraction * std::min(dx.norm(), dy.norm()), options.refinement.min_window_px,
+                     options.refinement.max_window_px);
       const auto refined = RefineCorner(gray, xy, half, std::atan2(dx.x(), -dx.y()),
                                         std::atan2(dy.x(), -dy.y()), options.refinement);
       if (!refined) {  // no clean corner there
@@ -211,7 +222,8 @@ MarkerBoardDetection DetectMarkerBoard(const cv::Mat& gray, const MarkerBoardOpt
   cv::Ptr<cv::aruco::CharucoBoard> charuco;
   const cv::Ptr<cv::aruco::Board> board = MakeBoard(options, dictionary, &charuco);
   const BoardMarkers markers = DetectBoardMarkers(gray, options, dictionary, board, &detection);
-  if (options.type == "charuco" && !markers.ids.empty()) AddCharucoCorners(gray, options, markers, charuco, &detection);
+  if (options.type == "charuco" && !markers.ids.empty())
+    AddCharucoCorners(gray, options, markers, charuco, &detection);
   if (static_cast<int>(detection.points.size()) < options.min_points) {
     detection.reason = "only " + std::to_string(detection.points.size()) + " board points (" +
                        std::to_string(markers.ids.size()) + " of the board's markers) found";
@@ -221,10 +233,12 @@ MarkerBoardDetection DetectMarkerBoard(const cv::Mat& gray, const MarkerBoardOpt
   if (detection.num_markers_unfitted > 0) {
     const int found = static_cast<int>(markers.ids.size());
     const int unfitted = detection.num_markers_unfitted;
-    detection.note = std::to_string(4 * unfitted) + " of " + std::to_string(4 * found) + " marker corners left out (" +
-                     std::to_string(unfitted) + (unfitted == 1 ? " marker" : " markers") +
-                     (unfitted == 1 ? " too foreshortened, cut or blurred for its edges to be fitted)"
-                                   : " too foreshortened, cut or blurred for their edges to be fitted)");
+    detection.note =
+        std::to_string(4 * unfitted) + " of " + std::to_string(4 * found) +
+        " marker corners left out (" + std::to_string(unfitted) +
+        (unfitted == 1 ? " marker" : " markers") +
+        (unfitted == 1 ? " too foreshortened, cut or blurred for its edges to be fitted)"
+                       : " too foreshortened, cut or blurred for their edges to be fitted)");
   } else if (detection.num_corners_unrefined > 0) {
     detection.note = std::to_string(detection.num_corners_unrefined) + " of " +
                      std::to_string(detection.num_corners_unrefined + detection.points.size()) +
@@ -236,19 +250,22 @@ MarkerBoardDetection DetectMarkerBoard(const cv::Mat& gray, const MarkerBoardOpt
 std::vector<BoardPoint> MarkerBoardLayout(const MarkerBoardOptions& options) {
   options.Check();
   cv::Ptr<cv::aruco::CharucoBoard> charuco;
-  const cv::Ptr<cv::aruco::Board> board = MakeBoard(options, ArucoDictionaryByName(options.dictionary), &charuco);
+  const cv::Ptr<cv::aruco::Board> board =
+      MakeBoard(options, ArucoDictionaryByName(options.dictionary), &charuco);
   std::vector<BoardPoint> points;
   if (charuco) {
     for (size_t i = 0; i < charuco->chessboardCorners.size(); ++i) {
       const cv::Point3f& p = charuco->chessboardCorners[i];
-      points.push_back({static_cast<int64_t>(i), Eigen::Vector2d::Zero(), Eigen::Vector3d(p.x, p.y, p.z)});
+      points.push_back(
+          {static_cast<int64_t>(i), Eigen::Vector2d::Zero(), Eigen::Vector3d(p.x, p.y, p.z)});
     }
     return points;
   }
   for (size_t m = 0; m < board->ids.size(); ++m) {
     for (int k = 0; k < 4; ++k) {
       const cv::Point3f& p = board->objPoints[m][static_cast<size_t>(k)];
-      points.push_back({static_cast<int64_t>(board->ids[m]) * 4 + k, Eigen::Vector2d::Zero(), Eigen::Vector3d(p.x, p.y, p.z)});
+      points.push_back({static_cast<int64_t>(board->ids[m]) * 4 + k, Eigen::Vector2d::Zero(),
+                        Eigen::Vector3d(p.x, p.y, p.z)});
     }
   }
   return points;

@@ -42,9 +42,9 @@ struct MarkerBoardOptions {
 };
 
 struct BoardPoint {
-  int64_t point_id = 0;                  // aruco_grid: marker id * 4 + corner; charuco: corner id
-  Eigen::Vector2d xy;                    // COLMAP pixels
-  Eigen::Vector3d point_in_target;       // metres, OpenCV's board frame
+  int64_t point_id = 0;             // aruco_grid: marker id * 4 + corner; charuco: corner id
+  Eigen::Vector2d xy;               // COLMAP pixels
+  Eigen::Vector3d point_in_target;  // metres, OpenCV's board frame
 };
 
 struct MarkerBoardDetection {

@@ -18,7 +18,8 @@ std::optional<double> Sample(const cv::Mat& gray, const Eigen::Vector2d& p) {
   if (x0 < 0 || y0 < 0 || x0 + 1 >= gray.cols || y0 + 1 >= gray.rows) return std::nullopt;
   const double fx = x - x0, fy = y - y0;
   const auto v = [&](int r, int c) { return static_cast<double>(gray.at<uint8_t>(r, c)); };
-  return (1 - fy) * ((1 - fx) * v(y0, x0) + fx * v(y0, x0 + 1)) + fy * ((1 - fx) * v(y0 + 1, x0) + fx * v(y0 + 1, x0 + 1));
+  return (1 - fy) * ((1 - fx) * v(y0, x0) + fx * v(y0, x0 + 1)) +
+         fy * ((1 - fx) * v(y0 + 1, x0) + fx * v(y0 + 1, x0 + 1));
 }
 
 // Least squares with one pass dropping points beyond 3x the median
@@ -57,7 +58,7 @@ std::optional<Eigen::Vector3d> FitEdge(std::vector<Eigen::Vector2d> td, bool qua
 }  // namespace
 
 bool RefineMarkerCornersByCrossings(const cv::Mat& gray, const MarkerEdgeRefinementOptions& options,
-                         std::array<cv::Point2d, 4>* corners) {
+                                    std::array<cv::Point2d, 4>* corners) {
   std::array<Eigen::Vector2d, 4> c;
   for (int i = 0; i < 4; ++i) c[i] = Eigen::Vector2d((*corners)[i].x, (*corners)[i].y);
   std::array<EdgeCurve, 4> curves;
@@ -99,8 +100,10 @@ bool RefineMarkerCornersByCrossings(const cv::Mat& gray, const MarkerEdgeRefinem
       // The crossing nearest the predicted edge (s = 0).
       double best = 1e9;
       for (size_t j = 0; j + 1 < profile.size(); ++j) {
-        if ((profile[j] - mid) * (profile[j + 1] - mid) > 0 || profile[j] == profile[j + 1]) continue;
-        const double s = -half_width + kStep * (j + (mid - profile[j]) / (profile[j + 1] - profile[j]));
+        if ((profile[j] - mid) * (profile[j + 1] - mid) > 0 || profile[j] == profile[j + 1])
+          continue;
+        const double s =
+            -half_width + kStep * (j + (mid - profile[j]) / (profile[j + 1] - profile[j]));
         if (std::abs(s) < std::abs(best)) best = s;
       }
       if (best > 1e8) continue;
@@ -114,8 +117,8 @@ bool RefineMarkerCornersByCrossings(const cv::Mat& gray, const MarkerEdgeRefinem
   }
   // OpenCV's corner of a small, oblique marker can be pixels off; allow a
   // tenth of the side.
-  const double max_shift =
-      std::max(options.max_corner_shift_px, 0.025 * (lengths[0] + lengths[1] + lengths[2] + lengths[3]));
+  const double max_shift = std::max(options.max_corner_shift_px,
+                                    0.025 * (lengths[0] + lengths[1] + lengths[2] + lengths[3]));
   std::array<cv::Point2d, 4> refined;
   for (int i = 0; i < 4; ++i) {
     // Corner i joins side i-1 (c[i-1] -> c[i]) and side i (c[i] -> c[i+1]).

@@ -14,8 +14,9 @@ namespace {
 
 // The pixels whose centres lie within `half_width` of the side and away
 // from its ends (empty where the band leaves the image).
-std::vector<BandPixel> CollectBand(const cv::Mat& gray, const Eigen::Vector2d& a, const Eigen::Vector2d& u,
-                                   const Eigen::Vector2d& n, double length, double half_width, double end_margin) {
+std::vector<BandPixel> CollectBand(const cv::Mat& gray, const Eigen::Vector2d& a,
+                                   const Eigen::Vector2d& u, const Eigen::Vector2d& n,
+                                   double length, double half_width, double end_margin) {
   std::vector<BandPixel> band;
   const Eigen::Vector2d b = a + length * u;
   const double reach = half_width + 1;
@@ -44,7 +45,8 @@ std::vector<BandPixel> CollectBand(const cv::Mat& gray, const Eigen::Vector2d& a
     for (int x = static_cast<int>(std::ceil(from)); x <= static_cast<int>(std::floor(to)); ++x) {
       const Eigen::Vector2d p(x, y);  // OpenCV pixels: the pixel's centre
       const double t = (p - a).dot(u), s = (p - a).dot(n);
-      if (t < end_margin * length || t > (1 - end_margin) * length || std::abs(s) > half_width) continue;
+      if (t < end_margin * length || t > (1 - end_margin) * length || std::abs(s) > half_width)
+        continue;
       band.push_back({t / length, s, static_cast<double>(gray.at<uint8_t>(y, x))});
     }
   }
@@ -52,8 +54,8 @@ std::vector<BandPixel> CollectBand(const cv::Mat& gray, const Eigen::Vector2d& a
 }
 
 // Levenberg-Marquardt from `q`; false where a step is not finite.
-bool MinimiseBand(const EdgeBandModel& model, const std::vector<BandPixel>& band, const std::vector<char>& use,
-                  EdgeBandModel::Params* q) {
+bool MinimiseBand(const EdgeBandModel& model, const std::vector<BandPixel>& band,
+                  const std::vector<char>& use, EdgeBandModel::Params* q) {
   EdgeBandModel::Normal jtj, trial_jtj;
   EdgeBandModel::Params jtr, trial_jtr;
   double cost = model.Linearise(band, use, *q, &jtj, &jtr);
@@ -68,7 +70,8 @@ bool MinimiseBand(const EdgeBandModel& model, const std::vector<BandPixel>& band
       *q += step;
       // The edge's offset to a ten-thousandth of a pixel is plenty for
       // corners good to hundredths.
-      const bool converged = cost - trial_cost < 1e-7 * cost || step.head<3>().cwiseAbs().maxCoeff() < 1e-4;
+      const bool converged =
+          cost - trial_cost < 1e-7 * cost || step.head<3>().cwiseAbs().maxCoeff() < 1e-4;
       cost = trial_cost;
       jtj = trial_jtj;
       jtr = trial_jtr;
@@ -88,9 +91,10 @@ bool MinimiseBand(const EdgeBandModel& model, const std::vector<BandPixel>& band
 // reaches the next module would shift. A second fit leaves out the pixels
 // beyond 4 robust sigmas of the first (a bit's corner or a specular spot
 // reaching into the band). Returns d's coefficients in t (pixels).
-std::optional<Eigen::Vector3d> FitEdgeToPixels(const cv::Mat& gray, const Eigen::Vector2d& a, const Eigen::Vector2d& u,
-                                               const Eigen::Vector2d& n, double length, double half_width,
-                                               double end_margin, bool quadratic, double min_contrast) {
+std::optional<Eigen::Vector3d> FitEdgeToPixels(const cv::Mat& gray, const Eigen::Vector2d& a,
+                                               const Eigen::Vector2d& u, const Eigen::Vector2d& n,
+                                               double length, double half_width, double end_margin,
+                                               bool quadratic, double min_contrast) {
   const std::vector<BandPixel> band = CollectBand(gray, a, u, n, length, half_width, end_margin);
   if (band.size() < 20) return std::nullopt;
   double dark = 0, light = 0;
@@ -134,8 +138,9 @@ std::optional<Eigen::Vector3d> FitEdgeToPixels(const cv::Mat& gray, const Eigen:
 
 // Each side's curve fitted in a band about the line through the corners
 // `c`; false where a side cannot be fitted.
-bool FitSides(const cv::Mat& gray, const MarkerEdgeRefinementOptions& options, const std::array<Eigen::Vector2d, 4>& c,
-              std::array<EdgeCurve, 4>* curves, std::array<double, 4>* lengths) {
+bool FitSides(const cv::Mat& gray, const MarkerEdgeRefinementOptions& options,
+              const std::array<Eigen::Vector2d, 4>& c, std::array<EdgeCurve, 4>* curves,
+              std::array<double, 4>* lengths) {
   for (int i = 0; i < 4; ++i) {
     const QuadSide side = SideOfQuad(c, i);
     const Eigen::Vector2d a = side.a, u = side.u, n = side.n;
@@ -150,8 +155,8 @@ bool FitSides(const cv::Mat& gray, const MarkerEdgeRefinementOptions& options, c
     if (module < options.min_module_px) return false;
     const double half_width = std::clamp(0.45 * module, 1.5, 6.0);
     // A bend needs a long side to be measured; short sides are lines.
-    const auto fit = FitEdgeToPixels(gray, a, u, n, length, half_width, options.end_margin, length >= 40,
-                                     options.min_contrast);
+    const auto fit = FitEdgeToPixels(gray, a, u, n, length, half_width, options.end_margin,
+                                     length >= 40, options.min_contrast);
     if (!fit) return false;
     (*curves)[i] = EdgeCurve{a, u, n, *fit};
     (*lengths)[i] = length;
@@ -186,8 +191,8 @@ bool RefineMarkerCorners(const cv::Mat& gray, const MarkerEdgeRefinementOptions&
     c = next;
     if (largest_move < 0.01) break;
   }
-  const double max_shift =
-      std::max(options.max_corner_shift_px, 0.025 * (lengths[0] + lengths[1] + lengths[2] + lengths[3]));
+  const double max_shift = std::max(options.max_corner_shift_px,
+                                    0.025 * (lengths[0] + lengths[1] + lengths[2] + lengths[3]));
   for (int i = 0; i < 4; ++i) {
     if ((c[i] - start[i]).norm() > max_shift) return false;
   }

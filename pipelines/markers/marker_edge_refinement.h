@@ -18,12 +18,13 @@
 namespace portcal {
 
 struct MarkerEdgeRefinementOptions {
-  int bits_per_side = 4;        // marker bits per side (the border adds 2 modules)
-  double end_margin = 0.15;     // fraction of each side left out at both ends
-  double min_contrast = 12;     // gray levels between border and surround
+  int bits_per_side = 4;             // marker bits per side (the border adds 2 modules)
+  double end_margin = 0.15;          // fraction of each side left out at both ends
+  double min_contrast = 12;          // gray levels between border and surround
   double max_corner_shift_px = 2.0;  // or a tenth of the side: larger moves are refused
-  double min_module_px = 2.5;   // a module's width across a side below which the edge cannot be fitted
-  int max_passes = 3;           // bands laid again about the fitted corners
+  double min_module_px =
+      2.5;             // a module's width across a side below which the edge cannot be fitted
+  int max_passes = 3;  // bands laid again about the fitted corners
 };
 
 // `corners`: OpenCV pixel coordinates, OpenCV's order (clockwise from the

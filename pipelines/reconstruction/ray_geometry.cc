@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgproc.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opengv/absolute_pose/NoncentralAbsoluteAdapter.hpp>
 #include <opengv/absolute_pose/methods.hpp>
 #include <opengv/sac/Ransac.hpp>
@@ -53,10 +53,9 @@ double MaxTriangulationAngle(const std::vector<Ray3d>& rays, const Eigen::Vector
   return best;
 }
 
-std::optional<Rigid3d> EstimateGeneralizedAbsolutePose(const std::vector<Ray3d>& rays_in_cam,
-                                                       const std::vector<Eigen::Vector3d>& points,
-                                                       const GeneralizedAbsolutePoseOptions& options,
-                                                       std::vector<char>* inliers) {
+std::optional<Rigid3d> EstimateGeneralizedAbsolutePose(
+    const std::vector<Ray3d>& rays_in_cam, const std::vector<Eigen::Vector3d>& points,
+    const GeneralizedAbsolutePoseOptions& options, std::vector<char>* inliers) {
   const size_t n = rays_in_cam.size();
   inliers->assign(n, 0);
   if (n < 6 || static_cast<int>(n) < options.min_num_inliers) return std::nullopt;
@@ -74,8 +73,8 @@ std::optional<Rigid3d> EstimateGeneralizedAbsolutePose(const std::vector<Ray3d>&
     rotations.push_back(Eigen::Matrix3d::Identity());
     correspondences.push_back(static_cast<int>(i));
   }
-  opengv::absolute_pose::NoncentralAbsoluteAdapter adapter(bearings, correspondences, world, offsets,
-                                                           rotations);
+  opengv::absolute_pose::NoncentralAbsoluteAdapter adapter(bearings, correspondences, world,
+                                                           offsets, rotations);
   using Problem = opengv::sac_problems::absolute_pose::AbsolutePoseSacProblem;
   opengv::sac::Ransac<Problem> ransac;
   // Deterministic: OpenGV seeds its generator from the clock unless told.
@@ -85,7 +84,8 @@ std::optional<Rigid3d> EstimateGeneralizedAbsolutePose(const std::vector<Ray3d>&
   ransac.threshold_ = 1.0 - std::cos(options.max_angle_error_rad);
   ransac.max_iterations_ = options.max_iterations;
   ransac.probability_ = options.confidence;
-  if (!ransac.computeModel() || static_cast<int>(ransac.inliers_.size()) < options.min_num_inliers) {
+  if (!ransac.computeModel() ||
+      static_cast<int>(ransac.inliers_.size()) < options.min_num_inliers) {
     return std::nullopt;
   }
   adapter.sett(ransac.model_coefficients_.col(3));
@@ -102,7 +102,8 @@ std::optional<Rigid3d> EstimateGeneralizedAbsolutePose(const std::vector<Ray3d>&
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d in_cam = cam_from_world * points[i];
     const Eigen::Vector3d d = (in_cam - rays_in_cam[i].origin).normalized();
-    const double angle = std::acos(std::clamp(d.dot(rays_in_cam[i].direction.normalized()), -1.0, 1.0));
+    const double angle =
+        std::acos(std::clamp(d.dot(rays_in_cam[i].direction.normalized()), -1.0, 1.0));
     (*inliers)[i] = angle < options.max_angle_error_rad;
     count += (*inliers)[i];
   }
@@ -122,8 +123,10 @@ std::optional<Rigid3d> EstimateRelativePose(const std::vector<Eigen::Vector3d>& 
     // Rays at 90 degrees or more from the optical axis have no image
     // coordinates; they are left out of the essential matrix.
     if (directions1[i].z() < 1e-3 || directions2[i].z() < 1e-3) continue;
-    p1.emplace_back(directions1[i].x() / directions1[i].z(), directions1[i].y() / directions1[i].z());
-    p2.emplace_back(directions2[i].x() / directions2[i].z(), directions2[i].y() / directions2[i].z());
+    p1.emplace_back(directions1[i].x() / directions1[i].z(),
+                    directions1[i].y() / directions1[i].z());
+    p2.emplace_back(directions2[i].x() / directions2[i].z(),
+                    directions2[i].y() / directions2[i].z());
     index.push_back(i);
   }
   if (p1.size() < 8) return std::nullopt;
@@ -134,7 +137,8 @@ std::optional<Rigid3d> EstimateRelativePose(const std::vector<Eigen::Vector3d>& 
   if (E.rows != 3 || E.cols != 3) return std::nullopt;
   cv::Mat R, t;
   if (cv::recoverPose(E, p1, p2, cv::Mat::eye(3, 3, CV_64F), R, t, mask) < 8) return std::nullopt;
-  for (size_t k = 0; k < index.size(); ++k) (*inliers)[index[k]] = mask.at<uchar>(static_cast<int>(k)) != 0;
+  for (size_t k = 0; k < index.size(); ++k)
+    (*inliers)[index[k]] = mask.at<uchar>(static_cast<int>(k)) != 0;
   Eigen::Matrix3d rotation;
   Eigen::Vector3d translation;
   cv::cv2eigen(R, rotation);
@@ -142,11 +146,13 @@ std::optional<Rigid3d> EstimateRelativePose(const std::vector<Eigen::Vector3d>& 
   return Rigid3d(Eigen::Quaterniond(rotation).normalized(), translation.normalized());
 }
 
-std::optional<double> FocalLengthFromMarkers(const std::vector<MarkerQuad>& markers, double cx, double cy) {
+std::optional<double> FocalLengthFromMarkers(const std::vector<MarkerQuad>& markers, double cx,
+                                             double cy) {
   // Homography from the unit square (0,0),(1,0),(1,1),(0,1) to the corners
   // centred on the principal point.
   std::vector<double> estimates;
-  const std::vector<cv::Point2f> square = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};  // OpenCV wants floats here
+  const std::vector<cv::Point2f> square = {
+      {0, 0}, {1, 0}, {1, 1}, {0, 1}};  // OpenCV wants floats here
   for (const MarkerQuad& marker : markers) {
     std::vector<cv::Point2f> image;
     for (const Eigen::Vector2d& c : marker.corners) {

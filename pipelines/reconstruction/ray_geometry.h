@@ -34,10 +34,9 @@ struct GeneralizedAbsolutePoseOptions {
 // the world points they see: OpenGV's gp3p (Kneip, Furgale and Siegwart
 // 2013) in RANSAC, then OpenGV's non-linear refinement on the inliers.
 // `inliers` gets a flag per correspondence. nullopt when too few inliers.
-std::optional<Rigid3d> EstimateGeneralizedAbsolutePose(const std::vector<Ray3d>& rays_in_cam,
-                                                       const std::vector<Eigen::Vector3d>& points_in_world,
-                                                       const GeneralizedAbsolutePoseOptions& options,
-                                                       std::vector<char>* inliers);
+std::optional<Rigid3d> EstimateGeneralizedAbsolutePose(
+    const std::vector<Ray3d>& rays_in_cam, const std::vector<Eigen::Vector3d>& points_in_world,
+    const GeneralizedAbsolutePoseOptions& options, std::vector<char>* inliers);
 
 // Relative pose of two views from the directions of corresponding rays,
 // treating each camera as central (the port offsets the rays by millimetres
@@ -57,6 +56,7 @@ std::optional<Rigid3d> EstimateRelativePose(const std::vector<Eigen::Vector3d>& 
 struct MarkerQuad {
   std::array<Eigen::Vector2d, 4> corners;  // COLMAP pixels, OpenCV's order
 };
-std::optional<double> FocalLengthFromMarkers(const std::vector<MarkerQuad>& markers, double cx, double cy);
+std::optional<double> FocalLengthFromMarkers(const std::vector<MarkerQuad>& markers, double cx,
+                                             double cy);
 
 }  // namespace portcal

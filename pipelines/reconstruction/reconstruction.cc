@@ -20,8 +20,8 @@ SfmInputs SfmInputs::Read(Database* database, const std::set<std::string>* only)
   for (const DatabaseImage& row : database->ReadAllImages()) {
     if (only && !only->count(row.name)) continue;
     if (!inputs.cameras.count(row.camera_id)) {
-      throw InputError(database->path() + ": image '" + row.name + "' has camera " + std::to_string(row.camera_id) +
-                       ", which the cameras table does not hold");
+      throw InputError(database->path() + ": image '" + row.name + "' has camera " +
+                       std::to_string(row.camera_id) + ", which the cameras table does not hold");
     }
     SfmImage& image = inputs.images[row.image_id];
     image.image_id = row.image_id;
@@ -39,9 +39,11 @@ SfmInputs SfmInputs::Read(Database* database, const std::set<std::string>* only)
     if (geometry.inlier_matches.empty()) continue;
     image_t id1, id2;
     PairIdToImagePair(pair_id, &id1, &id2);
-    if (only && (!inputs.images.count(id1) || !inputs.images.count(id2))) continue;  // outside the subset
+    if (only && (!inputs.images.count(id1) || !inputs.images.count(id2)))
+      continue;  // outside the subset
     if (!inputs.images.count(id1) || !inputs.images.count(id2)) {
-      throw InputError(database->path() + ": two_view_geometries of " + database->PairLabel(pair_id) +
+      throw InputError(database->path() + ": two_view_geometries of " +
+                       database->PairLabel(pair_id) +
                        " names an image the images table does not hold");
     }
     SfmImage& image1 = inputs.images.at(id1);
@@ -49,14 +51,16 @@ SfmInputs SfmInputs::Read(Database* database, const std::set<std::string>* only)
     for (const FeatureMatch& m : geometry.inlier_matches) {
       if (m.point2D_idx1 >= image1.keypoints.size() || m.point2D_idx2 >= image2.keypoints.size()) {
         throw InputError(database->path() + ": inlier match of images '" + image1.name + "' and '" +
-                         image2.name + "' names a keypoint that does not exist (features changed "
+                         image2.name +
+                         "' names a keypoint that does not exist (features changed "
                          "after matching? rerun the matcher)");
       }
       image1.correspondences[m.point2D_idx1].push_back({id2, m.point2D_idx2});
       image2.correspondences[m.point2D_idx2].push_back({id1, m.point2D_idx1});
     }
     inputs.pair_inliers[pair_id] = static_cast<int>(geometry.inlier_matches.size());
-    if (geometry.config == TwoViewGeometryConfig::kPlanar || geometry.config == TwoViewGeometryConfig::kPanoramic ||
+    if (geometry.config == TwoViewGeometryConfig::kPlanar ||
+        geometry.config == TwoViewGeometryConfig::kPanoramic ||
         geometry.config == TwoViewGeometryConfig::kPlanarOrPanoramic) {
       inputs.planar_pairs.insert(pair_id);
     }
@@ -129,7 +133,9 @@ void Reconstruction::UpdateVisibility(image_t image_id, point2D_t idx, int chang
   }
 }
 
-int Reconstruction::NumVisiblePoints(image_t image_id) const { return num_visible_points_.at(image_id); }
+int Reconstruction::NumVisiblePoints(image_t image_id) const {
+  return num_visible_points_.at(image_id);
+}
 
 void Reconstruction::UpdateRays() {
   std::vector<const SfmImage*> images;
@@ -167,7 +173,8 @@ point3D_t Reconstruction::PointOf(image_t image_id, point2D_t idx) const {
   return it == point_of_.end() ? kInvalidPoint3DId : it->second[idx];
 }
 
-point3D_t Reconstruction::AddPoint(const Eigen::Vector3d& xyz, const std::vector<TrackElement>& track) {
+point3D_t Reconstruction::AddPoint(const Eigen::Vector3d& xyz,
+                                   const std::vector<TrackElement>& track) {
   const point3D_t id = next_point_id_++;
   SfmPoint& point = points_[id];
   point.xyz = xyz;
@@ -235,7 +242,8 @@ const HousedCamera& Reconstruction::CameraOf(image_t image_id) const {
   return cameras_.at(inputs_->images.at(image_id).camera_id);
 }
 
-double Reconstruction::ReprojectionError(image_t image_id, point2D_t idx, const Eigen::Vector3d& xyz) const {
+double Reconstruction::ReprojectionError(image_t image_id, point2D_t idx,
+                                         const Eigen::Vector3d& xyz) const {
   const HousedCamera& camera = CameraOf(image_id);
   const Eigen::Vector3d in_cam = poses_.at(image_id) * xyz;
   const auto pixel = camera.Project(in_cam);
@@ -298,7 +306,8 @@ SparseModel Reconstruction::ToSparseModel() const {
     p.color.setConstant(128);
     p.track = point.track;
     double sum = 0;
-    for (const TrackElement& e : point.track) sum += ReprojectionError(e.image_id, e.point2D_idx, point.xyz);
+    for (const TrackElement& e : point.track)
+      sum += ReprojectionError(e.image_id, e.point2D_idx, point.xyz);
     p.error = point.track.empty() ? 0.0 : sum / point.track.size();
   }
   return model;

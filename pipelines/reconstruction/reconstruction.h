@@ -30,8 +30,8 @@ struct SfmImage {
   image_t image_id = 0;
   std::string name;
   camera_t camera_id = kInvalidCameraId;
-  std::vector<Eigen::Vector2d> keypoints;               // COLMAP pixels
-  std::vector<float> scales;                            // SIFT scale per keypoint (empty: unknown)
+  std::vector<Eigen::Vector2d> keypoints;  // COLMAP pixels
+  std::vector<float> scales;               // SIFT scale per keypoint (empty: unknown)
   std::vector<std::vector<Correspondence>> correspondences;  // per keypoint
   std::vector<MarkerDetection> markers;
   // Where navigation says the camera centre was (world frame, metres).
@@ -125,7 +125,9 @@ class Reconstruction {
   // image (behind the camera, inside a port's outer surface, totally
   // reflected): a model rescaled or realigned, its points moved, can hold
   // them, and an adjustment cannot start with one. Returns how many.
-  int DeleteUnprojectableObservations() { return DeleteObservationsBeyond(std::numeric_limits<double>::max()); }
+  int DeleteUnprojectableObservations() {
+    return DeleteObservationsBeyond(std::numeric_limits<double>::max());
+  }
 
   SparseModel ToSparseModel() const;
   // The model's poses and points (inputs from SfmInputs::FromSparseModel).

@@ -18,8 +18,9 @@ namespace portcal {
 // uncertainty, the lens's distortion and correlations, the housing to
 // scale; with `image_root` (the images' folder) the worst views on their
 // images and every view's thumbnail with its corners.
-HtmlReport CalibrationHtml(const CalibrationReport& report, const std::vector<CalibrationView>& views,
-                           const std::string& title, const std::filesystem::path& image_root = {});
+HtmlReport CalibrationHtml(const CalibrationReport& report,
+                           const std::vector<CalibrationView>& views, const std::string& title,
+                           const std::filesystem::path& image_root = {});
 
 // The projection uncertainty of a target calibration of `views` (report's
 // camera, housing, kept views' poses, board warp, held parameters and
@@ -29,24 +30,30 @@ ProjectionUncertaintyGrid ProjectionUncertaintyOf(const CalibrationReport& repor
 
 // A stereo calibration: the rig from above, then each camera's coverage
 // and per-view RMS.
-HtmlReport StereoCalibrationHtml(const StereoCalibrationResult& result, const std::vector<CalibrationView>& views1,
-                                 const std::vector<CalibrationView>& views2, const std::string& report_text);
+HtmlReport StereoCalibrationHtml(const StereoCalibrationResult& result,
+                                 const std::vector<CalibrationView>& views1,
+                                 const std::vector<CalibrationView>& views2,
+                                 const std::string& report_text);
 
 // A held-out evaluation: coverage, per-view held-out RMS, residual vectors
 // and the residuals' mean per cell.
-HtmlReport EvaluationHtml(const HeldOutEvaluation& evaluation, const std::vector<CalibrationView>& views,
-                          const HousedCamera& camera, const std::string& report_text);
+HtmlReport EvaluationHtml(const HeldOutEvaluation& evaluation,
+                          const std::vector<CalibrationView>& views, const HousedCamera& camera,
+                          const std::string& report_text);
 
 // A self-calibration (auto_calibrator, refractive_bundle_adjuster) of
 // `model`'s first camera: the reconstruction from above, the features'
 // coverage, per-image RMS, residual vectors, the housing to scale.
-HtmlReport SelfCalibrationHtml(const CalibrationReport& report, const SparseModel& model, const std::string& title);
+HtmlReport SelfCalibrationHtml(const CalibrationReport& report, const SparseModel& model,
+                               const std::string& title);
 
 // A cross-check against mrcal: the projection differences (PNG files the
 // stage wrote into the folder, named here), then portcal's calibration of
 // the same views as CalibrationHtml shows it.
-HtmlReport CrossCheckHtml(const CalibrationReport& portcal, const std::vector<CalibrationView>& views,
-                          const std::vector<ReportPicture>& difference_maps, const std::string& report_text);
+HtmlReport CrossCheckHtml(const CalibrationReport& portcal,
+                          const std::vector<CalibrationView>& views,
+                          const std::vector<ReportPicture>& difference_maps,
+                          const std::string& report_text);
 
 // The page's form of a verdict.
 HtmlVerdict HtmlVerdictOf(const CalibrationVerdict& verdict);

@@ -6,8 +6,8 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,7 +37,8 @@ struct PointResidual {
 std::vector<PointResidual> ResidualsAtPoses(const ViewsAtPoses& views);
 
 // Where the observations lie: counts per cell over the image.
-cv::Mat CoveragePicture(const Camera& camera, const std::vector<Eigen::Vector2d>& pixels, const std::string& what);
+cv::Mat CoveragePicture(const Camera& camera, const std::vector<Eigen::Vector2d>& pixels,
+                        const std::string& what);
 
 // Each view's RMS; outliers red, dropped grey; the residual sigma dashed.
 cv::Mat PerViewRmsPicture(const std::vector<CalibratedView>& views, double residual_sigma_px,
@@ -45,8 +46,8 @@ cv::Mat PerViewRmsPicture(const std::vector<CalibratedView>& views, double resid
 
 // The residuals as arrows from their observations, magnified, coloured by
 // view (mrcal's residual field); dropped views' left out.
-cv::Mat ResidualVectorsPicture(const Camera& camera, const std::vector<PointResidual>& residuals, int num_views,
-                               const std::string& title);
+cv::Mat ResidualVectorsPicture(const Camera& camera, const std::vector<PointResidual>& residuals,
+                               int num_views, const std::string& title);
 
 // The expected projection uncertainty (px, 1 sigma, mrcal's mean-frames
 // measure) over the image at the kept views' median depth and at infinity,
@@ -54,10 +55,13 @@ cv::Mat ResidualVectorsPicture(const Camera& camera, const std::vector<PointResi
 // (guidance/projection_uncertainty.h): of the intrinsics not held (and the
 // board warp, when fitted), or with `housing_calibration` of the housing's
 // refined parameters.
-ProjectionUncertaintyGrid ProjectionUncertaintyOfViews(const ViewsAtPoses& views, bool housing_calibration,
-                                                       const std::vector<int>& fixed, double pixel_sigma_px);
+ProjectionUncertaintyGrid ProjectionUncertaintyOfViews(const ViewsAtPoses& views,
+                                                       bool housing_calibration,
+                                                       const std::vector<int>& fixed,
+                                                       double pixel_sigma_px);
 
 // The grid's map at the working distance (or at infinity) as a heat map.
-cv::Mat UncertaintyPicture(const ProjectionUncertaintyGrid& grid, int width, int height, bool at_infinity = false);
+cv::Mat UncertaintyPicture(const ProjectionUncertaintyGrid& grid, int width, int height,
+                           bool at_infinity = false);
 
 }  // namespace portcal

@@ -29,8 +29,8 @@ constexpr View2d kFromSide{2, 1, -1.0, "from the side: z forward (right), y down
 
 void DrawCameraCentre(PlanCanvas* canvas, const View2d& view, double axis_length) {
   const cv::Point centre = (*canvas)(view(Eigen::Vector3d::Zero()));
-  cv::arrowedLine(canvas->image(), centre, (*canvas)(view(Eigen::Vector3d(0, 0, axis_length))), kBlack, 1,
-                  cv::LINE_AA, 0, 0.08);
+  cv::arrowedLine(canvas->image(), centre, (*canvas)(view(Eigen::Vector3d(0, 0, axis_length))),
+                  kBlack, 1, cv::LINE_AA, 0, 0.08);
   cv::circle(canvas->image(), centre, 4, kBlack, cv::FILLED, cv::LINE_AA);
   DrawLabel(&canvas->image(), "camera", centre + cv::Point(6, 16), 0.45);
 }
@@ -39,15 +39,17 @@ void DrawPort(DomePort, const double* port, const View2d& view, PlanCanvas* canv
   const Eigen::Vector3d centre = DomePort::Center(port);
   const cv::Point c = (*canvas)(view(centre));
   for (const double radius : {DomePort::InnerRadius(port), DomePort::OuterRadius(port)}) {
-    cv::circle(canvas->image(), c, static_cast<int>(std::lround(radius * canvas->PixelsPerMetre())), kGlass, 2,
-               cv::LINE_AA);
+    cv::circle(canvas->image(), c, static_cast<int>(std::lround(radius * canvas->PixelsPerMetre())),
+               kGlass, 2, cv::LINE_AA);
   }
-  cv::arrowedLine(canvas->image(), (*canvas)(view(Eigen::Vector3d::Zero())), c, kRed, 2, cv::LINE_AA, 0, 0.15);
+  cv::arrowedLine(canvas->image(), (*canvas)(view(Eigen::Vector3d::Zero())), c, kRed, 2,
+                  cv::LINE_AA, 0, 0.15);
   cv::circle(canvas->image(), c, 3, kBlue, cv::FILLED, cv::LINE_AA);
   // As a legend under the title: beside a centre a few millimetres from the
   // camera's, the label ran over the camera's.
   cv::circle(canvas->image(), cv::Point(14, 44), 3, kBlue, cv::FILLED, cv::LINE_AA);
-  DrawLabel(&canvas->image(), "dome centre, offset " + FormatFixed(centre.norm() * 1000, 2) + " mm (red arrow)",
+  DrawLabel(&canvas->image(),
+            "dome centre, offset " + FormatFixed(centre.norm() * 1000, 2) + " mm (red arrow)",
             cv::Point(22, 49), 0.45, kRed);
   DrawCameraCentre(canvas, view, DomePort::InnerRadius(port));
 }
@@ -71,14 +73,15 @@ void DrawPort(FlatPort, const double* port, const View2d& view, PlanCanvas* canv
   const double half = 2.5 * (d + t);
   for (const double distance : {d, d + t}) {
     const Eigen::Vector3d foot = normal * distance;
-    cv::line(canvas->image(), (*canvas)(view(foot - half * in_plane)), (*canvas)(view(foot + half * in_plane)),
-             kGlass, 2, cv::LINE_AA);
+    cv::line(canvas->image(), (*canvas)(view(foot - half * in_plane)),
+             (*canvas)(view(foot + half * in_plane)), kGlass, 2, cv::LINE_AA);
   }
-  cv::arrowedLine(canvas->image(), (*canvas)(view(Eigen::Vector3d::Zero())), (*canvas)(view(normal * d)), kRed, 2,
-                  cv::LINE_AA, 0, 0.12);
+  cv::arrowedLine(canvas->image(), (*canvas)(view(Eigen::Vector3d::Zero())),
+                  (*canvas)(view(normal * d)), kRed, 2, cv::LINE_AA, 0, 0.12);
   const double tilt_deg = std::acos(std::clamp(normal.z(), -1.0, 1.0)) * 180 / M_PI;
   DrawLabel(&canvas->image(),
-            "normal tilted " + FormatFixed(tilt_deg, 2) + " deg, glass at " + FormatFixed(d * 1000, 2) + " mm",
+            "normal tilted " + FormatFixed(tilt_deg, 2) + " deg, glass at " +
+                FormatFixed(d * 1000, 2) + " mm",
             (*canvas)(view(normal * d)) + cv::Point(8, -10), 0.45, kRed);
   DrawCameraCentre(canvas, view, 0.6 * d);
 }
@@ -114,15 +117,17 @@ cv::Mat HousingPicture(const Housing& housing) {
 namespace {
 
 // A camera from above: its centre, and its field of view's edges.
-void DrawCameraFromAbove(PlanCanvas* canvas, const Rigid3d& world_from_cam, double half_fov, double reach,
-                         const cv::Scalar& colour, const std::string& name) {
+void DrawCameraFromAbove(PlanCanvas* canvas, const Rigid3d& world_from_cam, double half_fov,
+                         double reach, const cv::Scalar& colour, const std::string& name) {
   const Eigen::Vector3d centre = world_from_cam.translation;
   const cv::Point c = (*canvas)(kFromAbove(centre));
   for (const double side : {-1.0, 1.0}) {
     const Eigen::Vector3d edge(side * std::tan(half_fov) * reach, 0, reach);
-    cv::line(canvas->image(), c, (*canvas)(kFromAbove(world_from_cam * edge)), colour, 1, cv::LINE_AA);
+    cv::line(canvas->image(), c, (*canvas)(kFromAbove(world_from_cam * edge)), colour, 1,
+             cv::LINE_AA);
   }
-  cv::arrowedLine(canvas->image(), c, (*canvas)(kFromAbove(world_from_cam * Eigen::Vector3d(0, 0, 0.5 * reach))),
+  cv::arrowedLine(canvas->image(), c,
+                  (*canvas)(kFromAbove(world_from_cam * Eigen::Vector3d(0, 0, 0.5 * reach))),
                   colour, 2, cv::LINE_AA, 0, 0.1);
   cv::circle(canvas->image(), c, 4, colour, cv::FILLED, cv::LINE_AA);
   DrawLabel(&canvas->image(), name, c + cv::Point(6, 16), 0.45, colour);
@@ -135,7 +140,8 @@ cv::Mat RigFromAbovePicture(const Camera& camera1, const Rigid3d& cam2_from_cam1
   const Rigid3d cam1_from_cam2 = cam2_from_cam1.Inverse();
   const double baseline = cam2_from_cam1.translation.norm();
   double reach = 2 * baseline;
-  std::vector<Eigen::Vector2d> extent = {kFromAbove(Eigen::Vector3d::Zero()), kFromAbove(cam1_from_cam2.translation)};
+  std::vector<Eigen::Vector2d> extent = {kFromAbove(Eigen::Vector3d::Zero()),
+                                         kFromAbove(cam1_from_cam2.translation)};
   for (const Rigid3d& pose : cam1_from_target) {
     extent.push_back(kFromAbove(pose.translation));
     reach = std::max(reach, pose.translation.z());
@@ -146,7 +152,8 @@ cv::Mat RigFromAbovePicture(const Camera& camera1, const Rigid3d& cam2_from_cam1
                         std::to_string(cam1_from_target.size()) + " target positions");
   const double half_fov = std::atan(0.5 * camera1.width / camera1.MeanFocalLength());
   for (const Rigid3d& pose : cam1_from_target) {
-    cv::circle(canvas.image(), canvas(kFromAbove(pose.translation)), 3, cv::Scalar(120, 120, 120), cv::FILLED);
+    cv::circle(canvas.image(), canvas(kFromAbove(pose.translation)), 3, cv::Scalar(120, 120, 120),
+               cv::FILLED);
   }
   DrawCameraFromAbove(&canvas, Rigid3d(), half_fov, reach, kBlue, "camera 1");
   DrawCameraFromAbove(&canvas, cam1_from_cam2, half_fov, reach, kRed, "camera 2");
@@ -154,7 +161,8 @@ cv::Mat RigFromAbovePicture(const Camera& camera1, const Rigid3d& cam2_from_cam1
   return canvas.image();
 }
 
-cv::Mat SceneFromAbovePicture(const std::vector<Eigen::Vector3d>& points, const std::vector<Rigid3d>& cam_from_world,
+cv::Mat SceneFromAbovePicture(const std::vector<Eigen::Vector3d>& points,
+                              const std::vector<Rigid3d>& cam_from_world,
                               const std::string& title) {
   // The plane of the two widest axes of the cameras and points.
   std::vector<Eigen::Vector3d> all = points;
@@ -166,19 +174,22 @@ cv::Mat SceneFromAbovePicture(const std::vector<Eigen::Vector3d>& points, const 
   for (const Eigen::Vector3d& p : all) scatter += (p - mean) * (p - mean).transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
   const Eigen::Vector3d u = eigen.eigenvectors().col(2), v = eigen.eigenvectors().col(1);
-  const auto plan = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d((p - mean).dot(u), (p - mean).dot(v)); };
+  const auto plan = [&](const Eigen::Vector3d& p) {
+    return Eigen::Vector2d((p - mean).dot(u), (p - mean).dot(v));
+  };
   std::vector<Eigen::Vector2d> extent;
   for (const Eigen::Vector3d& p : all) extent.push_back(plan(p));
   PlanCanvas canvas(extent, 900, 700, title);
   for (const Eigen::Vector3d& p : points) {
     cv::circle(canvas.image(), canvas(plan(p)), 1, cv::Scalar(90, 90, 90), cv::FILLED);
   }
-  const double reach = 0.04 * std::max(1e-9, (extent.empty() ? 1.0 : 900 / canvas.PixelsPerMetre()));
+  const double reach =
+      0.04 * std::max(1e-9, (extent.empty() ? 1.0 : 900 / canvas.PixelsPerMetre()));
   for (const Rigid3d& pose : cam_from_world) {
     const Rigid3d world_from_cam = pose.Inverse();
     const cv::Point c = canvas(plan(world_from_cam.translation));
-    cv::arrowedLine(canvas.image(), c, canvas(plan(world_from_cam * Eigen::Vector3d(0, 0, reach))), kRed, 1,
-                    cv::LINE_AA, 0, 0.3);
+    cv::arrowedLine(canvas.image(), c, canvas(plan(world_from_cam * Eigen::Vector3d(0, 0, reach))),
+                    kRed, 1, cv::LINE_AA, 0, 0.3);
     cv::circle(canvas.image(), c, 3, kRed, cv::FILLED, cv::LINE_AA);
   }
   canvas.DrawScaleBar("the reconstruction's two widest axes; red: cameras and their axes");

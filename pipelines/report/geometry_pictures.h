@@ -24,7 +24,7 @@ cv::Mat RigFromAbovePicture(const Camera& camera1, const Rigid3d& cam2_from_cam1
                             const std::vector<Rigid3d>& cam1_from_target);
 
 // A reconstruction from above (its two widest axes): points and cameras.
-cv::Mat SceneFromAbovePicture(const std::vector<Eigen::Vector3d>& points, const std::vector<Rigid3d>& cam_from_world,
-                              const std::string& title);
+cv::Mat SceneFromAbovePicture(const std::vector<Eigen::Vector3d>& points,
+                              const std::vector<Rigid3d>& cam_from_world, const std::string& title);
 
 }  // namespace portcal

@@ -13,7 +13,7 @@ namespace portcal {
 struct ReportPicture {
   std::string file_name;  // e.g. "coverage.png", beside report.html
   std::string caption;    // what to look for
-  cv::Mat image;  // empty: the file is already in the folder (written by the stage)
+  cv::Mat image;          // empty: the file is already in the folder (written by the stage)
 };
 
 struct ReportSection {

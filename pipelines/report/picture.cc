@@ -32,7 +32,8 @@ cv::Vec3b Viridis(double fraction) {
 }
 
 // The colour bar right of a map at (x, top), `h` high, 0..max_value.
-void DrawColourBar(cv::Mat* canvas, int x, int top, int h, double max_value, const std::string& unit) {
+void DrawColourBar(cv::Mat* canvas, int x, int top, int h, double max_value,
+                   const std::string& unit) {
   for (int r = 0; r < h; ++r) {
     cv::line(*canvas, cv::Point(x, top + r), cv::Point(x + 20, top + r),
              cv::Scalar(Viridis(static_cast<double>(h - 1 - r) / std::max(1, h - 1))), 1);
@@ -46,7 +47,8 @@ void DrawColourBar(cv::Mat* canvas, int x, int top, int h, double max_value, con
 
 }  // namespace
 
-void DrawLabel(cv::Mat* canvas, const std::string& text, cv::Point origin, double scale, cv::Scalar colour) {
+void DrawLabel(cv::Mat* canvas, const std::string& text, cv::Point origin, double scale,
+               cv::Scalar colour) {
   cv::putText(*canvas, text, origin, cv::FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv::LINE_AA);
 }
 
@@ -68,7 +70,8 @@ double DrawingScale(double image_width) {
   return image_width < 640 ? 640.0 / image_width : std::min(1.0, 960.0 / image_width);
 }
 
-cv::Mat HeatMapPicture(const Eigen::MatrixXd& grid, int image_width, int image_height, const HeatMapStyle& style) {
+cv::Mat HeatMapPicture(const Eigen::MatrixXd& grid, int image_width, int image_height,
+                       const HeatMapStyle& style) {
   const double scale = DrawingScale(image_width);
   const int w = std::max(1, static_cast<int>(image_width * scale));
   const int h = std::max(1, static_cast<int>(image_height * scale));
@@ -104,17 +107,21 @@ cv::Mat HeatMapPicture(const Eigen::MatrixXd& grid, int image_width, int image_h
 }
 
 cv::Mat BarChartPicture(const std::vector<double>& values, const std::vector<cv::Scalar>& colours,
-                        const std::vector<std::string>& labels, const std::string& title, const std::string& unit,
-                        double reference, const std::string& reference_name) {
+                        const std::vector<std::string>& labels, const std::string& title,
+                        const std::string& unit, double reference,
+                        const std::string& reference_name) {
   const int left = 60, bottom = 60, plot_h = 260;
   const int bar_w = std::clamp(800 / std::max<int>(1, static_cast<int>(values.size())), 3, 40);
   const int plot_w = bar_w * static_cast<int>(values.size());
-  cv::Mat canvas = TitledCanvas(std::max(720, left + plot_w + 20), kTitleHeight + plot_h + bottom, title);
+  cv::Mat canvas =
+      TitledCanvas(std::max(720, left + plot_w + 20), kTitleHeight + plot_h + bottom, title);
   double max_value = reference;
   for (double v : values) max_value = std::max(max_value, v);
   if (!(max_value > 0)) max_value = 1;
   const int base = kTitleHeight + plot_h;
-  const auto y_of = [&](double v) { return base - static_cast<int>(plot_h * 0.95 * v / max_value); };
+  const auto y_of = [&](double v) {
+    return base - static_cast<int>(plot_h * 0.95 * v / max_value);
+  };
   cv::line(canvas, cv::Point(left, base), cv::Point(left + plot_w, base), cv::Scalar(0, 0, 0), 1);
   cv::line(canvas, cv::Point(left, base), cv::Point(left, kTitleHeight), cv::Scalar(0, 0, 0), 1);
   for (int t = 0; t <= 4; ++t) {
@@ -125,18 +132,21 @@ cv::Mat BarChartPicture(const std::vector<double>& values, const std::vector<cv:
   const int label_every = std::max(1, 40 / bar_w);
   for (size_t i = 0; i < values.size(); ++i) {
     const int x = left + static_cast<int>(i) * bar_w;
-    cv::rectangle(canvas, cv::Point(x + 1, y_of(values[i])), cv::Point(x + bar_w - 1, base), colours[i],
-                  cv::FILLED);
+    cv::rectangle(canvas, cv::Point(x + 1, y_of(values[i])), cv::Point(x + bar_w - 1, base),
+                  colours[i], cv::FILLED);
     if (i % static_cast<size_t>(label_every) == 0 && i < labels.size()) {
-      DrawLabel(&canvas, labels[i], cv::Point(x, base + 16 + 14 * static_cast<int>((i / label_every) % 2)), 0.35);
+      DrawLabel(&canvas, labels[i],
+                cv::Point(x, base + 16 + 14 * static_cast<int>((i / label_every) % 2)), 0.35);
     }
   }
   if (reference > 0) {
     for (int x = left; x < left + plot_w; x += 12) {
-      cv::line(canvas, cv::Point(x, y_of(reference)), cv::Point(std::min(x + 6, left + plot_w), y_of(reference)),
-               cv::Scalar(0, 0, 200), 1);
+      cv::line(canvas, cv::Point(x, y_of(reference)),
+               cv::Point(std::min(x + 6, left + plot_w), y_of(reference)), cv::Scalar(0, 0, 200),
+               1);
     }
-    DrawLabel(&canvas, reference_name, cv::Point(left + 4, y_of(reference) - 4), 0.4, cv::Scalar(0, 0, 200));
+    DrawLabel(&canvas, reference_name, cv::Point(left + 4, y_of(reference) - 4), 0.4,
+              cv::Scalar(0, 0, 200));
   }
   return canvas;
 }
@@ -174,7 +184,8 @@ void PlanCanvas::DrawScaleBar(const std::string& axes) {
 
 void WritePng(const cv::Mat& picture, const std::filesystem::path& path) {
   std::vector<uchar> png;
-  if (!cv::imencode(".png", picture, png)) throw InputError(path.string() + ": PNG encoding failed");
+  if (!cv::imencode(".png", picture, png))
+    throw InputError(path.string() + ": PNG encoding failed");
   WriteFileAtomically(path, true, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
   });

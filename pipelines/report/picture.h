@@ -25,9 +25,9 @@ cv::Scalar DistinctColour(int index, int count);
 
 struct HeatMapStyle {
   std::string title;
-  std::string unit;                     // of the colour bar, e.g. "px"
-  std::vector<double> contour_levels;   // white iso-lines
-  double max_value = 0;                 // top of the colour bar; 0: the grid's maximum
+  std::string unit;                    // of the colour bar, e.g. "px"
+  std::vector<double> contour_levels;  // white iso-lines
+  double max_value = 0;                // top of the colour bar; 0: the grid's maximum
 };
 
 // How much an image is scaled to be drawn: 640-960 px wide, so that a small
@@ -37,20 +37,23 @@ double DrawingScale(double image_width);
 // A grid of values over the image (rows x cols evenly spread; negative: no
 // value, drawn grey) as a colour map DrawingScale() of the image, with a
 // colour bar.
-cv::Mat HeatMapPicture(const Eigen::MatrixXd& grid, int image_width, int image_height, const HeatMapStyle& style);
+cv::Mat HeatMapPicture(const Eigen::MatrixXd& grid, int image_width, int image_height,
+                       const HeatMapStyle& style);
 
 // Bars of `values` in `colours`, labelled every few bars by `labels`, with a
 // dashed horizontal line at `reference` (<= 0: none) named `reference_name`.
 cv::Mat BarChartPicture(const std::vector<double>& values, const std::vector<cv::Scalar>& colours,
-                        const std::vector<std::string>& labels, const std::string& title, const std::string& unit,
-                        double reference, const std::string& reference_name);
+                        const std::vector<std::string>& labels, const std::string& title,
+                        const std::string& unit, double reference,
+                        const std::string& reference_name);
 
 // A plan in metres on a canvas: x to the right, `up` (the plan's second
 // coordinate) drawn upwards, equal scale, the extent of the points given
 // with a margin, and a scale bar.
 class PlanCanvas {
  public:
-  PlanCanvas(const std::vector<Eigen::Vector2d>& extent_points, int width, int height, const std::string& title);
+  PlanCanvas(const std::vector<Eigen::Vector2d>& extent_points, int width, int height,
+             const std::string& title);
   cv::Point operator()(const Eigen::Vector2d& plan) const;
   double PixelsPerMetre() const { return scale_; }
   cv::Mat& image() { return image_; }

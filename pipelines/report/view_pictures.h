@@ -16,7 +16,8 @@ namespace portcal {
 // The `count` kept views of highest RMS, each on its image (grey where the
 // image cannot be read), the corners green and the residuals red,
 // magnified so that the p95 residual is 20 px; named with their RMS.
-cv::Mat WorstViewsPicture(const ViewsAtPoses& views, const std::filesystem::path& image_root, int count = 3);
+cv::Mat WorstViewsPicture(const ViewsAtPoses& views, const std::filesystem::path& image_root,
+                          int count = 3);
 
 // Every view (at most 48, in order) as a 200 px wide thumbnail with its
 // corners (green; grey for a dropped view) and its name; empty when no

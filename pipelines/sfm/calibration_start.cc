@@ -8,7 +8,8 @@
 
 namespace portcal {
 
-bool StartFocalFromMarkers(const SfmInputs& inputs, std::optional<bool> mode, std::map<camera_t, HousedCamera>* cameras) {
+bool StartFocalFromMarkers(const SfmInputs& inputs, std::optional<bool> mode,
+                           std::map<camera_t, HousedCamera>* cameras) {
   if (mode == false) return false;
   bool any = false;
   for (auto& [camera_id, camera] : *cameras) {
@@ -18,7 +19,8 @@ bool StartFocalFromMarkers(const SfmInputs& inputs, std::optional<bool> mode, st
       if (image.camera_id != camera_id) continue;
       for (const MarkerDetection& m : image.markers) quads.push_back({m.corners});
     }
-    auto focal = FocalLengthFromMarkers(quads, camera.camera.PrincipalPointX(), camera.camera.PrincipalPointY());
+    auto focal = FocalLengthFromMarkers(quads, camera.camera.PrincipalPointX(),
+                                        camera.camera.PrincipalPointY());
     // The markers give the focal length the camera appears to have in
     // water (a flat port magnifies paraxial rays); bundle adjustment refines
     // the rest.
@@ -28,20 +30,23 @@ bool StartFocalFromMarkers(const SfmInputs& inputs, std::optional<bool> mode, st
                    << camera.camera.MeanFocalLength() << " px";
       continue;
     }
-    LOG(INFO) << "camera " << camera_id << ": focal length from " << quads.size() << " markers: " << *focal
-              << " px (was " << camera.camera.MeanFocalLength() << ")";
-    for (int idx : CameraModelFocalLengthIdxs(camera.camera.model_id)) camera.camera.params[idx] = *focal;
+    LOG(INFO) << "camera " << camera_id << ": focal length from " << quads.size()
+              << " markers: " << *focal << " px (was " << camera.camera.MeanFocalLength() << ")";
+    for (int idx : CameraModelFocalLengthIdxs(camera.camera.model_id))
+      camera.camera.params[idx] = *focal;
     any = true;
   }
   return any;
 }
 
-void StartRadialFromMatches(const SfmInputs& inputs, std::optional<bool> mode, bool distortion_refined,
-                            const RadialStartOptions& options, std::map<camera_t, HousedCamera>* cameras) {
+void StartRadialFromMatches(const SfmInputs& inputs, std::optional<bool> mode,
+                            bool distortion_refined, const RadialStartOptions& options,
+                            std::map<camera_t, HousedCamera>* cameras) {
   if (mode == false || (!mode && !distortion_refined)) return;
   for (auto& [camera_id, camera] : *cameras) {
     const std::vector<int> extra = CameraModelExtraParamsIdxs(camera.camera.model_id);
-    const std::vector<double>& params = camera.camera.params;  // a lambda may not capture a binding (C++17)
+    const std::vector<double>& params =
+        camera.camera.params;  // a lambda may not capture a binding (C++17)
     const bool undistorted =
         std::all_of(extra.begin(), extra.end(), [&params](int idx) { return params[idx] == 0; });
     // A fisheye model at k = 0 is the equidistant projection, near what
@@ -52,12 +57,14 @@ void StartRadialFromMatches(const SfmInputs& inputs, std::optional<bool> mode, b
     if (!mode && (camera.camera.has_prior_focal_length || !undistorted || fisheye)) continue;
     const auto start = EstimateFirstRadialTerm(inputs, camera_id, camera, options);
     if (!start) {
-      VLOG(1) << "camera " << camera_id << ": no first radial term from the matches (no such term or too few pairs)";
+      VLOG(1) << "camera " << camera_id
+              << ": no first radial term from the matches (no such term or too few pairs)";
       continue;
     }
-    LOG(INFO) << "camera " << camera_id << ": first radial term from " << start->num_matches << " matches of "
-              << start->num_pairs << " pairs: " << start->k << " (epipolar RMS " << start->residual_px
-              << " px; at the start " << start->residual_at_start_px << " px)";
+    LOG(INFO) << "camera " << camera_id << ": first radial term from " << start->num_matches
+              << " matches of " << start->num_pairs << " pairs: " << start->k << " (epipolar RMS "
+              << start->residual_px << " px; at the start " << start->residual_at_start_px
+              << " px)";
     camera.camera.params[FirstRadialParamIdx(camera.camera)] = start->k;
   }
 }

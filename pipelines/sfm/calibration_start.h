@@ -28,7 +28,8 @@ bool StartFocalFromMarkers(const SfmInputs& inputs, std::optional<bool> mode,
 // (EstimateFirstRadialTerm). `mode`: always, never, or (nullopt) where the
 // camera has no prior focal length, its distortion is all zero and
 // `distortion_refined`, and the model is not a fisheye.
-void StartRadialFromMatches(const SfmInputs& inputs, std::optional<bool> mode, bool distortion_refined,
-                            const RadialStartOptions& options, std::map<camera_t, HousedCamera>* cameras);
+void StartRadialFromMatches(const SfmInputs& inputs, std::optional<bool> mode,
+                            bool distortion_refined, const RadialStartOptions& options,
+                            std::map<camera_t, HousedCamera>* cameras);
 
 }  // namespace portcal

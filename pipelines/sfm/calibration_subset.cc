@@ -9,7 +9,8 @@ namespace portcal {
 
 void CalibrationSubsetOptions::Check() const {
   if (num_images < 2) throw OptionError("--Subset.num_images", std::to_string(num_images), ">= 2");
-  if (min_num_inliers < 1) throw OptionError("--Subset.min_num_inliers", std::to_string(min_num_inliers), ">= 1");
+  if (min_num_inliers < 1)
+    throw OptionError("--Subset.min_num_inliers", std::to_string(min_num_inliers), ">= 1");
 }
 
 namespace {
@@ -34,8 +35,8 @@ CalibrationSubset ChooseCalibrationSubset(const std::vector<image_t>& ordered,
   subset.images.push_back(ordered[0]);
   while (last + 1 < n) {
     const size_t goal = std::min(
-        n - 1,
-        std::max(last + 1, static_cast<size_t>(std::lround(static_cast<double>(subset.images.size()) * stride))));
+        n - 1, std::max(last + 1, static_cast<size_t>(std::lround(
+                                      static_cast<double>(subset.images.size()) * stride))));
     // The farthest image up to the goal that the last kept one is linked
     // to; failing that, the nearest one beyond it.
     size_t next = 0;

@@ -16,7 +16,7 @@
 namespace portcal {
 
 struct CalibrationSubsetOptions {
-  int num_images = 300;       // --Subset.num_images: the subset's size (more where the pairs fall short)
+  int num_images = 300;  // --Subset.num_images: the subset's size (more where the pairs fall short)
   int min_num_inliers = 100;  // --Subset.min_num_inliers: a link of the chain
   void Check() const;         // throws OptionError naming the option
 };

@@ -14,10 +14,12 @@ double MaxImageShiftPx(const HousedCamera& before, const HousedCamera& after, do
   double max_shift = 0;
   for (int i = 0; i < kGrid; ++i) {
     for (int j = 0; j < kGrid; ++j) {
-      const Eigen::Vector2d pixel(0.5 + (width - 1) * i / (kGrid - 1), 0.5 + (height - 1) * j / (kGrid - 1));
+      const Eigen::Vector2d pixel(0.5 + (width - 1) * i / (kGrid - 1),
+                                  0.5 + (height - 1) * j / (kGrid - 1));
       const auto ray = before.Unproject(pixel);
       if (!ray || !(ray->direction.z() > 0)) return std::numeric_limits<double>::infinity();
-      const Eigen::Vector3d point = ray->origin + (depth_m - ray->origin.z()) / ray->direction.z() * ray->direction;
+      const Eigen::Vector3d point =
+          ray->origin + (depth_m - ray->origin.z()) / ray->direction.z() * ray->direction;
       const auto seen = after.Project(point);
       if (!seen) return std::numeric_limits<double>::infinity();
       max_shift = std::max(max_shift, (*seen - pixel).norm());

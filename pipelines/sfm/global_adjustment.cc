@@ -7,8 +7,9 @@
 
 namespace portcal {
 
-BundleAdjustmentOptions GlobalAdjustmentOptions(const IncrementalMapperOptions& options, int num_images,
-                                                bool refine_intrinsics, AdjustmentEnd end) {
+BundleAdjustmentOptions GlobalAdjustmentOptions(const IncrementalMapperOptions& options,
+                                                int num_images, bool refine_intrinsics,
+                                                AdjustmentEnd end) {
   BundleAdjustmentOptions ba;
   ba.refine_focal_length = refine_intrinsics && options.ba_refine_focal_length;
   ba.refine_principal_point = refine_intrinsics && options.ba_refine_principal_point;
@@ -23,19 +24,24 @@ BundleAdjustmentOptions GlobalAdjustmentOptions(const IncrementalMapperOptions& 
   // While growing, with the calibration held the adjustment only carries
   // the model along until the next one; one that refines the calibration
   // converges (it decides whether the port has settled).
-  if ((end == AdjustmentEnd::kGrowing && !refine_intrinsics) || end == AdjustmentEnd::kWeightsSettled) {
+  if ((end == AdjustmentEnd::kGrowing && !refine_intrinsics) ||
+      end == AdjustmentEnd::kWeightsSettled) {
     ba.max_unsettled_weight_fraction = options.ba_global_max_unsettled_weights;
   }
-  if (end == AdjustmentEnd::kHeldWeightsSolve) return ba.WithWeightsHeld(kHeldWeightsTrustRegionRadius);
+  if (end == AdjustmentEnd::kHeldWeightsSolve)
+    return ba.WithWeightsHeld(kHeldWeightsTrustRegionRadius);
   return ba;
 }
 
 bool EndedOnItsCriterion(const ceres::Solver::Summary& summary) {
-  return summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::USER_SUCCESS;
+  return summary.termination_type == ceres::CONVERGENCE ||
+         summary.termination_type == ceres::USER_SUCCESS;
 }
 
-bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before, const std::map<camera_t, HousedCamera>& after,
-                     const std::map<camera_t, HousedCamera>& start, double max_focal_ratio_to_start) {
+bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before,
+                     const std::map<camera_t, HousedCamera>& after,
+                     const std::map<camera_t, HousedCamera>& start,
+                     double max_focal_ratio_to_start) {
   for (const auto& [id, camera] : after) {
     if (ImplausibleIntrinsics(before.at(id).camera, camera.camera)) return true;
     const double ratio = camera.camera.MeanFocalLength() / start.at(id).camera.MeanFocalLength();
@@ -51,8 +57,10 @@ double PrepareMarkerCorners(Reconstruction* r, double max_error_px, double side_
   // a poor start (AutoCalibrationRealCameras' in-air target: focal length
   // 10 px, 3 sigma, off). Behind a housing refraction sets the scale.
   const bool refracted = AnyHoused(r->cameras());
-  const double scale = refracted ? ScaleToMarkers(r, max_error_px, side_length_m).value_or(1.0) : 1.0;
-  VLOG(2) << "global adjustment: " << r->poses().size() << " images scaled by " << scale << " to the markers";
+  const double scale =
+      refracted ? ScaleToMarkers(r, max_error_px, side_length_m).value_or(1.0) : 1.0;
+  VLOG(2) << "global adjustment: " << r->poses().size() << " images scaled by " << scale
+          << " to the markers";
   for (MarkerCorner& corner : *corners) corner.xyz *= scale;
   *corners = UpdateMarkerCorners(*r, max_error_px, *corners);
   return scale;

@@ -31,8 +31,8 @@ enum class AdjustmentEnd {
 // the intrinsics and housing refined as the mapper's options say when
 // `refine_intrinsics`, only the first extra parameter below
 // ba_full_intrinsics_min_images; ending as `end` says.
-BundleAdjustmentOptions GlobalAdjustmentOptions(const IncrementalMapperOptions& options, int num_images,
-                                                bool refine_intrinsics,
+BundleAdjustmentOptions GlobalAdjustmentOptions(const IncrementalMapperOptions& options,
+                                                int num_images, bool refine_intrinsics,
                                                 AdjustmentEnd end = AdjustmentEnd::kCostChange);
 
 // An adjustment ended on its own criterion rather than its iteration
@@ -43,8 +43,10 @@ bool EndedOnItsCriterion(const ceres::Solver::Summary& summary);
 // COLMAP's bogus-camera test against the intrinsics before the adjustment,
 // and the focal length against the mapper's start, which a slow drift of
 // many adjustments would otherwise pass.
-bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before, const std::map<camera_t, HousedCamera>& after,
-                     const std::map<camera_t, HousedCamera>& start, double max_focal_ratio_to_start);
+bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before,
+                     const std::map<camera_t, HousedCamera>& after,
+                     const std::map<camera_t, HousedCamera>& start,
+                     double max_focal_ratio_to_start);
 
 // The markers' corners for a global adjustment of `r` (markers of side
 // `side_length_m`): the model scaled to them first (ScaleToMarkers) when a

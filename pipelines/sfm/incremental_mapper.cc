@@ -34,7 +34,8 @@ void IncrementalMapperOptions::Check() const {
   positive(ba_global_images_ratio, "ba_global_images_ratio");
   positive(max_num_models, "max_num_models");
   if (!(position_prior_sigma_m >= 0)) {
-    throw OptionError("--PosePrior.position_sigma", std::to_string(position_prior_sigma_m), ">= 0 m");
+    throw OptionError("--PosePrior.position_sigma", std::to_string(position_prior_sigma_m),
+                      ">= 0 m");
   }
   const auto angle = [](double v, const char* name) {
     if (!(v >= 0 && v < 90)) {
@@ -46,31 +47,36 @@ void IncrementalMapperOptions::Check() const {
   angle(tri_min_angle_deg, "tri_min_angle");
   marker_scale.Check();
   if (abs_pose_min_num_inliers < 6) {
-    throw OptionError("--Mapper.abs_pose_min_num_inliers", std::to_string(abs_pose_min_num_inliers), ">= 6");
+    throw OptionError("--Mapper.abs_pose_min_num_inliers", std::to_string(abs_pose_min_num_inliers),
+                      ">= 6");
   }
   if (!(max_focal_ratio_to_start > 1)) {
-    throw OptionError("--Mapper.max_focal_ratio_to_start", std::to_string(max_focal_ratio_to_start), "> 1");
+    throw OptionError("--Mapper.max_focal_ratio_to_start", std::to_string(max_focal_ratio_to_start),
+                      "> 1");
   }
   if (random_seed < 0) throw OptionError("--random_seed", std::to_string(random_seed), ">= 0");
-  if (init_max_restarts < 0) throw OptionError("--Mapper.init_max_restarts", std::to_string(init_max_restarts), ">= 0");
-  if (min_model_size < 2) throw OptionError("--Mapper.min_model_size", std::to_string(min_model_size), ">= 2");
+  if (init_max_restarts < 0)
+    throw OptionError("--Mapper.init_max_restarts", std::to_string(init_max_restarts), ">= 0");
+  if (min_model_size < 2)
+    throw OptionError("--Mapper.min_model_size", std::to_string(min_model_size), ">= 2");
   if (ba_local_num_images < 1) {
     throw OptionError("--Mapper.ba_local_num_images", std::to_string(ba_local_num_images), ">= 1");
   }
   if (!(ba_global_function_tolerance > 0 && ba_global_function_tolerance < 1)) {
-    throw OptionError("--Mapper.ba_global_function_tolerance", std::to_string(ba_global_function_tolerance),
-                      "in (0, 1)");
+    throw OptionError("--Mapper.ba_global_function_tolerance",
+                      std::to_string(ba_global_function_tolerance), "in (0, 1)");
   }
   if (!(ba_global_max_unsettled_weights >= 0 && ba_global_max_unsettled_weights < 1)) {
-    throw OptionError("--Mapper.ba_global_max_unsettled_weights", std::to_string(ba_global_max_unsettled_weights),
-                      "in [0, 1)");
+    throw OptionError("--Mapper.ba_global_max_unsettled_weights",
+                      std::to_string(ba_global_max_unsettled_weights), "in [0, 1)");
   }
   if (!(ba_calibration_settled_px >= 0)) {
-    throw OptionError("--Mapper.ba_calibration_settled_px", std::to_string(ba_calibration_settled_px), ">= 0");
+    throw OptionError("--Mapper.ba_calibration_settled_px",
+                      std::to_string(ba_calibration_settled_px), ">= 0");
   }
   if (ba_full_intrinsics_min_images < 0) {
-    throw OptionError("--Mapper.ba_full_intrinsics_min_images", std::to_string(ba_full_intrinsics_min_images),
-                      ">= 0");
+    throw OptionError("--Mapper.ba_full_intrinsics_min_images",
+                      std::to_string(ba_full_intrinsics_min_images), ">= 0");
   }
   if (ba_calibration_settled_min_images < 2) {
     throw OptionError("--Mapper.ba_calibration_settled_min_images",
@@ -101,13 +107,16 @@ class Mapper {
   int Triangulate(Reconstruction* r, image_t image_id);
   int Filter(Reconstruction* r, const std::set<image_t>* images);
   void LocalAdjust(Reconstruction* r, image_t image_id);
-  void GlobalAdjust(Reconstruction* r, bool refine_intrinsics, AdjustmentEnd end = AdjustmentEnd::kCostChange);
+  void GlobalAdjust(Reconstruction* r, bool refine_intrinsics,
+                    AdjustmentEnd end = AdjustmentEnd::kCostChange);
   // The housing's adjustments before the joint one (see GlobalAdjust).
-  void AdjustHousingFirst(Reconstruction* r, const BundleAdjustmentOptions& ba, std::vector<MarkerCorner>* markers);
+  void AdjustHousingFirst(Reconstruction* r, const BundleAdjustmentOptions& ba,
+                          std::vector<MarkerCorner>* markers);
   // Records a global adjustment's refinement of the calibration and whether
   // it has settled.
   void NoteRefinement(const Reconstruction& r, const BundleAdjustmentOptions& ba, bool implausible,
-                      const ceres::Solver::Summary& summary, const std::map<camera_t, HousedCamera>& cameras_before);
+                      const ceres::Solver::Summary& summary,
+                      const std::map<camera_t, HousedCamera>& cameras_before);
   // Clears what the mapper tracks about the model it grows.
   void StartModel();
   // Registers images one at a time, triangulating and adjusting, until none
@@ -140,7 +149,9 @@ class Mapper {
   // less than ba_calibration_settled_px in a row, up to the last one.
   int num_settled_in_a_row_ = 0;
   std::vector<CalibrationRefinement> refinements_;  // of the current model
-  bool CalibrationSettled() const { return options_.ba_calibration_settled_px > 0 && num_settled_in_a_row_ >= 2; }
+  bool CalibrationSettled() const {
+    return options_.ba_calibration_settled_px > 0 && num_settled_in_a_row_ >= 2;
+  }
   // Seconds spent per step, for the debug log.
   std::map<std::string, double> seconds_;
   template <typename F>
@@ -150,7 +161,10 @@ class Mapper {
       std::map<std::string, double>* seconds;
       const char* step;
       std::chrono::steady_clock::time_point start;
-      ~Add() { (*seconds)[step] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
+      ~Add() {
+        (*seconds)[step] +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      }
     } add{&seconds_, step, start};
     return f();
   }
@@ -179,24 +193,28 @@ std::vector<MappedModel> Mapper::Run(ProgressSink& progress) {
       may_abandon = false;
       continue;
     }
-    const bool abandon_allowed = may_abandon && static_cast<int>(abandoned.size()) < options_.init_max_restarts;
+    const bool abandon_allowed =
+        may_abandon && static_cast<int>(abandoned.size()) < options_.init_max_restarts;
     progress.Advance(2);
     GrowModel(&r, abandon_allowed, progress);
     if (!Abandon(abandon_allowed)) FinishModel(&r, models.size());
     if (Abandon(abandon_allowed) || (abandon_allowed && num_implausible_in_a_row_ > 0)) {
-      LOG(WARNING) << "refractive_mapper: the intrinsics refined on " << r.poses().size() << " images of model "
-                   << models.size() << " came out implausible " << num_implausible_in_a_row_
-                   << " time(s) in a row: its initial pair was likely wrong; starting it again from another";
+      LOG(WARNING)
+          << "refractive_mapper: the intrinsics refined on " << r.poses().size()
+          << " images of model " << models.size() << " came out implausible "
+          << num_implausible_in_a_row_
+          << " time(s) in a row: its initial pair was likely wrong; starting it again from another";
       abandoned.push_back(start);
-      progress.Begin("refractive_mapper: images registered (another initial pair)", inputs_.images.size());
+      progress.Begin("refractive_mapper: images registered (another initial pair)",
+                     inputs_.images.size());
       progress.Advance(used_.size());
       continue;
     }
     abandoned.clear();
     may_abandon = true;
-    VLOG(1) << "refractive_mapper: seconds in next " << seconds_["next"] << ", register " << seconds_["register"]
-            << ", triangulate " << seconds_["triangulate"] << ", local " << seconds_["local"] << ", global "
-            << seconds_["global"];
+    VLOG(1) << "refractive_mapper: seconds in next " << seconds_["next"] << ", register "
+            << seconds_["register"] << ", triangulate " << seconds_["triangulate"] << ", local "
+            << seconds_["local"] << ", global " << seconds_["global"];
     const bool keep = static_cast<int>(r.poses().size()) >= options_.min_model_size;
     for (const auto& [id, pose] : r.poses()) used_.insert(id);
     if (keep) models.push_back(MappedModel{std::move(r), start, std::move(refinements_)});
@@ -233,16 +251,22 @@ void Mapper::GrowModel(Reconstruction* r, bool abandon_allowed, ProgressSink& pr
       }
       failed_.clear();
       Timed("triangulate", [&] { return Triangulate(r, image_id); });
-      Timed("local", [&] { LocalAdjust(r, image_id); return 0; });
+      Timed("local", [&] {
+        LocalAdjust(r, image_id);
+        return 0;
+      });
       progress.Advance(1);
       if (r->poses().size() >= options_.ba_global_images_ratio * last_global) {
         // Intrinsics move the rays of every image (and need the exact,
         // slower error): refine them while the model is small and then
         // whenever it has grown by a third, until they have settled
         // (IncrementalMapperOptions::ba_calibration_settled_px).
-        const bool refine =
-            (r->poses().size() <= 8 || r->poses().size() >= 1.33 * last_refine) && !CalibrationSettled();
-        Timed("global", [&] { GlobalAdjust(r, refine, AdjustmentEnd::kGrowing); return 0; });
+        const bool refine = (r->poses().size() <= 8 || r->poses().size() >= 1.33 * last_refine) &&
+                            !CalibrationSettled();
+        Timed("global", [&] {
+          GlobalAdjust(r, refine, AdjustmentEnd::kGrowing);
+          return 0;
+        });
         if (refine) last_refine = r->poses().size();
         last_global = r->poses().size();
       }
@@ -261,8 +285,9 @@ void Mapper::FinishModel(Reconstruction* r, size_t model_index) {
   GlobalAdjust(r, true, held ? AdjustmentEnd::kWeightsSettled : AdjustmentEnd::kCostChange);
   Filter(r, nullptr);
   GlobalAdjust(r, true, held ? AdjustmentEnd::kHeldWeightsSolve : AdjustmentEnd::kCostChange);
-  LOG(INFO) << "refractive_mapper: model " << model_index << ": " << r->poses().size() << " images, "
-            << r->points().size() << " points, mean reprojection error " << r->MeanReprojectionError() << " px";
+  LOG(INFO) << "refractive_mapper: model " << model_index << ": " << r->poses().size()
+            << " images, " << r->points().size() << " points, mean reprojection error "
+            << r->MeanReprojectionError() << " px";
 }
 
 bool Mapper::Initialize(Reconstruction* r, std::set<image_pair_t>* tried, image_pair_t* start) {
@@ -274,8 +299,8 @@ bool Mapper::Initialize(Reconstruction* r, std::set<image_pair_t>* tried, image_
     PairIdToImagePair(pair_id, &a, &b);
     if (TryInitialPair(r, a, b)) {
       LOG(INFO) << "refractive_mapper: initial pair '" << inputs_.images.at(a).name << "' + '"
-                << inputs_.images.at(b).name << "' (" << inputs_.pair_inliers.at(pair_id) << " inlier matches), "
-                << r->points().size() << " points";
+                << inputs_.images.at(b).name << "' (" << inputs_.pair_inliers.at(pair_id)
+                << " inlier matches), " << r->points().size() << " points";
       *start = pair_id;
       return true;
     }
@@ -350,9 +375,10 @@ bool Mapper::Register(Reconstruction* r, image_t image_id) {
     fixed_points.push_back(points[i]);
     const Ray3d& ray = rays[i];
     ceres::CostFunction* cost =
-        ray.direction.z() > 1e-6
-            ? CreateFixedRayCost(VirtualCenterOf(camera, ray), ray.direction, camera.camera.MeanFocalLength(), 1.0)
-            : CreateReprojectionCost(model, CostBlocks::kPosePoint, image.keypoints[links[i].first], 1.0);
+        ray.direction.z() > 1e-6 ? CreateFixedRayCost(VirtualCenterOf(camera, ray), ray.direction,
+                                                      camera.camera.MeanFocalLength(), 1.0)
+                                 : CreateReprojectionCost(model, CostBlocks::kPosePoint,
+                                                          image.keypoints[links[i].first], 1.0);
     problem.AddResidualBlock(cost, loss, pose.data(), fixed_points.back().data());
     problem.SetParameterBlockConstant(fixed_points.back().data());
   }
@@ -374,7 +400,9 @@ bool Mapper::Register(Reconstruction* r, image_t image_id) {
     bool already = false;  // two keypoints of one image on one point
     for (const TrackElement& e : r->points().at(p).track) already |= e.image_id == image_id;
     if (already) continue;
-    if (r->ReprojectionError(image_id, k, r->points().at(p).xyz) > options_.filter_max_reproj_error_px) continue;
+    if (r->ReprojectionError(image_id, k, r->points().at(p).xyz) >
+        options_.filter_max_reproj_error_px)
+      continue;
     r->AddObservation(p, {image_id, k});
     ++added;
   }
@@ -456,7 +484,8 @@ int Mapper::Filter(Reconstruction* r, const std::set<image_t>* images) {
     for (const TrackElement& e : r->points().at(id).track) {
       rays.push_back(RayInWorld(*r->RayOf(e.image_id, e.point2D_idx), r->poses().at(e.image_id)));
     }
-    if (MaxTriangulationAngle(rays, r->points().at(id).xyz) < options_.filter_min_tri_angle_deg * kDegree) {
+    if (MaxTriangulationAngle(rays, r->points().at(id).xyz) <
+        options_.filter_min_tri_angle_deg * kDegree) {
       removed += static_cast<int>(rays.size());
       r->DeletePoint(id);
     }
@@ -479,7 +508,8 @@ void Mapper::LocalAdjust(Reconstruction* r, image_t image_id) {
   std::sort(ranked.rbegin(), ranked.rend());
   BundleAdjustmentScope scope;
   scope.variable_images.insert(image_id);
-  for (size_t i = 0; i < ranked.size() && static_cast<int>(i) < options_.ba_local_num_images - 1; ++i) {
+  for (size_t i = 0; i < ranked.size() && static_cast<int>(i) < options_.ba_local_num_images - 1;
+       ++i) {
     scope.variable_images.insert(ranked[i].second);
   }
   // COLMAP's local adjustment budget: a few iterations refine a pose
@@ -500,15 +530,16 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics, AdjustmentE
   // repeated with the intrinsics held.
   const int num_images = static_cast<int>(r->poses().size());
   refine_intrinsics = refine_intrinsics && num_images >= kMinImagesForIntrinsics;
-  BundleAdjustmentOptions ba = GlobalAdjustmentOptions(options_, num_images, refine_intrinsics, end);
+  BundleAdjustmentOptions ba =
+      GlobalAdjustmentOptions(options_, num_images, refine_intrinsics, end);
   if (options_.position_prior_sigma_m > 0 && options_.marker_scale.side_length_m <= 0 &&
       AlignToPositionPriors(r, 5 * options_.position_prior_sigma_m)) {
     // The model in the priors' metric frame, the priors as residuals.
     ba.position_prior_sigma_m = options_.position_prior_sigma_m;
   }
   if (options_.marker_scale.side_length_m > 0) {
-    PrepareMarkerCorners(r, options_.filter_max_reproj_error_px * 4, options_.marker_scale.side_length_m,
-                         &marker_corners_);
+    PrepareMarkerCorners(r, options_.filter_max_reproj_error_px * 4,
+                         options_.marker_scale.side_length_m, &marker_corners_);
   }
   std::vector<MarkerCorner>& markers = marker_corners_;  // this adjustment's, kept for the next
   const ModelSnapshot before = ModelSnapshot::Of(*r, markers);
@@ -516,11 +547,14 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics, AdjustmentE
   const ceres::Solver::Summary summary =
       AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
   const bool implausible =
-      refine_intrinsics && BogusIntrinsics(before.cameras, r->cameras(), cameras_, options_.max_focal_ratio_to_start);
-  if (refine_intrinsics) num_implausible_in_a_row_ = implausible ? num_implausible_in_a_row_ + 1 : 0;
+      refine_intrinsics &&
+      BogusIntrinsics(before.cameras, r->cameras(), cameras_, options_.max_focal_ratio_to_start);
+  if (refine_intrinsics)
+    num_implausible_in_a_row_ = implausible ? num_implausible_in_a_row_ + 1 : 0;
   if (implausible) {
     LOG(WARNING) << "refractive_mapper: intrinsics refined on " << r->poses().size()
-                 << " images came out implausible (" << CalibrationText(*r, false) << " ); held for now";
+                 << " images came out implausible (" << CalibrationText(*r, false)
+                 << " ); held for now";
     before.Restore(r, &markers);
     ba = ba.WithIntrinsicsHeld();
     ba.refine_housing = false;
@@ -531,7 +565,8 @@ void Mapper::GlobalAdjust(Reconstruction* r, bool refine_intrinsics, AdjustmentE
   }
   NoteRefinement(*r, ba, implausible, summary, before.cameras);
   if (VLOG_IS_ON(1) && (ba.refine_housing || ba.refine_focal_length)) {
-    VLOG(1) << "global adjustment of " << r->poses().size() << " images:" << CalibrationText(*r, true);
+    VLOG(1) << "global adjustment of " << r->poses().size()
+            << " images:" << CalibrationText(*r, true);
   }
   Filter(r, nullptr);
 }
@@ -548,21 +583,26 @@ void Mapper::AdjustHousingFirst(Reconstruction* r, const BundleAdjustmentOptions
     normal_first.refine_housing_position = false;
     AdjustBundle(r, normal_first, BundleAdjustmentScope(), markers, options_.marker_scale);
   }
-  if (ba.refine_housing && (ba.refine_focal_length || ba.refine_principal_point || ba.refine_extra_params)) {
+  if (ba.refine_housing &&
+      (ba.refine_focal_length || ba.refine_principal_point || ba.refine_extra_params)) {
     // The housing first, under the held intrinsics (see
     // RunRefractiveBundleAdjuster: jointly from a poor start, focal length
     // and port distance trade off).
-    AdjustBundle(r, ba.WithIntrinsicsHeld(), BundleAdjustmentScope(), markers, options_.marker_scale);
+    AdjustBundle(r, ba.WithIntrinsicsHeld(), BundleAdjustmentScope(), markers,
+                 options_.marker_scale);
   }
 }
 
-void Mapper::NoteRefinement(const Reconstruction& r, const BundleAdjustmentOptions& ba, bool implausible,
-                            const ceres::Solver::Summary& summary,
+void Mapper::NoteRefinement(const Reconstruction& r, const BundleAdjustmentOptions& ba,
+                            bool implausible, const ceres::Solver::Summary& summary,
                             const std::map<camera_t, HousedCamera>& cameras_before) {
   const bool refined = !implausible && (ba.refine_housing || ba.refine_focal_length ||
                                         ba.refine_principal_point || ba.refine_extra_params);
-  if (refined) refinements_.push_back({static_cast<int>(r.poses().size()), std::numeric_limits<double>::infinity()});
-  if (!refined || static_cast<int>(r.poses().size()) < options_.ba_calibration_settled_min_images) return;
+  if (refined)
+    refinements_.push_back(
+        {static_cast<int>(r.poses().size()), std::numeric_limits<double>::infinity()});
+  if (!refined || static_cast<int>(r.poses().size()) < options_.ba_calibration_settled_min_images)
+    return;
   const double depth = MedianSceneDepth(r);
   double& shift = refinements_.back().image_shift_px;
   if (depth > 0 && EndedOnItsCriterion(summary)) {
@@ -571,22 +611,29 @@ void Mapper::NoteRefinement(const Reconstruction& r, const BundleAdjustmentOptio
       shift = std::max(shift, MaxImageShiftPx(cameras_before.at(id), camera, depth));
     }
   }
-  num_settled_in_a_row_ = shift < options_.ba_calibration_settled_px ? num_settled_in_a_row_ + 1 : 0;
+  num_settled_in_a_row_ =
+      shift < options_.ba_calibration_settled_px ? num_settled_in_a_row_ + 1 : 0;
   refinements_.back().settled = CalibrationSettled();
   std::ostringstream moved;
-  if (!EndedOnItsCriterion(summary)) moved << "ended before converging (image shift not measured)";
-  else if (std::isinf(shift)) moved << "had no scene depth (image shift not measured)";
-  else moved << "moved the image by up to " << shift << " px";
-  if (summary.termination_type == ceres::USER_SUCCESS) moved << " (ended once the robust weights settled)";
-  VLOG(1) << "refractive_mapper: the refinement on " << r.poses().size() << " images " << moved.str()
-          << " at the median depth " << depth << (CalibrationSettled() ? " (settled)" : "");
+  if (!EndedOnItsCriterion(summary))
+    moved << "ended before converging (image shift not measured)";
+  else if (std::isinf(shift))
+    moved << "had no scene depth (image shift not measured)";
+  else
+    moved << "moved the image by up to " << shift << " px";
+  if (summary.termination_type == ceres::USER_SUCCESS)
+    moved << " (ended once the robust weights settled)";
+  VLOG(1) << "refractive_mapper: the refinement on " << r.poses().size() << " images "
+          << moved.str() << " at the median depth " << depth
+          << (CalibrationSettled() ? " (settled)" : "");
 }
 
 }  // namespace
 
 std::vector<MappedModel> RunIncrementalMapper(const SfmInputs& inputs,
                                               const std::map<camera_t, HousedCamera>& cameras,
-                                              const IncrementalMapperOptions& options, ProgressSink& progress) {
+                                              const IncrementalMapperOptions& options,
+                                              ProgressSink& progress) {
   options.Check();
   Mapper mapper(inputs, cameras, options);
   return mapper.Run(progress);

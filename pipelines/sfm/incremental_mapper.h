@@ -133,12 +133,14 @@ struct CalibrationRefinement {
 struct MappedModel {
   Reconstruction reconstruction;
   image_pair_t initial_pair = 0;  // the pair it grew from
-  std::vector<CalibrationRefinement> calibration_refinements;  // in order; the final adjustment's last
+  std::vector<CalibrationRefinement>
+      calibration_refinements;  // in order; the final adjustment's last
 };
 
 // Grows models until no image can be added; returns them largest first.
 std::vector<MappedModel> RunIncrementalMapper(const SfmInputs& inputs,
                                               const std::map<camera_t, HousedCamera>& cameras,
-                                              const IncrementalMapperOptions& options, ProgressSink& progress);
+                                              const IncrementalMapperOptions& options,
+                                              ProgressSink& progress);
 
 }  // namespace portcal

@@ -41,8 +41,8 @@ PairRays RaysOfPair(const Reconstruction& r, image_t a, image_t b) {
 // The inlier pairs' points in a's frame (NaN where they do not triangulate
 // in front of both cameras) and the triangulation angles of those that do.
 void TriangulatePair(const Reconstruction& r, image_t a, image_t b, const PairRays& rays,
-                     const std::vector<char>& inliers, const Rigid3d& pose_b, std::vector<Eigen::Vector3d>* points,
-                     std::vector<double>* angles) {
+                     const std::vector<char>& inliers, const Rigid3d& pose_b,
+                     std::vector<Eigen::Vector3d>* points, std::vector<double>* angles) {
   points->assign(rays.pairs.size(), Eigen::Vector3d::Constant(std::nan("")));
   angles->clear();
   for (size_t i = 0; i < rays.pairs.size(); ++i) {
@@ -61,7 +61,9 @@ void TriangulatePair(const Reconstruction& r, image_t a, image_t b, const PairRa
 bool SeeACommonMarker(const SfmImage& a, const SfmImage& b) {
   for (const MarkerDetection& seen_by_a : a.markers) {
     for (const MarkerDetection& seen_by_b : b.markers) {
-      if (seen_by_a.marker_id == seen_by_b.marker_id && seen_by_a.dictionary == seen_by_b.dictionary) return true;
+      if (seen_by_a.marker_id == seen_by_b.marker_id &&
+          seen_by_a.dictionary == seen_by_b.dictionary)
+        return true;
     }
   }
   return false;
@@ -69,8 +71,10 @@ bool SeeACommonMarker(const SfmImage& a, const SfmImage& b) {
 
 }  // namespace
 
-std::vector<image_pair_t> RankInitialPairs(const SfmInputs& inputs, const std::map<camera_t, HousedCamera>& cameras,
-                                           const IncrementalMapperOptions& options, const std::set<image_t>& used,
+std::vector<image_pair_t> RankInitialPairs(const SfmInputs& inputs,
+                                           const std::map<camera_t, HousedCamera>& cameras,
+                                           const IncrementalMapperOptions& options,
+                                           const std::set<image_t>& used,
                                            const std::set<image_pair_t>& tried) {
   // Most inlier matches first, but pairs whose geometry is a homography
   // last: a relative pose from a plane seen twice is ambiguous (two
@@ -111,7 +115,8 @@ std::vector<image_pair_t> RankInitialPairs(const SfmInputs& inputs, const std::m
   return ranked;
 }
 
-bool StartFromPair(const IncrementalMapperOptions& options, image_t a, image_t b, Reconstruction* r) {
+bool StartFromPair(const IncrementalMapperOptions& options, image_t a, image_t b,
+                   Reconstruction* r) {
   const auto focal_of = [&](image_t id) {
     return r->cameras().at(r->inputs().images.at(id).camera_id).camera.MeanFocalLength();
   };
@@ -119,7 +124,8 @@ bool StartFromPair(const IncrementalMapperOptions& options, image_t a, image_t b
   if (static_cast<int>(rays.pairs.size()) < options.init_min_num_inliers) return false;
   std::vector<char> inliers;
   const double angle = options.init_max_error_px / std::min(focal_of(a), focal_of(b));
-  const auto b_from_a = EstimateRelativePose(rays.dirs_a, rays.dirs_b, angle, options.random_seed, &inliers);
+  const auto b_from_a =
+      EstimateRelativePose(rays.dirs_a, rays.dirs_b, angle, options.random_seed, &inliers);
   if (!b_from_a) return false;
   std::vector<Eigen::Vector3d> points;
   std::vector<double> angles;
@@ -141,8 +147,9 @@ bool StartFromPair(const IncrementalMapperOptions& options, image_t a, image_t b
   if (options.marker_scale.side_length_m > 0) {
     // Markers seen by both: their measured sides against the known one
     // (every corner kept: two views cannot tell a bad corner).
-    if (const auto factor = MarkerScaleRatio(TriangulateMarkerCorners(*r, 1e9), options.marker_scale.side_length_m,
-                                             /*with_diagonals=*/false)) {
+    if (const auto factor =
+            MarkerScaleRatio(TriangulateMarkerCorners(*r, 1e9), options.marker_scale.side_length_m,
+                             /*with_diagonals=*/false)) {
       pose_b.translation *= *factor;
       r->Register(b, pose_b);
     }

@@ -20,8 +20,10 @@ namespace portcal {
 // mapper's start) is behind a housing, the best of the pairs that see a
 // marker in common and are not homographies (half of
 // `options.init_max_num_trials` at most) before all others.
-std::vector<image_pair_t> RankInitialPairs(const SfmInputs& inputs, const std::map<camera_t, HousedCamera>& cameras,
-                                           const IncrementalMapperOptions& options, const std::set<image_t>& used,
+std::vector<image_pair_t> RankInitialPairs(const SfmInputs& inputs,
+                                           const std::map<camera_t, HousedCamera>& cameras,
+                                           const IncrementalMapperOptions& options,
+                                           const std::set<image_t>& used,
                                            const std::set<image_pair_t>& tried);
 
 // Registers `a` at the origin and `b` by the relative pose of their matched
@@ -31,6 +33,7 @@ std::vector<image_pair_t> RankInitialPairs(const SfmInputs& inputs, const std::m
 // `options.init_max_error_px`. False, with `r` as it was, when the pair has
 // too few matches or inliers, too small a triangulation angle, or too few
 // points.
-bool StartFromPair(const IncrementalMapperOptions& options, image_t a, image_t b, Reconstruction* r);
+bool StartFromPair(const IncrementalMapperOptions& options, image_t a, image_t b,
+                   Reconstruction* r);
 
 }  // namespace portcal

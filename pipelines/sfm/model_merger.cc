@@ -10,7 +10,8 @@ namespace portcal {
 
 void ModelMergeOptions::Check() const {
   if (min_shared_points < 3) {
-    throw OptionError("--Hierarchical.min_shared_points", std::to_string(min_shared_points), ">= 3");
+    throw OptionError("--Hierarchical.min_shared_points", std::to_string(min_shared_points),
+                      ">= 3");
   }
 }
 
@@ -20,8 +21,8 @@ Eigen::Vector3d Apply(const Similarity3d& s, const Eigen::Vector3d& x) {
   return s.scale * (s.rotation * x) + s.translation;
 }
 
-Similarity3d FitSelected(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to,
-                     const std::vector<char>& use) {
+Similarity3d FitSelected(const std::vector<Eigen::Vector3d>& from,
+                         const std::vector<Eigen::Vector3d>& to, const std::vector<char>& use) {
   const int n = static_cast<int>(std::count(use.begin(), use.end(), 1));
   Eigen::Matrix3Xd src(3, n), dst(3, n);
   for (size_t i = 0, k = 0; i < from.size(); ++i) {
@@ -43,7 +44,8 @@ void FitRobustly(const std::vector<Eigen::Vector3d>& from, const std::vector<Eig
     std::vector<double> errors(from.size());
     for (size_t i = 0; i < from.size(); ++i) errors[i] = (Apply(sim, from[i]) - to[i]).norm();
     std::vector<double> sorted = errors;
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+    std::nth_element(sorted.begin(),
+                     sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
     const double limit = 3.0 * 1.4826 * sorted[sorted.size() / 2];
     for (size_t i = 0; i < from.size(); ++i) use[i] = errors[i] <= limit;
     if (std::count(use.begin(), use.end(), 1) < 3) break;
@@ -63,8 +65,8 @@ void FitRobustly(const std::vector<Eigen::Vector3d>& from, const std::vector<Eig
 
 // The points of `model` observed through a keypoint that also observes a
 // point of `merged`: (the model's point, the merged one), one per model point.
-void SharedPoints(const SparseModel& merged, const SparseModel& model, std::vector<Eigen::Vector3d>* from,
-                  std::vector<Eigen::Vector3d>* to) {
+void SharedPoints(const SparseModel& merged, const SparseModel& model,
+                  std::vector<Eigen::Vector3d>* from, std::vector<Eigen::Vector3d>* to) {
   for (const auto& [id, point] : model.points3D) {
     for (const TrackElement& e : point.track) {
       const auto image = merged.images.find(e.image_id);
@@ -92,8 +94,10 @@ void AddModel(const SparseModel& model, const Similarity3d& s, SparseModel* merg
     if (merged->images.count(id)) continue;
     Image moved = image;
     // cam_from_merged = (R_c R^T, s t_c - R_c R^T t), as in AlignToPositionPriors.
-    const Eigen::Quaterniond rotation = (image.cam_from_world.rotation * s.rotation.conjugate()).normalized();
-    moved.cam_from_world = Rigid3d(rotation, s.scale * image.cam_from_world.translation - rotation * s.translation);
+    const Eigen::Quaterniond rotation =
+        (image.cam_from_world.rotation * s.rotation.conjugate()).normalized();
+    moved.cam_from_world =
+        Rigid3d(rotation, s.scale * image.cam_from_world.translation - rotation * s.translation);
     for (Point2D& p : moved.points2D) p.point3D_id = kInvalidPoint3DId;
     merged->images[id] = moved;
   }
@@ -102,7 +106,8 @@ void AddModel(const SparseModel& model, const Similarity3d& s, SparseModel* merg
     point3D_t target = kInvalidPoint3DId;
     std::vector<TrackElement> free;
     for (const TrackElement& e : point.track) {
-      const point3D_t observed = merged->images.at(e.image_id).points2D.at(e.point2D_idx).point3D_id;
+      const point3D_t observed =
+          merged->images.at(e.image_id).points2D.at(e.point2D_idx).point3D_id;
       if (observed == kInvalidPoint3DId) free.push_back(e);
       if (observed != kInvalidPoint3DId && target == kInvalidPoint3DId) target = observed;
     }
@@ -118,8 +123,9 @@ void AddModel(const SparseModel& model, const Similarity3d& s, SparseModel* merg
     for (const TrackElement& e : free) {
       // One observation per image in a track: a second keypoint of an image
       // already in it is a different feature.
-      const bool seen = std::any_of(joined.track.begin(), joined.track.end(),
-                                    [&](const TrackElement& t) { return t.image_id == e.image_id; });
+      const bool seen =
+          std::any_of(joined.track.begin(), joined.track.end(),
+                      [&](const TrackElement& t) { return t.image_id == e.image_id; });
       if (seen) continue;
       joined.track.push_back(e);
       merged->images.at(e.image_id).points2D.at(e.point2D_idx).point3D_id = target;
@@ -135,8 +141,9 @@ MergedModels MergeModels(const std::vector<SparseModel>& models, const ModelMerg
   if (models.empty()) return result;
   std::vector<size_t> pending(models.size());
   for (size_t i = 0; i < models.size(); ++i) pending[i] = i;
-  std::stable_sort(pending.begin(), pending.end(),
-                   [&](size_t a, size_t b) { return models[a].images.size() > models[b].images.size(); });
+  std::stable_sort(pending.begin(), pending.end(), [&](size_t a, size_t b) {
+    return models[a].images.size() > models[b].images.size();
+  });
   result.model = models[pending.front()];
   ModelAlignment first;
   first.model_index = pending.front();

@@ -14,13 +14,16 @@
 namespace portcal {
 
 void RadialStartOptions::Check() const {
-  if (!(min_k < max_k)) throw OptionError("--Mapper.init_radial_min_k", std::to_string(min_k), "< max_k");
-  if (num_steps < 3) throw OptionError("--Mapper.init_radial_num_steps", std::to_string(num_steps), ">= 3");
+  if (!(min_k < max_k))
+    throw OptionError("--Mapper.init_radial_min_k", std::to_string(min_k), "< max_k");
+  if (num_steps < 3)
+    throw OptionError("--Mapper.init_radial_num_steps", std::to_string(num_steps), ">= 3");
   if (max_num_pairs < 2) {
     throw OptionError("--Mapper.init_radial_max_num_pairs", std::to_string(max_num_pairs), ">= 2");
   }
   if (max_matches_per_pair < 16) {
-    throw OptionError("--Mapper.init_radial_max_matches", std::to_string(max_matches_per_pair), ">= 16");
+    throw OptionError("--Mapper.init_radial_max_matches", std::to_string(max_matches_per_pair),
+                      ">= 16");
   }
 }
 
@@ -36,7 +39,8 @@ namespace {
 
 using Matches = std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>>;  // pixels in a, in b
 
-double SampsonSquared(const Eigen::Matrix3d& F, const Eigen::Vector2d& x1, const Eigen::Vector2d& x2) {
+double SampsonSquared(const Eigen::Matrix3d& F, const Eigen::Vector2d& x1,
+                      const Eigen::Vector2d& x2) {
   const Eigen::Vector3d p1 = x1.homogeneous(), p2 = x2.homogeneous();
   const Eigen::Vector3d Fp1 = F * p1, Ftp2 = F.transpose() * p2;
   const double e = p2.dot(Fp1);
@@ -47,7 +51,8 @@ double SampsonSquared(const Eigen::Matrix3d& F, const Eigen::Vector2d& x1, const
 // The eight-point fundamental matrix x2' F x1 = 0, each row weighted (the
 // reweighting by the Sampson denominator makes the algebraic fit
 // approximate the geometric one), rank 2 enforced.
-Eigen::Matrix3d FitFundamental(const std::vector<Eigen::Vector2d>& x1, const std::vector<Eigen::Vector2d>& x2,
+Eigen::Matrix3d FitFundamental(const std::vector<Eigen::Vector2d>& x1,
+                               const std::vector<Eigen::Vector2d>& x2,
                                const std::vector<double>& weights) {
   const Eigen::Matrix3d T1 = HartleyNormalization(x1), T2 = HartleyNormalization(x2);
   Eigen::Matrix<double, 9, 9> AtA = Eigen::Matrix<double, 9, 9>::Zero();
@@ -55,7 +60,8 @@ Eigen::Matrix3d FitFundamental(const std::vector<Eigen::Vector2d>& x1, const std
     if (weights[i] <= 0) continue;
     const Eigen::Vector3d a = T1 * x1[i].homogeneous(), b = T2 * x2[i].homogeneous();
     Eigen::Matrix<double, 9, 1> row;
-    row << b.x() * a.x(), b.x() * a.y(), b.x(), b.y() * a.x(), b.y() * a.y(), b.y(), a.x(), a.y(), 1;
+    row << b.x() * a.x(), b.x() * a.y(), b.x(), b.y() * a.x(), b.y() * a.y(), b.y(), a.x(), a.y(),
+        1;
     AtA += weights[i] * row * row.transpose();
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> eigen(AtA);
@@ -73,7 +79,8 @@ Eigen::Matrix3d FitFundamental(const std::vector<Eigen::Vector2d>& x1, const std
 // coordinates) of one pair's rays, after a fit that drops what lies beyond
 // three times the median: the verified inliers still hold a few wrong
 // matches, and they must not choose the distortion.
-std::pair<double, int> PairResidual(const std::vector<Eigen::Vector2d>& x1, const std::vector<Eigen::Vector2d>& x2) {
+std::pair<double, int> PairResidual(const std::vector<Eigen::Vector2d>& x1,
+                                    const std::vector<Eigen::Vector2d>& x2) {
   std::vector<double> weights(x1.size(), 1.0), errors(x1.size());
   Eigen::Matrix3d F = FitFundamental(x1, x2, weights);
   for (int pass = 0; pass < 3; ++pass) {
@@ -82,7 +89,8 @@ std::pair<double, int> PairResidual(const std::vector<Eigen::Vector2d>& x1, cons
     std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
     const double cut = 9.0 * sorted[sorted.size() / 2];
     for (size_t i = 0; i < x1.size(); ++i) {
-      const Eigen::Vector3d Fp1 = F * x1[i].homogeneous(), Ftp2 = F.transpose() * x2[i].homogeneous();
+      const Eigen::Vector3d Fp1 = F * x1[i].homogeneous(),
+                            Ftp2 = F.transpose() * x2[i].homogeneous();
       const double denominator = Fp1.head<2>().squaredNorm() + Ftp2.head<2>().squaredNorm();
       weights[i] = errors[i] <= cut && denominator > 0 ? 1.0 / denominator : 0.0;
     }
@@ -97,7 +105,8 @@ std::pair<double, int> PairResidual(const std::vector<Eigen::Vector2d>& x1, cons
 }
 
 // The best-matched non-planar pairs of the camera, their matched pixels.
-std::vector<Matches> CollectPairs(const SfmInputs& inputs, camera_t camera_id, const RadialStartOptions& options) {
+std::vector<Matches> CollectPairs(const SfmInputs& inputs, camera_t camera_id,
+                                  const RadialStartOptions& options) {
   std::vector<std::pair<int, image_pair_t>> ranked;
   for (const auto& [pair_id, count] : inputs.pair_inliers) {
     image_t a, b;
@@ -119,12 +128,14 @@ std::vector<Matches> CollectPairs(const SfmInputs& inputs, camera_t camera_id, c
     Matches matches;
     for (point2D_t k = 0; k < image_a.correspondences.size(); ++k) {
       for (const Correspondence& c : image_a.correspondences[k]) {
-        if (c.image_id == b) matches.emplace_back(image_a.keypoints[k], image_b.keypoints[c.point2D_idx]);
+        if (c.image_id == b)
+          matches.emplace_back(image_a.keypoints[k], image_b.keypoints[c.point2D_idx]);
       }
     }
     if (matches.size() < 16) continue;
     // An even subsample keeps the spread of the matches over the image.
-    const size_t step = (matches.size() + options.max_matches_per_pair - 1) / options.max_matches_per_pair;
+    const size_t step =
+        (matches.size() + options.max_matches_per_pair - 1) / options.max_matches_per_pair;
     Matches kept;
     for (size_t i = 0; i < matches.size(); i += step) kept.push_back(matches[i]);
     pairs.push_back(std::move(kept));
@@ -134,7 +145,8 @@ std::vector<Matches> CollectPairs(const SfmInputs& inputs, camera_t camera_id, c
 
 // Mean squared residual over all pairs, in pixels squared, and its count,
 // with the radial term k.
-std::pair<double, int> ResidualAt(const std::vector<Matches>& pairs, const HousedCamera& camera, int idx, double k) {
+std::pair<double, int> ResidualAt(const std::vector<Matches>& pairs, const HousedCamera& camera,
+                                  int idx, double k) {
   Camera trial = camera.camera;
   trial.params[idx] = k;
   const Housing* housing = camera.HousingOrNull();
@@ -169,12 +181,15 @@ std::pair<double, int> ResidualAt(const std::vector<Matches>& pairs, const House
 // from the middle one in units of the spacing (0 where it has no minimum).
 double ParabolaVertex(double c0, double c1, double c2) {
   const double curvature = c0 - 2 * c1 + c2;
-  return std::isfinite(curvature) && curvature > 0 ? std::clamp(0.5 * (c0 - c2) / curvature, -1.0, 1.0) : 0.0;
+  return std::isfinite(curvature) && curvature > 0
+             ? std::clamp(0.5 * (c0 - c2) / curvature, -1.0, 1.0)
+             : 0.0;
 }
 
 // The best k and its mean squared residual: the grid's minimum, then the
 // parabola's vertex if that is lower still.
-std::pair<double, double> BestRadialTerm(const std::vector<Matches>& pairs, const HousedCamera& camera, int idx,
+std::pair<double, double> BestRadialTerm(const std::vector<Matches>& pairs,
+                                         const HousedCamera& camera, int idx,
                                          const RadialStartOptions& options) {
   const double step = (options.max_k - options.min_k) / (options.num_steps - 1);
   std::vector<double> costs(options.num_steps);
@@ -183,15 +198,18 @@ std::pair<double, double> BestRadialTerm(const std::vector<Matches>& pairs, cons
   });
   const size_t best = std::min_element(costs.begin(), costs.end()) - costs.begin();
   double k = options.min_k + best * step;
-  if (best > 0 && best + 1 < costs.size()) k += step * ParabolaVertex(costs[best - 1], costs[best], costs[best + 1]);
+  if (best > 0 && best + 1 < costs.size())
+    k += step * ParabolaVertex(costs[best - 1], costs[best], costs[best + 1]);
   const double cost = ResidualAt(pairs, camera, idx, k).first;
-  return cost <= costs[best] ? std::make_pair(k, cost) : std::make_pair(options.min_k + best * step, costs[best]);
+  return cost <= costs[best] ? std::make_pair(k, cost)
+                             : std::make_pair(options.min_k + best * step, costs[best]);
 }
 
 }  // namespace
 
 std::optional<RadialStart> EstimateFirstRadialTerm(const SfmInputs& inputs, camera_t camera_id,
-                                                   const HousedCamera& camera, const RadialStartOptions& options) {
+                                                   const HousedCamera& camera,
+                                                   const RadialStartOptions& options) {
   options.Check();
   const int idx = FirstRadialParamIdx(camera.camera);
   if (idx < 0) return std::nullopt;
@@ -204,7 +222,8 @@ std::optional<RadialStart> EstimateFirstRadialTerm(const SfmInputs& inputs, came
   std::tie(start.k, cost) = BestRadialTerm(pairs, camera, idx, options);
   if (!std::isfinite(cost)) return std::nullopt;
   start.residual_px = std::sqrt(cost);
-  start.residual_at_start_px = std::sqrt(ResidualAt(pairs, camera, idx, camera.camera.params[idx]).first);
+  start.residual_at_start_px =
+      std::sqrt(ResidualAt(pairs, camera, idx, camera.camera.params[idx]).first);
   start.num_pairs = static_cast<int>(pairs.size());
   start.num_matches = num_matches;
   return start;

@@ -31,15 +31,15 @@ namespace portcal {
 struct RadialStartOptions {
   double min_k = -0.6;  // search range of the first radial term
   double max_k = 0.6;
-  int num_steps = 49;          // grid over the range, then a parabola at the best
-  int max_num_pairs = 12;      // best-matched non-planar pairs of the camera
+  int num_steps = 49;      // grid over the range, then a parabola at the best
+  int max_num_pairs = 12;  // best-matched non-planar pairs of the camera
   int max_matches_per_pair = 600;
   void Check() const;  // throws OptionError naming --Mapper.init_radial_*
 };
 
 struct RadialStart {
-  double k = 0;              // the first radial term chosen
-  double residual_px = 0;    // RMS epipolar (Sampson) residual there (trimmed), pixels
+  double k = 0;                     // the first radial term chosen
+  double residual_px = 0;           // RMS epipolar (Sampson) residual there (trimmed), pixels
   double residual_at_start_px = 0;  // the same at the camera's own value
   int num_pairs = 0;
   int num_matches = 0;
@@ -50,6 +50,7 @@ int FirstRadialParamIdx(const Camera& camera);
 
 // nullopt when the model has no radial term or fewer than two usable pairs.
 std::optional<RadialStart> EstimateFirstRadialTerm(const SfmInputs& inputs, camera_t camera_id,
-                                                   const HousedCamera& camera, const RadialStartOptions& options);
+                                                   const HousedCamera& camera,
+                                                   const RadialStartOptions& options);
 
 }  // namespace portcal

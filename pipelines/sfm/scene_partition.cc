@@ -12,9 +12,11 @@ namespace portcal {
 
 void ScenePartitionOptions::Check() const {
   if (leaf_max_num_images < 10) {
-    throw OptionError("--Hierarchical.leaf_max_num_images", std::to_string(leaf_max_num_images), ">= 10");
+    throw OptionError("--Hierarchical.leaf_max_num_images", std::to_string(leaf_max_num_images),
+                      ">= 10");
   }
-  if (image_overlap < 2) throw OptionError("--Hierarchical.image_overlap", std::to_string(image_overlap), ">= 2");
+  if (image_overlap < 2)
+    throw OptionError("--Hierarchical.image_overlap", std::to_string(image_overlap), ">= 2");
 }
 
 namespace {
@@ -37,7 +39,8 @@ SceneGraph BuildGraph(const std::map<image_pair_t, int>& pair_inliers) {
   graph.images.assign(ids.begin(), ids.end());
   graph.weight.resize(graph.images.size());
   const auto node = [&](image_t id) {
-    return static_cast<idx_t>(std::lower_bound(graph.images.begin(), graph.images.end(), id) - graph.images.begin());
+    return static_cast<idx_t>(std::lower_bound(graph.images.begin(), graph.images.end(), id) -
+                              graph.images.begin());
   };
   for (const auto& [pair_id, inliers] : pair_inliers) {
     image_t a, b;
@@ -66,15 +69,18 @@ std::vector<idx_t> CutGraph(const SceneGraph& graph, idx_t num_parts) {
   std::vector<idx_t> part(graph.images.size(), 0);
   // Recursive bisection for two parts (k-way wants more), k-way beyond.
   const auto partition = num_parts == 2 ? METIS_PartGraphRecursive : METIS_PartGraphKway;
-  const int status = partition(&num_nodes, &num_constraints, xadj.data(), adjncy.data(), nullptr, nullptr,
-                               adjwgt.data(), &num_parts, nullptr, nullptr, options, &cut, part.data());
-  if (status != METIS_OK) throw NumericalError("scene partition: METIS failed (status " + std::to_string(status) + ")");
+  const int status =
+      partition(&num_nodes, &num_constraints, xadj.data(), adjncy.data(), nullptr, nullptr,
+                adjwgt.data(), &num_parts, nullptr, nullptr, options, &cut, part.data());
+  if (status != METIS_OK)
+    throw NumericalError("scene partition: METIS failed (status " + std::to_string(status) + ")");
   return part;
 }
 
 // The images outside `cluster` sharing the most inliers with it, at most
 // `count`.
-std::vector<idx_t> StrongestNeighbours(const SceneGraph& graph, const std::vector<idx_t>& cluster, int count) {
+std::vector<idx_t> StrongestNeighbours(const SceneGraph& graph, const std::vector<idx_t>& cluster,
+                                       int count) {
   const std::set<idx_t> inside(cluster.begin(), cluster.end());
   std::map<idx_t, idx_t> shared;
   for (idx_t node : cluster) {
@@ -86,7 +92,8 @@ std::vector<idx_t> StrongestNeighbours(const SceneGraph& graph, const std::vecto
   for (const auto& [node, weight] : shared) ranked.emplace_back(-weight, node);
   std::sort(ranked.begin(), ranked.end());
   std::vector<idx_t> chosen;
-  for (size_t k = 0; k < ranked.size() && static_cast<int>(k) < count; ++k) chosen.push_back(ranked[k].second);
+  for (size_t k = 0; k < ranked.size() && static_cast<int>(k) < count; ++k)
+    chosen.push_back(ranked[k].second);
   return chosen;
 }
 
@@ -98,12 +105,13 @@ std::vector<std::vector<image_t>> PartitionScene(const std::map<image_pair_t, in
   const SceneGraph graph = BuildGraph(pair_inliers);
   const size_t n = graph.images.size();
   if (n == 0) return {};
-  const idx_t num_parts =
-      static_cast<idx_t>((n + static_cast<size_t>(options.leaf_max_num_images) - 1) / options.leaf_max_num_images);
+  const idx_t num_parts = static_cast<idx_t>(
+      (n + static_cast<size_t>(options.leaf_max_num_images) - 1) / options.leaf_max_num_images);
   if (num_parts <= 1) return {graph.images};
   const std::vector<idx_t> part = CutGraph(graph, num_parts);
   std::vector<std::vector<idx_t>> parts(static_cast<size_t>(num_parts));
-  for (size_t node = 0; node < n; ++node) parts[static_cast<size_t>(part[node])].push_back(static_cast<idx_t>(node));
+  for (size_t node = 0; node < n; ++node)
+    parts[static_cast<size_t>(part[node])].push_back(static_cast<idx_t>(node));
   std::vector<std::vector<image_t>> clusters;
   for (const std::vector<idx_t>& nodes : parts) {
     if (nodes.empty()) continue;
@@ -115,7 +123,8 @@ std::vector<std::vector<image_t>> PartitionScene(const std::map<image_pair_t, in
     std::sort(cluster.begin(), cluster.end());
     clusters.push_back(cluster);
   }
-  std::stable_sort(clusters.begin(), clusters.end(), [](const auto& a, const auto& b) { return a.size() > b.size(); });
+  std::stable_sort(clusters.begin(), clusters.end(),
+                   [](const auto& a, const auto& b) { return a.size() > b.size(); });
   return clusters;
 }
 

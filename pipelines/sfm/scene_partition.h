@@ -15,9 +15,10 @@
 namespace portcal {
 
 struct ScenePartitionOptions {
-  int leaf_max_num_images = 250;  // --Hierarchical.leaf_max_num_images: a cluster's size before the overlap
-  int image_overlap = 50;         // --Hierarchical.image_overlap: images each cluster takes from outside
-  void Check() const;             // throws OptionError naming the option
+  int leaf_max_num_images =
+      250;  // --Hierarchical.leaf_max_num_images: a cluster's size before the overlap
+  int image_overlap = 50;  // --Hierarchical.image_overlap: images each cluster takes from outside
+  void Check() const;      // throws OptionError naming the option
 };
 
 // The clusters, each a sorted list of image ids, largest first. Every image

@@ -53,7 +53,8 @@ std::optional<double> WriteMarkersFocalToDatabase(const std::string& database_pa
   Transaction transaction = database.BeginTransaction();
   std::optional<double> focal;
   for (const auto& [id, camera] : cameras) {
-    if (camera.camera.params != inputs.cameras.at(id).camera.params) focal = camera.camera.MeanFocalLength();
+    if (camera.camera.params != inputs.cameras.at(id).camera.params)
+      focal = camera.camera.MeanFocalLength();
     database.UpdateCamera(camera.camera);
   }
   transaction.Commit();
@@ -76,23 +77,28 @@ constexpr double kMaxRelativeFocalStdDev = 0.01;
 // report, of what the views leave undetermined.
 void JudgeAutoCalibration(const std::optional<double>& markers_focal, CalibrationReport* report) {
   const double focal = report->camera.MeanFocalLength();
-  const std::string remedy = "give the in-air intrinsics (--ImageReader.camera_params), more views, or views "
-                             "with wider tilt and nearer the image corners";
+  const std::string remedy =
+      "give the in-air intrinsics (--ImageReader.camera_params), more views, or views "
+      "with wider tilt and nearer the image corners";
   if (markers_focal && !(focal / *markers_focal < kMaxFocalRatioToMarkers &&
                          *markers_focal / focal < kMaxFocalRatioToMarkers)) {
-    throw NumericalError("auto_calibrator: the refined focal length " + FormatNumber(focal) +
-                         " px is far from the ArUco markers' estimate " + FormatNumber(*markers_focal) +
-                         " px: the reconstruction settled in a wrong solution (lens distortion and housing "
-                         "traded against each other); " + remedy);
+    throw NumericalError(
+        "auto_calibrator: the refined focal length " + FormatNumber(focal) +
+        " px is far from the ArUco markers' estimate " + FormatNumber(*markers_focal) +
+        " px: the reconstruction settled in a wrong solution (lens distortion and housing "
+        "traded against each other); " +
+        remedy);
   }
   const std::vector<int> focal_idxs = CameraModelFocalLengthIdxs(report->camera.model_id);
   const double focal_std_dev = report->parameters_std_dev.at(focal_idxs.front());
   if (focal_std_dev < 0) {
-    report->warnings.push_back("the focal length is undetermined (no finite standard deviation); " + remedy);
+    report->warnings.push_back("the focal length is undetermined (no finite standard deviation); " +
+                               remedy);
     LOG(WARNING) << "auto_calibrator: " << report->warnings.back();
   } else if (focal_std_dev > kMaxRelativeFocalStdDev * focal) {
-    report->warnings.push_back("the focal length is poorly determined: std dev " + FormatNumber(focal_std_dev) +
-                               " px, " + FormatNumber(100 * focal_std_dev / focal) + " % of it; " + remedy);
+    report->warnings.push_back("the focal length is poorly determined: std dev " +
+                               FormatNumber(focal_std_dev) + " px, " +
+                               FormatNumber(100 * focal_std_dev / focal) + " % of it; " + remedy);
     LOG(WARNING) << "auto_calibrator: " << report->warnings.back();
   }
 }
@@ -131,8 +137,9 @@ void KeepStart(const fs::path& output_path, int kept, int num_starts) {
   for (int k = 1; k < num_starts; ++k) fs::remove_all(output_path / StartDir(k));
 }
 
-RefractiveMapperOptions MapperOptions(const AutoCalibratorOptions& options, const std::string& database_path,
-                                      const fs::path& dir, int random_seed, bool refine_intrinsics,
+RefractiveMapperOptions MapperOptions(const AutoCalibratorOptions& options,
+                                      const std::string& database_path, const fs::path& dir,
+                                      int random_seed, bool refine_intrinsics,
                                       const std::set<image_pair_t>& excluded_pairs) {
   RefractiveMapperOptions map;
   map.mapper.init_excluded_pairs = excluded_pairs;
@@ -154,7 +161,8 @@ RefractiveMapperOptions MapperOptions(const AutoCalibratorOptions& options, cons
   // refinement. Only with marker scale: without it the port distance is
   // barely observed and refining it splits the models
   // (docs/dev/auto_calibration_notes.md).
-  map.mapper.ba_refine_housing = options.housing && !options.housing->Refinement().orientation.empty() &&
+  map.mapper.ba_refine_housing = options.housing &&
+                                 !options.housing->Refinement().orientation.empty() &&
                                  options.marker_scale.side_length_m > 0;
   // The principal point with it: held at the image centre when it is not
   // there, the global adjustments fight the port. With the dome left to the
@@ -165,7 +173,8 @@ RefractiveMapperOptions MapperOptions(const AutoCalibratorOptions& options, cons
   return map;
 }
 
-RefractiveBundleAdjusterOptions RefinerOptions(const AutoCalibratorOptions& options, const std::string& database_path,
+RefractiveBundleAdjusterOptions RefinerOptions(const AutoCalibratorOptions& options,
+                                               const std::string& database_path,
                                                const std::string& input_path, const fs::path& dir,
                                                bool refine_intrinsics) {
   const bool refine_principal_point = refine_intrinsics && options.refine_principal_point != false;
@@ -192,19 +201,24 @@ RefractiveBundleAdjusterOptions RefinerOptions(const AutoCalibratorOptions& opti
 // initial pair) and the refinement, judged; throws NumericalError where
 // either fails or the result is ruled out. Adds the pair the model grew
 // from to `excluded_pairs`.
-CalibrationStart MapAndRefine(const AutoCalibratorOptions& options, const std::string& database_path, int k,
+CalibrationStart MapAndRefine(const AutoCalibratorOptions& options,
+                              const std::string& database_path, int k,
                               const std::optional<double>& markers_focal, bool refine_intrinsics,
                               std::set<image_pair_t>* excluded_pairs, ProgressSink& progress) {
-  const fs::path dir = k == 0 ? fs::path(options.output_path) : fs::path(options.output_path) / StartDir(k);
-  const RefractiveMapperSummary mapped = RunRefractiveMapper(
-      MapperOptions(options, database_path, dir, options.random_seed + k, refine_intrinsics, *excluded_pairs),
-      progress);
+  const fs::path dir =
+      k == 0 ? fs::path(options.output_path) : fs::path(options.output_path) / StartDir(k);
+  const RefractiveMapperSummary mapped =
+      RunRefractiveMapper(MapperOptions(options, database_path, dir, options.random_seed + k,
+                                        refine_intrinsics, *excluded_pairs),
+                          progress);
   excluded_pairs->insert(mapped.initial_pairs.at(0));
   CalibrationStart start;
   start.index = k;
   start.num_registered = static_cast<int>(ReadSparseModel(mapped.model_paths.at(0)).images.size());
   start.refined = RunRefractiveBundleAdjuster(
-      RefinerOptions(options, database_path, mapped.model_paths.at(0).string(), dir, refine_intrinsics), progress);
+      RefinerOptions(options, database_path, mapped.model_paths.at(0).string(), dir,
+                     refine_intrinsics),
+      progress);
   if (refine_intrinsics) {
     const size_t num_warnings = start.refined.report.warnings.size();
     JudgeAutoCalibration(markers_focal, &start.refined.report);
@@ -212,7 +226,8 @@ CalibrationStart MapAndRefine(const AutoCalibratorOptions& options, const std::s
     // the housing: another start cannot cure it either (own fisheye behind
     // a decentred dome: three starts, three identical models).
     if (start.refined.num_geometry_warnings > 0) {
-      start.refined.num_geometry_warnings += static_cast<int>(start.refined.report.warnings.size() - num_warnings);
+      start.refined.num_geometry_warnings +=
+          static_cast<int>(start.refined.report.warnings.size() - num_warnings);
     }
   }
   return start;
@@ -232,18 +247,20 @@ CalibrationStart BestStart(const AutoCalibratorOptions& options, const std::stri
   std::set<image_pair_t> excluded_pairs;
   for (int k = 0; k < num_starts; ++k) {
     try {
-      CalibrationStart start =
-          MapAndRefine(options, database_path, k, markers_focal, refine_intrinsics, &excluded_pairs, progress);
+      CalibrationStart start = MapAndRefine(options, database_path, k, markers_focal,
+                                            refine_intrinsics, &excluded_pairs, progress);
       if (!best || BetterStart(start, *best)) best = std::move(start);
     } catch (const NumericalError& e) {
       if (first_error.empty()) first_error = e.what();
-      LOG(WARNING) << "auto_calibrator: start " << k + 1 << " of " << num_starts << " failed: " << e.what();
+      LOG(WARNING) << "auto_calibrator: start " << k + 1 << " of " << num_starts
+                   << " failed: " << e.what();
     }
     if (best && NumCurableWarnings(best->refined) == 0) break;
     if (k + 1 < num_starts) {
-      LOG(WARNING) << "auto_calibrator: start " << k + 1
-                   << " is not to be trusted; mapping again from another initial pair and random seed "
-                   << options.random_seed + k + 1;
+      LOG(WARNING)
+          << "auto_calibrator: start " << k + 1
+          << " is not to be trusted; mapping again from another initial pair and random seed "
+          << options.random_seed + k + 1;
     }
   }
   KeepStart(options.output_path, best ? best->index : -1, num_starts);
@@ -263,7 +280,8 @@ camera_t OnlyCameraId(Database* database, const std::string& database_path) {
 
 }  // namespace
 
-AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, ProgressSink& progress) {
+AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options,
+                                        ProgressSink& progress) {
   options.Check();
   const fs::path output(options.output_path);
   // A failed run removes what it made (the folder if it was not there, the
@@ -304,7 +322,8 @@ AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   }
 
   std::optional<double> markers_focal;
-  if (!intrinsics_given) markers_focal = WriteMarkersFocalToDatabase(database_path, options.housing);
+  if (!intrinsics_given)
+    markers_focal = WriteMarkersFocalToDatabase(database_path, options.housing);
 
   FeatureMatcherOptions match;
   match.database_path = database_path;
@@ -314,7 +333,8 @@ AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   RunFeatureMatcher(match, progress);
   lap(PairingModeName(options.matcher) + "_matcher");
 
-  const CalibrationStart best = BestStart(options, database_path, markers_focal, refine_intrinsics, progress);
+  const CalibrationStart best =
+      BestStart(options, database_path, markers_focal, refine_intrinsics, progress);
   result.refined = best.refined;
   result.num_registered = best.num_registered;
   lap("refractive_mapper + refractive_bundle_adjuster");
@@ -322,15 +342,17 @@ AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, Pr
   if (options.update_database) database.emplace(database_path, Database::OpenMode::kReadWrite);
   const SparseModel refined = ReadSparseModel(fs::path(options.output_path) / "refined");
   // Judged again: the report gained this stage's own warnings.
-  result.refined.report.verdict =
-      JudgeCalibration(result.refined.report, refined, refined.cameras.empty() ? 0 : refined.cameras.begin()->first);
-  WriteCalibrationOutput(result.refined.report, options.output_path, database ? &*database : nullptr,
-                         database ? OnlyCameraId(&*database, database_path) : kInvalidCameraId, [&] {
-                           WriteHtml(SelfCalibrationHtml(result.refined.report, refined, "Auto-calibration"),
-                                     options.output_path);
-                         });
+  result.refined.report.verdict = JudgeCalibration(
+      result.refined.report, refined, refined.cameras.empty() ? 0 : refined.cameras.begin()->first);
+  WriteCalibrationOutput(
+      result.refined.report, options.output_path, database ? &*database : nullptr,
+      database ? OnlyCameraId(&*database, database_path) : kInvalidCameraId, [&] {
+        WriteHtml(SelfCalibrationHtml(result.refined.report, refined, "Auto-calibration"),
+                  options.output_path);
+      });
   std::string times;
-  for (const auto& [stage, seconds] : result.stage_seconds) times += " " + stage + " " + std::to_string(seconds) + " s;";
+  for (const auto& [stage, seconds] : result.stage_seconds)
+    times += " " + stage + " " + std::to_string(seconds) + " s;";
   LOG(INFO) << "auto_calibrator: " << result.num_registered << " of " << result.num_images
             << " images calibrated; times:" << times;
   new_paths.Keep();

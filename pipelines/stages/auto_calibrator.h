@@ -24,12 +24,12 @@ struct AutoCalibratorOptions {
   std::string image_path;
   std::string output_path;
   std::string camera_model = "RADIAL";
-  std::string camera_params;  // given: intrinsics known and held
+  std::string camera_params;       // given: intrinsics known and held
   std::optional<Housing> housing;  // the housing to calibrate, with a first guess; none: in air
   std::string marker_dictionary = "DICT_4X4_50";
   MarkerScale marker_scale;  // side_length_m > 0: metric scale from the markers
   double mask_enlargement_factor = 3.0;
-  bool mask = true;                   // keep only features near markers
+  bool mask = true;                                // keep only features near markers
   PairingMode matcher = PairingMode::kExhaustive;  // exhaustive or sequential
   SiftExtractionOptions sift;
   // Refine the intrinsics with the housing; nullopt: when camera_params is
@@ -75,6 +75,7 @@ struct AutoCalibratorSummary {
 // report for a poorly determined focal length.
 void JudgeAutoCalibration(const std::optional<double>& markers_focal, CalibrationReport* report);
 
-AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options, ProgressSink& progress);
+AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options,
+                                        ProgressSink& progress);
 
 }  // namespace portcal

@@ -21,11 +21,15 @@ namespace fs = std::filesystem;
 namespace portcal {
 
 void CalibrationEvaluatorOptions::Check() const {
-  if (database_path.empty()) throw OptionError("--database_path", "''", "a database with target observations");
-  if (input_calibration.empty()) throw OptionError("--input_calibration", "''", "the calibration.yaml to judge");
-  if (output_path.empty()) throw OptionError("--output_path", "''", "a folder for evaluation.yaml/.txt");
+  if (database_path.empty())
+    throw OptionError("--database_path", "''", "a database with target observations");
+  if (input_calibration.empty())
+    throw OptionError("--input_calibration", "''", "the calibration.yaml to judge");
+  if (output_path.empty())
+    throw OptionError("--output_path", "''", "a folder for evaluation.yaml/.txt");
   CheckOutputFolder("--output_path", output_path);
-  if (folds != 0 && folds < 2) throw OptionError("--Evaluation.folds", std::to_string(folds), "0 (none) or >= 2");
+  if (folds != 0 && folds < 2)
+    throw OptionError("--Evaluation.folds", std::to_string(folds), "0 (none) or >= 2");
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
 }
 
@@ -36,11 +40,13 @@ namespace {
 // start), or a lens from the report's as the start (the board as the
 // evaluation takes it: the report's warp applied, not fitted again).
 CalibrationMethod MethodLike(const CalibrationReport& report, int num_threads) {
-  return [report, num_threads](const std::vector<CalibrationView>& views, double* rms_px) -> HousedCamera {
+  return [report, num_threads](const std::vector<CalibrationView>& views,
+                               double* rms_px) -> HousedCamera {
     if (report.housing) {
       HousingCalibrationSettings settings;
       settings.num_threads = num_threads;
-      const HousingCalibrationResult result = CalibrateHousing(views, report.camera, *report.housing, settings);
+      const HousingCalibrationResult result =
+          CalibrateHousing(views, report.camera, *report.housing, settings);
       *rms_px = result.overall_rms_px;
       return {result.camera, result.housing};
     }
@@ -64,24 +70,27 @@ void WriteEvaluation(const CalibrationEvaluatorOptions& options, const Calibrati
                      const CalibrationEvaluatorSummary& summary) {
   const HeldOutEvaluation& e = summary.evaluation;
   std::ostringstream yaml, text;
-  yaml << "# portcal held-out evaluation of " << options.input_calibration << " on " << options.database_path
-       << "\nmodel: " << report.camera.ModelName()
+  yaml << "# portcal held-out evaluation of " << options.input_calibration << " on "
+       << options.database_path << "\nmodel: " << report.camera.ModelName()
        << "\nhousing: " << (report.housing ? report.housing->ModelName() : "none")
        << "\nrms_px: " << Number(e.rms_px) << "\nnum_points: " << e.num_points
-       << "\nsystematic_px: " << Number(e.systematic_px) << "\nnoise_floor_px: " << Number(e.noise_floor_px)
-       << "\nviews:\n";
+       << "\nsystematic_px: " << Number(e.systematic_px)
+       << "\nnoise_floor_px: " << Number(e.noise_floor_px) << "\nviews:\n";
   const CalibrationVerdict verdict =
       JudgeHeldOut(e, report, summary.folds, summary.cross_validation_rms_px);
   text << VerdictText(verdict) << "\n";
   text << "Held-out evaluation: " << options.input_calibration << " (" << report.camera.ModelName()
-       << (report.housing ? " + " + report.housing->ModelName() : std::string()) << ") on " << options.database_path
-       << "\n\n" << std::fixed << std::setprecision(4) << "RMS " << e.rms_px << " px over " << e.num_points
-       << " points, each view's pose alone with the calibration fixed\nresidual pattern: mean residual per cell of a "
+       << (report.housing ? " + " + report.housing->ModelName() : std::string()) << ") on "
+       << options.database_path << "\n\n"
+       << std::fixed << std::setprecision(4) << "RMS " << e.rms_px << " px over " << e.num_points
+       << " points, each view's pose alone with the calibration fixed\nresidual pattern: mean "
+          "residual per cell of a "
           "16 x 9 grid, RMS "
-       << e.systematic_px << " px (the cells' own scatter would give about " << e.noise_floor_px << " px)\n";
+       << e.systematic_px << " px (the cells' own scatter would give about " << e.noise_floor_px
+       << " px)\n";
   if (report.board_warp && report.board_warp->norm() > 0 && !sagged) {
-    text << "note: the calibration fitted a board warp on another target ('" << report.target_description
-         << "'); these views' board is taken flat\n";
+    text << "note: the calibration fitted a board warp on another target ('"
+         << report.target_description << "'); these views' board is taken flat\n";
   } else if (sagged) {
     text << std::setprecision(3) << "note: the board sags as the calibration fitted it (x "
          << 1000 * report.board_warp->x() << " mm, y " << 1000 * report.board_warp->y()
@@ -90,21 +99,28 @@ void WriteEvaluation(const CalibrationEvaluatorOptions& options, const Calibrati
   }
   text << "\n  view                          rms px  points\n";
   for (const ViewEvaluation& view : e.views) {
-    yaml << "  - {image: " << YamlQuoted(view.image_name) << ", evaluated: " << (view.evaluated ? "true" : "false")
-         << ", rms_px: " << Number(view.evaluated ? view.rms_px : NAN) << ", points: " << view.num_points << "}\n";
+    yaml << "  - {image: " << YamlQuoted(view.image_name)
+         << ", evaluated: " << (view.evaluated ? "true" : "false")
+         << ", rms_px: " << Number(view.evaluated ? view.rms_px : NAN)
+         << ", points: " << view.num_points << "}\n";
     text << "  " << std::left << std::setw(28) << view.image_name << std::right << std::setw(8)
          << (view.evaluated ? Number(view.rms_px) : "-") << std::setw(8) << view.num_points
          << (view.evaluated ? "" : "  not evaluated: " + view.why) << "\n";
   }
   if (!summary.folds.empty()) {
-    yaml << "cross_validation:\n  rms_px: " << Number(summary.cross_validation_rms_px) << "\n  folds:\n";
-    text << "\n" << summary.folds.size() << "-fold cross-validation (view i in fold i mod K): held-out RMS "
-         << summary.cross_validation_rms_px << " px\n  fold  train  test  train rms  held-out rms\n";
+    yaml << "cross_validation:\n  rms_px: " << Number(summary.cross_validation_rms_px)
+         << "\n  folds:\n";
+    text << "\n"
+         << summary.folds.size() << "-fold cross-validation (view i in fold i mod K): held-out RMS "
+         << summary.cross_validation_rms_px
+         << " px\n  fold  train  test  train rms  held-out rms\n";
     for (const FoldEvaluation& f : summary.folds) {
-      yaml << "    - {fold: " << f.fold << ", train_views: " << f.num_train << ", test_views: " << f.num_test
-           << ", train_rms_px: " << Number(f.train_rms_px) << ", test_rms_px: " << Number(f.test_rms_px) << "}\n";
-      text << "  " << std::setw(4) << f.fold << std::setw(7) << f.num_train << std::setw(6) << f.num_test
-           << std::setw(11) << f.train_rms_px << std::setw(14) << f.test_rms_px << "\n";
+      yaml << "    - {fold: " << f.fold << ", train_views: " << f.num_train
+           << ", test_views: " << f.num_test << ", train_rms_px: " << Number(f.train_rms_px)
+           << ", test_rms_px: " << Number(f.test_rms_px) << "}\n";
+      text << "  " << std::setw(4) << f.fold << std::setw(7) << f.num_train << std::setw(6)
+           << f.num_test << std::setw(11) << f.train_rms_px << std::setw(14) << f.test_rms_px
+           << "\n";
     }
   }
   const fs::path dir(options.output_path);
@@ -112,9 +128,11 @@ void WriteEvaluation(const CalibrationEvaluatorOptions& options, const Calibrati
   fs::create_directories(dir, error);
   if (!fs::is_directory(dir)) throw InputError(dir.string() + ": cannot create the output folder");
   const std::string yaml_text = yaml.str(), text_text = text.str();
-  WriteFileAtomically(dir / "evaluation.yaml", false, [&](std::ostream& out) { out << yaml_text << VerdictYaml(verdict); });
+  WriteFileAtomically(dir / "evaluation.yaml", false,
+                      [&](std::ostream& out) { out << yaml_text << VerdictYaml(verdict); });
   WriteFileAtomically(dir / "evaluation.txt", false, [&](std::ostream& out) { out << text_text; });
-  HtmlReport html = EvaluationHtml(summary.evaluation, views, {report.camera, report.housing}, text_text);
+  HtmlReport html =
+      EvaluationHtml(summary.evaluation, views, {report.camera, report.housing}, text_text);
   html.verdict = HtmlVerdictOf(verdict);
   WriteHtml(html, dir);
 }
@@ -130,10 +148,12 @@ CalibrationEvaluatorSummary RunCalibrationEvaluator(const CalibrationEvaluatorOp
   const TargetViews target_views = ReadTargetViews(&database);
   const camera_t camera_id = ChooseCamera(target_views, options.camera_id, options.database_path);
   const Camera database_camera = *database.ReadCamera(camera_id);
-  if (database_camera.width != report.camera.width || database_camera.height != report.camera.height) {
-    throw InputError(options.input_calibration + ": a " + std::to_string(report.camera.width) + "x" +
-                     std::to_string(report.camera.height) + " camera, but camera " + std::to_string(camera_id) +
-                     " of " + options.database_path + " is " + std::to_string(database_camera.width) + "x" +
+  if (database_camera.width != report.camera.width ||
+      database_camera.height != report.camera.height) {
+    throw InputError(options.input_calibration + ": a " + std::to_string(report.camera.width) +
+                     "x" + std::to_string(report.camera.height) + " camera, but camera " +
+                     std::to_string(camera_id) + " of " + options.database_path + " is " +
+                     std::to_string(database_camera.width) + "x" +
                      std::to_string(database_camera.height));
   }
   // The board as the calibration found it, warped if it fitted a warp;
@@ -141,14 +161,16 @@ CalibrationEvaluatorSummary RunCalibrationEvaluator(const CalibrationEvaluatorOp
   const std::vector<CalibrationView>& stored = target_views.by_camera.at(camera_id);
   const bool sagged = report.board_warp && report.board_warp->norm() > 0 &&
                       report.target_description == target_views.target;
-  const std::vector<CalibrationView> views = sagged ? WithBoardSag(stored, *report.board_warp) : stored;
+  const std::vector<CalibrationView> views =
+      sagged ? WithBoardSag(stored, *report.board_warp) : stored;
   CalibrationEvaluatorSummary summary;
   // The evaluation, then each fold's calibration and evaluation.
   progress.Begin("calibration_evaluator", 1 + static_cast<size_t>(options.folds));
   summary.evaluation = EvaluateHeldOut(views, {report.camera, report.housing}, options.num_threads);
   progress.Advance(1);
   if (options.folds > 0) {
-    summary.folds = CrossValidate(views, options.folds, MethodLike(report, options.num_threads), options.num_threads);
+    summary.folds = CrossValidate(views, options.folds, MethodLike(report, options.num_threads),
+                                  options.num_threads);
     double sum_squares = 0;
     int points = 0;
     for (const FoldEvaluation& fold : summary.folds) {
@@ -161,10 +183,12 @@ CalibrationEvaluatorSummary RunCalibrationEvaluator(const CalibrationEvaluatorOp
   progress.End();
   WriteEvaluation(options, report, views, sagged, summary);
   LOG(INFO) << "calibration_evaluator: held-out RMS " << summary.evaluation.rms_px << " px over "
-            << summary.evaluation.num_points << " points (pattern " << summary.evaluation.systematic_px
-            << " px, the cells' scatter alone ~" << summary.evaluation.noise_floor_px << " px)"
-            << (summary.folds.empty() ? std::string()
-                                      : ", cross-validated " + Number(summary.cross_validation_rms_px) + " px")
+            << summary.evaluation.num_points << " points (pattern "
+            << summary.evaluation.systematic_px << " px, the cells' scatter alone ~"
+            << summary.evaluation.noise_floor_px << " px)"
+            << (summary.folds.empty()
+                    ? std::string()
+                    : ", cross-validated " + Number(summary.cross_validation_rms_px) + " px")
             << " -> " << options.output_path;
   new_output.Keep();
   return summary;

@@ -32,6 +32,7 @@ struct CalibrationEvaluatorSummary {
 
 // Throws InputError (the database, the calibration, a camera of another
 // size) and NumericalError (no view can be evaluated).
-CalibrationEvaluatorSummary RunCalibrationEvaluator(const CalibrationEvaluatorOptions& options, ProgressSink& progress);
+CalibrationEvaluatorSummary RunCalibrationEvaluator(const CalibrationEvaluatorOptions& options,
+                                                    ProgressSink& progress);
 
 }  // namespace portcal

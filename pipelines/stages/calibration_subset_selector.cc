@@ -25,8 +25,8 @@ void CalibrationSubsetSelectorOptions::Check() const {
   subset.Check();
 }
 
-CalibrationSubsetSelectorSummary RunCalibrationSubsetSelector(const CalibrationSubsetSelectorOptions& options,
-                                                              ProgressSink& progress) {
+CalibrationSubsetSelectorSummary RunCalibrationSubsetSelector(
+    const CalibrationSubsetSelectorOptions& options, ProgressSink& progress) {
   options.Check();
   Database database(options.database_path, Database::OpenMode::kReadOnly);
   std::vector<DatabaseImage> images = database.ReadAllImages();
@@ -41,11 +41,13 @@ CalibrationSubsetSelectorSummary RunCalibrationSubsetSelector(const CalibrationS
   progress.Begin("calibration_subset_selector: verified pairs", 1);
   std::map<image_pair_t, int> inliers;
   for (const auto& [pair_id, geometry] : database.ReadTwoViewGeometries()) {
-    if (!geometry.inlier_matches.empty()) inliers[pair_id] = static_cast<int>(geometry.inlier_matches.size());
+    if (!geometry.inlier_matches.empty())
+      inliers[pair_id] = static_cast<int>(geometry.inlier_matches.size());
   }
   progress.Advance(1);
   progress.End();
-  if (inliers.empty()) throw InputError(options.database_path + ": no verified image pairs; run a matcher first");
+  if (inliers.empty())
+    throw InputError(options.database_path + ": no verified image pairs; run a matcher first");
   const CalibrationSubset subset = ChooseCalibrationSubset(ordered, inliers, options.subset);
 
   // Written beside and renamed: a failed write leaves no partial list.
@@ -64,13 +66,14 @@ CalibrationSubsetSelectorSummary RunCalibrationSubsetSelector(const CalibrationS
   summary.num_images = static_cast<int>(ordered.size());
   summary.num_selected = static_cast<int>(subset.images.size());
   summary.num_breaks = subset.num_breaks;
-  LOG(INFO) << "calibration_subset_selector: " << summary.num_selected << " of " << summary.num_images << " images -> "
-            << options.output_path;
+  LOG(INFO) << "calibration_subset_selector: " << summary.num_selected << " of "
+            << summary.num_images << " images -> " << options.output_path;
   if (subset.num_breaks > 0) {
-    LOG(WARNING) << "calibration_subset_selector: " << subset.num_breaks << " place(s) where no later image shares "
-                 << options.subset.min_num_inliers
-                 << " verified inliers with the last kept one: the subset may map as several models "
-                    "(lower --Subset.min_num_inliers, or match more pairs)";
+    LOG(WARNING)
+        << "calibration_subset_selector: " << subset.num_breaks
+        << " place(s) where no later image shares " << options.subset.min_num_inliers
+        << " verified inliers with the last kept one: the subset may map as several models "
+           "(lower --Subset.min_num_inliers, or match more pairs)";
   }
   return summary;
 }

@@ -27,7 +27,7 @@ struct CalibrationSubsetSelectorSummary {
 
 // Throws InputError (no verified pairs) or DatabaseError; a failed run
 // leaves no list.
-CalibrationSubsetSelectorSummary RunCalibrationSubsetSelector(const CalibrationSubsetSelectorOptions& options,
-                                                              ProgressSink& progress);
+CalibrationSubsetSelectorSummary RunCalibrationSubsetSelector(
+    const CalibrationSubsetSelectorOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

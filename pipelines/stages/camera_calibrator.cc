@@ -6,10 +6,10 @@
 #include "colmap_ext/util/new_paths.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_output.h"
-#include "pipelines/report/calibration_html.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
 #include "pipelines/crosscheck/mrcal_export.h"
+#include "pipelines/report/calibration_html.h"
 
 namespace portcal {
 
@@ -23,11 +23,12 @@ void CameraCalibratorOptions::Check() const {
   calibration.Check();
 }
 
-CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& options, ProgressSink& progress) {
+CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& options,
+                                            ProgressSink& progress) {
   options.Check();
   NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
-  Database database(options.database_path,
-                    options.update_database ? Database::OpenMode::kReadWrite : Database::OpenMode::kReadOnly);
+  Database database(options.database_path, options.update_database ? Database::OpenMode::kReadWrite
+                                                                   : Database::OpenMode::kReadOnly);
   const TargetViews target_views = ReadTargetViews(&database);
   const camera_t camera_id = ChooseCamera(target_views, options.camera_id, options.database_path);
   const std::vector<CalibrationView>& views = target_views.by_camera.at(camera_id);
@@ -40,7 +41,8 @@ CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& optio
             << views.size() << " views";
   const CameraCalibrationResult result = CalibrateCamera(views, camera, options.calibration);
 
-  CalibrationReport report = ReportOf(result, options.calibration.estimate_board_warp, target_views.target);
+  CalibrationReport report =
+      ReportOf(result, options.calibration.estimate_board_warp, target_views.target);
   if (options.calibration.estimate_board_warp) {
     CameraCalibrationSettings flat = options.calibration;
     flat.estimate_board_warp = false;
@@ -48,14 +50,14 @@ CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& optio
   }
   report.projection_uncertainty = ProjectionUncertaintyOf(report, views);
   report.verdict = JudgeCalibration(report, views);
-  WriteCalibrationOutput(report, options.output_path, options.update_database ? &database : nullptr, camera_id,
-                         [&] {
-                           WriteCalibrationCameraModel(views, result, options.calibration, options.output_path);
-                           WriteHtml(CalibrationHtml(report, views, "Camera calibration", options.image_path),
-                                     options.output_path);
-                         });
-  LOG(INFO) << "camera_calibrator: RMS " << result.overall_rms_px << " px over " << result.num_points
-            << " points -> " << options.output_path;
+  WriteCalibrationOutput(
+      report, options.output_path, options.update_database ? &database : nullptr, camera_id, [&] {
+        WriteCalibrationCameraModel(views, result, options.calibration, options.output_path);
+        WriteHtml(CalibrationHtml(report, views, "Camera calibration", options.image_path),
+                  options.output_path);
+      });
+  LOG(INFO) << "camera_calibrator: RMS " << result.overall_rms_px << " px over "
+            << result.num_points << " points -> " << options.output_path;
   new_output.Keep();
   return result;
 }

@@ -20,7 +20,7 @@ struct CameraCalibratorOptions {
   // Directory for calibration.yaml / .txt and camera.cameramodel (mrcal's,
   // with the optimization_inputs of the solve where mrcal can express it).
   std::string output_path;
-  int camera_id = -1;        // -1: the only camera with observations
+  int camera_id = -1;  // -1: the only camera with observations
   // The images' folder (target_extractor's --image_path), optional: the
   // report then draws the worst views and every view's thumbnail on them.
   std::string image_path;
@@ -45,6 +45,7 @@ struct CameraCalibratorOptions {
 // The stage's summary is the calibration itself.
 using CameraCalibratorSummary = CameraCalibrationResult;
 
-CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& options, ProgressSink& progress);
+CameraCalibratorSummary RunCameraCalibrator(const CameraCalibratorOptions& options,
+                                            ProgressSink& progress);
 
 }  // namespace portcal

@@ -11,8 +11,8 @@
 #include "colmap_ext/io/mrcal_model.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
-#include "colmap_ext/util/string_utils.h"
 #include "colmap_ext/util/new_paths.h"
+#include "colmap_ext/util/string_utils.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
@@ -37,12 +37,14 @@ std::vector<ParameterComparison> CompareParameters(const Camera& portcal,
     const int s = sources[i];
     p.portcal = s >= 0 ? portcal.params[s] : 0.0;
     // -1: undetermined by portcal's views (rank-deficient covariance).
-    p.portcal_std_dev = s >= 0 && s < static_cast<int>(portcal_std_dev.size()) ? portcal_std_dev[s] : 0.0;
+    p.portcal_std_dev =
+        s >= 0 && s < static_cast<int>(portcal_std_dev.size()) ? portcal_std_dev[s] : 0.0;
     p.mrcal = mrcal.camera.params[i];
     p.mrcal_std_dev = mrcal.params_std_dev[i];
     const double combined = std::hypot(std::max(0.0, p.portcal_std_dev), p.mrcal_std_dev);
     p.z = p.portcal_std_dev < 0 ? std::numeric_limits<double>::quiet_NaN()
-                                : combined > 0 ? (p.mrcal - p.portcal) / combined : 0.0;
+          : combined > 0        ? (p.mrcal - p.portcal) / combined
+                                : 0.0;
     out.push_back(p);
   }
   return out;
@@ -101,7 +103,8 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views, const C
   out.settings = description;
   for (int a = 0; a < k; ++a) {
     for (int b = a + 1; b < k; ++b) {
-      const ProjectionDiff diff = ComputeProjectionDiff(LensOf(fits[a]), LensOf(fits[b]), diff_options);
+      const ProjectionDiff diff =
+          ComputeProjectionDiff(LensOf(fits[a]), LensOf(fits[b]), diff_options);
       FoldComparison fold;
       fold.fold_a = a;
       fold.fold_b = b;
@@ -112,9 +115,11 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views, const C
       fold.predicted_mean_px = diff.predicted_mean_px;
       fold.predicted_p95_px = diff.predicted_p95_px;
       out.pairs.push_back(fold);
-      if (diff.predicted_p95_px > 0) out.worst_ratio = std::max(out.worst_ratio, diff.p95_px / diff.predicted_p95_px);
+      if (diff.predicted_p95_px > 0)
+        out.worst_ratio = std::max(out.worst_ratio, diff.p95_px / diff.predicted_p95_px);
       if (a == 0 && b == 1) {
-        WriteProjectionDiffHeatMap(diff, static_cast<int>(initial.width), static_cast<int>(initial.height),
+        WriteProjectionDiffHeatMap(diff, static_cast<int>(initial.width),
+                                   static_cast<int>(initial.height),
                                    "fold 0 vs fold 1, " + description, heat_map);
       }
     }
@@ -134,7 +139,8 @@ CrossValidation CrossValidate(const std::vector<CalibrationView>& views, const C
 
 // The target views of the calibrated camera that the input calibration
 // used (its dropped outlier views stay out); the image size must match.
-std::vector<CalibrationView> ViewsOfInput(const CrossCheckOptions& options, const CalibrationReport& input) {
+std::vector<CalibrationView> ViewsOfInput(const CrossCheckOptions& options,
+                                          const CalibrationReport& input) {
   Database database(options.database_path, Database::OpenMode::kReadOnly);
   const TargetViews target_views = ReadTargetViews(&database);
   const camera_t camera_id = ChooseCamera(target_views, options.camera_id, options.database_path);
@@ -147,41 +153,44 @@ std::vector<CalibrationView> ViewsOfInput(const CrossCheckOptions& options, cons
     if (!dropped.count(view.image_name)) views.push_back(view);
   }
   if (!dropped.empty()) {
-    LOG(INFO) << "cross_check: " << dropped.size() << " views dropped by the input calibration left out";
+    LOG(INFO) << "cross_check: " << dropped.size()
+              << " views dropped by the input calibration left out";
   }
   const Camera db_camera = *database.ReadCamera(camera_id);
   if (db_camera.width != input.camera.width || db_camera.height != input.camera.height) {
-    throw InputError(options.input_calibration + ": image size " + std::to_string(input.camera.width) +
-                     "x" + std::to_string(input.camera.height) + " differs from camera " +
-                     std::to_string(camera_id) + " of " + options.database_path + " (" +
-                     std::to_string(db_camera.width) + "x" + std::to_string(db_camera.height) + ")");
+    throw InputError(
+        options.input_calibration + ": image size " + std::to_string(input.camera.width) + "x" +
+        std::to_string(input.camera.height) + " differs from camera " + std::to_string(camera_id) +
+        " of " + options.database_path + " (" + std::to_string(db_camera.width) + "x" +
+        std::to_string(db_camera.height) + ")");
   }
   return views;
 }
 
 // A cause when the input is not portcal's solution of these observations.
-void NoteResolveDifference(const Camera& input, const Camera& resolved, const ProjectionDiffOptions& diff_options,
-                           CrossCheckResult* result) {
+void NoteResolveDifference(const Camera& input, const Camera& resolved,
+                           const ProjectionDiffOptions& diff_options, CrossCheckResult* result) {
   ProjectionDiffOptions plain = diff_options;
   plain.focus_radius = 1e9;  // the whole imager, unweighted
   const ProjectionDiff resolve = ComputeProjectionDiff({input, {}}, {resolved, {}}, plain);
   if (resolve.mean_px > 0.01) {
     result->causes.push_back(
         "the input calibration is not portcal's solution of these observations (re-solving "
-        "from it moves the projection by " + FormatFixed(resolve.mean_px, 3) +
-        " px on average): made from other views or settings?");
+        "from it moves the projection by " +
+        FormatFixed(resolve.mean_px, 3) + " px on average): made from other views or settings?");
   }
 }
 
 // mrcal's fit, outliers and board warp into the result.
-void NoteMrcalSolution(const std::vector<CalibrationView>& views, const MrcalCalibrationResult& mrcal,
-                       CrossCheckResult* result) {
+void NoteMrcalSolution(const std::vector<CalibrationView>& views,
+                       const MrcalCalibrationResult& mrcal, CrossCheckResult* result) {
   result->num_points = mrcal.num_points;
   result->mrcal_rms_px = mrcal.rms_px;
   result->mrcal_outliers = mrcal.num_outliers;
   for (size_t v = 0; v < views.size(); ++v) {
     if (!mrcal.outliers[v].empty()) {
-      result->mrcal_outliers_per_view.emplace_back(views[v].image_name, static_cast<int>(mrcal.outliers[v].size()));
+      result->mrcal_outliers_per_view.emplace_back(views[v].image_name,
+                                                   static_cast<int>(mrcal.outliers[v].size()));
     }
   }
   result->mrcal_warp = mrcal.board_warp;
@@ -195,33 +204,40 @@ void ExplainDisagreement(const CalibrationReport& input, const std::string& lens
                          bool mrcal_regularization, CrossCheckResult* result) {
   if (warp_cause) {
     result->causes.push_back(
-        "board warp: mrcal finds the board bent by x " + FormatFixed(mrcal.board_warp.x() * 1e3, 2) +
-        " +- " + FormatFixed(mrcal.board_warp_std_dev.x() * 1e3, 2) + " mm, y " +
-        FormatFixed(mrcal.board_warp.y() * 1e3, 2) + " +- " + FormatFixed(mrcal.board_warp_std_dev.y() * 1e3, 2) +
+        "board warp: mrcal finds the board bent by x " +
+        FormatFixed(mrcal.board_warp.x() * 1e3, 2) + " +- " +
+        FormatFixed(mrcal.board_warp_std_dev.x() * 1e3, 2) + " mm, y " +
+        FormatFixed(mrcal.board_warp.y() * 1e3, 2) + " +- " +
+        FormatFixed(mrcal.board_warp_std_dev.y() * 1e3, 2) +
         " mm, portcal holds it flat (camera_calibrator --Calibration.estimate_board_warp 1)");
   }
   if (outlier_cause) {
     result->causes.push_back("outliers: mrcal rejected " + std::to_string(mrcal.num_outliers) +
-                             " corners in " + std::to_string(result->mrcal_outliers_per_view.size()) +
+                             " corners in " +
+                             std::to_string(result->mrcal_outliers_per_view.size()) +
                              " views; portcal fits every corner");
   }
   const std::string freedom = MrcalExtraFreedom(input.camera.ModelName());
   if (!freedom.empty()) {
-    result->causes.push_back("parameterisation: mrcal's " + lensmodel + " frees " + freedom + ", which " +
-                             input.camera.ModelName() + " holds");
+    result->causes.push_back("parameterisation: mrcal's " + lensmodel + " frees " + freedom +
+                             ", which " + input.camera.ModelName() + " holds");
   }
   if (mrcal_regularization) {
-    result->causes.push_back("regularisation: mrcal pulls the distortions and the principal point "
-                             "weakly towards zero and the centre (a small bias by design)");
+    result->causes.push_back(
+        "regularisation: mrcal pulls the distortions and the principal point "
+        "weakly towards zero and the centre (a small bias by design)");
   }
 }
 
 // portcal re-run with what mrcal did differently (board warp, without its
 // outlier corners), compared again; returns the views it used.
-std::vector<CalibrationView> RerunAsMrcal(const std::vector<CalibrationView>& views, const Camera& camera,
-                                          const MrcalCalibrationResult& mrcal, bool outlier_cause,
-                                          const ProjectionDiffOptions& diff_options, const std::filesystem::path& dir,
-                                          CameraCalibrationSettings* rerun_settings, CrossCheckResult* result) {
+std::vector<CalibrationView> RerunAsMrcal(const std::vector<CalibrationView>& views,
+                                          const Camera& camera, const MrcalCalibrationResult& mrcal,
+                                          bool outlier_cause,
+                                          const ProjectionDiffOptions& diff_options,
+                                          const std::filesystem::path& dir,
+                                          CameraCalibrationSettings* rerun_settings,
+                                          CrossCheckResult* result) {
   std::vector<CalibrationView> rerun_views = views;
   rerun_settings->estimate_board_warp = true;
   if (outlier_cause) {
@@ -248,30 +264,36 @@ std::vector<CalibrationView> RerunAsMrcal(const std::vector<CalibrationView>& vi
 // What the report says before any comparison: the models, the threshold,
 // the views and portcal's own fit.
 // The projection-difference maps the stage wrote, for the page.
-std::vector<ReportPicture> DifferenceMaps(const CrossCheckResult& result, const CrossCheckOptions& options) {
+std::vector<ReportPicture> DifferenceMaps(const CrossCheckResult& result,
+                                          const CrossCheckOptions& options) {
   std::vector<ReportPicture> maps = {
       {"projection_diff.png",
-       "How far portcal's and mrcal's calibrations of the same views project the same ray apart, over the image "
+       "How far portcal's and mrcal's calibrations of the same views project the same ray apart, "
+       "over the image "
        "(mrcal's projection difference, with its implied transform). Within the noise: they agree.",
        {}}};
   if (result.rerun_diff) {
-    maps.push_back(
-        {"projection_diff_rerun.png", "The same after portcal re-ran as mrcal did (board warp, outliers).", {}});
+    maps.push_back({"projection_diff_rerun.png",
+                    "The same after portcal re-ran as mrcal did (board warp, outliers).",
+                    {}});
   }
   if (options.folds >= 2) {
-    maps.push_back({"cross_validation_diff.png",
-                    "Fold 0 against fold 1, each calibrated on its own views: the difference the data alone "
-                    "makes.",
-                    {}});
+    maps.push_back(
+        {"cross_validation_diff.png",
+         "Fold 0 against fold 1, each calibrated on its own views: the difference the data alone "
+         "makes.",
+         {}});
     if (result.rerun_diff) {
-      maps.push_back({"cross_validation_diff_rerun.png", "The same, calibrated as the re-run.", {}});
+      maps.push_back(
+          {"cross_validation_diff_rerun.png", "The same, calibrated as the re-run.", {}});
     }
   }
   return maps;
 }
 
 CrossCheckResult ResultHeader(const CrossCheckOptions& options, const CalibrationReport& input,
-                              const std::string& lensmodel, int num_views, const CameraCalibrationResult& portcal) {
+                              const std::string& lensmodel, int num_views,
+                              const CameraCalibrationResult& portcal) {
   CrossCheckResult result;
   result.camera_model = input.camera.ModelName();
   result.mrcal_lensmodel = lensmodel;
@@ -297,12 +319,16 @@ MrcalCalibrationOptions MrcalOptionsOf(const CrossCheckOptions& options) {
 
 void CrossCheckOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
-  if (input_calibration.empty()) throw OptionError("--input_calibration", "''", "a calibration.yaml");
+  if (input_calibration.empty())
+    throw OptionError("--input_calibration", "''", "a calibration.yaml");
   if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
   CheckOutputFolder("--output_path", output_path);
-  if (folds == 1 || folds < 0) throw OptionError("--CrossCheck.folds", std::to_string(folds), "0 or >= 2");
-  if (!(max_diff_px > 0)) throw OptionError("--CrossCheck.max_diff_px", std::to_string(max_diff_px), "> 0");
-  if (gridn_width < 3) throw OptionError("--CrossCheck.gridn_width", std::to_string(gridn_width), ">= 3");
+  if (folds == 1 || folds < 0)
+    throw OptionError("--CrossCheck.folds", std::to_string(folds), "0 or >= 2");
+  if (!(max_diff_px > 0))
+    throw OptionError("--CrossCheck.max_diff_px", std::to_string(max_diff_px), "> 0");
+  if (gridn_width < 3)
+    throw OptionError("--CrossCheck.gridn_width", std::to_string(gridn_width), ">= 3");
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
 }
 
@@ -311,9 +337,10 @@ CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& 
   NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
   const CalibrationReport input = ReadCalibrationReport(options.input_calibration);
   if (input.housing) {
-    throw InputError(options.input_calibration + ": a calibration behind a " + input.housing->ModelName() +
-                     " housing; mrcal has no refraction, so cross_check compares in-air intrinsics only (give "
-                     "camera_calibrator's calibration.yaml of the in-air views)");
+    throw InputError(
+        options.input_calibration + ": a calibration behind a " + input.housing->ModelName() +
+        " housing; mrcal has no refraction, so cross_check compares in-air intrinsics only (give "
+        "camera_calibrator's calibration.yaml of the in-air views)");
   }
   // A model mrcal cannot express stops here, naming the nearest one.
   const std::string lensmodel = MrcalLensModelFor(input.camera.ModelName());
@@ -331,7 +358,8 @@ CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& 
   const CameraCalibrationResult portcal = CalibrateCamera(views, input.camera, settings);
   CalibratedLens portcal_lens{input.camera, portcal.params_covariance};
 
-  CrossCheckResult result = ResultHeader(options, input, lensmodel, static_cast<int>(views.size()), portcal);
+  CrossCheckResult result =
+      ResultHeader(options, input, lensmodel, static_cast<int>(views.size()), portcal);
   ProjectionDiffOptions diff_options;
   diff_options.gridn_width = options.gridn_width;
   NoteResolveDifference(input.camera, portcal.camera, diff_options, &result);
@@ -341,7 +369,7 @@ CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& 
   NoteMrcalSolution(views, mrcal, &result);
   const std::vector<double> portcal_std_dev =
       input.parameters_std_dev.size() == input.camera.params.size() ? input.parameters_std_dev
-                                                                      : portcal.params_std_dev;
+                                                                    : portcal.params_std_dev;
   result.parameters = CompareParameters(input.camera, portcal_std_dev, mrcal);
   result.diff = ComputeProjectionDiff(portcal_lens, LensOf(mrcal), diff_options);
   result.pass = result.diff.p95_px <= options.max_diff_px;
@@ -352,18 +380,21 @@ CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& 
   WriteMrcalCameraModel(mrcal.camera, Rigid3d(), dir / "mrcal.cameramodel");
   WriteMrcalCameraModel(input.camera, Rigid3d(), dir / "portcal.cameramodel");
 
-  const double max_z = std::accumulate(result.parameters.begin(), result.parameters.end(), 0.0,
-                                       [](double m, const ParameterComparison& p) { return std::max(m, std::abs(p.z)); });
+  const double max_z = std::accumulate(
+      result.parameters.begin(), result.parameters.end(), 0.0,
+      [](double m, const ParameterComparison& p) { return std::max(m, std::abs(p.z)); });
   const bool warp_cause = !input.board_warp && options.mrcal_board_warp && WarpSignificant(mrcal);
   const bool outlier_cause = mrcal.num_outliers > 0;
   if (!result.pass || max_z > 3) {
-    ExplainDisagreement(input, lensmodel, mrcal, warp_cause, outlier_cause, options.mrcal_regularization, &result);
+    ExplainDisagreement(input, lensmodel, mrcal, warp_cause, outlier_cause,
+                        options.mrcal_regularization, &result);
   }
 
   CameraCalibrationSettings rerun_settings = settings;
   std::vector<CalibrationView> rerun_views = views;
   if ((!result.pass || max_z > 3) && (warp_cause || outlier_cause)) {
-    rerun_views = RerunAsMrcal(views, input.camera, mrcal, outlier_cause, diff_options, dir, &rerun_settings, &result);
+    rerun_views = RerunAsMrcal(views, input.camera, mrcal, outlier_cause, diff_options, dir,
+                               &rerun_settings, &result);
   }
 
   if (options.folds >= 2) {
@@ -377,7 +408,8 @@ CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& 
                                                        dir / "cross_validation_diff_rerun.png"));
     }
   }
-  CalibrationReport portcal_report = ReportOf(portcal, settings.estimate_board_warp, input.target_description);
+  CalibrationReport portcal_report =
+      ReportOf(portcal, settings.estimate_board_warp, input.target_description);
   portcal_report.projection_uncertainty = ProjectionUncertaintyOf(portcal_report, views);
   result.verdict = JudgeCalibration(portcal_report, views);
   AddCrossCheckFindings(result, &*result.verdict);

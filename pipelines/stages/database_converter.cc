@@ -13,11 +13,13 @@ namespace portcal {
 void DatabaseConverterOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "the database to convert");
   if (!output_path.empty() && std::filesystem::exists(output_path)) {
-    throw OptionError("--output_path", output_path, "a file that does not exist yet (the converted copy)");
+    throw OptionError("--output_path", output_path,
+                      "a file that does not exist yet (the converted copy)");
   }
 }
 
-DatabaseConverterSummary RunDatabaseConverter(const DatabaseConverterOptions& options, ProgressSink& progress) {
+DatabaseConverterSummary RunDatabaseConverter(const DatabaseConverterOptions& options,
+                                              ProgressSink& progress) {
   options.Check();
   CheckDatabaseIntegrity(options.database_path);
   DatabaseConverterSummary summary;
@@ -25,7 +27,8 @@ DatabaseConverterSummary RunDatabaseConverter(const DatabaseConverterOptions& op
   // database_merger does: a killed run leaves no file under the output's
   // name (which a rerun would refuse), only a staging file the rerun
   // replaces.
-  const std::string staging = options.output_path.empty() ? "" : options.output_path + ".converting";
+  const std::string staging =
+      options.output_path.empty() ? "" : options.output_path + ".converting";
   std::string path = options.database_path;
   if (!staging.empty()) {
     std::filesystem::remove(staging);
@@ -51,8 +54,8 @@ DatabaseConverterSummary RunDatabaseConverter(const DatabaseConverterOptions& op
     path = options.output_path;
   }
   new_copy.Keep();
-  LOG(INFO) << path << ": converted from " << summary.from << "'s layout to " << summary.to << "'s ("
-            << summary.num_images << " images)";
+  LOG(INFO) << path << ": converted from " << summary.from << "'s layout to " << summary.to
+            << "'s (" << summary.num_images << " images)";
   return summary;
 }
 

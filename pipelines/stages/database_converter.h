@@ -27,6 +27,7 @@ struct DatabaseConverterSummary {
 // Throws InputError (the rows the target cannot hold, named) or
 // DatabaseError; either way nothing changes: the conversion is one
 // transaction and a copy that failed is removed.
-DatabaseConverterSummary RunDatabaseConverter(const DatabaseConverterOptions& options, ProgressSink& progress);
+DatabaseConverterSummary RunDatabaseConverter(const DatabaseConverterOptions& options,
+                                              ProgressSink& progress);
 
 }  // namespace portcal

@@ -9,7 +9,8 @@
 
 namespace portcal {
 
-DatabaseCreatorSummary RunDatabaseCreator(const DatabaseCreatorOptions& options, ProgressSink& progress) {
+DatabaseCreatorSummary RunDatabaseCreator(const DatabaseCreatorOptions& options,
+                                          ProgressSink& progress) {
   DatabaseCreatorSummary summary;
   summary.existed = std::filesystem::exists(options.database_path);
   NewDatabaseFile new_file(options.database_path);  // a full disk leaves no half-made file
@@ -22,15 +23,16 @@ DatabaseCreatorSummary RunDatabaseCreator(const DatabaseCreatorOptions& options,
     if (summary.existed && options.colmap_version &&
         NewestVersionWith(database.layout()) != *options.colmap_version &&
         summary.layout != LayoutOf(*options.colmap_version).VersionRange()) {
-      throw InputError(options.database_path + ": an existing database of " + summary.layout + "'s layout, not " +
-                       "COLMAP " + ColmapVersionName(*options.colmap_version) +
-                       "'s (--Database.colmap_version); convert it with portcal database_converter");
+      throw InputError(
+          options.database_path + ": an existing database of " + summary.layout +
+          "'s layout, not " + "COLMAP " + ColmapVersionName(*options.colmap_version) +
+          "'s (--Database.colmap_version); convert it with portcal database_converter");
     }
   }
   new_file.Keep();
   LOG(INFO) << (summary.existed ? "Checked existing database " : "Created database ")
-            << options.database_path << " (" << summary.layout << "): " << summary.num_cameras << " cameras, "
-            << summary.num_images << " images";
+            << options.database_path << " (" << summary.layout << "): " << summary.num_cameras
+            << " cameras, " << summary.num_images << " images";
   return summary;
 }
 

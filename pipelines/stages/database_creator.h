@@ -26,6 +26,7 @@ struct DatabaseCreatorSummary {
 // `database_path`, or checks an existing one (as `colmap database_creator`
 // does). Throws DatabaseError, and InputError for an existing database of
 // another layout than the one asked for (database_converter converts).
-DatabaseCreatorSummary RunDatabaseCreator(const DatabaseCreatorOptions& options, ProgressSink& progress);
+DatabaseCreatorSummary RunDatabaseCreator(const DatabaseCreatorOptions& options,
+                                          ProgressSink& progress);
 
 }  // namespace portcal

@@ -22,7 +22,8 @@ void DatabaseMergerOptions::Check() const {
   if (database_path2.empty()) throw OptionError("--database_path2", "''", "the second database");
   if (merged_database_path.empty()) throw OptionError("--merged_database_path", "''", "a new file");
   if (fs::exists(merged_database_path)) {
-    throw OptionError("--merged_database_path", merged_database_path, "a file that does not exist yet");
+    throw OptionError("--merged_database_path", merged_database_path,
+                      "a file that does not exist yet");
   }
   std::error_code ignored;
   if (fs::equivalent(database_path1, database_path2, ignored)) {
@@ -50,7 +51,8 @@ void CheckNoNameInBoth(Database* first, Database* second) {
 
 }  // namespace
 
-DatabaseMergerSummary RunDatabaseMerger(const DatabaseMergerOptions& options, ProgressSink& progress) {
+DatabaseMergerSummary RunDatabaseMerger(const DatabaseMergerOptions& options,
+                                        ProgressSink& progress) {
   options.Check();
   CheckDatabaseIntegrity(options.database_path1);
   CheckDatabaseIntegrity(options.database_path2);
@@ -59,8 +61,8 @@ DatabaseMergerSummary RunDatabaseMerger(const DatabaseMergerOptions& options, Pr
     Database second(options.database_path2, Database::OpenMode::kReadOnly);
     CheckNoNameInBoth(&first, &second);
   }
-  StageRun run("database_merger",
-               "database_path1=" + options.database_path1 + "\ndatabase_path2=" + options.database_path2 + "\n");
+  StageRun run("database_merger", "database_path1=" + options.database_path1 +
+                                      "\ndatabase_path2=" + options.database_path2 + "\n");
   // Made under a staging name and renamed when complete: a killed merge
   // leaves no file that looks like the merged database.
   const fs::path staging = options.merged_database_path + ".merging";
@@ -82,16 +84,18 @@ DatabaseMergerSummary RunDatabaseMerger(const DatabaseMergerOptions& options, Pr
     summary.num_cameras = static_cast<int64_t>(merge.cameras.size());
     summary.num_images = static_cast<int64_t>(merge.images.size());
     summary.num_pairs = merge.num_pairs;
-    run.Finish(&merged,
-               {{"cameras", summary.num_cameras}, {"images", summary.num_images}, {"pairs", summary.num_pairs}});
+    run.Finish(&merged, {{"cameras", summary.num_cameras},
+                         {"images", summary.num_images},
+                         {"pairs", summary.num_pairs}});
     CancelFlag::ThrowIfRequested();
     transaction.Commit();
   }
   fs::rename(staging, options.merged_database_path);
   new_file.Keep();
-  LOG(INFO) << "database_merger: " << options.database_path2 << "'s " << summary.num_cameras << " cameras, "
-            << summary.num_images << " images and " << summary.num_pairs << " pairs after " << options.database_path1
-            << "'s -> " << options.merged_database_path;
+  LOG(INFO) << "database_merger: " << options.database_path2 << "'s " << summary.num_cameras
+            << " cameras, " << summary.num_images << " images and " << summary.num_pairs
+            << " pairs after " << options.database_path1 << "'s -> "
+            << options.merged_database_path;
   return summary;
 }
 

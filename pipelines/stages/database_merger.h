@@ -25,6 +25,7 @@ struct DatabaseMergerSummary {
 };
 
 // Throws InputError or DatabaseError; the merged file is then not made.
-DatabaseMergerSummary RunDatabaseMerger(const DatabaseMergerOptions& options, ProgressSink& progress);
+DatabaseMergerSummary RunDatabaseMerger(const DatabaseMergerOptions& options,
+                                        ProgressSink& progress);
 
 }  // namespace portcal

@@ -1,8 +1,8 @@
 #include "pipelines/stages/feature_extractor.h"
 
-#include <opencv2/imgcodecs.hpp>
 #include <algorithm>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
 #include <set>
 #include <sstream>
 
@@ -62,18 +62,20 @@ std::map<std::string, int64_t> Counts(const FeatureExtractorSummary& summary) {
 }
 
 // Success on nothing would log the stage as done with no image.
-void CheckSomethingExtracted(const FeatureExtractorOptions& options, const FeatureExtractorSummary& summary) {
+void CheckSomethingExtracted(const FeatureExtractorOptions& options,
+                             const FeatureExtractorSummary& summary) {
   if (summary.num_extracted > 0 && summary.num_features == 0) {
     // A database of images without a feature is no work done: the matcher
     // would find nothing, far from the cause.
-    throw InputError(options.image_path + ": no SIFT feature in any of the " + std::to_string(summary.num_extracted) +
+    throw InputError(options.image_path + ": no SIFT feature in any of the " +
+                     std::to_string(summary.num_extracted) +
                      " images (blank or featureless images, or --SiftExtraction.peak_threshold " +
                      FormatShortest(options.sift.peak_threshold) + " / edge_threshold too strict)");
   }
   if (summary.num_extracted > 0 || summary.num_skipped > 0) return;
   throw InputError(options.image_path + ": none of the " + std::to_string(summary.num_images) +
-                   " image files could be read and used (unreadable, or under " + std::to_string(kMinImageSide) +
-                   " px a side)");
+                   " image files could be read and used (unreadable, or under " +
+                   std::to_string(kMinImageSide) + " px a side)");
 }
 
 FeatureExtractorSummary SumOverRanks(const FeatureExtractorSummary& mine) {
@@ -145,18 +147,22 @@ FeatureExtractorSummary RunOnRanks(const FeatureExtractorOptions& options, Progr
       remove_shard);
   const FeatureExtractorSummary total = SumOverRanks(mine);
   RunOnEveryRank(
-      "feature_extractor", [&] { if (shard.index == 0) MergeShards(options, merge, total, &run); }, remove_shard);
+      "feature_extractor",
+      [&] {
+        if (shard.index == 0) MergeShards(options, merge, total, &run);
+      },
+      remove_shard);
   remove_shard();
   LOG(INFO) << "feature_extractor: " << MpiWorld::Size() << " ranks: " << total.num_extracted
-            << " images extracted (" << total.num_features << " features), " << total.num_skipped << " skipped, "
-            << total.num_unreadable << " unreadable";
+            << " images extracted (" << total.num_features << " features), " << total.num_skipped
+            << " skipped, " << total.num_unreadable << " unreadable";
   return total;
 }
 
 }  // namespace
 
 FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& options,
-                                         ProgressSink& progress) {
+                                            ProgressSink& progress) {
   options.Check();
   if (options.shard.Whole() && MpiWorld::Distributed()) return RunOnRanks(options, progress);
   StageRun run("feature_extractor", OptionsText(options));
@@ -178,8 +184,8 @@ FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& optio
     if (image && !options.overwrite && database.ExistsKeypoints(image->image_id) &&
         database.ExistsDescriptors(image->image_id)) {
       const Camera camera = *database.ReadCamera(image->camera_id);
-      ImportImage(&database, options.reader, name, static_cast<int>(camera.width), static_cast<int>(camera.height),
-                  &shared_cameras);
+      ImportImage(&database, options.reader, name, static_cast<int>(camera.width),
+                  static_cast<int>(camera.height), &shared_cameras);
       ++summary.num_skipped;
     } else {
       todo.push_back(name);
@@ -193,9 +199,10 @@ FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& optio
   OrderedParallelFor(
       todo.size(), options.num_threads, 2 * static_cast<size_t>(options.num_threads) + 2,
       [&](size_t i) {
-        const cv::Mat gray = cv::imread((fs::path(options.image_path) / todo[i]).string(),
-                                        cv::IMREAD_GRAYSCALE);
-        slots[i].skip_reason = gray.empty() ? "cannot read the image" : ImageSizeProblem(gray.cols, gray.rows);
+        const cv::Mat gray =
+            cv::imread((fs::path(options.image_path) / todo[i]).string(), cv::IMREAD_GRAYSCALE);
+        slots[i].skip_reason =
+            gray.empty() ? "cannot read the image" : ImageSizeProblem(gray.cols, gray.rows);
         if (!slots[i].skip_reason.empty()) return;
         slots[i].readable = true;
         slots[i].width = gray.cols;
@@ -222,7 +229,8 @@ FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& optio
         summary.num_features += static_cast<int64_t>(extracted.features.keypoints.size());
       });
   progress.End();
-  if (options.shard.Whole()) CheckSomethingExtracted(options, summary);  // a shard's block may be all unreadable
+  if (options.shard.Whole())
+    CheckSomethingExtracted(options, summary);  // a shard's block may be all unreadable
   run.Finish(&database, Counts(summary));
   CancelFlag::ThrowIfRequested();
   transaction.Commit();

@@ -42,6 +42,6 @@ struct FeatureExtractorSummary {
 // copy of it, if it exists) and rank 0 merges the shards in one
 // transaction: the same rows as one process's run. Every rank calls it.
 FeatureExtractorSummary RunFeatureExtractor(const FeatureExtractorOptions& options,
-                                         ProgressSink& progress);
+                                            ProgressSink& progress);
 
 }  // namespace portcal

@@ -1,8 +1,8 @@
 #include "pipelines/stages/feature_masker.h"
 
-#include <opencv2/imgcodecs.hpp>
 #include <cstring>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "colmap_ext/util/error.h"
@@ -34,8 +34,9 @@ namespace {
 // again). True where they were kept before (the image was masked), false
 // where they are the image's current features. Throws naming the image
 // when the two tables disagree.
-bool FeaturesBeforeMasking(const FeatureMaskerOptions& options, const DatabaseImage& image, Database* database,
-                           FeatureKeypoints* keypoints, FeatureDescriptors* descriptors) {
+bool FeaturesBeforeMasking(const FeatureMaskerOptions& options, const DatabaseImage& image,
+                           Database* database, FeatureKeypoints* keypoints,
+                           FeatureDescriptors* descriptors) {
   if (database->ReadUnmaskedFeatures(image.image_id, keypoints, descriptors)) return true;
   *keypoints = database->ReadKeypoints(image.image_id);
   *descriptors = database->ReadDescriptors(image.image_id);
@@ -59,21 +60,24 @@ bool SameKeypoints(const FeatureKeypoints& a, const FeatureKeypoints& b) {
 // Keeps the features of one image inside its markers' enlarged quads (and
 // deletes the image's matches if that changed its features).
 void MaskImage(const FeatureMaskerOptions& options, const DatabaseImage& image,
-               const std::vector<MarkerDetection>& markers, Database* database, FeatureMaskerSummary* summary) {
+               const std::vector<MarkerDetection>& markers, Database* database,
+               FeatureMaskerSummary* summary) {
   const image_t image_id = image.image_id;
   database->WriteMarkerDetections(image_id, markers);
   summary->num_markers += static_cast<int64_t>(markers.size());
   summary->num_without_markers += markers.empty();
   FeatureKeypoints keypoints;
   FeatureDescriptors descriptors;
-  if (options.keep_all_features && !database->ReadUnmaskedFeatures(image_id, &keypoints, &descriptors)) {
+  if (options.keep_all_features &&
+      !database->ReadUnmaskedFeatures(image_id, &keypoints, &descriptors)) {
     // Never masked: its features are as extracted (no copy kept aside).
     const int64_t count = static_cast<int64_t>(database->ReadKeypoints(image_id).size());
     summary->num_features_before += count;
     summary->num_features_kept += count;
     return;
   }
-  const bool masked_before = FeaturesBeforeMasking(options, image, database, &keypoints, &descriptors);
+  const bool masked_before =
+      FeaturesBeforeMasking(options, image, database, &keypoints, &descriptors);
   FeatureKeypoints kept_keypoints;
   std::vector<Eigen::Index> kept;
   for (size_t k = 0; k < keypoints.size(); ++k) {
@@ -90,12 +94,15 @@ void MaskImage(const FeatureMaskerOptions& options, const DatabaseImage& image,
   summary->num_features_before += static_cast<int64_t>(keypoints.size());
   summary->num_features_kept += static_cast<int64_t>(kept.size());
   if (markers.empty() && !options.keep_all_features) {
-    LOG(WARNING) << image.name << ": no " << options.dictionary << " markers; all its features are removed";
+    LOG(WARNING) << image.name << ": no " << options.dictionary
+                 << " markers; all its features are removed";
   }
   // Unchanged (the same mask again): its matches stay valid.
-  if (SameKeypoints(kept_keypoints, masked_before ? database->ReadKeypoints(image_id) : keypoints)) return;
+  if (SameKeypoints(kept_keypoints, masked_before ? database->ReadKeypoints(image_id) : keypoints))
+    return;
   FeatureDescriptors kept_descriptors(static_cast<Eigen::Index>(kept.size()), 128);
-  for (size_t r = 0; r < kept.size(); ++r) kept_descriptors.row(static_cast<Eigen::Index>(r)) = descriptors.row(kept[r]);
+  for (size_t r = 0; r < kept.size(); ++r)
+    kept_descriptors.row(static_cast<Eigen::Index>(r)) = descriptors.row(kept[r]);
   database->WriteKeypoints(image_id, kept_keypoints);
   database->WriteDescriptors(image_id, kept_descriptors);
   database->DeleteMatchesOfImage(image_id);
@@ -126,10 +133,12 @@ std::string MaskOfTheFeatures(Database* database) {
     if (entry.stage != "feature_masker") continue;
     std::map<std::string, std::string> options = ParseLines(entry.options);
     // Runs before the flag's rename logged Mask.dictionary.
-    const std::string dictionary =
-        options.count("Markers.dictionary") ? options["Markers.dictionary"] : options["Mask.dictionary"];
+    const std::string dictionary = options.count("Markers.dictionary")
+                                       ? options["Markers.dictionary"]
+                                       : options["Mask.dictionary"];
     mask = dictionary + ", enlargement factor " + options["Mask.enlargement_factor"];
-    if (options["Mask.keep_all_features"] == "1") mask.clear();  // detections only: the features as extracted
+    if (options["Mask.keep_all_features"] == "1")
+      mask.clear();  // detections only: the features as extracted
   }
   return mask;
 }
@@ -139,14 +148,16 @@ std::string MaskOfTheFeatures(Database* database) {
 FeatureMaskerSummary RunFeatureMasker(const FeatureMaskerOptions& options, ProgressSink& progress) {
   options.Check();
   std::ostringstream options_text;
-  options_text << "image_path=" << options.image_path << "\nMarkers.dictionary=" << options.dictionary
+  options_text << "image_path=" << options.image_path
+               << "\nMarkers.dictionary=" << options.dictionary
                << "\nMask.enlargement_factor=" << options.enlargement_factor
                << "\nMask.keep_all_features=" << options.keep_all_features << "\n";
   StageRun run("feature_masker", options_text.str());
   Database database(options.database_path, Database::OpenMode::kReadWrite);
   Transaction transaction = database.BeginTransaction();
   const std::vector<DatabaseImage> images = database.ReadAllImages();
-  if (images.empty()) throw InputError(options.database_path + ": no images; run feature_extractor first");
+  if (images.empty())
+    throw InputError(options.database_path + ": no images; run feature_extractor first");
   // Another mask starts from the features as extracted, kept aside at the
   // first masking; a database masked by a portcal that did not keep them
   // cannot bring back what that mask removed.
@@ -156,8 +167,11 @@ FeatureMaskerSummary RunFeatureMasker(const FeatureMaskerOptions& options, Progr
   const std::string mask = MaskOfTheFeatures(&database);
   if (!mask.empty() && mask != asked.str() && database.NumImagesWithUnmaskedFeatures() == 0) {
     throw InputError(options.database_path + ": its features were masked before (" + mask +
-                     ") without keeping them as extracted; a mask cannot bring back what an earlier one removed, "
-                     "so " + asked.str() + " was not applied: extract the features again (feature_extractor "
+                     ") without keeping them as extracted; a mask cannot bring back what an "
+                     "earlier one removed, "
+                     "so " +
+                     asked.str() +
+                     " was not applied: extract the features again (feature_extractor "
                      "--overwrite 1, or a new database or output folder), then mask");
   }
 
@@ -183,8 +197,9 @@ FeatureMaskerSummary RunFeatureMasker(const FeatureMaskerOptions& options, Progr
   progress.End();
   if (summary.num_without_markers == summary.num_images) {
     // Every feature would go: markers of another dictionary, most likely.
-    throw InputError(options.database_path + ": no " + options.dictionary + " marker in any of the " +
-                     std::to_string(summary.num_images) + " images under " + options.image_path +
+    throw InputError(options.database_path + ": no " + options.dictionary +
+                     " marker in any of the " + std::to_string(summary.num_images) +
+                     " images under " + options.image_path +
                      "; nothing was changed (markers of another dictionary? --Markers.dictionary)");
   }
   run.Finish(&database, {{"images", summary.num_images},
@@ -196,8 +211,8 @@ FeatureMaskerSummary RunFeatureMasker(const FeatureMaskerOptions& options, Progr
   transaction.Commit();
   LOG(INFO) << "feature_masker: " << summary.num_markers << " markers in "
             << summary.num_images - summary.num_without_markers << " of " << summary.num_images
-            << " images; kept " << summary.num_features_kept << " of " << summary.num_features_before
-            << " features";
+            << " images; kept " << summary.num_features_kept << " of "
+            << summary.num_features_before << " features";
   return summary;
 }
 

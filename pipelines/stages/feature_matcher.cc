@@ -58,8 +58,9 @@ std::string OptionsText(const FeatureMatcherOptions& o) {
 }
 
 // Unique unordered pairs, minus those already done unless `overwrite`.
-std::vector<std::pair<image_t, image_t>> PairsToMatch(const std::vector<std::pair<image_t, image_t>>& candidates,
-                                                      bool overwrite, Database* db, FeatureMatcherSummary* summary) {
+std::vector<std::pair<image_t, image_t>> PairsToMatch(
+    const std::vector<std::pair<image_t, image_t>>& candidates, bool overwrite, Database* db,
+    FeatureMatcherSummary* summary) {
   std::unordered_set<image_pair_t> done;
   if (!overwrite) {
     for (image_pair_t id : db->ReadTwoViewGeometryPairIds()) done.insert(id);
@@ -83,9 +84,11 @@ std::vector<std::pair<image_t, image_t>> PairsToMatch(const std::vector<std::pai
 // batch needs are loaded once, by this thread (the database connection is
 // not shared), and dropped when no later batch needs them, so memory stays
 // bounded on long surveys.
-void MatchInBatches(const FeatureMatcherOptions& options, const std::vector<std::pair<image_t, image_t>>& pairs,
-                    const std::map<image_t, camera_t>& camera_of, const std::map<camera_t, Camera>& cameras,
-                    const std::string& stage, Database* db, Database* out, ProgressSink& progress,
+void MatchInBatches(const FeatureMatcherOptions& options,
+                    const std::vector<std::pair<image_t, image_t>>& pairs,
+                    const std::map<image_t, camera_t>& camera_of,
+                    const std::map<camera_t, Camera>& cameras, const std::string& stage,
+                    Database* db, Database* out, ProgressSink& progress,
                     FeatureMatcherSummary* summary) {
   constexpr size_t kBatchSize = 256;
   std::map<image_t, size_t> last_use;
@@ -119,8 +122,9 @@ void MatchInBatches(const FeatureMatcherOptions& options, const std::vector<std:
       const ImageFeatures& fa = cache.at(a);
       const ImageFeatures& fb = cache.at(b);
       matches[k] = MatchDescriptors(fa.descriptors, fb.descriptors, options.matching);
-      geometries[k] = VerifyTwoView(cameras.at(fa.camera_id), fa.keypoints, cameras.at(fb.camera_id),
-                                    fb.keypoints, matches[k], options.verification);
+      geometries[k] =
+          VerifyTwoView(cameras.at(fa.camera_id), fa.keypoints, cameras.at(fb.camera_id),
+                        fb.keypoints, matches[k], options.verification);
       progress.Advance(1);
     });
     for (size_t k = 0; k < matches.size(); ++k) {
@@ -139,8 +143,8 @@ void MatchInBatches(const FeatureMatcherOptions& options, const std::vector<std:
 
 // Matches this shard's block of the pairs (all of them for a whole run)
 // from `database` into `out`.
-FeatureMatcherSummary MatchPairs(const FeatureMatcherOptions& options, const std::string& stage, Database* database,
-                                 Database* out, ProgressSink& progress) {
+FeatureMatcherSummary MatchPairs(const FeatureMatcherOptions& options, const std::string& stage,
+                                 Database* database, Database* out, ProgressSink& progress) {
   std::vector<DatabaseImage> images = database->ReadAllImages();
   if (images.size() < 2) {
     throw InputError(options.database_path + ": " + std::to_string(images.size()) +
@@ -148,14 +152,14 @@ FeatureMatcherSummary MatchPairs(const FeatureMatcherOptions& options, const std
   }
   // Pairs without features would be written as empty rows and the stage
   // logged as done: success on nothing.
-  const size_t with_features =
-      static_cast<size_t>(std::count_if(images.begin(), images.end(), [&](const DatabaseImage& image) {
-        return database->ExistsKeypoints(image.image_id);
-      }));
+  const size_t with_features = static_cast<size_t>(std::count_if(
+      images.begin(), images.end(),
+      [&](const DatabaseImage& image) { return database->ExistsKeypoints(image.image_id); }));
   if (with_features < 2) {
-    throw InputError(options.database_path + ": " + std::to_string(with_features) + " of " +
-                     std::to_string(images.size()) +
-                     " images have features; matching needs at least 2 (run feature_extractor first)");
+    throw InputError(
+        options.database_path + ": " + std::to_string(with_features) + " of " +
+        std::to_string(images.size()) +
+        " images have features; matching needs at least 2 (run feature_extractor first)");
   }
   std::sort(images.begin(), images.end(),
             [](const DatabaseImage& a, const DatabaseImage& b) { return a.name < b.name; });
@@ -170,12 +174,12 @@ FeatureMatcherSummary MatchPairs(const FeatureMatcherOptions& options, const std
 
   FeatureMatcherSummary summary;
   const ImagePairs candidates =
-      CandidatePairs({options.mode, options.sequential, options.spatial}, images, ids, options.database_path, stage,
-                     database, progress, &summary.num_loop_pairs);
+      CandidatePairs({options.mode, options.sequential, options.spatial}, images, ids,
+                     options.database_path, stage, database, progress, &summary.num_loop_pairs);
   const std::vector<std::pair<image_t, image_t>> pairs =
       options.shard.Block(PairsToMatch(candidates, options.overwrite, database, &summary));
-  LOG(INFO) << stage << ": " << images.size() << " images, " << summary.num_pairs << " pairs, " << pairs.size()
-            << " to match" << (options.shard.Whole() ? "" : " in this shard");
+  LOG(INFO) << stage << ": " << images.size() << " images, " << summary.num_pairs << " pairs, "
+            << pairs.size() << " to match" << (options.shard.Whole() ? "" : " in this shard");
   MatchInBatches(options, pairs, camera_of, cameras, stage, database, out, progress, &summary);
   return summary;
 }
@@ -247,7 +251,8 @@ FeatureMatcherSummary RunOnRanks(const FeatureMatcherOptions& options, const std
 
 }  // namespace
 
-FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, ProgressSink& progress) {
+FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options,
+                                        ProgressSink& progress) {
   options.Check();
   const std::string stage = PairingModeName(options.mode) + "_matcher";
   if (options.shard.Whole() && MpiWorld::Distributed()) return RunOnRanks(options, stage, progress);

@@ -47,6 +47,7 @@ struct FeatureMatcherSummary {
 // the pairs into a shard database and rank 0 copies the shards' rows into
 // the database in one transaction: the same rows as one process's run.
 // Every rank calls it.
-FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options, ProgressSink& progress);
+FeatureMatcherSummary RunFeatureMatcher(const FeatureMatcherOptions& options,
+                                        ProgressSink& progress);
 
 }  // namespace portcal

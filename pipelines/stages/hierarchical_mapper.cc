@@ -17,7 +17,8 @@ namespace portcal {
 
 void HierarchicalMapperOptions::Check() const {
   if (!mapper.image_list_path.empty()) {
-    throw OptionError("--image_list_path", mapper.image_list_path, "'' (the clusters are the stage's lists)");
+    throw OptionError("--image_list_path", mapper.image_list_path,
+                      "'' (the clusters are the stage's lists)");
   }
   mapper.Check();
   partition.Check();
@@ -28,8 +29,8 @@ namespace {
 
 // Maps cluster `index` of `clusters` into OUTPUT/clusters/INDEX; returns
 // nothing: its models are read back from there.
-void MapCluster(const HierarchicalMapperOptions& options, const std::vector<image_t>& cluster, size_t index,
-                const std::map<image_t, std::string>& names, ProgressSink& progress) {
+void MapCluster(const HierarchicalMapperOptions& options, const std::vector<image_t>& cluster,
+                size_t index, const std::map<image_t, std::string>& names, ProgressSink& progress) {
   const fs::path folder = fs::path(options.mapper.output_path) / "clusters";
   const fs::path list = folder / (std::to_string(index) + ".txt");
   {
@@ -37,12 +38,13 @@ void MapCluster(const HierarchicalMapperOptions& options, const std::vector<imag
     for (image_t id : cluster) {
       const auto name = names.find(id);
       if (name == names.end()) {
-        throw InputError(options.mapper.database_path + ": a verified pair names image " + std::to_string(id) +
-                         ", which the images table does not hold");
+        throw InputError(options.mapper.database_path + ": a verified pair names image " +
+                         std::to_string(id) + ", which the images table does not hold");
       }
       out << name->second << "\n";
     }
-    if (!(out << std::flush)) throw InputError(list.string() + ": cannot write the cluster's image list");
+    if (!(out << std::flush))
+      throw InputError(list.string() + ": cannot write the cluster's image list");
   }
   RefractiveMapperOptions mapper = options.mapper;
   mapper.image_list_path = list.string();
@@ -60,29 +62,34 @@ void MapCluster(const HierarchicalMapperOptions& options, const std::vector<imag
     return;
   }
   LOG(INFO) << "hierarchical_mapper: cluster " << index << " (rank " << MpiWorld::Rank()
-            << "): " << summary.num_registered << " of " << cluster.size() << " images in " << summary.num_models
-            << " model(s)";
+            << "): " << summary.num_registered << " of " << cluster.size() << " images in "
+            << summary.num_models << " model(s)";
 }
 
 // The merged model adjusted as a whole: scaled to the markers or aligned
 // to the position priors (whichever gives the scale), adjusted, filtered,
 // adjusted again.
 void AdjustMerged(const IncrementalMapperOptions& mapper, Reconstruction* r) {
-  BundleAdjustmentOptions ba = GlobalAdjustmentOptions(mapper, static_cast<int>(r->poses().size()), true);
+  BundleAdjustmentOptions ba =
+      GlobalAdjustmentOptions(mapper, static_cast<int>(r->poses().size()), true);
   std::vector<MarkerCorner> markers;
   if (mapper.marker_scale.side_length_m > 0) {
-    PrepareMarkerCorners(r, 4 * mapper.filter_max_reproj_error_px, mapper.marker_scale.side_length_m, &markers);
-  } else if (mapper.position_prior_sigma_m > 0 && AlignToPositionPriors(r, 5 * mapper.position_prior_sigma_m)) {
+    PrepareMarkerCorners(r, 4 * mapper.filter_max_reproj_error_px,
+                         mapper.marker_scale.side_length_m, &markers);
+  } else if (mapper.position_prior_sigma_m > 0 &&
+             AlignToPositionPriors(r, 5 * mapper.position_prior_sigma_m)) {
     ba.position_prior_sigma_m = mapper.position_prior_sigma_m;
   }
-  r->DeleteUnprojectableObservations();  // clusters merged by similarities: a point may lie inside a port
+  r->DeleteUnprojectableObservations();  // clusters merged by similarities: a point may lie inside
+                                         // a port
   AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, mapper.marker_scale);
   r->DeleteObservationsBeyond(mapper.filter_max_reproj_error_px);
   AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, mapper.marker_scale);
 }
 
 // Rank 0's part: the clusters' models merged, adjusted and written.
-void MergeClusters(const HierarchicalMapperOptions& options, size_t num_clusters, HierarchicalMapperSummary* summary) {
+void MergeClusters(const HierarchicalMapperOptions& options, size_t num_clusters,
+                   HierarchicalMapperSummary* summary) {
   const fs::path folder = fs::path(options.mapper.output_path) / "clusters";
   std::vector<SparseModel> models;
   for (size_t c = 0; c < num_clusters; ++c) {
@@ -98,13 +105,15 @@ void MergeClusters(const HierarchicalMapperOptions& options, size_t num_clusters
   }
   const MergedModels merged = MergeModels(models, options.merge);
   for (const ModelAlignment& a : merged.alignments) {
-    LOG(INFO) << "hierarchical_mapper: merged cluster " << a.model_index << ": " << a.num_shared_images
-              << " shared images, " << a.num_inliers << " of " << a.num_shared_points
-              << " shared points fit the similarity (scale " << a.merged_from_model.scale << ", RMS " << a.rms << ")";
+    LOG(INFO) << "hierarchical_mapper: merged cluster " << a.model_index << ": "
+              << a.num_shared_images << " shared images, " << a.num_inliers << " of "
+              << a.num_shared_points << " shared points fit the similarity (scale "
+              << a.merged_from_model.scale << ", RMS " << a.rms << ")";
   }
   if (!merged.left_out.empty()) {
-    LOG(WARNING) << "hierarchical_mapper: " << merged.left_out.size() << " cluster model(s) shared fewer than "
-                 << options.merge.min_shared_points << " points with the rest and were left out";
+    LOG(WARNING) << "hierarchical_mapper: " << merged.left_out.size()
+                 << " cluster model(s) shared fewer than " << options.merge.min_shared_points
+                 << " points with the rest and were left out";
   }
   if (merged.model.images.size() < 2) {
     throw NumericalError("hierarchical_mapper: no cluster of " + options.mapper.database_path +
@@ -126,24 +135,28 @@ void MergeClusters(const HierarchicalMapperOptions& options, size_t num_clusters
   }
   r.UpdateRays();
   AdjustMerged(options.mapper.mapper, &r);
-  WriteSparseModel(r.ToSparseModel(), fs::path(options.mapper.output_path) / "0", ModelFormat::kBinary);
+  WriteSparseModel(r.ToSparseModel(), fs::path(options.mapper.output_path) / "0",
+                   ModelFormat::kBinary);
   summary->alignments = merged.alignments;
   summary->num_left_out = static_cast<int>(merged.left_out.size());
   summary->num_registered = static_cast<int>(r.poses().size());
   summary->mean_reprojection_error_px = r.MeanReprojectionError();
-  LOG(INFO) << "hierarchical_mapper: " << summary->num_registered << " images in the merged model from "
-            << models.size() << " of " << num_clusters << " clusters (" << summary->num_unmapped << " unmapped, "
-            << summary->num_left_out << " left out)";
+  LOG(INFO) << "hierarchical_mapper: " << summary->num_registered
+            << " images in the merged model from " << models.size() << " of " << num_clusters
+            << " clusters (" << summary->num_unmapped << " unmapped, " << summary->num_left_out
+            << " left out)";
 }
 
 }  // namespace
 
-HierarchicalMapperSummary RunHierarchicalMapper(const HierarchicalMapperOptions& options, ProgressSink& progress) {
+HierarchicalMapperSummary RunHierarchicalMapper(const HierarchicalMapperOptions& options,
+                                                ProgressSink& progress) {
   options.Check();
   const fs::path output(options.mapper.output_path);
   // Rank 0 owns the output: a failed run on any rank leaves no folder it made.
   std::optional<NewPaths> new_output;
-  if (MpiWorld::Rank() == 0) new_output.emplace(std::vector<fs::path>{output, output / "clusters", output / "0"});
+  if (MpiWorld::Rank() == 0)
+    new_output.emplace(std::vector<fs::path>{output, output / "clusters", output / "0"});
   MpiWorld::Barrier();  // before any rank makes a folder
   // The partition needs only the pairs' inlier counts and the images'
   // names; the keypoints and correspondences stay in the database (each
@@ -152,26 +165,31 @@ HierarchicalMapperSummary RunHierarchicalMapper(const HierarchicalMapperOptions&
   std::map<image_t, std::string> names;
   {
     Database database(options.mapper.database_path, Database::OpenMode::kReadOnly);
-    for (const auto& [pair_id, inliers] : database.ReadTwoViewGeometryNumInliers()) pair_inliers[pair_id] = inliers;
+    for (const auto& [pair_id, inliers] : database.ReadTwoViewGeometryNumInliers())
+      pair_inliers[pair_id] = inliers;
     for (const DatabaseImage& image : database.ReadAllImages()) names[image.image_id] = image.name;
   }
   if (pair_inliers.empty()) {
-    throw InputError(options.mapper.database_path + ": no verified image pairs; run a matcher first");
+    throw InputError(options.mapper.database_path +
+                     ": no verified image pairs; run a matcher first");
   }
-  const std::vector<std::vector<image_t>> clusters = PartitionScene(pair_inliers, options.partition);
+  const std::vector<std::vector<image_t>> clusters =
+      PartitionScene(pair_inliers, options.partition);
   HierarchicalMapperSummary summary;
   summary.num_clusters = static_cast<int>(clusters.size());
   std::set<image_t> clustered;
   for (const auto& cluster : clusters) clustered.insert(cluster.begin(), cluster.end());
   summary.num_images = static_cast<int>(clustered.size());
-  LOG(INFO) << "hierarchical_mapper: " << clusters.size() << " clusters over " << MpiWorld::Size() << " rank(s)";
+  LOG(INFO) << "hierarchical_mapper: " << clusters.size() << " clusters over " << MpiWorld::Size()
+            << " rank(s)";
   const auto clean_up = [] {};
   RunOnEveryRank(
       "hierarchical_mapper",
       [&] {
         fs::create_directories(output / "clusters");
         for (size_t c = 0; c < clusters.size(); ++c) {
-          if (static_cast<int>(c % static_cast<size_t>(MpiWorld::Size())) != MpiWorld::Rank()) continue;
+          if (static_cast<int>(c % static_cast<size_t>(MpiWorld::Size())) != MpiWorld::Rank())
+            continue;
           MapCluster(options, clusters[c], c, names, progress);
         }
       },

@@ -40,6 +40,7 @@ struct HierarchicalMapperSummary {
   double mean_reprojection_error_px = 0;
 };
 
-HierarchicalMapperSummary RunHierarchicalMapper(const HierarchicalMapperOptions& options, ProgressSink& progress);
+HierarchicalMapperSummary RunHierarchicalMapper(const HierarchicalMapperOptions& options,
+                                                ProgressSink& progress);
 
 }  // namespace portcal

@@ -51,6 +51,7 @@ struct HousingCalibratorOptions {
 // The stage's summary is the calibration itself.
 using HousingCalibratorSummary = HousingCalibrationResult;
 
-HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& options, ProgressSink& progress);
+HousingCalibratorSummary RunHousingCalibrator(const HousingCalibratorOptions& options,
+                                              ProgressSink& progress);
 
 }  // namespace portcal

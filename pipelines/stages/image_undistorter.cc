@@ -59,7 +59,8 @@ void ReadStereoInput(const ImageUndistorterOptions& options, UndistortionInput* 
   for (const std::string& name : ListImages(options.image_path)) {
     const std::string folder = fs::path(name).begin()->string();
     if (folder == name) continue;  // a file beside the folders
-    if (std::find(folders.begin(), folders.end(), folder) == folders.end()) folders.push_back(folder);
+    if (std::find(folders.begin(), folders.end(), folder) == folders.end())
+      folders.push_back(folder);
     const auto index = std::find(folders.begin(), folders.end(), folder) - folders.begin();
     if (index < 2) input->images.push_back({name, static_cast<camera_t>(index + 1)});
   }
@@ -76,7 +77,8 @@ UndistortionInput ReadInput(const ImageUndistorterOptions& options) {
   if (fs::is_directory(options.input_path)) {
     input.model = ReadSparseModel(options.input_path);
     input.has_poses = true;
-    for (const auto& [image_id, image] : input.model.images) input.images.push_back({image.name, image.camera_id});
+    for (const auto& [image_id, image] : input.model.images)
+      input.images.push_back({image.name, image.camera_id});
   } else if (!fs::exists(options.input_path)) {
     throw InputError(options.input_path + ": no such file or directory");
   } else if (IsStereoCalibrationFile(options.input_path)) {
@@ -84,14 +86,17 @@ UndistortionInput ReadInput(const ImageUndistorterOptions& options) {
   } else {
     const CalibrationReport report = ReadCalibrationReport(options.input_path);
     AddCamera({report.camera, report.housing}, 1, &input.model);
-    for (const std::string& name : ListImages(options.image_path)) input.images.push_back({name, 1});
+    for (const std::string& name : ListImages(options.image_path))
+      input.images.push_back({name, 1});
   }
-  if (input.images.empty() && input.has_poses) throw InputError(options.input_path + ": the model has no images");
+  if (input.images.empty() && input.has_poses)
+    throw InputError(options.input_path + ": the model has no images");
   // Names come from the model: each must stay inside --image_path when read
   // and inside the output's images/ when written, before any work.
   for (const ImageToUndistort& image : input.images) {
     ConfinedPath(options.image_path, image.name, "image name in " + options.input_path);
-    ConfinedPath(fs::path(options.output_path) / "images", image.name, "image name in " + options.input_path);
+    ConfinedPath(fs::path(options.output_path) / "images", image.name,
+                 "image name in " + options.input_path);
   }
   size_t missing = 0;
   std::string first_missing;
@@ -122,7 +127,9 @@ std::optional<DepthRange> PointDepthRange(const SparseModel& model, camera_t cam
   }
   if (depths.size() < 10) return std::nullopt;
   std::sort(depths.begin(), depths.end());
-  const auto at = [&](double q) { return depths[static_cast<size_t>(q * static_cast<double>(depths.size() - 1))]; };
+  const auto at = [&](double q) {
+    return depths[static_cast<size_t>(q * static_cast<double>(depths.size() - 1))];
+  };
   return DepthRange{at(0.05), std::max(at(0.95), at(0.05))};
 }
 
@@ -139,14 +146,16 @@ void ChooseDepths(const ImageUndistorterOptions& options, const HousedCamera& ca
   } else if (points) {
     plan->range = *points;
   } else if (camera.housing) {
-    throw InputError(name + " sits behind a " + camera.housing->ModelName() +
-                     " and there are no points to take its depths from: give --Undistort.distance or "
-                     "--Undistort.depth_range (metres)");
+    throw InputError(
+        name + " sits behind a " + camera.housing->ModelName() +
+        " and there are no points to take its depths from: give --Undistort.distance or "
+        "--Undistort.depth_range (metres)");
   } else {
     plan->range = {1.0, 1.0};  // in air every depth maps alike
   }
   const double reach = HousingReach(camera);
-  const double nearest = options.distance > 0 ? std::min(options.distance, plan->range.near) : plan->range.near;
+  const double nearest =
+      options.distance > 0 ? std::min(options.distance, plan->range.near) : plan->range.near;
   if (!(nearest > reach)) {
     const std::string option = range_given            ? "--Undistort.depth_range"
                                : options.distance > 0 ? "--Undistort.distance"
@@ -154,14 +163,16 @@ void ChooseDepths(const ImageUndistorterOptions& options, const HousedCamera& ca
     throw InputError(option + ": " + FormatShortest(nearest) + " m is inside " + name +
                      "'s housing, whose port reaches z = " + FormatFixed(reach, 4) + " m");
   }
-  const std::string range_words = range_given            ? "--Undistort.depth_range"
-                                  : options.distance > 0 ? "half to twice the distance"
-                                                         : "5th-95th percentile of the model's point depths";
+  const std::string range_words = range_given ? "--Undistort.depth_range"
+                                  : options.distance > 0
+                                      ? "half to twice the distance"
+                                      : "5th-95th percentile of the model's point depths";
   if (options.distance > 0) {
     plan->pinhole.design_depth = options.distance;
     plan->depth_choice = "--Undistort.distance; error over " + range_words;
   } else {
-    plan->pinhole.design_depth = ChooseDesignDepth(camera, plan->range, rotation, options.field_of_view);
+    plan->pinhole.design_depth =
+        ChooseDesignDepth(camera, plan->range, rotation, options.field_of_view);
     plan->depth_choice = "the smallest worst error over " + range_words;
   }
 }
@@ -176,30 +187,34 @@ void MeasureError(const ImageUndistorterOptions& options, CameraUndistortion* pl
 }
 
 CameraUndistortion PlanCamera(const ImageUndistorterOptions& options, const HousedCamera& camera,
-                              const std::optional<DepthRange>& points, const Eigen::Matrix3d& pinhole_from_cam) {
+                              const std::optional<DepthRange>& points,
+                              const Eigen::Matrix3d& pinhole_from_cam) {
   CameraUndistortion plan;
   plan.pinhole.pinhole_from_cam = pinhole_from_cam;
   ChooseDepths(options, camera, points, &plan);
-  plan.pinhole = FitVirtualPinhole(camera, plan.pinhole.design_depth, pinhole_from_cam, options.field_of_view);
+  plan.pinhole =
+      FitVirtualPinhole(camera, plan.pinhole.design_depth, pinhole_from_cam, options.field_of_view);
   MeasureError(options, &plan);
   return plan;
 }
 
 // A rig's two cameras as rectified pinholes.
-std::vector<CameraUndistortion> PlanRectifiedPair(const ImageUndistorterOptions& options, const SparseModel& model,
+std::vector<CameraUndistortion> PlanRectifiedPair(const ImageUndistorterOptions& options,
+                                                  const SparseModel& model,
                                                   const Rigid3d& cam2_from_cam1) {
   const RectifyingRotations rotations = RectifyingRotationsOf(cam2_from_cam1);
   std::vector<CameraUndistortion> plans;
   for (camera_t id : {1u, 2u}) {
     const auto housing = model.housings.find(id);
-    const HousedCamera camera{model.cameras.at(id),
-                              housing == model.housings.end() ? std::nullopt : std::optional<Housing>(housing->second)};
-    plans.push_back(
-        PlanCamera(options, camera, std::nullopt, id == 1 ? rotations.rect_from_cam1 : rotations.rect_from_cam2));
+    const HousedCamera camera{model.cameras.at(id), housing == model.housings.end()
+                                                        ? std::nullopt
+                                                        : std::optional<Housing>(housing->second)};
+    plans.push_back(PlanCamera(options, camera, std::nullopt,
+                               id == 1 ? rotations.rect_from_cam1 : rotations.rect_from_cam2));
   }
-  std::tie(plans[0].pinhole, plans[1].pinhole) =
-      FitRectifiedPinholes(plans[0].pinhole.source, plans[1].pinhole.source, rotations, plans[0].pinhole.design_depth,
-                           plans[1].pinhole.design_depth, options.field_of_view);
+  std::tie(plans[0].pinhole, plans[1].pinhole) = FitRectifiedPinholes(
+      plans[0].pinhole.source, plans[1].pinhole.source, rotations, plans[0].pinhole.design_depth,
+      plans[1].pinhole.design_depth, options.field_of_view);
   for (size_t i = 0; i < 2; ++i) {
     MeasureError(options, &plans[i]);
     plans[i].stereo_partner = i == 0 ? 2 : 1;
@@ -208,10 +223,12 @@ std::vector<CameraUndistortion> PlanRectifiedPair(const ImageUndistorterOptions&
   return plans;
 }
 
-void UndistortImages(const ImageUndistorterOptions& options, const std::vector<ImageToUndistort>& images,
-                     const std::map<camera_t, RemapTables>& tables, const SparseModel& model, const fs::path& folder,
-                     ProgressSink& progress) {
-  for (const ImageToUndistort& image : images) fs::create_directories((folder / image.name).parent_path());
+void UndistortImages(const ImageUndistorterOptions& options,
+                     const std::vector<ImageToUndistort>& images,
+                     const std::map<camera_t, RemapTables>& tables, const SparseModel& model,
+                     const fs::path& folder, ProgressSink& progress) {
+  for (const ImageToUndistort& image : images)
+    fs::create_directories((folder / image.name).parent_path());
   progress.Begin("undistorted images", images.size());
   ParallelFor(images.size(), options.num_threads, [&](size_t i) {
     const fs::path path = fs::path(options.image_path) / images[i].name;
@@ -220,10 +237,12 @@ void UndistortImages(const ImageUndistorterOptions& options, const std::vector<I
     const Camera& camera = model.cameras.at(images[i].camera_id);
     cv::Mat output;
     try {
-      output = ApplyRemapTables(tables.at(images[i].camera_id), image,
-                                cv::Size(static_cast<int>(camera.width), static_cast<int>(camera.height)));
+      output = ApplyRemapTables(
+          tables.at(images[i].camera_id), image,
+          cv::Size(static_cast<int>(camera.width), static_cast<int>(camera.height)));
     } catch (const InputError& e) {
-      throw InputError(path.string() + ": " + e.what() + " (camera " + std::to_string(camera.camera_id) + ")");
+      throw InputError(path.string() + ": " + e.what() + " (camera " +
+                       std::to_string(camera.camera_id) + ")");
     }
     if (!cv::imwrite((folder / images[i].name).string(), output)) {
       throw InputError((fs::path(options.output_path) / "images" / images[i].name).string() +
@@ -244,10 +263,12 @@ void MoveIntoPlace(const fs::path& staging, const fs::path& output) {
 }
 
 void WriteReports(const ImageUndistorterSummary& summary, const fs::path& staging) {
-  WriteFileAtomically(staging / "undistortion.txt", false,
-                      [&](std::ostream& out) { out << UndistortionReportText(summary.cameras, summary.warnings); });
-  WriteFileAtomically(staging / "undistortion.yaml", false,
-                      [&](std::ostream& out) { out << UndistortionReportYaml(summary.cameras, summary.warnings); });
+  WriteFileAtomically(staging / "undistortion.txt", false, [&](std::ostream& out) {
+    out << UndistortionReportText(summary.cameras, summary.warnings);
+  });
+  WriteFileAtomically(staging / "undistortion.yaml", false, [&](std::ostream& out) {
+    out << UndistortionReportYaml(summary.cameras, summary.warnings);
+  });
   fs::create_directories(staging / "report");
   WriteHtmlReport(UndistortionHtml(summary.cameras, summary.warnings), staging / "report");
 }
@@ -255,16 +276,20 @@ void WriteReports(const ImageUndistorterSummary& summary, const fs::path& stagin
 }  // namespace
 
 void ImageUndistorterOptions::Check() const {
-  if (input_path.empty()) throw OptionError("--input_path", "''", "a sparse model folder or a calibration file");
+  if (input_path.empty())
+    throw OptionError("--input_path", "''", "a sparse model folder or a calibration file");
   if (image_path.empty()) throw OptionError("--image_path", "''", "the folder of the images");
-  if (output_path.empty()) throw OptionError("--output_path", "''", "the workspace folder to write");
+  if (output_path.empty())
+    throw OptionError("--output_path", "''", "the workspace folder to write");
   CheckOutputFolder("--output_path", output_path);
   field_of_view.Check();
   if (!(distance >= 0) || !std::isfinite(distance)) {
-    throw OptionError("--Undistort.distance", FormatShortest(distance), "a depth in metres (> 0), or 0: not given");
+    throw OptionError("--Undistort.distance", FormatShortest(distance),
+                      "a depth in metres (> 0), or 0: not given");
   }
   const bool no_range = depth_range.near == 0 && depth_range.far == 0;
-  if (!no_range && !(depth_range.near > 0 && depth_range.far >= depth_range.near && std::isfinite(depth_range.far))) {
+  if (!no_range && !(depth_range.near > 0 && depth_range.far >= depth_range.near &&
+                     std::isfinite(depth_range.far))) {
     throw OptionError("--Undistort.depth_range",
                       FormatShortest(depth_range.near) + "," + FormatShortest(depth_range.far),
                       "NEAR,FAR in metres with 0 < NEAR <= FAR");
@@ -272,7 +297,8 @@ void ImageUndistorterOptions::Check() const {
   if (num_error_depths < 2 || num_error_depths > 50) {
     throw OptionError("--Undistort.num_error_depths", std::to_string(num_error_depths), "2 to 50");
   }
-  if (!(max_error_px > 0)) throw OptionError("--Undistort.max_error_px", FormatShortest(max_error_px), "> 0");
+  if (!(max_error_px > 0))
+    throw OptionError("--Undistort.max_error_px", FormatShortest(max_error_px), "> 0");
   if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
 }
 
@@ -287,10 +313,11 @@ static ImageUndistorterSummary Run(const ImageUndistorterOptions& options, Progr
   } else {
     for (const auto& [camera_id, camera] : input.model.cameras) {
       const auto housing = input.model.housings.find(camera_id);
-      const HousedCamera housed{
-          camera, housing == input.model.housings.end() ? std::nullopt : std::optional<Housing>(housing->second)};
-      summary.cameras.push_back(
-          PlanCamera(options, housed, PointDepthRange(input.model, camera_id), Eigen::Matrix3d::Identity()));
+      const HousedCamera housed{camera, housing == input.model.housings.end()
+                                            ? std::nullopt
+                                            : std::optional<Housing>(housing->second)};
+      summary.cameras.push_back(PlanCamera(options, housed, PointDepthRange(input.model, camera_id),
+                                           Eigen::Matrix3d::Identity()));
     }
   }
   std::map<camera_t, VirtualPinhole> pinholes;
@@ -309,7 +336,8 @@ static ImageUndistorterSummary Run(const ImageUndistorterOptions& options, Progr
   if (input.has_poses) {
     WriteDenseWorkspace(pinhole_model, staging);
   } else {
-    WriteSparseModel(pinhole_model, staging / "sparse", ModelFormat::kBinary);  // the camera; no poses to hand on
+    WriteSparseModel(pinhole_model, staging / "sparse",
+                     ModelFormat::kBinary);  // the camera; no poses to hand on
   }
   if (options.write_maps) {
     fs::create_directories(staging / "maps");
@@ -329,7 +357,8 @@ static ImageUndistorterSummary Run(const ImageUndistorterOptions& options, Progr
   return summary;
 }
 
-ImageUndistorterSummary RunImageUndistorter(const ImageUndistorterOptions& options, ProgressSink& progress) {
+ImageUndistorterSummary RunImageUndistorter(const ImageUndistorterOptions& options,
+                                            ProgressSink& progress) {
   try {
     return Run(options, progress);
   } catch (const Cancelled&) {

@@ -48,6 +48,7 @@ struct ImageUndistorterSummary {
 
 // Throws InputError naming the file, image, camera or option at fault; a
 // failed run leaves output_path as it was.
-ImageUndistorterSummary RunImageUndistorter(const ImageUndistorterOptions& options, ProgressSink& progress);
+ImageUndistorterSummary RunImageUndistorter(const ImageUndistorterOptions& options,
+                                            ProgressSink& progress);
 
 }  // namespace portcal

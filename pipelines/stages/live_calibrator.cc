@@ -1,11 +1,11 @@
 #include "pipelines/stages/live_calibrator.h"
 
-#include <filesystem>
 #include <algorithm>
+#include <filesystem>
 #include <iomanip>
 #include <map>
-#include <set>
 #include <opencv2/imgcodecs.hpp>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -13,8 +13,8 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "database/database.h"
-#include "database/session_lock.h"
 #include "database/new_database_file.h"
+#include "database/session_lock.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/detection/detection_rows.h"
 #include "pipelines/stages/camera_calibrator.h"
@@ -31,13 +31,16 @@ void LiveCalibratorOptions::Check() const {
   if (output_path.empty()) throw OptionError("--output_path", "''", "a folder for the reports");
   if (housing.has_value() != !input_calibration.empty()) {
     throw OptionError(housing ? "--input_calibration" : "--Housing.model", "''",
-                      "both --input_calibration and --Housing.model for a housing calibration, neither for a camera's");
+                      "both --input_calibration and --Housing.model for a housing calibration, "
+                      "neither for a camera's");
   }
   if (!input_calibration2.empty() && !live.Stereo()) {
-    throw OptionError("--input_calibration2", input_calibration2, "only with --source2 (a stereo rig)");
+    throw OptionError("--input_calibration2", input_calibration2,
+                      "only with --source2 (a stereo rig)");
   }
   if (live.Stereo() && housing && input_calibration2.empty()) {
-    throw OptionError("--input_calibration2", "''", "camera 2's in-air calibration.yaml (a rig behind housings)");
+    throw OptionError("--input_calibration2", "''",
+                      "camera 2's in-air calibration.yaml (a rig behind housings)");
   }
   reader.Check();
   live.Check();
@@ -50,17 +53,21 @@ namespace {
 // camera, cam1/ and cam2/ for a rig (a camera per folder, as
 // target_extractor imports a rig and stereo_calibrator pairs it by name).
 std::vector<std::string> CameraFolders(const LiveCalibratorOptions& options) {
-  return options.live.Stereo() ? std::vector<std::string>{"cam1", "cam2"} : std::vector<std::string>{""};
+  return options.live.Stereo() ? std::vector<std::string>{"cam1", "cam2"}
+                               : std::vector<std::string>{""};
 }
 
 // Kept frames as files and rows: the files are moved into place first, then
 // the rows are committed (a failed commit removes the files again).
 class DatabaseFrameStore : public KeptFrameStore {
  public:
-  DatabaseFrameStore(const LiveCalibratorOptions& options, const std::vector<ImageReaderOptions>& readers,
-                     Database* database)
-      : options_(options), database_(database), target_(TargetDescriptionText(options.live.detector)),
-        readers_(readers), folders_(CameraFolders(options)) {
+  DatabaseFrameStore(const LiveCalibratorOptions& options,
+                     const std::vector<ImageReaderOptions>& readers, Database* database)
+      : options_(options),
+        database_(database),
+        target_(TargetDescriptionText(options.live.detector)),
+        readers_(readers),
+        folders_(CameraFolders(options)) {
     const bool stereo = folders_.size() > 1;
     for (ImageReaderOptions& reader : readers_) {
       reader.single_camera = !stereo;
@@ -81,11 +88,13 @@ class DatabaseFrameStore : public KeptFrameStore {
   // a failure at the first keep.
   void CheckContinues(const DatabaseImage& image) const {
     // Only the views count: a database may hold other images too.
-    const std::optional<TargetDetectionStatus> status = database_->ReadTargetDetectionStatus(image.image_id);
+    const std::optional<TargetDetectionStatus> status =
+        database_->ReadTargetDetectionStatus(image.image_id);
     if (!status || !status->found) return;
     if (status->target != target_) {
-      throw InputError(options_.database_path + ": its views (" + image.name + ") are of the target '" +
-                       status->target + "', the --Target.* options describe '" + target_ +
+      throw InputError(options_.database_path + ": its views (" + image.name +
+                       ") are of the target '" + status->target +
+                       "', the --Target.* options describe '" + target_ +
                        "'; continue with the same board, or give another --database_path");
     }
     const std::optional<Camera> camera = database_->ReadCamera(image.camera_id);
@@ -93,22 +102,25 @@ class DatabaseFrameStore : public KeptFrameStore {
     while (c + 1 < folders_.size() && image.name.rfind(folders_[c] + "/", 0) != 0) ++c;
     const std::string& asked = readers_[c].camera_model;
     if (camera && camera->ModelName() != asked) {
-      throw InputError(options_.database_path + ": its views (" + image.name + ") are of a " + camera->ModelName() +
-                       " camera, this session's is " + asked +
-                       " (--ImageReader.camera_model or --input_calibration); continue with the same model, or give "
+      throw InputError(options_.database_path + ": its views (" + image.name + ") are of a " +
+                       camera->ModelName() + " camera, this session's is " + asked +
+                       " (--ImageReader.camera_model or --input_calibration); continue with the "
+                       "same model, or give "
                        "another --database_path");
     }
   }
 
-  std::string Store(const std::vector<cv::Mat>& images, const std::vector<TargetDetection>& detections) override {
+  std::string Store(const std::vector<cv::Mat>& images,
+                    const std::vector<TargetDetection>& detections) override {
     const std::string name = NextName();
     std::vector<fs::path> written;
     try {
-      for (size_t c = 0; c < images.size(); ++c) written.push_back(WriteFrame(images[c], ImageName(c, name)));
+      for (size_t c = 0; c < images.size(); ++c)
+        written.push_back(WriteFrame(images[c], ImageName(c, name)));
       Transaction transaction = database_->BeginTransaction();
       for (size_t c = 0; c < images.size(); ++c) {
-        const image_t id = ImportImage(database_, readers_[c], ImageName(c, name), images[c].cols, images[c].rows,
-                                       &shared_);
+        const image_t id = ImportImage(database_, readers_[c], ImageName(c, name), images[c].cols,
+                                       images[c].rows, &shared_);
         WriteTargetDetection(database_, id, detections[c], target_);
       }
       transaction.Commit();
@@ -126,7 +138,8 @@ class DatabaseFrameStore : public KeptFrameStore {
     Transaction transaction = database_->BeginTransaction();
     for (size_t c = 0; c < folders_.size(); ++c) {
       // The file renamed below must be one inside --image_path.
-      ConfinedPath(options_.image_path, ImageName(c, name), "image name in " + options_.database_path);
+      ConfinedPath(options_.image_path, ImageName(c, name),
+                   "image name in " + options_.database_path);
       const std::optional<DatabaseImage> image = database_->ReadImageWithName(ImageName(c, name));
       if (!image) throw InputError(ImageName(c, name) + ": not in " + options_.database_path);
       database_->DeleteImage(image->image_id);
@@ -171,18 +184,22 @@ class DatabaseFrameStore : public KeptFrameStore {
     if (!written) {
       fs::remove(partial, error);
       throw FrameStoreBroken(partial.string() + ": cannot write a kept frame (" +
-                             (error ? error.message() : "a full disk or a read-only folder?") + "); " +
-                             Kept() + " stay in " + options_.database_path + " and " + options_.image_path);
+                             (error ? error.message() : "a full disk or a read-only folder?") +
+                             "); " + Kept() + " stay in " + options_.database_path + " and " +
+                             options_.image_path);
     }
     fs::rename(partial, path, error);
     if (error) {
-      throw FrameStoreBroken(path.string() + ": cannot move a kept frame into place (" + error.message() + "); " +
-                             Kept() + " stay in " + options_.database_path + " and " + options_.image_path);
+      throw FrameStoreBroken(path.string() + ": cannot move a kept frame into place (" +
+                             error.message() + "); " + Kept() + " stay in " +
+                             options_.database_path + " and " + options_.image_path);
     }
     return path;
   }
 
-  std::string Kept() const { return std::to_string(database_->NumImages()) + " images kept before"; }
+  std::string Kept() const {
+    return std::to_string(database_->NumImages()) + " images kept before";
+  }
 
   // live_NNNN.png after the highest such name in the folders or database.
   std::string NextName() {
@@ -216,7 +233,8 @@ std::vector<KeptView> ExistingViews(Database* database, const std::vector<std::s
   for (const DatabaseImage& image : database->ReadAllImages()) {
     const fs::path path(image.name);
     const bool stereo = folders.size() > 1;
-    const auto folder = std::find(folders.begin(), folders.end(), path.parent_path().generic_string());
+    const auto folder =
+        std::find(folders.begin(), folders.end(), path.parent_path().generic_string());
     if (stereo && folder == folders.end()) continue;
     const bool second = stereo && folder != folders.begin();
     const std::string name = stereo ? path.filename().string() : image.name;
@@ -232,7 +250,8 @@ std::vector<KeptView> ExistingViews(Database* database, const std::vector<std::s
   }
   std::vector<KeptView> kept;
   for (auto& [name, view] : by_name) {
-    const bool complete = !view.view.pixels.empty() && (folders.size() == 1 || !view.view2.pixels.empty());
+    const bool complete =
+        !view.view.pixels.empty() && (folders.size() == 1 || !view.view2.pixels.empty());
     if (complete) kept.push_back(std::move(view));
   }
   return kept;
@@ -258,7 +277,8 @@ ImageReaderOptions ReaderFor(const ImageReaderOptions& reader, const std::string
 
 // The estimators' starts (a rig's camera 2 behind a housing of the same
 // kind, from the same start) and each camera's import options.
-LiveSessionOptions SessionOptions(const LiveCalibratorOptions& options, std::vector<ImageReaderOptions>* readers) {
+LiveSessionOptions SessionOptions(const LiveCalibratorOptions& options,
+                                  std::vector<ImageReaderOptions>* readers) {
   LiveSessionOptions live = options.live;
   live.estimator.fixed_params = options.fixed_params;
   live.estimator.housing = options.housing;
@@ -271,8 +291,9 @@ LiveSessionOptions SessionOptions(const LiveCalibratorOptions& options, std::vec
 }
 
 // One camera's final report, by the batch calibrators on the database.
-void CalibrateCameraAtEnd(const LiveCalibratorOptions& options, int camera_id, const std::string& input_calibration,
-                          const std::string& output_path, ProgressSink& progress,
+void CalibrateCameraAtEnd(const LiveCalibratorOptions& options, int camera_id,
+                          const std::string& input_calibration, const std::string& output_path,
+                          ProgressSink& progress,
                           std::optional<CameraCalibrationResult>* camera_result,
                           std::optional<HousingCalibrationResult>* housing_result) {
   if (options.housing) {
@@ -298,18 +319,18 @@ void CalibrateCameraAtEnd(const LiveCalibratorOptions& options, int camera_id, c
 // The final reports: one camera's in --output_path; a rig's cameras in
 // OUT/cam1 and OUT/cam2, then stereo_calibrator from those into OUT
 // (with --Stereo.refine_intrinsics 1 for a camera calibration).
-void CalibrateAtEnd(const LiveCalibratorOptions& options, const std::vector<int>& camera_ids, ProgressSink& progress,
-                    LiveCalibratorSummary* summary) {
+void CalibrateAtEnd(const LiveCalibratorOptions& options, const std::vector<int>& camera_ids,
+                    ProgressSink& progress, LiveCalibratorSummary* summary) {
   if (camera_ids.size() == 1) {
-    CalibrateCameraAtEnd(options, camera_ids[0], options.input_calibration, options.output_path, progress,
-                         &summary->camera, &summary->housing);
+    CalibrateCameraAtEnd(options, camera_ids[0], options.input_calibration, options.output_path,
+                         progress, &summary->camera, &summary->housing);
     return;
   }
   const fs::path out(options.output_path);
-  CalibrateCameraAtEnd(options, camera_ids[0], options.input_calibration, (out / "cam1").string(), progress,
-                       &summary->camera, &summary->housing);
-  CalibrateCameraAtEnd(options, camera_ids[1], options.input_calibration2, (out / "cam2").string(), progress,
-                       &summary->camera2, &summary->housing2);
+  CalibrateCameraAtEnd(options, camera_ids[0], options.input_calibration, (out / "cam1").string(),
+                       progress, &summary->camera, &summary->housing);
+  CalibrateCameraAtEnd(options, camera_ids[1], options.input_calibration2, (out / "cam2").string(),
+                       progress, &summary->camera2, &summary->housing2);
   StereoCalibratorOptions stereo;
   stereo.database_path = options.database_path;
   stereo.output_path = options.output_path;
@@ -339,7 +360,8 @@ using Conclusion = std::function<std::string(const SessionOutcome&)>;
 // every 0.4 s, so it gets the outcome before the server goes (it keeps
 // showing it after portcal exits). Not after Ctrl-C: the person is at the
 // terminal.
-void Conclude(const SessionOutcome& outcome, const Conclusion& conclude, LiveSession* session, bool page) {
+void Conclude(const SessionOutcome& outcome, const Conclusion& conclude, LiveSession* session,
+              bool page) {
   const auto linger = [page] {
     if (page) std::this_thread::sleep_for(std::chrono::milliseconds(1500));
   };
@@ -365,7 +387,9 @@ SessionOutcome RunSession(const LiveCalibratorOptions& options, const LiveSessio
   NewDatabaseFile new_file(options.database_path);
   Database database(options.database_path, Database::OpenMode::kCreate);
   const SessionLock one_session(options.database_path, "live_calibrator session");
-  { Transaction probe = database.BeginTransaction(); }  // fails now, not at the first keep, when locked
+  {
+    Transaction probe = database.BeginTransaction();
+  }  // fails now, not at the first keep, when locked
   DatabaseFrameStore store(options, readers, &database);
   LiveSession session(live, &store, ExistingViews(&database, CameraFolders(options)));
   std::optional<LiveServer> page;
@@ -393,16 +417,19 @@ std::string FinalCalibration(const LiveCalibratorOptions& options, const Session
   const int views = outcome.num_views;
   const std::string what = options.live.Stereo() ? " pairs" : " views";
   if (outcome.summary.end_reason == "interrupted") {
-    throw Cancelled(std::to_string(views) + what + " kept in " + options.database_path + " and " +
-                    options.image_path + " (calibrate them with camera_calibrator / housing_calibrator" +
-                    (options.live.Stereo() ? " and stereo_calibrator" : "") + ", or rerun to add more)");
+    throw Cancelled(
+        std::to_string(views) + what + " kept in " + options.database_path + " and " +
+        options.image_path + " (calibrate them with camera_calibrator / housing_calibrator" +
+        (options.live.Stereo() ? " and stereo_calibrator" : "") + ", or rerun to add more)");
   }
-  if (!options.calibrate_at_end) return std::to_string(views) + what + " kept; not calibrated (--calibrate_at_end 0)";
+  if (!options.calibrate_at_end)
+    return std::to_string(views) + what + " kept; not calibrated (--calibrate_at_end 0)";
   const int needed = options.housing ? 2 : 3;
   if (views < needed) {
     throw NumericalError("live_calibrator: " + std::to_string(views) + what + " kept (" +
-                         outcome.summary.end_reason + "); a calibration needs " + std::to_string(needed) +
-                         ". They stay in " + options.database_path + "; rerun to add more");
+                         outcome.summary.end_reason + "); a calibration needs " +
+                         std::to_string(needed) + ". They stay in " + options.database_path +
+                         "; rerun to add more");
   }
   CalibrateAtEnd(options, outcome.camera_ids, progress, summary);
   summary->calibrated = true;
@@ -416,8 +443,9 @@ std::string FinalCalibration(const LiveCalibratorOptions& options, const Session
   rms("camera 2 ", summary->camera2);
   rms("camera 2 ", summary->housing2);
   if (summary->stereo) {
-    line << "; baseline " << std::setprecision(5) << 1000 * summary->stereo->cam2_from_cam1.translation.norm()
-         << " mm ± " << std::setprecision(2) << 1000 * summary->stereo->translation_std_dev.norm() << " mm";
+    line << "; baseline " << std::setprecision(5)
+         << 1000 * summary->stereo->cam2_from_cam1.translation.norm() << " mm ± "
+         << std::setprecision(2) << 1000 * summary->stereo->translation_std_dev.norm() << " mm";
   }
   line << ")";
   return line.str();
@@ -425,17 +453,18 @@ std::string FinalCalibration(const LiveCalibratorOptions& options, const Session
 
 }  // namespace
 
-LiveCalibratorSummary RunLiveCalibrator(const LiveCalibratorOptions& options, ProgressSink& progress,
-                                        const std::function<void(LiveSession&, const std::string&)>& on_start) {
+LiveCalibratorSummary RunLiveCalibrator(
+    const LiveCalibratorOptions& options, ProgressSink& progress,
+    const std::function<void(LiveSession&, const std::string&)>& on_start) {
   options.Check();
   LiveCalibratorOptions adjusted = options;
   adjusted.page.output_path = options.output_path;
   std::vector<ImageReaderOptions> readers;
   const LiveSessionOptions live = SessionOptions(options, &readers);
   LiveCalibratorSummary summary;
-  const SessionOutcome outcome = RunSession(adjusted, live, readers, on_start, [&](const SessionOutcome& o) {
-    return FinalCalibration(options, o, progress, &summary);
-  });
+  const SessionOutcome outcome = RunSession(
+      adjusted, live, readers, on_start,
+      [&](const SessionOutcome& o) { return FinalCalibration(options, o, progress, &summary); });
   summary.session = outcome.summary;
   return summary;
 }

@@ -24,10 +24,10 @@
 namespace portcal {
 
 struct LiveCalibratorOptions {
-  std::string database_path;   // created if missing; a continued session adds to it
-  std::string image_path;      // kept frames (live_0001.png, ...), created if missing
-  std::string output_path;     // the final reports
-  ImageReaderOptions reader;   // the camera model (one camera for every frame)
+  std::string database_path;  // created if missing; a continued session adds to it
+  std::string image_path;     // kept frames (live_0001.png, ...), created if missing
+  std::string output_path;    // the final reports
+  ImageReaderOptions reader;  // the camera model (one camera for every frame)
   // Housing calibration: the in-air calibration.yaml and the port (its
   // constants and a start); camera calibration without them.
   std::string input_calibration;
@@ -59,7 +59,8 @@ struct LiveCalibratorSummary {
 // input calibration), NumericalError (too few views for the final
 // calibration: they stay in the database), Cancelled after Ctrl-C (every
 // view kept so far stays).
-LiveCalibratorSummary RunLiveCalibrator(const LiveCalibratorOptions& options, ProgressSink& progress,
-                                        const std::function<void(LiveSession&, const std::string&)>& on_start = {});
+LiveCalibratorSummary RunLiveCalibrator(
+    const LiveCalibratorOptions& options, ProgressSink& progress,
+    const std::function<void(LiveSession&, const std::string&)>& on_start = {});
 
 }  // namespace portcal

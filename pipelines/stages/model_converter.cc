@@ -65,7 +65,8 @@ void ModelConverterOptions::Check() const {
   if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory or file");
   if (!IsModelType(output_type) && output_type != "CAMERAMODEL" && output_type != "OPENCV_YAML" &&
       output_type != "ROS_YAML") {
-    throw OptionError("--output_type", output_type, "BIN, TXT, CAMERAMODEL, OPENCV_YAML or ROS_YAML");
+    throw OptionError("--output_type", output_type,
+                      "BIN, TXT, CAMERAMODEL, OPENCV_YAML or ROS_YAML");
   }
   if (IsModelType(output_type)) {
     CheckOutputFolder("--output_path", output_path);
@@ -74,7 +75,8 @@ void ModelConverterOptions::Check() const {
   }
 }
 
-ModelConverterSummary RunModelConverter(const ModelConverterOptions& options, ProgressSink& progress) {
+ModelConverterSummary RunModelConverter(const ModelConverterOptions& options,
+                                        ProgressSink& progress) {
   options.Check();
   const SparseModel model = ReadInput(options.input_path);
   NewPaths new_output({options.output_path});  // a failed run leaves no output it made
@@ -96,12 +98,15 @@ ModelConverterSummary RunModelConverter(const ModelConverterOptions& options, Pr
     }
     if (options.output_type == "CAMERAMODEL") {
       WriteMrcalCameraModel(camera, Rigid3d(), options.output_path);
-      LOG(INFO) << options.output_path << " holds the lens only; the camera.cameramodel camera_calibrator "
-                << "writes also holds the solve (mrcal's optimization_inputs) for mrcal's uncertainty tools";
+      LOG(INFO) << options.output_path
+                << " holds the lens only; the camera.cameramodel camera_calibrator "
+                << "writes also holds the solve (mrcal's optimization_inputs) for mrcal's "
+                   "uncertainty tools";
     } else if (options.output_type == "OPENCV_YAML") {
       WriteOpenCvCameraYaml(camera, options.output_path);
     } else {
-      WriteRosCameraInfoYaml(camera, "camera" + std::to_string(camera.camera_id), options.output_path);
+      WriteRosCameraInfoYaml(camera, "camera" + std::to_string(camera.camera_id),
+                             options.output_path);
     }
     summary = "camera " + std::to_string(camera.camera_id) + " (" + camera.ModelName() +
               ") written as " + options.output_type + " to " + options.output_path;

@@ -27,6 +27,7 @@ struct ModelConverterSummary {
   std::string description;  // one line: what was converted into what
 };
 
-ModelConverterSummary RunModelConverter(const ModelConverterOptions& options, ProgressSink& progress);
+ModelConverterSummary RunModelConverter(const ModelConverterOptions& options,
+                                        ProgressSink& progress);
 
 }  // namespace portcal

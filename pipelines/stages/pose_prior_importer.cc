@@ -16,7 +16,8 @@ namespace portcal {
 void PosePriorImporterOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "an existing database");
   if (!std::filesystem::is_regular_file(database_path)) {
-    throw OptionError("--database_path", database_path, "an existing database (run feature_extractor first)");
+    throw OptionError("--database_path", database_path,
+                      "an existing database (run feature_extractor first)");
   }
   if (input_path.empty()) throw OptionError("--input_path", "''", "a file of 'NAME X Y Z' lines");
 }
@@ -39,13 +40,15 @@ std::map<std::string, Eigen::Vector3d> ReadPositionsFile(const std::string& path
       throw InputError(where + ": expected 'NAME X Y Z', got '" + line + "'");
     }
     if (!xyz.allFinite()) throw InputError(where + ": position of '" + name + "' is not finite");
-    if (!positions.emplace(name, xyz).second) throw InputError(where + ": '" + name + "' listed twice");
+    if (!positions.emplace(name, xyz).second)
+      throw InputError(where + ": '" + name + "' listed twice");
   }
   if (positions.empty()) throw InputError(path + ": no 'NAME X Y Z' line");
   return positions;
 }
 
-PosePriorImporterSummary RunPosePriorImporter(const PosePriorImporterOptions& options, ProgressSink& progress) {
+PosePriorImporterSummary RunPosePriorImporter(const PosePriorImporterOptions& options,
+                                              ProgressSink& progress) {
   options.Check();
   const std::map<std::string, Eigen::Vector3d> positions = ReadPositionsFile(options.input_path);
   StageRun run("pose_prior_importer", "input_path=" + options.input_path + "\n");
@@ -57,19 +60,22 @@ PosePriorImporterSummary RunPosePriorImporter(const PosePriorImporterOptions& op
   for (const auto& [name, xyz] : positions) {
     const auto it = ids.find(name);
     if (it == ids.end()) {
-      throw InputError(options.input_path + ": image '" + name + "' is not in " + options.database_path);
+      throw InputError(options.input_path + ": image '" + name + "' is not in " +
+                       options.database_path);
     }
     database.UpdatePositionPrior(it->second, xyz);
     ++summary.num_imported;
   }
   summary.num_images_without = static_cast<int>(ids.size()) - summary.num_imported;
-  run.Finish(&database, {{"imported", summary.num_imported}, {"images_without", summary.num_images_without}});
+  run.Finish(&database,
+             {{"imported", summary.num_imported}, {"images_without", summary.num_images_without}});
   transaction.Commit();
   LOG(INFO) << "pose_prior_importer: " << summary.num_imported << " position priors stored; "
             << summary.num_images_without << " image(s) without one";
   if (summary.num_images_without > 0) {
     LOG(WARNING) << "pose_prior_importer: " << summary.num_images_without << " image(s) of "
-                 << options.database_path << " are not in " << options.input_path << " and keep no prior";
+                 << options.database_path << " are not in " << options.input_path
+                 << " and keep no prior";
   }
   return summary;
 }

@@ -11,10 +11,9 @@
 // line or an unknown image name stores nothing.
 #pragma once
 
+#include <Eigen/Core>
 #include <map>
 #include <string>
-
-#include <Eigen/Core>
 
 #include "colmap_ext/util/progress.h"
 
@@ -35,6 +34,7 @@ struct PosePriorImporterSummary {
 // throws InputError naming the file and line.
 std::map<std::string, Eigen::Vector3d> ReadPositionsFile(const std::string& path);
 
-PosePriorImporterSummary RunPosePriorImporter(const PosePriorImporterOptions& options, ProgressSink& progress);
+PosePriorImporterSummary RunPosePriorImporter(const PosePriorImporterOptions& options,
+                                              ProgressSink& progress);
 
 }  // namespace portcal

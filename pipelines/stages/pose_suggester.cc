@@ -26,7 +26,8 @@ void PoseSuggesterOptions::Check() const {
   if (num_poses < 1) throw OptionError("--num_poses", std::to_string(num_poses), ">= 1");
   if (housing.has_value() != !input_calibration.empty()) {
     throw OptionError(housing ? "--input_calibration" : "--Housing.model", "''",
-                      "both --input_calibration and --Housing.model for a housing calibration, neither for a camera's");
+                      "both --input_calibration and --Housing.model for a housing calibration, "
+                      "neither for a camera's");
   }
   target.Check();
   guidance.Check();
@@ -60,7 +61,8 @@ DatabaseViews ReadViews(const PoseSuggesterOptions& options) {
   const std::optional<Camera> camera = camera_id ? database.ReadCamera(*camera_id) : std::nullopt;
   if (!camera) {
     throw InputError(options.database_path + ": no camera" +
-                     (options.camera_id >= 0 ? " " + std::to_string(options.camera_id) : std::string(" to choose")) +
+                     (options.camera_id >= 0 ? " " + std::to_string(options.camera_id)
+                                             : std::string(" to choose")) +
                      " (import images first: live_calibrator or target_extractor)");
   }
   result.camera = *camera;
@@ -77,28 +79,31 @@ DatabaseViews ReadViews(const PoseSuggesterOptions& options) {
 std::string PoseLine(int index, const PoseSuggestion& pose) {
   const Rigid3d& p = pose.cam_from_target;
   std::ostringstream line;
-  line << std::setprecision(9) << index << " " << p.rotation.w() << " " << p.rotation.x() << " " << p.rotation.y()
-       << " " << p.rotation.z() << " " << p.translation.x() << " " << p.translation.y() << " " << p.translation.z()
-       << " " << std::setprecision(4) << (pose.after.determined ? pose.after.mean_px : -1.0) << " # " << pose.why
-       << "\n";
+  line << std::setprecision(9) << index << " " << p.rotation.w() << " " << p.rotation.x() << " "
+       << p.rotation.y() << " " << p.rotation.z() << " " << p.translation.x() << " "
+       << p.translation.y() << " " << p.translation.z() << " " << std::setprecision(4)
+       << (pose.after.determined ? pose.after.mean_px : -1.0) << " # " << pose.why << "\n";
   return line.str();
 }
 
-void WriteSuggestions(const PoseSuggesterOptions& options, const HousedCamera& camera, const TargetShape& target,
-                      const std::vector<PoseSuggestion>& poses) {
+void WriteSuggestions(const PoseSuggesterOptions& options, const HousedCamera& camera,
+                      const TargetShape& target, const std::vector<PoseSuggestion>& poses) {
   const fs::path dir(options.output_path);
   fs::create_directories(dir);
   std::string text =
       "# The next target poses: INDEX QW QX QY QZ TX TY TZ EXPECTED_UNCERTAINTY_PX # WHY\n"
-      "# cam_from_target (target frame -> camera frame, metres); the expected projection uncertainty (mean over\n"
-      "# the image, 1 sigma, px) once this and the poses before it are added; -1: still undetermined.\n";
+      "# cam_from_target (target frame -> camera frame, metres); the expected projection "
+      "uncertainty (mean over\n"
+      "# the image, 1 sigma, px) once this and the poses before it are added; -1: still "
+      "undetermined.\n";
   for (size_t k = 0; k < poses.size(); ++k) {
     text += PoseLine(static_cast<int>(k + 1), poses[k]);
     std::ostringstream name, caption;
     name << "suggested_pose_" << std::setw(2) << std::setfill('0') << k + 1 << ".png";
     caption << "pose " << k + 1 << ": " << poses[k].why;
     const fs::path partial = dir / ("." + name.str() + ".partial.png");
-    if (!cv::imwrite(partial.string(), PosePreview(camera, target, poses[k].cam_from_target, caption.str()))) {
+    if (!cv::imwrite(partial.string(),
+                     PosePreview(camera, target, poses[k].cam_from_target, caption.str()))) {
       throw InputError(partial.string() + ": cannot write the preview");
     }
     fs::rename(partial, dir / name.str());
@@ -128,7 +133,8 @@ PoseSuggesterSummary RunPoseSuggester(const PoseSuggesterOptions& options, Progr
   NextPoseOptions guidance = options.guidance;
   guidance.uncertainty.pixel_sigma_px = std::max(0.02, summary.estimate.pixel_sigma_px);
   summary.poses = SuggestPoses(estimator.Unknowns(summary.estimate.camera), estimator.target(),
-                               summary.estimate.information, summary.estimate.num_views, options.num_poses, guidance);
+                               summary.estimate.information, summary.estimate.num_views,
+                               options.num_poses, guidance);
   progress.Advance(static_cast<size_t>(options.num_poses));
   progress.End();
   WriteSuggestions(options, summary.estimate.camera, estimator.target(), summary.poses);

@@ -23,12 +23,14 @@ void ProjectPointsOptions::Check() const {
   }
   const int num_sources = !input_path.empty() + !input_calibration.empty() + !camera_model.empty();
   if (num_sources != 1) {
-    throw InputError(std::string(num_sources == 0 ? "no camera given" : "more than one camera given") +
-                     ": give one of --input_path (a sparse model), --input_calibration (a calibration file) or "
-                     "--Camera.model with --Camera.params, --Camera.width and --Camera.height");
+    throw InputError(
+        std::string(num_sources == 0 ? "no camera given" : "more than one camera given") +
+        ": give one of --input_path (a sparse model), --input_calibration (a calibration file) or "
+        "--Camera.model with --Camera.params, --Camera.width and --Camera.height");
   }
   if (!input_path.empty() && housing) {
-    throw OptionError("--Housing.model", housing->ModelName(), "not with --input_path (its housings.txt says)");
+    throw OptionError("--Housing.model", housing->ModelName(),
+                      "not with --input_path (its housings.txt says)");
   }
   if (housing) housing->ValidateInput("--Housing.params");
   if (!camera_model.empty()) {
@@ -49,16 +51,18 @@ HousedCamera CameraOfModel(const std::string& input_path, int camera_id) {
   if (camera_id < 0) {
     if (model.cameras.size() != 1) {
       std::string ids;
-      for (const auto& [each, camera] : model.cameras) ids += (ids.empty() ? "" : ", ") + std::to_string(each);
+      for (const auto& [each, camera] : model.cameras)
+        ids += (ids.empty() ? "" : ", ") + std::to_string(each);
       throw OptionError("--camera_id", "-1 (the only camera)",
-                        "the id of one of the " + std::to_string(model.cameras.size()) + " cameras of " +
-                            input_path + " (" + ids + ")");
+                        "the id of one of the " + std::to_string(model.cameras.size()) +
+                            " cameras of " + input_path + " (" + ids + ")");
     }
     id = model.cameras.begin()->first;
   }
   const auto it = model.cameras.find(id);
   if (it == model.cameras.end()) {
-    throw InputError(input_path + ": no camera with id " + std::to_string(camera_id) + " (--camera_id)");
+    throw InputError(input_path + ": no camera with id " + std::to_string(camera_id) +
+                     " (--camera_id)");
   }
   HousedCamera housed;
   housed.camera = it->second;
@@ -131,9 +135,10 @@ ProjectPointsSummary RunProjectPoints(const ProjectPointsOptions& options, Progr
     std::optional<std::string> answer = Answer(camera, values, options.unproject);
     if (!answer) {
       ++summary.num_invalid;
-      answer = options.unproject
-                   ? "invalid no ray (distortion not invertible or total internal reflection)"
-                   : "invalid not visible (behind the camera, inside the housing or totally reflected)";
+      answer =
+          options.unproject
+              ? "invalid no ray (distortion not invertible or total internal reflection)"
+              : "invalid not visible (behind the camera, inside the housing or totally reflected)";
     }
     summary.lines.push_back(std::move(*answer));
   }

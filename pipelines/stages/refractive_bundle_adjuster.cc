@@ -22,10 +22,12 @@ void RefractiveBundleAdjusterOptions::Check() const {
   if (output_path.empty()) throw OptionError("--output_path", "''", "a directory for the results");
   CheckOutputFolder("--output_path", output_path);
   if (marker_scale.side_length_m > 0 && database_path.empty()) {
-    throw OptionError("--database_path", "''", "the database with the marker detections (--Markers.side_length)");
+    throw OptionError("--database_path", "''",
+                      "the database with the marker detections (--Markers.side_length)");
   }
   if (ba.position_prior_sigma_m > 0 && database_path.empty()) {
-    throw OptionError("--database_path", "''", "the database with the position priors (--PosePrior.position_sigma)");
+    throw OptionError("--database_path", "''",
+                      "the database with the position priors (--PosePrior.position_sigma)");
   }
   SelfCalibrationOptions::Check();
 }
@@ -47,14 +49,16 @@ constexpr double kTradeOffWarningFactor = 10.0;
 // a self-calibration that traded the port against the lens, however small
 // its standard deviations (issue 21: a flat port 361 mm from the camera
 // centre, reported at 0.39 +- 0.07 m).
-std::vector<std::string> ImplausibleHousingWarnings(const std::map<camera_t, HousedCamera>& cameras) {
+std::vector<std::string> ImplausibleHousingWarnings(
+    const std::map<camera_t, HousedCamera>& cameras) {
   std::vector<std::string> warnings;
   for (const auto& [id, camera] : cameras) {
     if (!camera.housing) continue;
     if (const std::optional<std::string> why = camera.housing->Implausibility()) {
-      warnings.push_back("camera " + std::to_string(id) + ": " + *why +
-                         ": the calibration likely traded the housing against the lens; give the in-air "
-                         "intrinsics (--ImageReader.camera_params), a closer housing guess, or more views");
+      warnings.push_back(
+          "camera " + std::to_string(id) + ": " + *why +
+          ": the calibration likely traded the housing against the lens; give the in-air "
+          "intrinsics (--ImageReader.camera_params), a closer housing guess, or more views");
     }
   }
   return warnings;
@@ -83,8 +87,8 @@ struct TradeOff {
   double factor = 1;  // the housing's sd at least this many times that with the intrinsics known
 };
 
-std::vector<TradeOff> TradeOffs(const std::map<camera_t, HousedCamera>& cameras, const CalibrationStdDevs& std_devs,
-                                double limit) {
+std::vector<TradeOff> TradeOffs(const std::map<camera_t, HousedCamera>& cameras,
+                                const CalibrationStdDevs& std_devs, double limit) {
   std::vector<TradeOff> trade_offs;
   for (const auto& [id, correlation] : std_devs.intrinsics_housing_correlation) {
     if (correlation.size() == 0) continue;
@@ -96,7 +100,8 @@ std::vector<TradeOff> TradeOffs(const std::map<camera_t, HousedCamera>& cameras,
     const std::vector<std::string> housing = SplitParamsInfo(camera.housing->ParamsInfo());
     const double factor = 1.0 / std::sqrt(std::max(1e-12, 1.0 - strongest * strongest));
     std::ostringstream note;
-    note << std::fixed << std::setprecision(4) << (cameras.size() > 1 ? "camera " + std::to_string(id) + ": " : "")
+    note << std::fixed << std::setprecision(4)
+         << (cameras.size() > 1 ? "camera " + std::to_string(id) + ": " : "")
          << intrinsic.at(static_cast<size_t>(i)) << " and " << housing.at(static_cast<size_t>(j))
          << " are correlated at " << std::showpos << correlation(i, j) << std::noshowpos
          << ": the views hardly tell them apart (the housing's standard deviation is at least "
@@ -110,15 +115,18 @@ std::vector<TradeOff> TradeOffs(const std::map<camera_t, HousedCamera>& cameras,
 
 // The model's images and cameras (the housing override applied), with the
 // database's marker detections, position priors and keypoint scales.
-SfmInputs ReadAdjusterInputs(const RefractiveBundleAdjusterOptions& options, const SparseModel& model) {
+SfmInputs ReadAdjusterInputs(const RefractiveBundleAdjusterOptions& options,
+                             const SparseModel& model) {
   SfmInputs inputs = SfmInputs::FromSparseModel(model);
   if (options.housing) ReplaceHousings(*options.housing, &inputs.cameras);
   if (options.ba.refine_housing) {
     bool any = false;
     for (const auto& [id, camera] : inputs.cameras) any |= camera.housing.has_value();
     if (!any) {
-      throw InputError(options.input_path + ": no camera has a housing (housings.txt) to refine; give "
-                       "--Housing.model and --Housing.params or --BundleAdjustment.refine_housing 0");
+      throw InputError(
+          options.input_path +
+          ": no camera has a housing (housings.txt) to refine; give "
+          "--Housing.model and --Housing.params or --BundleAdjustment.refine_housing 0");
     }
   }
   if (!options.database_path.empty()) {
@@ -146,36 +154,43 @@ SfmInputs ReadAdjusterInputs(const RefractiveBundleAdjusterOptions& options, con
 
 // The metric scale: the model aligned to the images' position priors, or
 // the markers' corners triangulated, as the options ask.
-void PrepareScale(const RefractiveBundleAdjusterOptions& options, bool use_priors, Reconstruction* r,
-                  std::vector<MarkerCorner>* markers, RefractiveBundleAdjusterSummary* result) {
+void PrepareScale(const RefractiveBundleAdjusterOptions& options, bool use_priors,
+                  Reconstruction* r, std::vector<MarkerCorner>* markers,
+                  RefractiveBundleAdjusterSummary* result) {
   if (use_priors) {
     const auto alignment = AlignToPositionPriors(r, 5 * options.ba.position_prior_sigma_m);
     if (!alignment) {
-      throw InputError(options.database_path + ": fewer than 3 registered images of " + options.input_path +
-                       " have position priors, or their positions are collinear; the scale cannot come "
-                       "from --PosePrior.position_sigma (run pose_prior_importer, or set it to 0)");
+      throw InputError(
+          options.database_path + ": fewer than 3 registered images of " + options.input_path +
+          " have position priors, or their positions are collinear; the scale cannot come "
+          "from --PosePrior.position_sigma (run pose_prior_importer, or set it to 0)");
     }
     result->num_position_priors = alignment->num_inliers;
     LOG(INFO) << "refractive_bundle_adjuster: aligned to " << alignment->num_inliers << " of "
-              << alignment->num_priors << " position priors (scale " << alignment->new_from_old.scale
-              << ", RMS " << alignment->rms_m << " m; " << alignment->num_unprojectable_deleted
+              << alignment->num_priors << " position priors (scale "
+              << alignment->new_from_old.scale << ", RMS " << alignment->rms_m << " m; "
+              << alignment->num_unprojectable_deleted
               << " observations no longer projectable deleted)";
   }
   if (options.marker_scale.side_length_m > 0) {
     *markers = TriangulateMarkerCorners(*r, 4 * options.max_reproj_error_px);
     result->num_marker_corners = static_cast<int>(markers->size());
     if (markers->empty()) {
-      throw InputError(options.database_path + ": no marker corner is seen by two registered images; the "
-                       "scale cannot come from --Markers.side_length (run feature_masker, or set it to 0)");
+      throw InputError(
+          options.database_path +
+          ": no marker corner is seen by two registered images; the "
+          "scale cannot come from --Markers.side_length (run feature_masker, or set it to 0)");
     }
-    LOG(INFO) << "refractive_bundle_adjuster: " << markers->size() << " marker corners give the scale";
+    LOG(INFO) << "refractive_bundle_adjuster: " << markers->size()
+              << " marker corners give the scale";
   }
 }
 
 // The report of camera `camera_id`: parameters, standard deviations,
 // exact reprojection RMS overall and per view.
-void FillReport(const RefractiveBundleAdjusterOptions& options, const Reconstruction& r, camera_t camera_id,
-                const CalibrationStdDevs& std_devs, bool use_priors, CalibrationReport* out) {
+void FillReport(const RefractiveBundleAdjusterOptions& options, const Reconstruction& r,
+                camera_t camera_id, const CalibrationStdDevs& std_devs, bool use_priors,
+                CalibrationReport* out) {
   CalibrationReport& report = *out;
   const HousedCamera& camera = r.cameras().at(camera_id);
   report.camera = camera.camera;
@@ -197,9 +212,9 @@ void FillReport(const RefractiveBundleAdjusterOptions& options, const Reconstruc
   report.housing_std_dev_by_clusters = of_camera(std_devs.housing_by_clusters);
   // A refined parameter without a finite standard deviation is
   // undetermined (negative in the report), not held (0).
-  for (auto* std_dev : {&report.parameters_std_dev, &report.housing_std_dev, &report.parameters_std_dev_by_noise,
-                        &report.parameters_std_dev_by_clusters, &report.housing_std_dev_by_noise,
-                        &report.housing_std_dev_by_clusters}) {
+  for (auto* std_dev : {&report.parameters_std_dev, &report.housing_std_dev,
+                        &report.parameters_std_dev_by_noise, &report.parameters_std_dev_by_clusters,
+                        &report.housing_std_dev_by_noise, &report.housing_std_dev_by_clusters}) {
     for (double& v : *std_dev) {
       if (!std::isfinite(v)) v = -1.0;
     }
@@ -210,9 +225,9 @@ void FillReport(const RefractiveBundleAdjusterOptions& options, const Reconstruc
       options.marker_scale.side_length_m > 0
           ? "auto-calibration (SIFT points, ArUco markers of side " +
                 std::to_string(options.marker_scale.side_length_m) + " m give the scale)"
-          : use_priors ? "self-calibration (SIFT points; position priors of sigma " +
-                             std::to_string(options.ba.position_prior_sigma_m) + " m give the scale)"
-                       : "auto-calibration (SIFT points; no metric scale)";
+      : use_priors ? "self-calibration (SIFT points; position priors of sigma " +
+                         std::to_string(options.ba.position_prior_sigma_m) + " m give the scale)"
+                   : "auto-calibration (SIFT points; no metric scale)";
   double sum_sq = 0;
   int64_t count = 0;
   std::map<image_t, std::pair<double, int>> per_image;
@@ -244,15 +259,18 @@ void FillReport(const RefractiveBundleAdjusterOptions& options, const Reconstruc
 // implausible housing, intrinsics traded against the housing (warnings or,
 // below the warning factor, notes).
 void AddCalibrationWarnings(const RefractiveBundleAdjusterOptions& options, const Reconstruction& r,
-                            camera_t at_bound, const CalibrationStdDevs& std_devs, std::vector<std::string>* warnings,
-                            std::vector<std::string>* notes, RefractiveBundleAdjusterSummary* result) {
+                            camera_t at_bound, const CalibrationStdDevs& std_devs,
+                            std::vector<std::string>* warnings, std::vector<std::string>* notes,
+                            RefractiveBundleAdjusterSummary* result) {
   if (at_bound != kInvalidCameraId) {
     // Not an estimate: its standard deviations describe a bound.
     const Housing& housing = *r.cameras().at(at_bound).housing;
-    warnings->push_back("camera " + std::to_string(at_bound) + ": the housing ended at a bound of the adjustment (" +
-                        housing.Refinement().bound_description +
-                        "), not an estimate; the data traded it against the intrinsics: give the intrinsics, more "
-                        "views or a closer housing guess");
+    warnings->push_back(
+        "camera " + std::to_string(at_bound) +
+        ": the housing ended at a bound of the adjustment (" +
+        housing.Refinement().bound_description +
+        "), not an estimate; the data traded it against the intrinsics: give the intrinsics, more "
+        "views or a closer housing guess");
     LOG(WARNING) << "refractive_bundle_adjuster: " << warnings->back();
   }
   if (options.ba.refine_housing) {
@@ -275,8 +293,9 @@ void AddCalibrationWarnings(const RefractiveBundleAdjusterOptions& options, cons
 // The adjusted model and the report of its first camera (RMS of the exact
 // reprojection error).
 void WriteAdjusted(const RefractiveBundleAdjusterOptions& options, const Reconstruction& r,
-                   const CalibrationStdDevs& std_devs, bool use_priors, std::vector<std::string> notes,
-                   std::vector<std::string> warnings, RefractiveBundleAdjusterSummary* result) {
+                   const CalibrationStdDevs& std_devs, bool use_priors,
+                   std::vector<std::string> notes, std::vector<std::string> warnings,
+                   RefractiveBundleAdjusterSummary* result) {
   const camera_t camera_id = r.cameras().begin()->first;
   if (r.cameras().size() > 1) {
     LOG(WARNING) << "refractive_bundle_adjuster: " << r.cameras().size()
@@ -290,24 +309,27 @@ void WriteAdjusted(const RefractiveBundleAdjusterOptions& options, const Reconst
   report.verdict = JudgeCalibration(report, model, camera_id);
   WriteSparseModel(model, options.output_path, ModelFormat::kBinary);
   WriteCalibrationReport(report, options.output_path);
-  WriteHtml(SelfCalibrationHtml(report, model, "Refractive bundle adjustment"), options.output_path);
-  LOG(INFO) << "refractive_bundle_adjuster: RMS " << report.overall_rms_px << " px over " << report.num_points
-            << " observations; " << result->num_filtered << " observations dropped; written to "
-            << options.output_path;
+  WriteHtml(SelfCalibrationHtml(report, model, "Refractive bundle adjustment"),
+            options.output_path);
+  LOG(INFO) << "refractive_bundle_adjuster: RMS " << report.overall_rms_px << " px over "
+            << report.num_points << " observations; " << result->num_filtered
+            << " observations dropped; written to " << options.output_path;
   const HousedCamera& camera = r.cameras().at(camera_id);
-  if (camera.housing) LOG(INFO) << "housing: " << camera.housing->ModelName() << " " << [&] {
-    std::string s;
-    for (double v : camera.housing->params) s += std::to_string(v) + " ";
-    return s;
-  }();
+  if (camera.housing)
+    LOG(INFO) << "housing: " << camera.housing->ModelName() << " " << [&] {
+      std::string s;
+      for (double v : camera.housing->params) s += std::to_string(v) + " ";
+      return s;
+    }();
 }
 
 // The input model over `inputs` (filled from it and the database), aligned
 // to its scale source. The run reads it again rather than keeping a copy
 // for its rare second attempt: a survey's model is a tenth of the
 // refinement's memory.
-Reconstruction ReadAlignedModel(const RefractiveBundleAdjusterOptions& options, bool use_priors, SfmInputs* inputs,
-                                std::vector<MarkerCorner>* markers, RefractiveBundleAdjusterSummary* result) {
+Reconstruction ReadAlignedModel(const RefractiveBundleAdjusterOptions& options, bool use_priors,
+                                SfmInputs* inputs, std::vector<MarkerCorner>* markers,
+                                RefractiveBundleAdjusterSummary* result) {
   const SparseModel model = ReadSparseModel(options.input_path);
   model.Validate(options.input_path);
   if (model.images.size() < 2) {
@@ -316,7 +338,8 @@ Reconstruction ReadAlignedModel(const RefractiveBundleAdjusterOptions& options, 
   }
   if (model.points3D.empty()) {
     // Nothing to adjust: the output would be the input, logged as refined.
-    throw InputError(options.input_path + ": no 3D point; bundle adjustment needs the points the images observe");
+    throw InputError(options.input_path +
+                     ": no 3D point; bundle adjustment needs the points the images observe");
   }
   *inputs = ReadAdjusterInputs(options, model);
   Reconstruction r = Reconstruction::FromSparseModel(inputs, model);
@@ -326,8 +349,8 @@ Reconstruction ReadAlignedModel(const RefractiveBundleAdjusterOptions& options, 
 
 }  // namespace
 
-RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options,
-                                                            ProgressSink& progress) {
+RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(
+    const RefractiveBundleAdjusterOptions& options, ProgressSink& progress) {
   options.Check();
   NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
   RefractiveBundleAdjusterSummary result;
@@ -336,9 +359,10 @@ RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBund
   std::vector<MarkerCorner> markers;
   Reconstruction r = ReadAlignedModel(options, use_priors, &inputs, &markers, &result);
   if (options.ba.refine_housing && options.marker_scale.side_length_m <= 0 && !use_priors) {
-    LOG(WARNING) << "refractive_bundle_adjuster: no marker scale (--Markers.side_length): the model's scale "
-                    "is arbitrary, so a flat port's distance and a dome's decentering are not in metres "
-                    "(refraction observes the scale only weakly)";
+    LOG(WARNING)
+        << "refractive_bundle_adjuster: no marker scale (--Markers.side_length): the model's scale "
+           "is arbitrary, so a flat port's distance and a dome's decentering are not in metres "
+           "(refraction observes the scale only weakly)";
   }
   SelfCalibration adjustment(options, options.input_path, &r, &markers);
   // The model's own housing at a bound (the mapper can slide a flat port's
@@ -346,8 +370,9 @@ RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBund
   // there the solve stays there, even with the intrinsics adjusted first.
   // It starts from the guess's bound parameters instead, the intrinsics
   // first (figures: docs/dev/auto_calibration_notes.md).
-  const bool start_at_bound =
-      adjustment.joint() && adjustment.HousingAtBound() != kInvalidCameraId && options.housing_guess.has_value();
+  const bool start_at_bound = adjustment.joint() &&
+                              adjustment.HousingAtBound() != kInvalidCameraId &&
+                              options.housing_guess.has_value();
   if (start_at_bound) MoveHousingsOffBound(options.housing_guess, &r);
   CalibrationStdDevs std_devs;
   SelfCalibrationOutcome outcome = adjustment.Calibrate(start_at_bound, &std_devs);
@@ -355,7 +380,8 @@ RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBund
     // The housing slid into a bound under the mapper's intrinsics: adjusting
     // the intrinsics first (housing held) moves them to the right side of
     // the trade (docs/dev/auto_calibration_notes.md).
-    LOG(WARNING) << "refractive_bundle_adjuster: the housing ended at a bound; adjusting again, the intrinsics "
+    LOG(WARNING) << "refractive_bundle_adjuster: the housing ended at a bound; adjusting again, "
+                    "the intrinsics "
                     "first";
     markers.clear();
     r = ReadAlignedModel(options, use_priors, &inputs, &markers, &result);
@@ -366,7 +392,8 @@ RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBund
   result.principal_point_held = outcome.principal_point_held;
   std::vector<std::string> notes = std::move(outcome.notes);
   std::vector<std::string> warnings = std::move(outcome.warnings);
-  AddCalibrationWarnings(options, r, adjustment.HousingAtBound(), std_devs, &warnings, &notes, &result);
+  AddCalibrationWarnings(options, r, adjustment.HousingAtBound(), std_devs, &warnings, &notes,
+                         &result);
   WriteAdjusted(options, r, std_devs, use_priors, std::move(notes), std::move(warnings), &result);
   new_output.Keep();
   return result;

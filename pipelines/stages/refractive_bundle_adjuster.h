@@ -25,9 +25,9 @@ namespace portcal {
 // The schedule's options (ba, marker_scale, the IRLS tolerances, the
 // principal point test) are SelfCalibrationOptions'.
 struct RefractiveBundleAdjusterOptions : SelfCalibrationOptions {
-  std::string input_path;     // sparse model (+ housings.txt)
-  std::string output_path;    // adjusted model and reports
-  std::string database_path;  // for marker detections (optional)
+  std::string input_path;          // sparse model (+ housings.txt)
+  std::string output_path;         // adjusted model and reports
+  std::string database_path;       // for marker detections (optional)
   std::optional<Housing> housing;  // replaces the model's housings
   // The first guess of the housing, for one case only: the model's own
   // housing lies at a bound of the adjustment (a flat port's distance at its
@@ -52,7 +52,7 @@ struct RefractiveBundleAdjusterSummary {
   int num_geometry_warnings = 0;
 };
 
-RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(const RefractiveBundleAdjusterOptions& options,
-                                                            ProgressSink& progress);
+RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(
+    const RefractiveBundleAdjusterOptions& options, ProgressSink& progress);
 
 }  // namespace portcal

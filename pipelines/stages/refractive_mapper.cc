@@ -56,7 +56,8 @@ SfmInputs ReadInputs(const RefractiveMapperOptions& options) {
 
 }  // namespace
 
-RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& options, ProgressSink& progress) {
+RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& options,
+                                            ProgressSink& progress) {
   options.Check();
   NewPaths new_output({options.output_path});  // a failed run leaves no output folder it made
   const SfmInputs inputs = ReadInputs(options);
@@ -66,17 +67,19 @@ RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& optio
   if (options.mapper.position_prior_sigma_m > 0 &&
       std::none_of(inputs.images.begin(), inputs.images.end(),
                    [](const auto& entry) { return entry.second.position_prior.has_value(); })) {
-    throw InputError(options.database_path + ": no image has a position prior, so --PosePrior.position_sigma "
+    throw InputError(options.database_path +
+                     ": no image has a position prior, so --PosePrior.position_sigma "
                      "has nothing to use (run pose_prior_importer, or set it to 0)");
   }
   std::map<camera_t, HousedCamera> cameras = inputs.cameras;
   if (options.housing) ReplaceHousings(*options.housing, &cameras);
   IncrementalMapperOptions mapper = options.mapper;
   if (StartFocalFromMarkers(inputs, options.init_focal_from_markers, &cameras)) {
-    mapper.max_focal_ratio_to_start = std::min(mapper.max_focal_ratio_to_start, kMaxFocalRatioToMarkers);
+    mapper.max_focal_ratio_to_start =
+        std::min(mapper.max_focal_ratio_to_start, kMaxFocalRatioToMarkers);
   }
-  StartRadialFromMatches(inputs, options.init_radial_from_matches, options.mapper.ba_refine_extra_params,
-                         options.radial_start, &cameras);
+  StartRadialFromMatches(inputs, options.init_radial_from_matches,
+                         options.mapper.ba_refine_extra_params, options.radial_start, &cameras);
   const std::vector<MappedModel> models = RunIncrementalMapper(inputs, cameras, mapper, progress);
   if (models.empty()) {
     throw NumericalError("refractive_mapper: no model could be initialised from " +
@@ -97,14 +100,15 @@ RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& optio
                                    [](const CalibrationRefinement& c) { return c.settled; });
     summary.calibration_refinements.push_back(refinements);
     if (held != refinements.end()) {
-      LOG(INFO) << "refractive_mapper: model " << m << ": intrinsics and housing held from " << held->num_images
-                << " images on (that refinement moved the image by " << held->image_shift_px
-                << " px), refined again at the end";
+      LOG(INFO) << "refractive_mapper: model " << m << ": intrinsics and housing held from "
+                << held->num_images << " images on (that refinement moved the image by "
+                << held->image_shift_px << " px), refined again at the end";
     }
   }
   summary.num_models = static_cast<int>(models.size());
-  LOG(INFO) << "refractive_mapper: " << summary.num_models << " model(s), " << summary.num_registered << " of "
-            << summary.num_images << " images registered; written to " << options.output_path;
+  LOG(INFO) << "refractive_mapper: " << summary.num_models << " model(s), "
+            << summary.num_registered << " of " << summary.num_images
+            << " images registered; written to " << options.output_path;
   new_output.Keep();
   return summary;
 }

@@ -48,6 +48,7 @@ struct RefractiveMapperSummary {
   std::vector<std::vector<CalibrationRefinement>> calibration_refinements;
 };
 
-RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& options, ProgressSink& progress);
+RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& options,
+                                            ProgressSink& progress);
 
 }  // namespace portcal

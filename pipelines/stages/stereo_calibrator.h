@@ -27,6 +27,7 @@ struct StereoCalibratorOptions {
 // The stage's summary is the calibration itself.
 using StereoCalibratorSummary = StereoCalibrationResult;
 
-StereoCalibratorSummary RunStereoCalibrator(const StereoCalibratorOptions& options, ProgressSink& progress);
+StereoCalibratorSummary RunStereoCalibrator(const StereoCalibratorOptions& options,
+                                            ProgressSink& progress);
 
 }  // namespace portcal

@@ -81,20 +81,23 @@ std::string ExtraYaml(const DatasetConfig& config, const Clutter* clutter, const
   if (survey) {
     const SurveyOptions& s = config.survey_options;
     out << "survey:\n  world_frame: seabed, z up; cam_from_target = cam_from_world\n"
-        << "  height: " << s.height_m << "\n  speed: " << s.speed_m_s << "\n  frame_rate: "
-        << s.frame_rate_hz << "\n  side_overlap: " << s.side_overlap << "\n  line_length: "
-        << s.line_length_m << "\n  line_spacing: " << survey->line_spacing_m
-        << "\n  frame_spacing: " << survey->frame_spacing_m << "\n  footprint_width: "
-        << survey->footprint_width_m << "\n  roughness: " << s.roughness_m
-        << "\n  relief_wavelength: " << s.relief_wavelength_m << "\n  texel: " << s.texel_m
-        << "\n  seed: " << s.texture_seed << "\n";
+        << "  height: " << s.height_m << "\n  speed: " << s.speed_m_s
+        << "\n  frame_rate: " << s.frame_rate_hz << "\n  side_overlap: " << s.side_overlap
+        << "\n  line_length: " << s.line_length_m << "\n  line_spacing: " << survey->line_spacing_m
+        << "\n  frame_spacing: " << survey->frame_spacing_m
+        << "\n  footprint_width: " << survey->footprint_width_m
+        << "\n  roughness: " << s.roughness_m << "\n  relief_wavelength: " << s.relief_wavelength_m
+        << "\n  texel: " << s.texel_m << "\n  seed: " << s.texture_seed << "\n";
     if (!markers.empty()) {
-      out << "  markers:\n    dictionary: " << s.markers.dictionary << "\n    side: " << s.markers.side_m
-          << "\n    corners:  # id: TL, TR, BR, BL in the world frame\n" << std::setprecision(9);
+      out << "  markers:\n    dictionary: " << s.markers.dictionary
+          << "\n    side: " << s.markers.side_m
+          << "\n    corners:  # id: TL, TR, BR, BL in the world frame\n"
+          << std::setprecision(9);
       for (const SeabedMarker& m : markers) {
         out << "      " << m.id << ": [";
         for (int k = 0; k < 4; ++k) {
-          out << (k ? ", " : "") << "[" << m.corners[k].x() << ", " << m.corners[k].y() << ", " << m.corners[k].z() << "]";
+          out << (k ? ", " : "") << "[" << m.corners[k].x() << ", " << m.corners[k].y() << ", "
+              << m.corners[k].z() << "]";
         }
         out << "]\n";
       }
@@ -103,8 +106,9 @@ std::string ExtraYaml(const DatasetConfig& config, const Clutter* clutter, const
     const ViewSamplingOptions& p = config.poses;
     out << "pose_generation:\n  distance: [" << p.distance_min_m << ", " << p.distance_max_m
         << "]\n  tilt_max_deg: " << p.tilt_max_deg << "\n  roll_max_deg: " << p.roll_max_deg
-        << "\n  border_margin_px: " << p.border_margin_px << "\n  max_view_angle_deg: "
-        << p.max_view_angle_deg << "\n  visibility: " << p.visibility << "\n";
+        << "\n  border_margin_px: " << p.border_margin_px
+        << "\n  max_view_angle_deg: " << p.max_view_angle_deg << "\n  visibility: " << p.visibility
+        << "\n";
   }
   return out.str();
 }
@@ -149,7 +153,8 @@ RenderedFrame RenderAndWrite(const FrameRenderer& renderer, const fs::path& stag
 }
 
 // The set's ground truth before any frame: names, cameras, housings, rig.
-GroundTruth TruthHeader(const DatasetConfig& config, const std::string& dir1, const std::string& dir2) {
+GroundTruth TruthHeader(const DatasetConfig& config, const std::string& dir1,
+                        const std::string& dir2) {
   GroundTruth truth;
   truth.name = config.name;
   truth.description = config.description;
@@ -157,7 +162,9 @@ GroundTruth TruthHeader(const DatasetConfig& config, const std::string& dir1, co
   truth.camera = config.camera;
   truth.housing = config.housing;
   if (config.stereo) {
-    truth.stereo = StereoTruth{config.cam2_from_cam1, config.camera2, config.housing2,
+    truth.stereo = StereoTruth{config.cam2_from_cam1,
+                               config.camera2,
+                               config.housing2,
                                config.cam2_from_cam1.Inverse().translation.norm(),
                                {dir1, dir2}};
   }
@@ -168,22 +175,27 @@ GroundTruth TruthHeader(const DatasetConfig& config, const std::string& dir1, co
 // finished set moved into `output` (a failed run leaves it as it was).
 void FinishSet(const SynthesizeOptions& options, const DatasetConfig& config, const Scene& scene,
                const GroundTruth& truth, const fs::path& staging, const fs::path& output) {
-  WriteGroundTruth(truth, staging / "ground_truth.yaml",
-                   ExtraYaml(config, scene.clutter ? &*scene.clutter : nullptr,
-                             config.survey ? &scene.survey : nullptr, scene.seabed_markers.markers));
+  WriteGroundTruth(
+      truth, staging / "ground_truth.yaml",
+      ExtraYaml(config, scene.clutter ? &*scene.clutter : nullptr,
+                config.survey ? &scene.survey : nullptr, scene.seabed_markers.markers));
   if (config.survey) {
-    const std::string navigation = NavigationText(truth, config.survey_options.navigation_sigma_m, config.seed);
-    WriteFileAtomically(staging / "navigation.txt", false, [&](std::ostream& out) { out << navigation; });
+    const std::string navigation =
+        NavigationText(truth, config.survey_options.navigation_sigma_m, config.seed);
+    WriteFileAtomically(staging / "navigation.txt", false,
+                        [&](std::ostream& out) { out << navigation; });
   }
   if (!config.survey && config.target.type == "target3d") {
     const std::string csv = DotsCsv(scene.target.dots);
     WriteFileAtomically(staging / "target_dots.csv", false, [&](std::ostream& out) { out << csv; });
   }
-  fs::copy_file(options.config_path, staging / "config_used.yaml", fs::copy_options::overwrite_existing);
+  fs::copy_file(options.config_path, staging / "config_used.yaml",
+                fs::copy_options::overwrite_existing);
   // The last moment to honour a stop; after it the output is replaced.
   if (CancelFlag::Requested()) throw Cancelled("nothing was written to " + options.output_path);
-  for (const char* entry : {"images", "ground_truth.yaml", "target_dots.csv", "config_used.yaml", "navigation.txt",
-                            "trajectory.yaml", "trajectory.avi", "trajectory_cam2.avi"}) {
+  for (const char* entry :
+       {"images", "ground_truth.yaml", "target_dots.csv", "config_used.yaml", "navigation.txt",
+        "trajectory.yaml", "trajectory.avi", "trajectory_cam2.avi"}) {
     if (!fs::exists(staging / entry)) continue;
     fs::remove_all(output / entry);
     fs::rename(staging / entry, output / entry);
@@ -193,11 +205,13 @@ void FinishSet(const SynthesizeOptions& options, const DatasetConfig& config, co
 
 // A trajectory's frames (its key poses sampled as independent views are),
 // which then set the number of images; empty without a trajectory.
-std::vector<TrajectoryFrame> PlanFrames(const Scene& scene, const HousedCamera& camera1, const HousedCamera& camera2,
-                                        std::mt19937_64* rng, DatasetConfig* config) {
+std::vector<TrajectoryFrame> PlanFrames(const Scene& scene, const HousedCamera& camera1,
+                                        const HousedCamera& camera2, std::mt19937_64* rng,
+                                        DatasetConfig* config) {
   if (!config->trajectory) return {};
-  const std::vector<Eigen::Vector3d>& check_points =
-      config->poses.visibility == "markers" ? scene.target.marker_points : scene.target.outline_points;
+  const std::vector<Eigen::Vector3d>& check_points = config->poses.visibility == "markers"
+                                                         ? scene.target.marker_points
+                                                         : scene.target.outline_points;
   std::vector<Rigid3d> key_poses;
   for (int k = 0; k < config->trajectory->num_pauses; ++k) {
     key_poses.push_back(SampleRigView(*config, scene, camera1, camera2, check_points, rng));
@@ -210,7 +224,8 @@ std::vector<TrajectoryFrame> PlanFrames(const Scene& scene, const HousedCamera& 
 void OpenVideo(const fs::path& path, const Camera& camera, double fps, cv::VideoWriter* video) {
   video->open(path.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
               cv::Size(static_cast<int>(camera.width), static_cast<int>(camera.height)), false);
-  if (!video->isOpened()) throw InputError(path.string() + ": OpenCV cannot write a Motion JPEG video here");
+  if (!video->isOpened())
+    throw InputError(path.string() + ": OpenCV cannot write a Motion JPEG video here");
 }
 
 // Renders a trajectory's frames (motion blur while the target moves), and
@@ -218,13 +233,14 @@ void OpenVideo(const fs::path& path, const Camera& camera, double fps, cv::Video
 // codec OpenCV writes without FFmpeg); trajectory.yaml says where the pauses
 // are.
 void RenderTrajectory(const DatasetConfig& config, const FrameRenderer& renderer,
-                      const std::vector<TrajectoryFrame>& frames, const fs::path& staging, std::mt19937_64* rng,
-                      GroundTruth* truth, ProgressSink& progress) {
+                      const std::vector<TrajectoryFrame>& frames, const fs::path& staging,
+                      std::mt19937_64* rng, GroundTruth* truth, ProgressSink& progress) {
   const TrajectoryOptions& options = *config.trajectory;
   cv::VideoWriter video, video2;
   if (options.video) {
     OpenVideo(staging / "trajectory.avi", config.camera, options.fps, &video);
-    if (config.stereo) OpenVideo(staging / "trajectory_cam2.avi", config.camera2, options.fps, &video2);
+    if (config.stereo)
+      OpenVideo(staging / "trajectory_cam2.avi", config.camera2, options.fps, &video2);
   }
   for (size_t f = 0; f < frames.size(); ++f) {
     CancelFlag::ThrowIfRequested();
@@ -232,8 +248,8 @@ void RenderTrajectory(const DatasetConfig& config, const FrameRenderer& renderer
     render.velocity_m_s = frames[f].velocity_m_s;
     render.angular_velocity_rad_s = frames[f].angular_velocity_rad_s;
     render.exposure_s = frames[f].pause < 0 ? options.exposure_s : 0.0;
-    RenderedFrame rendered =
-        RenderAndWrite(renderer, staging, static_cast<int>(f), frames[f].cam_from_target, render, rng);
+    RenderedFrame rendered = RenderAndWrite(renderer, staging, static_cast<int>(f),
+                                            frames[f].cam_from_target, render, rng);
     truth->images.push_back(std::move(rendered.truth));
     if (video.isOpened()) video.write(rendered.image1);
     if (video2.isOpened()) video2.write(rendered.image2);
@@ -254,14 +270,17 @@ static SynthesizeSummary Run(const SynthesizeOptions& options, ProgressSink& pro
   DatasetConfig config = ReadDatasetConfig(options.config_path);
   if (options.seed >= 0) config.seed = static_cast<uint64_t>(options.seed);
   config.render.num_threads = options.num_threads;
-  const HousedCamera camera1{config.camera, config.housing}, camera2{config.camera2, config.housing2};
+  const HousedCamera camera1{config.camera, config.housing},
+      camera2{config.camera2, config.housing2};
   std::mt19937_64 rng(config.seed);
   GroundTruth truth;
   const Scene scene = BuildScene(config, camera1, &truth);
-  const std::vector<TrajectoryFrame> trajectory = PlanFrames(scene, camera1, camera2, &rng, &config);
+  const std::vector<TrajectoryFrame> trajectory =
+      PlanFrames(scene, camera1, camera2, &rng, &config);
   LOG(INFO) << "synthesize: " << config.name << ", " << config.num_images << " frames of "
-            << config.camera.width << "x" << config.camera.height << (config.stereo ? " (stereo)" : "")
-            << ", " << (config.survey ? "survey" : config.target.type);
+            << config.camera.width << "x" << config.camera.height
+            << (config.stereo ? " (stereo)" : "") << ", "
+            << (config.survey ? "survey" : config.target.type);
 
   const fs::path output(options.output_path);
   const fs::path staging = output / ".synthesize_staging";
@@ -280,27 +299,33 @@ static SynthesizeSummary Run(const SynthesizeOptions& options, ProgressSink& pro
   truth.target = target;
 
   const auto ray_start = Clock::now();
-  const RayMap rays1(config.camera, camera1.HousingOrNull(), config.render.spp, options.num_threads);
+  const RayMap rays1(config.camera, camera1.HousingOrNull(), config.render.spp,
+                     options.num_threads);
   std::optional<RayMap> rays2;
-  if (config.stereo) rays2.emplace(config.camera2, camera2.HousingOrNull(), config.render.spp, options.num_threads);
+  if (config.stereo)
+    rays2.emplace(config.camera2, camera2.HousingOrNull(), config.render.spp, options.num_threads);
   const double ray_seconds = Seconds(ray_start);
 
   progress.Begin("synthesize: frames", config.num_images);
   const auto render_start = Clock::now();
   const FrameRenderer renderer{config, scene, camera1, camera2, rays1, rays2, dir1, dir2};
   if (trajectory.empty()) {
-    const std::vector<Eigen::Vector3d>& check_points =
-        config.poses.visibility == "markers" ? scene.target.marker_points : scene.target.outline_points;
+    const std::vector<Eigen::Vector3d>& check_points = config.poses.visibility == "markers"
+                                                           ? scene.target.marker_points
+                                                           : scene.target.outline_points;
     for (int frame = 0; frame < config.num_images; ++frame) {
       CancelFlag::ThrowIfRequested();
       Rigid3d cam_from_target;
       try {
-        cam_from_target = config.survey ? scene.survey.cam_from_world[frame]
-                                        : SampleRigView(config, scene, camera1, camera2, check_points, &rng);
+        cam_from_target = config.survey
+                              ? scene.survey.cam_from_world[frame]
+                              : SampleRigView(config, scene, camera1, camera2, check_points, &rng);
       } catch (const NumericalError& e) {
-        throw NumericalError(options.config_path + ": " + e.what());  // the config asks what cannot be
+        throw NumericalError(options.config_path + ": " +
+                             e.what());  // the config asks what cannot be
       }
-      truth.images.push_back(RenderAndWrite(renderer, staging, frame, cam_from_target, config.render, &rng).truth);
+      truth.images.push_back(
+          RenderAndWrite(renderer, staging, frame, cam_from_target, config.render, &rng).truth);
       progress.Advance(1);
     }
   } else {
@@ -315,8 +340,7 @@ static SynthesizeSummary Run(const SynthesizeOptions& options, ProgressSink& pro
   summary.num_images = config.num_images;
   summary.seconds = Seconds(start);
   summary.ray_seconds = ray_seconds;
-  summary.render_seconds_per_image =
-      render_seconds / (config.num_images * (config.stereo ? 2 : 1));
+  summary.render_seconds_per_image = render_seconds / (config.num_images * (config.stereo ? 2 : 1));
   LOG(INFO) << "synthesize: " << summary.num_images << " frames in " << summary.seconds
             << " s (rays " << ray_seconds << " s once, " << summary.render_seconds_per_image
             << " s per image) -> " << output.string();

@@ -9,17 +9,17 @@
 namespace portcal {
 
 struct SynthesizeOptions {
-  std::string config_path;   // dataset YAML
-  std::string output_path;   // directory (created); images/ and ground_truth.yaml
-  int64_t seed = -1;         // overrides the config's seed when >= 0
-  int num_threads = 2;       // >= 1
-  void Check() const;        // throws OptionError naming the option
+  std::string config_path;  // dataset YAML
+  std::string output_path;  // directory (created); images/ and ground_truth.yaml
+  int64_t seed = -1;        // overrides the config's seed when >= 0
+  int num_threads = 2;      // >= 1
+  void Check() const;       // throws OptionError naming the option
 };
 
 struct SynthesizeSummary {
-  int num_images = 0;        // per camera
-  double seconds = 0;        // wall time, rays included
-  double ray_seconds = 0;    // computing the cameras' ray maps (once per set)
+  int num_images = 0;      // per camera
+  double seconds = 0;      // wall time, rays included
+  double ray_seconds = 0;  // computing the cameras' ray maps (once per set)
   double render_seconds_per_image = 0;
 };
 

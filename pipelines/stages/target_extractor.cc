@@ -2,10 +2,9 @@
 
 #include <map>
 #include <mutex>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <tuple>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
@@ -53,9 +52,10 @@ std::string OptionsText(const TargetExtractorOptions& o) {
   out << "image_path=" << o.image_path << "\nImageReader.camera_model=" << o.reader.camera_model
       << "\nImageReader.single_camera=" << o.reader.single_camera
       << "\nImageReader.single_camera_per_folder=" << o.reader.single_camera_per_folder
-      << "\nImageReader.camera_params=" << o.reader.camera_params << "\nTarget.type=" << o.target_type
-      << "\nTarget.cols=" << o.chessboard.cols << "\nTarget.rows=" << o.chessboard.rows
-      << "\nTarget.square_size=" << o.square_size_m << "\n";
+      << "\nImageReader.camera_params=" << o.reader.camera_params
+      << "\nTarget.type=" << o.target_type << "\nTarget.cols=" << o.chessboard.cols
+      << "\nTarget.rows=" << o.chessboard.rows << "\nTarget.square_size=" << o.square_size_m
+      << "\n";
   return out.str();
 }
 
@@ -74,9 +74,11 @@ class SharedSizes {
     const auto& [first_name, first_width, first_height] = it->second;
     if (inserted || (first_width == width && first_height == height)) return;
     throw InputError(name + ": " + std::to_string(width) + "x" + std::to_string(height) + ", but " +
-                     first_name + " is " + std::to_string(first_width) + "x" + std::to_string(first_height) +
-                     (reader_.single_camera ? " and --ImageReader.single_camera 1 gives them one camera"
-                                            : " and --ImageReader.single_camera_per_folder 1 gives them one camera"));
+                     first_name + " is " + std::to_string(first_width) + "x" +
+                     std::to_string(first_height) +
+                     (reader_.single_camera
+                          ? " and --ImageReader.single_camera 1 gives them one camera"
+                          : " and --ImageReader.single_camera_per_folder 1 gives them one camera"));
   }
 
  private:
@@ -87,16 +89,18 @@ class SharedSizes {
 
 // Reads and detects every image on options.num_threads threads; the first
 // error (or a cancel) stops them all and is rethrown.
-std::vector<ImageResult> DetectAll(const TargetExtractorOptions& options, const std::vector<std::string>& names,
-                                   ProgressSink& progress) {
+std::vector<ImageResult> DetectAll(const TargetExtractorOptions& options,
+                                   const std::vector<std::string>& names, ProgressSink& progress) {
   std::vector<ImageResult> results(names.size());
   SharedSizes sizes(options.reader);
   progress.Begin("target_extractor: images", names.size());
   ParallelFor(names.size(), options.num_threads, [&](size_t i) {
     ImageResult& result = results[i];
     result.name = names[i];
-    const cv::Mat gray = cv::imread((fs::path(options.image_path) / names[i]).string(), cv::IMREAD_GRAYSCALE);
-    result.skip_reason = gray.empty() ? "cannot read the image" : ImageSizeProblem(gray.cols, gray.rows);
+    const cv::Mat gray =
+        cv::imread((fs::path(options.image_path) / names[i]).string(), cv::IMREAD_GRAYSCALE);
+    result.skip_reason =
+        gray.empty() ? "cannot read the image" : ImageSizeProblem(gray.cols, gray.rows);
     if (result.skip_reason.empty()) {
       result.readable = true;
       result.width = gray.cols;
@@ -113,7 +117,7 @@ std::vector<ImageResult> DetectAll(const TargetExtractorOptions& options, const 
 }  // namespace
 
 TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
-                                       ProgressSink& progress) {
+                                          ProgressSink& progress) {
   options.Check();
   StageRun run("target_extractor", OptionsText(options));
   const std::vector<std::string> names = ListImages(options.image_path);
@@ -143,8 +147,10 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
                                          result.height, &shared_cameras);
     const TargetDetection& detection = result.detection;
     if (!detection.found) LOG(WARNING) << result.name << ": " << detection.reason;
-    if (!detection.found && first_reason.empty()) first_reason = result.name + ": " + detection.reason;
-    if (detection.found && !detection.note.empty()) LOG(INFO) << result.name << ": " << detection.note;
+    if (!detection.found && first_reason.empty())
+      first_reason = result.name + ": " + detection.reason;
+    if (detection.found && !detection.note.empty())
+      LOG(INFO) << result.name << ": " << detection.note;
     WriteTargetDetection(&database, image_id, detection, target);
     ++summary.num_images;
     summary.num_found += detection.found;
@@ -154,20 +160,22 @@ TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
     // Success on nothing would leave a database with no image and a stage
     // logged as done.
     throw InputError(options.image_path + ": none of the " + std::to_string(names.size()) +
-                     " image files could be read and used (unreadable, or under " + std::to_string(kMinImageSide) +
-                     " px a side)");
+                     " image files could be read and used (unreadable, or under " +
+                     std::to_string(kMinImageSide) + " px a side)");
   }
   if (summary.num_found == 0) {
     // Nothing done is not a success: the next stage would only say "run
     // target_extractor first". The transaction rolls back, a new database
     // file goes, an existing one is left as it was.
-    std::string cause = options.target_type == "chessboard"
-                            ? "--Target.cols and --Target.rows count inner corners, not squares (a board of 9 x 7 "
-                              "squares has 8 x 6)"
-                            : "--Target.dictionary and the marker and square sizes must be the board's";
-    throw InputError(options.image_path + ": the target (" + target + ") was found in none of the " +
-                     std::to_string(summary.num_images) + " images (" + first_reason + "); " + cause +
-                     "; --Target.type is " + options.target_type);
+    std::string cause =
+        options.target_type == "chessboard"
+            ? "--Target.cols and --Target.rows count inner corners, not squares (a board of 9 x 7 "
+              "squares has 8 x 6)"
+            : "--Target.dictionary and the marker and square sizes must be the board's";
+    throw InputError(options.image_path + ": the target (" + target +
+                     ") was found in none of the " + std::to_string(summary.num_images) +
+                     " images (" + first_reason + "); " + cause + "; --Target.type is " +
+                     options.target_type);
   }
   run.Finish(&database, {{"images", summary.num_images},
                          {"found", summary.num_found},

@@ -6,8 +6,8 @@
 #include <string>
 
 #include "colmap_ext/util/progress.h"
-#include "pipelines/images/image_reader.h"
 #include "pipelines/detection/target_detector.h"
+#include "pipelines/images/image_reader.h"
 
 namespace portcal {
 
@@ -35,6 +35,6 @@ TargetDetectorOptions DetectorOptions(const TargetExtractorOptions& options);
 // Throws InputError (bad options, no images), DatabaseError, Cancelled; the
 // database is then left as it was.
 TargetExtractorSummary RunTargetExtractor(const TargetExtractorOptions& options,
-                                       ProgressSink& progress);
+                                          ProgressSink& progress);
 
 }  // namespace portcal

@@ -16,7 +16,8 @@ constexpr double kMaxRenderPixels = 1e8;
 void CheckRenderArea(const Camera& camera, const std::string& key) {
   const double area = static_cast<double>(camera.width) * static_cast<double>(camera.height);
   if (area > kMaxRenderPixels) {
-    throw OptionError(key + ".width x height", std::to_string(camera.width) + " x " + std::to_string(camera.height),
+    throw OptionError(key + ".width x height",
+                      std::to_string(camera.width) + " x " + std::to_string(camera.height),
                       "at most 10^8 pixels (100 megapixels) per image");
   }
 }
@@ -65,7 +66,8 @@ class ConfigReader {
   }
 
   template <typename T>
-  void Optional(const YAML::Node& node, const std::string& prefix, const char* key, T* value) const {
+  void Optional(const YAML::Node& node, const std::string& prefix, const char* key,
+                T* value) const {
     if (!node || !node[key] || node[key].IsNull()) return;
     try {
       *value = node[key].as<T>();
@@ -115,7 +117,8 @@ class ConfigReader {
       rotation = Eigen::Quaterniond(values[0], values[1], values[2], values[3]).normalized();
     } else if (node["rotation_axis_angle_deg"]) {
       Optional(node, key + ".", "rotation_axis_angle_deg", &values);
-      if (values.size() != 4) Fail(key + ".rotation_axis_angle_deg", "expected axis x, y, z, angle");
+      if (values.size() != 4)
+        Fail(key + ".rotation_axis_angle_deg", "expected axis x, y, z, angle");
       rotation = Eigen::AngleAxisd(values[3] * M_PI / 180.0,
                                    Eigen::Vector3d(values[0], values[1], values[2]).normalized());
     }
@@ -229,7 +232,8 @@ DatasetConfig ReadDatasetConfigUnguarded(const std::filesystem::path& path) {
     const YAML::Node s = root["stereo"];
     config.stereo = true;
     config.cam2_from_cam1 = reader.ReadPose(s["cam2_from_cam1"], "stereo.cam2_from_cam1");
-    config.camera2 = s["camera2"] ? reader.ReadCamera(s["camera2"], "stereo.camera2") : config.camera;
+    config.camera2 =
+        s["camera2"] ? reader.ReadCamera(s["camera2"], "stereo.camera2") : config.camera;
     config.housing2 =
         s["housing2"] ? reader.ReadHousing(s["housing2"], "stereo.housing2") : config.housing;
   }
@@ -273,7 +277,8 @@ DatasetConfig ReadDatasetConfigUnguarded(const std::filesystem::path& path) {
     reader.Optional(p, "poses.", "border_margin_px", &config.poses.border_margin_px);
     reader.Optional(p, "poses.", "max_view_angle_deg", &config.poses.max_view_angle_deg);
     reader.Optional(p, "poses.", "visibility", &config.poses.visibility);
-    if (config.target.type == "target3d" && !(p && p["visibility"])) config.poses.visibility = "markers";
+    if (config.target.type == "target3d" && !(p && p["visibility"]))
+      config.poses.visibility = "markers";
     if (root["trajectory"] && !root["trajectory"].IsNull()) {
       const YAML::Node t = root["trajectory"];
       TrajectoryOptions& trajectory = config.trajectory.emplace();

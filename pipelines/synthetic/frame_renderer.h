@@ -3,11 +3,10 @@
 // image and, with a rig, camera 2's, with each camera's ground truth.
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <optional>
 #include <random>
 #include <string>
-
-#include <opencv2/core.hpp>
 
 #include "colmap_ext/camera/housed_camera.h"
 #include "colmap_ext/io/ground_truth.h"

@@ -12,8 +12,10 @@ namespace portcal {
 
 void ImageFormationOptions::Check() const {
   if (spp < 1 || spp > 16) throw OptionError("render.spp", std::to_string(spp), "[1, 16]");
-  if (!(blur_sigma_px >= 0)) throw OptionError("render.blur_sigma", std::to_string(blur_sigma_px), ">= 0");
-  if (!(noise_sigma >= 0)) throw OptionError("render.noise_sigma", std::to_string(noise_sigma), ">= 0");
+  if (!(blur_sigma_px >= 0))
+    throw OptionError("render.blur_sigma", std::to_string(blur_sigma_px), ">= 0");
+  if (!(noise_sigma >= 0))
+    throw OptionError("render.noise_sigma", std::to_string(noise_sigma), ">= 0");
   if (!(attenuation_per_m >= 0)) {
     throw OptionError("water.attenuation", std::to_string(attenuation_per_m), ">= 0 (1/m)");
   }
@@ -21,12 +23,14 @@ void ImageFormationOptions::Check() const {
     throw OptionError("water.forward_scatter", std::to_string(forward_scatter_per_m), ">= 0 (1/m)");
   }
   if (!(forward_scatter_sigma_px > 0)) {
-    throw OptionError("water.forward_scatter_sigma_px", std::to_string(forward_scatter_sigma_px), "> 0");
+    throw OptionError("water.forward_scatter_sigma_px", std::to_string(forward_scatter_sigma_px),
+                      "> 0");
   }
   if (!(vignetting >= 0 && vignetting <= 1)) {
     throw OptionError("vignetting", std::to_string(vignetting), "[0, 1]");
   }
-  if (!(exposure_s >= 0)) throw OptionError("motion_blur.exposure", std::to_string(exposure_s), ">= 0 (s)");
+  if (!(exposure_s >= 0))
+    throw OptionError("motion_blur.exposure", std::to_string(exposure_s), ">= 0 (s)");
   if (motion_samples < 1 || motion_samples > 64) {
     throw OptionError("motion_blur.samples", std::to_string(motion_samples), "[1, 64]");
   }
@@ -85,8 +89,8 @@ std::vector<std::vector<PreparedObject>> PrepareSubframes(const std::vector<Plac
     const double tau = n == 1 ? 0.0 : options.exposure_s * ((i + 0.5) / n - 0.5);
     const Eigen::Vector3d w = options.angular_velocity_rad_s * tau;
     const Rigid3d moved_from_cam(
-        Eigen::Quaterniond(Eigen::AngleAxisd(w.norm(), w.norm() > 0 ? w.normalized()
-                                                                    : Eigen::Vector3d::UnitZ())),
+        Eigen::Quaterniond(
+            Eigen::AngleAxisd(w.norm(), w.norm() > 0 ? w.normalized() : Eigen::Vector3d::UnitZ())),
         options.velocity_m_s * tau);
     const Rigid3d cam_from_moved = moved_from_cam.Inverse();
     for (const PlacedObject& placed : objects) {
@@ -108,7 +112,8 @@ struct ShadedPixel {
 
 // t_near holds, per subframe and object, where the last ray that hit it
 // did (0: none yet); the next sample, beside it, starts its search there.
-ShadedPixel ShadePixel(const RayMap& rays, const std::vector<std::vector<PreparedObject>>& subframes,
+ShadedPixel ShadePixel(const RayMap& rays,
+                       const std::vector<std::vector<PreparedObject>>& subframes,
                        const ImageFormationOptions& options, double background, int col, int row,
                        std::vector<double>* t_near) {
   const int spp2 = options.spp * options.spp;
@@ -128,8 +133,8 @@ ShadedPixel ShadePixel(const RayMap& rays, const std::vector<std::vector<Prepare
       for (const PreparedObject& p : prepared) {
         Hit hit;
         double& near = (*t_near)[near_index++];
-        if (p.object->IntersectNear(p.rotation * origin + p.translation, p.rotation * dir, t_max, near,
-                                    &hit)) {
+        if (p.object->IntersectNear(p.rotation * origin + p.translation, p.rotation * dir, t_max,
+                                    near, &hit)) {
           near = hit.t;
           best = hit;
           t_max = hit.t;

@@ -15,14 +15,14 @@
 namespace portcal {
 
 struct ImageFormationOptions {
-  int spp = 4;  // samples per pixel side: spp^2 per pixel at stratum centres, [1, 16]
+  int spp = 4;               // samples per pixel side: spp^2 per pixel at stratum centres, [1, 16]
   double blur_sigma_px = 0;  // Gaussian optical blur, px, >= 0
   double noise_sigma = 1.0;  // Gaussian noise, gray levels, >= 0
   PrintLevels levels;
   // Water (apply along the ray's path from the port's outer surface, or the
   // camera centre without a housing):
-  double attenuation_per_m = 0;   // c in exp(-c L), >= 0
-  double backscatter_gray = 0;    // veil level B of L -> infinity (Jaffe-McGlamery)
+  double attenuation_per_m = 0;      // c in exp(-c L), >= 0
+  double backscatter_gray = 0;       // veil level B of L -> infinity (Jaffe-McGlamery)
   double forward_scatter_per_m = 0;  // blends a blurred image in by 1 - exp(-b L), >= 0
   double forward_scatter_sigma_px = 2.0;
   double vignetting = 0;  // strength in [0, 1]: gray *= 1 - v + v cos^4(angle off axis)

@@ -13,8 +13,8 @@ FacesObject::FacesObject(std::vector<Face> faces, float back_gray) : back_gray_(
   }
 }
 
-bool FacesObject::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
-                            double t_max, Hit* hit) const {
+bool FacesObject::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
+                            Hit* hit) const {
   bool found = false;
   for (const Prepared& p : faces_) {
     const Eigen::Vector3d o = p.face_from_object_rotation * origin + p.face_from_object_translation;
@@ -47,8 +47,8 @@ SeabedObject::SeabedObject(std::shared_ptr<const FaceTexture> texture, double ro
   const double amplitude = roughness_m * std::sqrt(2.0 / n);
   for (int i = 0; i < n; ++i) {
     const double a = angle(rng), lambda = wavelength_m * scale(rng);
-    waves_.push_back({Eigen::Vector2d(std::cos(a), std::sin(a)) * (2 * M_PI / lambda),
-                      amplitude, angle(rng)});
+    waves_.push_back(
+        {Eigen::Vector2d(std::cos(a), std::sin(a)) * (2 * M_PI / lambda), amplitude, angle(rng)});
   }
 }
 
@@ -68,8 +68,8 @@ bool SeabedObject::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3
   return IntersectNear(origin, dir, t_max, 0.0, hit);  // from the mean plane
 }
 
-bool SeabedObject::IntersectNear(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
-                                 double t_near, Hit* hit) const {
+bool SeabedObject::IntersectNear(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
+                                 double t_max, double t_near, Hit* hit) const {
   if (!(dir.z() < -1e-6)) return false;  // looking down only
   // Newton on f(t) = z(t) - height(x(t), y(t)) from t_near, or from the
   // mean plane when there is none; the relief is gentle (slopes << 1), so a
@@ -106,8 +106,8 @@ bool IntersectScene(const std::vector<PlacedObject>& objects, const Eigen::Vecto
   for (const PlacedObject& placed : objects) {
     const Rigid3d object_from_cam = placed.cam_from_object.Inverse();
     Hit candidate;
-    if (placed.object->Intersect(object_from_cam * origin, object_from_cam.rotation * dir,
-                                 t_max, &candidate)) {
+    if (placed.object->Intersect(object_from_cam * origin, object_from_cam.rotation * dir, t_max,
+                                 &candidate)) {
       *hit = candidate;
       t_max = candidate.t;
       found = true;

@@ -12,7 +12,7 @@
 namespace portcal {
 
 struct Hit {
-  double t = 0;      // distance along the (unit) ray, metres
+  double t = 0;  // distance along the (unit) ray, metres
   float gray = 0;
 };
 
@@ -20,12 +20,12 @@ class SceneObject {
  public:
   virtual ~SceneObject() = default;
   // Nearest hit with 0 < t < t_max of origin + t dir (object frame, dir unit).
-  virtual bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
-                         double t_max, Hit* hit) const = 0;
+  virtual bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
+                         Hit* hit) const = 0;
   // The same for a ray beside one that hit this object at t_near (the
   // renderer's neighbouring sample): objects found by iteration start there.
-  virtual bool IntersectNear(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
-                             double /*t_near*/, Hit* hit) const {
+  virtual bool IntersectNear(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
+                             double t_max, double /*t_near*/, Hit* hit) const {
     return Intersect(origin, dir, t_max, hit);
   }
 };
@@ -59,12 +59,12 @@ class FacesObject : public SceneObject {
 // direction and phase (gently rough), textured by a raster in (x, y).
 class SeabedObject : public SceneObject {
  public:
-  SeabedObject(std::shared_ptr<const FaceTexture> texture, double roughness_m,
-               double wavelength_m, uint64_t seed);
+  SeabedObject(std::shared_ptr<const FaceTexture> texture, double roughness_m, double wavelength_m,
+               uint64_t seed);
   bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
                  Hit* hit) const override;
-  bool IntersectNear(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max, double t_near,
-                     Hit* hit) const override;
+  bool IntersectNear(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
+                     double t_near, Hit* hit) const override;
   double Height(double x, double y, Eigen::Vector2d* gradient = nullptr) const;
 
  private:

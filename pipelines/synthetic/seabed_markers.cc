@@ -12,12 +12,15 @@ void SeabedMarkerOptions::Check() const {
   if (count < 0) throw OptionError("survey.markers.count", std::to_string(count), ">= 0");
   if (!(side_m > 0)) throw OptionError("survey.markers.side", std::to_string(side_m), "> 0 m");
   if (!(spacing_m > 1.5 * side_m)) {
-    throw OptionError("survey.markers.spacing", std::to_string(spacing_m), "> 1.5 x the side (the plates)");
+    throw OptionError("survey.markers.spacing", std::to_string(spacing_m),
+                      "> 1.5 x the side (the plates)");
   }
-  const cv::Ptr<cv::aruco::Dictionary> aruco = ArucoDictionaryByName(dictionary);  // throws for unknown names
+  const cv::Ptr<cv::aruco::Dictionary> aruco =
+      ArucoDictionaryByName(dictionary);  // throws for unknown names
   if (count > aruco->bytesList.rows) {
-    throw OptionError("survey.markers.count", std::to_string(count),
-                      "<= " + std::to_string(aruco->bytesList.rows) + " (the ids of " + dictionary + ")");
+    throw OptionError(
+        "survey.markers.count", std::to_string(count),
+        "<= " + std::to_string(aruco->bytesList.rows) + " (the ids of " + dictionary + ")");
   }
 }
 
@@ -40,7 +43,8 @@ Rigid3d PlateFrame(const SeabedObject& seabed, double x, double y, double half_e
   double lift = 0;
   for (int i = -2; i <= 2; ++i) {
     for (int j = -2; j <= 2; ++j) {
-      const Eigen::Vector3d offset = rotation * Eigen::Vector3d(0.5 * i * half_extent, 0.5 * j * half_extent, 0);
+      const Eigen::Vector3d offset =
+          rotation * Eigen::Vector3d(0.5 * i * half_extent, 0.5 * j * half_extent, 0);
       const Eigen::Vector3d p = Eigen::Vector3d(x, y, z) + offset;
       lift = std::max(lift, (seabed.Height(p.x(), p.y()) - p.z()) / up.z());
     }
@@ -71,7 +75,8 @@ SeabedMarkers PlaceSeabedMarkers(const SeabedMarkerOptions& options, const Seabe
     print.corners = corners;
     print.modules = ArucoMarkerModules(*dictionary, id, &print.modules_per_side);
     const Eigen::Vector4d extent(-half_extent, half_extent, -half_extent, half_extent);
-    auto texture = std::make_shared<MarkerBoardTexture>(std::vector<PlacedMarker>{print}, extent, levels);
+    auto texture =
+        std::make_shared<MarkerBoardTexture>(std::vector<PlacedMarker>{print}, extent, levels);
     const Rigid3d world_from_face = PlateFrame(seabed, x, y, half_extent);
     faces.push_back({texture, world_from_face, -1.0});
     SeabedMarker marker;

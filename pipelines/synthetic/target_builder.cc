@@ -20,12 +20,14 @@ void TargetOptions::Check() const {
   if (type == "charuco" && (squares_x < 3 || squares_y < 3)) {
     throw OptionError("target.squares_x/squares_y", std::to_string(squares_x), ">= 3 each");
   }
-  if (!(square_size_m > 0)) throw OptionError("target.square_size", std::to_string(square_size_m), "> 0 m");
+  if (!(square_size_m > 0))
+    throw OptionError("target.square_size", std::to_string(square_size_m), "> 0 m");
   if (!(margin_m >= 0)) throw OptionError("target.margin", std::to_string(margin_m), ">= 0 m");
   if (type == "aruco_grid" && (markers_x < 1 || markers_y < 1)) {
     throw OptionError("target.markers_x/markers_y", std::to_string(markers_x), ">= 1 each");
   }
-  if (!(marker_size_m > 0)) throw OptionError("target.marker_size", std::to_string(marker_size_m), "> 0 m");
+  if (!(marker_size_m > 0))
+    throw OptionError("target.marker_size", std::to_string(marker_size_m), "> 0 m");
   if (type == "charuco" && !(marker_size_m < square_size_m)) {
     throw OptionError("target.marker_size", std::to_string(marker_size_m), "< square_size");
   }
@@ -33,7 +35,8 @@ void TargetOptions::Check() const {
     throw OptionError("target.marker_separation", std::to_string(marker_separation_m), ">= 0 m");
   }
   if (type == "target3d") {
-    if (num_faces < 2 || num_faces > 3) throw OptionError("target.num_faces", std::to_string(num_faces), "2 or 3");
+    if (num_faces < 2 || num_faces > 3)
+      throw OptionError("target.num_faces", std::to_string(num_faces), "2 or 3");
     if (!(fold_angle_deg >= 60 && fold_angle_deg <= 180)) {
       throw OptionError("target.fold_angle_deg", std::to_string(fold_angle_deg), "[60, 180]");
     }
@@ -41,10 +44,12 @@ void TargetOptions::Check() const {
       throw OptionError("target.face_width/face_height", std::to_string(face_width_m), "> 0 m");
     }
     if (!marker_ids.empty() && static_cast<int>(marker_ids.size()) != num_faces) {
-      throw OptionError("target.marker_ids", std::to_string(marker_ids.size()) + " ids", "one per face");
+      throw OptionError("target.marker_ids", std::to_string(marker_ids.size()) + " ids",
+                        "one per face");
     }
     if (!(dots.r_min_m > 0 && dots.r_max_m >= dots.r_min_m)) {
-      throw OptionError("target.dots.r_min/r_max", std::to_string(dots.r_min_m), "0 < r_min <= r_max");
+      throw OptionError("target.dots.r_min/r_max", std::to_string(dots.r_min_m),
+                        "0 < r_min <= r_max");
     }
     if (!(dots.coverage > 0 && dots.coverage <= 0.8)) {
       throw OptionError("target.dots.coverage", std::to_string(dots.coverage), "(0, 0.8]");
@@ -67,16 +72,19 @@ PlacedMarker MakeMarker(const cv::aruco::Dictionary& dictionary, int id,
 Eigen::Vector3d Lift(const Eigen::Vector2d& p) { return {p.x(), p.y(), 0.0}; }
 
 void AddOutline(const Eigen::Vector4d& extent, BuiltTarget* target) {
-  for (const Eigen::Vector2d& p : {Eigen::Vector2d(extent[0], extent[2]), Eigen::Vector2d(extent[1], extent[2]),
-                                   Eigen::Vector2d(extent[1], extent[3]), Eigen::Vector2d(extent[0], extent[3])}) {
+  for (const Eigen::Vector2d& p :
+       {Eigen::Vector2d(extent[0], extent[2]), Eigen::Vector2d(extent[1], extent[2]),
+        Eigen::Vector2d(extent[1], extent[3]), Eigen::Vector2d(extent[0], extent[3])}) {
     target->outline_points.push_back(Lift(p));
   }
-  target->center = Lift(Eigen::Vector2d(0.5 * (extent[0] + extent[1]), 0.5 * (extent[2] + extent[3])));
+  target->center =
+      Lift(Eigen::Vector2d(0.5 * (extent[0] + extent[1]), 0.5 * (extent[2] + extent[3])));
 }
 
 BuiltTarget BuildChessboard(const TargetOptions& o, const PrintLevels& levels) {
   BuiltTarget target;
-  auto texture = std::make_shared<ChessboardTexture>(o.cols, o.rows, o.square_size_m, o.margin_m, levels);
+  auto texture =
+      std::make_shared<ChessboardTexture>(o.cols, o.rows, o.square_size_m, o.margin_m, levels);
   TargetDescription& d = target.description;
   d.type = "chessboard";
   d.inner_corners_cols = o.cols;
@@ -84,12 +92,13 @@ BuiltTarget BuildChessboard(const TargetOptions& o, const PrintLevels& levels) {
   d.square_size = o.square_size_m;
   d.margin = o.margin_m;
   for (int r = 0; r < o.rows; ++r) {
-    for (int c = 0; c < o.cols; ++c) d.corners_3d.emplace_back(c * o.square_size_m, r * o.square_size_m, 0);
+    for (int c = 0; c < o.cols; ++c)
+      d.corners_3d.emplace_back(c * o.square_size_m, r * o.square_size_m, 0);
   }
   AddOutline(texture->Extent(), &target);
   target.marker_points = target.outline_points;
-  target.object = std::make_unique<FacesObject>(
-      std::vector<Face>{{texture, Rigid3d(), -1.0}}, static_cast<float>(levels.back));
+  target.object = std::make_unique<FacesObject>(std::vector<Face>{{texture, Rigid3d(), -1.0}},
+                                                static_cast<float>(levels.back));
   return target;
 }
 
@@ -133,8 +142,8 @@ BuiltTarget BuildMarkerBoard(const TargetOptions& o, const PrintLevels& levels,
   auto texture = std::make_shared<MarkerBoardTexture>(std::move(markers), extent, levels);
   if (charuco) texture->SetSquares(o.squares_x, o.squares_y, o.square_size_m);
   AddOutline(extent, &target);
-  target.object = std::make_unique<FacesObject>(
-      std::vector<Face>{{texture, Rigid3d(), front_z}}, static_cast<float>(levels.back));
+  target.object = std::make_unique<FacesObject>(std::vector<Face>{{texture, Rigid3d(), front_z}},
+                                                static_cast<float>(levels.back));
   return target;
 }
 
@@ -162,7 +171,8 @@ std::vector<Dot> RandomDots(const TargetOptions& o, int face, const Eigen::Vecto
     bool overlaps = false;
     for (const Dot& other : dots) {
       const double gap = dot.radius + other.radius + 0.5 * p.r_min_m;
-      if ((dot.x - other.x) * (dot.x - other.x) + (dot.y - other.y) * (dot.y - other.y) < gap * gap) {
+      if ((dot.x - other.x) * (dot.x - other.x) + (dot.y - other.y) * (dot.y - other.y) <
+          gap * gap) {
         overlaps = true;
         break;
       }
@@ -200,11 +210,13 @@ BuiltTarget BuildTarget3d(const TargetOptions& o, const PrintLevels& levels,
     target_from_face.emplace_back(about_y(-a), Eigen::Vector3d(0.5 * w * std::cos(a), 0, 0));
   } else {
     // A tent: a middle face square to the viewer, two wings folded back.
-    target_from_face.emplace_back(about_y(tilt), Eigen::Vector3d(-0.5 * w - 0.5 * w * std::cos(tilt), 0,
-                                                                 0.5 * w * std::sin(tilt)));
+    target_from_face.emplace_back(
+        about_y(tilt),
+        Eigen::Vector3d(-0.5 * w - 0.5 * w * std::cos(tilt), 0, 0.5 * w * std::sin(tilt)));
     target_from_face.emplace_back(Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
-    target_from_face.emplace_back(about_y(-tilt), Eigen::Vector3d(0.5 * w + 0.5 * w * std::cos(tilt), 0,
-                                                                  0.5 * w * std::sin(tilt)));
+    target_from_face.emplace_back(
+        about_y(-tilt),
+        Eigen::Vector3d(0.5 * w + 0.5 * w * std::cos(tilt), 0, 0.5 * w * std::sin(tilt)));
   }
   const Eigen::Vector4d extent(-0.5 * w, 0.5 * w, -0.5 * h, 0.5 * h);
   std::vector<Face> faces;
@@ -212,8 +224,9 @@ BuiltTarget BuildTarget3d(const TargetOptions& o, const PrintLevels& levels,
   for (int f = 0; f < o.num_faces; ++f) {
     const int id = o.marker_ids.empty() ? f : o.marker_ids[f];
     const double s = o.target3d_marker_size_m;
-    std::array<Eigen::Vector2d, 4> corners = {Eigen::Vector2d(-s / 2, -s / 2), Eigen::Vector2d(s / 2, -s / 2),
-                                              Eigen::Vector2d(s / 2, s / 2), Eigen::Vector2d(-s / 2, s / 2)};
+    std::array<Eigen::Vector2d, 4> corners = {
+        Eigen::Vector2d(-s / 2, -s / 2), Eigen::Vector2d(s / 2, -s / 2),
+        Eigen::Vector2d(s / 2, s / 2), Eigen::Vector2d(-s / 2, s / 2)};
     PlacedMarker marker = MakeMarker(dictionary, id, corners);
     const double module = s / marker.modules_per_side;
     const double quiet = o.quiet_zone_modules * module;
@@ -237,14 +250,16 @@ BuiltTarget BuildTarget3d(const TargetOptions& o, const PrintLevels& levels,
       target.marker_points.push_back(target_marker.corners[k]);
     }
     d.markers.push_back(target_marker);
-    for (const Eigen::Vector2d& p : {Eigen::Vector2d(extent[0], extent[2]), Eigen::Vector2d(extent[1], extent[2]),
-                                     Eigen::Vector2d(extent[1], extent[3]), Eigen::Vector2d(extent[0], extent[3])}) {
+    for (const Eigen::Vector2d& p :
+         {Eigen::Vector2d(extent[0], extent[2]), Eigen::Vector2d(extent[1], extent[2]),
+          Eigen::Vector2d(extent[1], extent[3]), Eigen::Vector2d(extent[0], extent[3])}) {
       target.outline_points.push_back(target_from_face[f] * Lift(p));
       centroid += target.outline_points.back();
     }
     target.dots.push_back(dots);
-    faces.push_back({std::make_shared<DotsFaceTexture>(std::move(dots), marker, quiet, extent, levels),
-                     target_from_face[f], -1.0});
+    faces.push_back(
+        {std::make_shared<DotsFaceTexture>(std::move(dots), marker, quiet, extent, levels),
+         target_from_face[f], -1.0});
   }
   target.center = centroid / static_cast<double>(target.outline_points.size());
   target.object = std::make_unique<FacesObject>(std::move(faces), static_cast<float>(levels.back));

@@ -16,7 +16,7 @@ struct DotsOptions {
   uint64_t seed = 11;
   double r_min_m = 0.0015;
   double r_max_m = 0.009;
-  double coverage = 0.5;    // fraction of the free face area covered, (0, 0.8]
+  double coverage = 0.5;  // fraction of the free face area covered, (0, 0.8]
   double gray_min = 20;
   double gray_max = 110;
   double edge_margin_m = 0.004;
@@ -56,7 +56,7 @@ struct BuiltTarget {
   std::vector<Eigen::Vector3d> marker_points;
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
   Eigen::Vector3d front_normal = -Eigen::Vector3d::UnitZ();  // towards the viewer
-  std::vector<std::vector<Dot>> dots;  // target3d: per face
+  std::vector<std::vector<Dot>> dots;                        // target3d: per face
 };
 
 BuiltTarget BuildTarget(const TargetOptions& options, const PrintLevels& levels);

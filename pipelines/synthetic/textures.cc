@@ -8,8 +8,8 @@
 
 namespace portcal {
 
-ChessboardTexture::ChessboardTexture(int inner_cols, int inner_rows, double square,
-                                     double margin, const PrintLevels& levels)
+ChessboardTexture::ChessboardTexture(int inner_cols, int inner_rows, double square, double margin,
+                                     const PrintLevels& levels)
     : cols_(inner_cols),
       rows_(inner_rows),
       square_(square),
@@ -76,8 +76,7 @@ const std::vector<int>* Cell(const std::vector<std::vector<int>>& grid, int cols
 }  // namespace
 
 MarkerBoardTexture::MarkerBoardTexture(std::vector<PlacedMarker> markers,
-                                       const Eigen::Vector4d& extent,
-                                       const PrintLevels& levels)
+                                       const Eigen::Vector4d& extent, const PrintLevels& levels)
     : markers_(std::move(markers)),
       extent_(extent),
       white_(static_cast<float>(levels.white)),
@@ -98,15 +97,16 @@ void MarkerBoardTexture::SetSquares(int squares_x, int squares_y, double square)
   square_ = square;
   square_has_marker_.assign(static_cast<size_t>(squares_x) * squares_y, 0);
   for (const PlacedMarker& m : markers_) {
-    const Eigen::Vector2d center = 0.25 * (m.corners[0] + m.corners[1] + m.corners[2] + m.corners[3]);
+    const Eigen::Vector2d center =
+        0.25 * (m.corners[0] + m.corners[1] + m.corners[2] + m.corners[3]);
     const int i = static_cast<int>(std::floor(center.x() / square));
     const int j = static_cast<int>(std::floor(center.y() / square));
-    if (i >= 0 && j >= 0 && i < squares_x && j < squares_y) square_has_marker_[j * squares_x + i] = 1;
+    if (i >= 0 && j >= 0 && i < squares_x && j < squares_y)
+      square_has_marker_[j * squares_x + i] = 1;
   }
 }
 
-bool MarkerBoardTexture::MarkerGray(const PlacedMarker& m, double x, double y,
-                                    float* gray) const {
+bool MarkerBoardTexture::MarkerGray(const PlacedMarker& m, double x, double y, float* gray) const {
   const Eigen::Vector2d p(x, y);
   const Eigen::Vector2d u_axis = m.corners[1] - m.corners[0];
   const Eigen::Vector2d v_axis = m.corners[3] - m.corners[0];
@@ -194,8 +194,8 @@ bool RasterTexture::Gray(double x, double y, float* gray) const {
   return true;
 }
 
-cv::Mat RandomShapesRaster(int cols, int rows, int num_shapes, uint64_t seed,
-                           int min_size_px, int max_size_px) {
+cv::Mat RandomShapesRaster(int cols, int rows, int num_shapes, uint64_t seed, int min_size_px,
+                           int max_size_px) {
   std::mt19937_64 rng(seed);
   std::uniform_int_distribution<int> gray(15, 240), x(0, cols - 1), y(0, rows - 1),
       size(min_size_px, max_size_px), kind(0, 2);

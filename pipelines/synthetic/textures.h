@@ -49,8 +49,8 @@ class ChessboardTexture : public FaceTexture {
 struct PlacedMarker {
   int id = 0;
   std::array<Eigen::Vector2d, 4> corners;
-  int modules_per_side = 0;        // including the black border
-  std::vector<uint8_t> modules;    // row-major, 1 = white
+  int modules_per_side = 0;      // including the black border
+  std::vector<uint8_t> modules;  // row-major, 1 = white
 };
 
 // White print with ArUco markers and, optionally, chessboard squares
@@ -121,7 +121,7 @@ class RasterTexture : public FaceTexture {
 
 // Random shapes (discs, rectangles, stripes) of random gray: textured
 // clutter and seabeds that give many SIFT features.
-cv::Mat RandomShapesRaster(int cols, int rows, int num_shapes, uint64_t seed,
-                           int min_size_px, int max_size_px);
+cv::Mat RandomShapesRaster(int cols, int rows, int num_shapes, uint64_t seed, int min_size_px,
+                           int max_size_px);
 
 }  // namespace portcal

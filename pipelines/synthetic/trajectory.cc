@@ -11,9 +11,12 @@ namespace portcal {
 void TrajectoryOptions::Check() const {
   if (!(fps > 0)) throw OptionError("trajectory.fps", std::to_string(fps), "> 0");
   if (num_pauses < 1) throw OptionError("trajectory.pauses", std::to_string(num_pauses), ">= 1");
-  if (!(pause_seconds > 0)) throw OptionError("trajectory.pause_seconds", std::to_string(pause_seconds), "> 0 s");
-  if (!(move_seconds > 0)) throw OptionError("trajectory.move_seconds", std::to_string(move_seconds), "> 0 s");
-  if (!(exposure_s >= 0)) throw OptionError("trajectory.exposure", std::to_string(exposure_s), ">= 0 s");
+  if (!(pause_seconds > 0))
+    throw OptionError("trajectory.pause_seconds", std::to_string(pause_seconds), "> 0 s");
+  if (!(move_seconds > 0))
+    throw OptionError("trajectory.move_seconds", std::to_string(move_seconds), "> 0 s");
+  if (!(exposure_s >= 0))
+    throw OptionError("trajectory.exposure", std::to_string(exposure_s), ">= 0 s");
 }
 
 namespace {
@@ -38,11 +41,14 @@ void Motion(const Rigid3d& now, const Rigid3d& later, double h, TrajectoryFrame*
 
 }  // namespace
 
-std::vector<TrajectoryFrame> PlanTrajectory(const std::vector<Rigid3d>& key_poses, const TrajectoryOptions& options) {
+std::vector<TrajectoryFrame> PlanTrajectory(const std::vector<Rigid3d>& key_poses,
+                                            const TrajectoryOptions& options) {
   options.Check();
   std::vector<TrajectoryFrame> frames;
-  const int pause_frames = std::max(1, static_cast<int>(std::lround(options.pause_seconds * options.fps)));
-  const int move_frames = std::max(1, static_cast<int>(std::lround(options.move_seconds * options.fps)));
+  const int pause_frames =
+      std::max(1, static_cast<int>(std::lround(options.pause_seconds * options.fps)));
+  const int move_frames =
+      std::max(1, static_cast<int>(std::lround(options.move_seconds * options.fps)));
   for (size_t k = 0; k < key_poses.size(); ++k) {
     for (int f = 0; f < pause_frames; ++f) {
       TrajectoryFrame frame;
@@ -64,20 +70,23 @@ std::vector<TrajectoryFrame> PlanTrajectory(const std::vector<Rigid3d>& key_pose
   return frames;
 }
 
-std::string TrajectoryYaml(const std::vector<TrajectoryFrame>& frames, const TrajectoryOptions& options) {
+std::string TrajectoryYaml(const std::vector<TrajectoryFrame>& frames,
+                           const TrajectoryOptions& options) {
   std::ostringstream out;
   out.precision(17);
-  out << "# A hand-held target: held still in the pauses, moving between them.\nfps: " << options.fps
-      << "\nexposure_s: " << options.exposure_s << "\nnum_frames: " << frames.size() << "\npauses:\n";
+  out << "# A hand-held target: held still in the pauses, moving between them.\nfps: "
+      << options.fps << "\nexposure_s: " << options.exposure_s << "\nnum_frames: " << frames.size()
+      << "\npauses:\n";
   for (size_t f = 0; f < frames.size(); ++f) {
     if (frames[f].pause < 0 || (f > 0 && frames[f - 1].pause == frames[f].pause)) continue;
     size_t last = f;
     while (last + 1 < frames.size() && frames[last + 1].pause == frames[f].pause) ++last;
     const Rigid3d& pose = frames[f].cam_from_target;
-    out << "  - {first_frame: " << f << ", last_frame: " << last << ", cam_from_target: {rotation_wxyz: ["
-        << pose.rotation.w() << ", " << pose.rotation.x() << ", " << pose.rotation.y() << ", " << pose.rotation.z()
-        << "], translation: [" << pose.translation.x() << ", " << pose.translation.y() << ", "
-        << pose.translation.z() << "]}}\n";
+    out << "  - {first_frame: " << f << ", last_frame: " << last
+        << ", cam_from_target: {rotation_wxyz: [" << pose.rotation.w() << ", " << pose.rotation.x()
+        << ", " << pose.rotation.y() << ", " << pose.rotation.z() << "], translation: ["
+        << pose.translation.x() << ", " << pose.translation.y() << ", " << pose.translation.z()
+        << "]}}\n";
   }
   return out.str();
 }

@@ -11,14 +11,15 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 
 bool InsideImage(const Camera& camera, const Eigen::Vector2d& pixel, double margin) {
-  return pixel.x() >= margin && pixel.y() >= margin &&
-         pixel.x() <= camera.width - margin && pixel.y() <= camera.height - margin;
+  return pixel.x() >= margin && pixel.y() >= margin && pixel.x() <= camera.width - margin &&
+         pixel.y() <= camera.height - margin;
 }
 
 }  // namespace
 
 void ViewSamplingOptions::Check() const {
-  if (!(distance_min_m > 0)) throw OptionError("poses.distance[0]", std::to_string(distance_min_m), "> 0 m");
+  if (!(distance_min_m > 0))
+    throw OptionError("poses.distance[0]", std::to_string(distance_min_m), "> 0 m");
   if (!(distance_max_m >= distance_min_m)) {
     throw OptionError("poses.distance[1]", std::to_string(distance_max_m), ">= distance[0]");
   }
@@ -64,8 +65,8 @@ Rigid3d SampleTargetView(const Camera& camera, const Housing* housing,
                                 margin + row_fraction * (camera.height - 2 * margin));
     const std::optional<Ray3d> ray = UnprojectPixel(camera, housing, pixel);
     if (!ray) continue;
-    const double distance = options.distance_min_m +
-                            unit(*rng) * (options.distance_max_m - options.distance_min_m);
+    const double distance =
+        options.distance_min_m + unit(*rng) * (options.distance_max_m - options.distance_min_m);
     const Eigen::Vector3d center_in_cam = ray->origin + distance * ray->direction;
     // Front normal: towards the camera, tilted by up to tilt_max (uniform on
     // the spherical cap), then a roll about the line of sight.
@@ -113,13 +114,16 @@ Rigid3d SampleTargetView(const Camera& camera, const Housing* housing,
 void SurveyOptions::Check() const {
   if (!(height_m > 0)) throw OptionError("survey.height", std::to_string(height_m), "> 0 m");
   if (!(speed_m_s > 0)) throw OptionError("survey.speed", std::to_string(speed_m_s), "> 0 m/s");
-  if (!(frame_rate_hz > 0)) throw OptionError("survey.frame_rate", std::to_string(frame_rate_hz), "> 0 Hz");
+  if (!(frame_rate_hz > 0))
+    throw OptionError("survey.frame_rate", std::to_string(frame_rate_hz), "> 0 Hz");
   if (!(side_overlap >= 0 && side_overlap <= 0.95)) {
     throw OptionError("survey.side_overlap", std::to_string(side_overlap), "[0, 0.95]");
   }
-  if (!(line_length_m > 0)) throw OptionError("survey.line_length", std::to_string(line_length_m), "> 0 m");
+  if (!(line_length_m > 0))
+    throw OptionError("survey.line_length", std::to_string(line_length_m), "> 0 m");
   if (num_images < 1) throw OptionError("survey.num_images", std::to_string(num_images), ">= 1");
-  if (!(roughness_m >= 0)) throw OptionError("survey.roughness", std::to_string(roughness_m), ">= 0 m");
+  if (!(roughness_m >= 0))
+    throw OptionError("survey.roughness", std::to_string(roughness_m), ">= 0 m");
   if (!(relief_wavelength_m > 0)) {
     throw OptionError("survey.relief_wavelength", std::to_string(relief_wavelength_m), "> 0 m");
   }
@@ -137,15 +141,16 @@ SurveyPath PlanSurvey(const Camera& camera, const Housing* housing, const Survey
   // image's left and right edges... the camera's x is along the track, so
   // the cross-track extent comes from the top and bottom rows.
   double y_min = 1e300, y_max = -1e300, x_min = 1e300, x_max = -1e300;
-  for (const Eigen::Vector2d& pixel :
-       {Eigen::Vector2d(camera.width / 2.0, 0.5), Eigen::Vector2d(camera.width / 2.0, camera.height - 0.5),
-        Eigen::Vector2d(0.5, camera.height / 2.0), Eigen::Vector2d(camera.width - 0.5, camera.height / 2.0)}) {
+  for (const Eigen::Vector2d& pixel : {Eigen::Vector2d(camera.width / 2.0, 0.5),
+                                       Eigen::Vector2d(camera.width / 2.0, camera.height - 0.5),
+                                       Eigen::Vector2d(0.5, camera.height / 2.0),
+                                       Eigen::Vector2d(camera.width - 0.5, camera.height / 2.0)}) {
     const auto ray = UnprojectPixel(camera, housing, pixel);
     if (!ray || ray->direction.z() <= 0) {
       throw InputError("survey: the camera's image edges have no rays towards the seabed");
     }
-    const Eigen::Vector3d on_bed = ray->origin + (options.height_m - ray->origin.z()) /
-                                                     ray->direction.z() * ray->direction;
+    const Eigen::Vector3d on_bed =
+        ray->origin + (options.height_m - ray->origin.z()) / ray->direction.z() * ray->direction;
     x_min = std::min(x_min, on_bed.x());
     x_max = std::max(x_max, on_bed.x());
     y_min = std::min(y_min, on_bed.y());
@@ -161,8 +166,8 @@ SurveyPath PlanSurvey(const Camera& camera, const Housing* housing, const Survey
   for (int i = 0; i < options.num_images; ++i) {
     const int line = i / frames_per_line, k = i % frames_per_line;
     const bool forward = line % 2 == 0;
-    const double x = forward ? k * path.frame_spacing_m
-                             : (frames_per_line - 1 - k) * path.frame_spacing_m;
+    const double x =
+        forward ? k * path.frame_spacing_m : (frames_per_line - 1 - k) * path.frame_spacing_m;
     const double y = line * path.line_spacing_m;
     Eigen::Matrix3d world_from_cam;
     const Eigen::Vector3d cam_x(forward ? 1.0 : -1.0, 0.0, 0.0);

@@ -15,11 +15,11 @@
 namespace portcal {
 
 struct ViewSamplingOptions {
-  double distance_min_m = 0.4;  // camera centre to target centre, > 0
-  double distance_max_m = 1.4;  // >= distance_min_m
-  double tilt_max_deg = 45;     // target normal vs line of sight, [0, 89]
-  double roll_max_deg = 30;     // about the line of sight, [0, 180]
-  double border_margin_px = 10; // check points this far inside the image, >= 0
+  double distance_min_m = 0.4;     // camera centre to target centre, > 0
+  double distance_max_m = 1.4;     // >= distance_min_m
+  double tilt_max_deg = 45;        // target normal vs line of sight, [0, 89]
+  double roll_max_deg = 30;        // about the line of sight, [0, 180]
+  double border_margin_px = 10;    // check points this far inside the image, >= 0
   double max_view_angle_deg = 75;  // at every check point, (0, 90]
   // full: every check point inside the image; markers: every marker corner;
   // any: the target centre only.
@@ -38,15 +38,15 @@ Rigid3d SampleTargetView(const Camera& camera, const Housing* housing,
                          const ViewSamplingOptions& options, std::mt19937_64* rng);
 
 struct SurveyOptions {
-  double height_m = 2.0;        // above the mean seabed, > 0
-  double speed_m_s = 0.5;       // along track, > 0
-  double frame_rate_hz = 1.0;   // > 0
-  double side_overlap = 0.6;    // between neighbouring lines, [0, 0.95]
-  double line_length_m = 10.0;  // > 0
-  int num_images = 100;         // >= 1
-  double roughness_m = 0.1;     // standard deviation of the relief, >= 0
+  double height_m = 2.0;             // above the mean seabed, > 0
+  double speed_m_s = 0.5;            // along track, > 0
+  double frame_rate_hz = 1.0;        // > 0
+  double side_overlap = 0.6;         // between neighbouring lines, [0, 0.95]
+  double line_length_m = 10.0;       // > 0
+  int num_images = 100;              // >= 1
+  double roughness_m = 0.1;          // standard deviation of the relief, >= 0
   double relief_wavelength_m = 2.0;  // > 0
-  double texel_m = 0.004;       // seabed texture resolution, > 0
+  double texel_m = 0.004;            // seabed texture resolution, > 0
   uint64_t texture_seed = 21;
   // Noise of the navigation positions written beside the images
   // (navigation.txt, per axis), metres: a DVL-aided INS over a short survey.

@@ -14,13 +14,16 @@ Eigen::VectorXd RobustFit(const Eigen::MatrixXd& basis, const Eigen::VectorXd& v
   const Eigen::VectorXd residuals = values - basis * fit;
   std::vector<double> magnitudes(residuals.size());
   for (Eigen::Index i = 0; i < residuals.size(); ++i) magnitudes[i] = std::abs(residuals[i]);
-  std::nth_element(magnitudes.begin(), magnitudes.begin() + magnitudes.size() / 2, magnitudes.end());
+  std::nth_element(magnitudes.begin(), magnitudes.begin() + magnitudes.size() / 2,
+                   magnitudes.end());
   const double limit = 3 * 1.4826 * magnitudes[magnitudes.size() / 2];
   std::vector<Eigen::Index> kept;
   for (Eigen::Index i = 0; i < residuals.size(); ++i) {
     if (std::abs(residuals[i]) <= limit) kept.push_back(i);
   }
-  if (static_cast<Eigen::Index>(kept.size()) == residuals.size() || kept.size() < 2 * size_t(basis.cols())) return fit;
+  if (static_cast<Eigen::Index>(kept.size()) == residuals.size() ||
+      kept.size() < 2 * size_t(basis.cols()))
+    return fit;
   Eigen::MatrixXd kept_basis(kept.size(), basis.cols());
   Eigen::VectorXd kept_values(kept.size());
   for (size_t k = 0; k < kept.size(); ++k) {
@@ -54,7 +57,8 @@ Eigen::MatrixXd BoardShading::BasisGradient(const Eigen::Vector2d& point) const 
 }
 
 std::optional<BoardShading> BoardShading::Fit(const std::vector<Eigen::Vector2d>& corners,
-                                              const std::vector<double>& means, const std::vector<double>& contrasts) {
+                                              const std::vector<double>& means,
+                                              const std::vector<double>& contrasts) {
   const size_t n = corners.size();
   if (n < 6) return std::nullopt;
   BoardShading shading;

@@ -27,7 +27,8 @@ struct LocalShading {
 
   // The gray at `offset` from the point brought to the point's levels.
   double Flatten(double gray, const Eigen::Vector2d& offset) const {
-    return mean + (gray - mean - mean_gradient.dot(offset)) / (1 + relative_contrast_gradient.dot(offset));
+    return mean +
+           (gray - mean - mean_gradient.dot(offset)) / (1 + relative_contrast_gradient.dot(offset));
   }
   // How far the levels drift over `radius` pixels, as a fraction of the
   // contrast `contrast` (the larger of the two).
@@ -41,7 +42,8 @@ struct LocalShading {
 // without corners beyond 3 robust sigmas. nullopt with fewer than 6.
 class BoardShading {
  public:
-  static std::optional<BoardShading> Fit(const std::vector<Eigen::Vector2d>& corners, const std::vector<double>& means,
+  static std::optional<BoardShading> Fit(const std::vector<Eigen::Vector2d>& corners,
+                                         const std::vector<double>& means,
                                          const std::vector<double>& contrasts);
   LocalShading At(const Eigen::Vector2d& point) const;
 

@@ -1,10 +1,9 @@
 #include "pipelines/target/chessboard_detector.h"
 
 #include <map>
-#include <set>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <set>
 
 #include "colmap_ext/util/error.h"
 #include "pipelines/target/coarse_level.h"
@@ -17,10 +16,12 @@ void ChessboardDetectionOptions::Check() const {
   if (cols < 2) throw OptionError("--Target.cols", std::to_string(cols), ">= 2 inner corners");
   if (rows < 2) throw OptionError("--Target.rows", std::to_string(rows), ">= 2 inner corners");
   if (coarse_max_image_size < 0) {
-    throw OptionError("--Target.coarse_max_image_size", std::to_string(coarse_max_image_size), ">= 0");
+    throw OptionError("--Target.coarse_max_image_size", std::to_string(coarse_max_image_size),
+                      ">= 0");
   }
   if (!(min_x_corner_fraction >= 0 && min_x_corner_fraction <= 1)) {
-    throw OptionError("--Target.min_x_corner_fraction", std::to_string(min_x_corner_fraction), "[0, 1]");
+    throw OptionError("--Target.min_x_corner_fraction", std::to_string(min_x_corner_fraction),
+                      "[0, 1]");
   }
   if (min_refined_corners < 4) {
     throw OptionError("--Target.min_refined_corners", std::to_string(min_refined_corners), ">= 4");
@@ -38,7 +39,8 @@ struct SearchLevels {
   bool searched = false;
 };
 
-SearchLevels GateAndLevels(const cv::Mat& gray, const ChessboardDetectionOptions& options, std::string* reason) {
+SearchLevels GateAndLevels(const cv::Mat& gray, const ChessboardDetectionOptions& options,
+                           std::string* reason) {
   SearchLevels search;
   search.levels = {CoarseLevel(gray, options.coarse_max_image_size)};
   if (search.levels.front().first < 1) search.levels.emplace_back(1.0, gray);
@@ -63,7 +65,8 @@ SearchLevels GateAndLevels(const cv::Mat& gray, const ChessboardDetectionOptions
 bool FindWholeQuickly(const SearchLevels& search, const ChessboardDetectionOptions& options,
                       std::vector<cv::Point2f>* corners, double* scale) {
   *scale = search.levels.front().first;
-  return cv::findChessboardCorners(search.levels.front().second, cv::Size(options.cols, options.rows), *corners,
+  return cv::findChessboardCorners(search.levels.front().second,
+                                   cv::Size(options.cols, options.rows), *corners,
                                    cv::CALIB_CB_NORMALIZE_IMAGE);
 }
 
@@ -78,7 +81,8 @@ bool FindWholeSlowly(const SearchLevels& search, const ChessboardDetectionOption
   const cv::Size pattern(options.cols, options.rows);
   const int adaptive = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE;
   const bool gated = options.min_x_corner_fraction > 0;
-  std::vector<std::pair<size_t, int>> attempts = {{0, adaptive | (gated ? 0 : cv::CALIB_CB_FAST_CHECK)}};
+  std::vector<std::pair<size_t, int>> attempts = {
+      {0, adaptive | (gated ? 0 : cv::CALIB_CB_FAST_CHECK)}};
   if (search.levels.size() > 1) attempts.emplace_back(1, adaptive | cv::CALIB_CB_FAST_CHECK);
   for (const auto& [level, flags] : attempts) {
     if (cv::findChessboardCorners(search.levels[level].second, pattern, *corners, flags)) {
@@ -87,7 +91,8 @@ bool FindWholeSlowly(const SearchLevels& search, const ChessboardDetectionOption
     }
   }
   for (const auto& [factor, image] : search.levels) {
-    if (cv::findChessboardCornersSB(image, pattern, *corners, cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_EXHAUSTIVE)) {
+    if (cv::findChessboardCornersSB(image, pattern, *corners,
+                                    cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_EXHAUSTIVE)) {
       *scale = factor;
       return true;
     }
@@ -100,8 +105,10 @@ bool FindWholeSlowly(const SearchLevels& search, const ChessboardDetectionOption
 // diagonally outside corner 0 and, unlike that one, always lies on the
 // board (the outer ring may be cut, or printed differently).
 double FirstSquareGray(const cv::Mat& gray, const std::vector<Eigen::Vector2d>& corners, int cols) {
-  const Eigen::Vector2d centre = 0.25 * (corners[0] + corners[1] + corners[cols] + corners[cols + 1]);
-  const double radius = 0.15 * std::min((corners[1] - corners[0]).norm(), (corners[cols] - corners[0]).norm());
+  const Eigen::Vector2d centre =
+      0.25 * (corners[0] + corners[1] + corners[cols] + corners[cols + 1]);
+  const double radius =
+      0.15 * std::min((corners[1] - corners[0]).norm(), (corners[cols] - corners[0]).norm());
   double sum = 0;
   int count = 0;
   for (int dy = -2; dy <= 2; ++dy) {
@@ -135,7 +142,8 @@ std::string LeftOutNote(const std::vector<CornerFailure>& failures) {
   int total = 0;
   std::string reasons;
   for (const auto& [failure, count] : counts) {
-    reasons += (reasons.empty() ? "" : ", ") + std::to_string(count) + " " + CornerFailureText(failure);
+    reasons +=
+        (reasons.empty() ? "" : ", ") + std::to_string(count) + " " + CornerFailureText(failure);
     total += count;
   }
   return std::to_string(total) + " of " + std::to_string(failures.size()) + " corners left out" +
@@ -146,10 +154,12 @@ std::string LeftOutNote(const std::vector<CornerFailure>& failures) {
 // next to each other in a row (never reaching the next corner), 2 to 10 px.
 // A fixed 5 x 5 window on a large, soft-edged board left the corners 2-5 px
 // apart from frame to frame of a board held still (docs/live.md).
-int QuickWindowHalf(const std::vector<bool>& seen, const std::vector<Eigen::Vector2d>& corners, int cols) {
+int QuickWindowHalf(const std::vector<bool>& seen, const std::vector<Eigen::Vector2d>& corners,
+                    int cols) {
   std::vector<double> spacings;
   for (size_t i = 0; i + 1 < corners.size(); ++i) {
-    if (static_cast<int>(i + 1) % cols != 0 && seen[i] && seen[i + 1]) spacings.push_back((corners[i + 1] - corners[i]).norm());
+    if (static_cast<int>(i + 1) % cols != 0 && seen[i] && seen[i + 1])
+      spacings.push_back((corners[i + 1] - corners[i]).norm());
   }
   if (spacings.empty()) return 2;
   std::nth_element(spacings.begin(), spacings.begin() + spacings.size() / 2, spacings.end());
@@ -157,7 +167,8 @@ int QuickWindowHalf(const std::vector<bool>& seen, const std::vector<Eigen::Vect
 }
 
 // cv::cornerSubPix at full resolution on corners in COLMAP pixels.
-void PolishQuickly(const cv::Mat& gray, const std::vector<bool>& seen, int cols, std::vector<Eigen::Vector2d>* corners) {
+void PolishQuickly(const cv::Mat& gray, const std::vector<bool>& seen, int cols,
+                   std::vector<Eigen::Vector2d>* corners) {
   std::vector<cv::Point2f> points;
   std::vector<size_t> indices;
   for (size_t i = 0; i < corners->size(); ++i) {
@@ -168,12 +179,14 @@ void PolishQuickly(const cv::Mat& gray, const std::vector<bool>& seen, int cols,
   const int half = QuickWindowHalf(seen, *corners, cols);
   cv::cornerSubPix(gray, points, cv::Size(half, half), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 20, 0.01));
-  for (size_t k = 0; k < points.size(); ++k) (*corners)[indices[k]] = Eigen::Vector2d(points[k].x + 0.5, points[k].y + 0.5);
+  for (size_t k = 0; k < points.size(); ++k)
+    (*corners)[indices[k]] = Eigen::Vector2d(points[k].x + 0.5, points[k].y + 0.5);
 }
 
 // The whole board's corners (COLMAP pixels of the image) in canonical
 // order, from OpenCV's corners on the level scaled by `scale`.
-std::vector<Eigen::Vector2d> CanonicalOrder(const cv::Mat& gray, const std::vector<cv::Point2f>& coarse, double scale,
+std::vector<Eigen::Vector2d> CanonicalOrder(const cv::Mat& gray,
+                                            const std::vector<cv::Point2f>& coarse, double scale,
                                             const ChessboardDetectionOptions& options) {
   // Back to full-resolution COLMAP pixels: OpenCV's (0, 0) is the centre of
   // the top-left pixel, also in the downscaled image.
@@ -184,7 +197,8 @@ std::vector<Eigen::Vector2d> CanonicalOrder(const cv::Mat& gray, const std::vect
   // findChessboardCorners may return the mirror image, a labelling no board
   // pose can give, which breaks the correspondence between two cameras'
   // views of one board.
-  const Eigen::Vector2d along_row = start[1] - start[0], along_column = start[options.cols] - start[0];
+  const Eigen::Vector2d along_row = start[1] - start[0],
+                        along_column = start[options.cols] - start[0];
   if (along_row.x() * along_column.y() - along_row.y() * along_column.x() < 0) {
     for (int r = 0; r < options.rows; ++r) {
       std::reverse(start.begin() + r * options.cols, start.begin() + (r + 1) * options.cols);
@@ -208,7 +222,8 @@ std::optional<PartialPlacement> PlacePartly(const SearchLevels& search, const Se
   if (!lattice) return std::nullopt;
   PartialPlacement placement = PlaceOnChessboard(level, *lattice, options.cols, options.rows);
   if (placement.board) {
-    for (Eigen::Vector2d& p : placement.board->corners) p = (p + Eigen::Vector2d(0.5, 0.5)) / search.levels.front().first;
+    for (Eigen::Vector2d& p : placement.board->corners)
+      p = (p + Eigen::Vector2d(0.5, 0.5)) / search.levels.front().first;
   }
   return placement;
 }
@@ -225,8 +240,9 @@ std::optional<PartialPlacement> PlacePartly(const SearchLevels& search, const Se
 // board (more junctions than it has, none of it in view, or only in part
 // and not where the image cuts it) the whole board is not in view either.
 // False with the reason.
-bool FindStart(const cv::Mat& gray, const ChessboardDetectionOptions& options, std::vector<Eigen::Vector2d>* start,
-               std::vector<bool>* seen, double* scale, ChessboardDetection* detection) {
+bool FindStart(const cv::Mat& gray, const ChessboardDetectionOptions& options,
+               std::vector<Eigen::Vector2d>* start, std::vector<bool>* seen, double* scale,
+               ChessboardDetection* detection) {
   const int squares = (options.cols + 1) + (options.rows + 1);
   detection->symmetric = squares % 2 == 0;
   const SearchLevels search = GateAndLevels(gray, options, &detection->reason);
@@ -240,7 +256,8 @@ bool FindStart(const cv::Mat& gray, const ChessboardDetectionOptions& options, s
     if (corners) coarse = *corners;
     whole = corners.has_value();
   }
-  const std::string board = std::to_string(options.cols) + "x" + std::to_string(options.rows) + " inner-corner chessboard";
+  const std::string board = std::to_string(options.cols) + "x" + std::to_string(options.rows) +
+                            " inner-corner chessboard";
   if (!whole && grid) {
     const auto partial = PlacePartly(search, *grid, options);
     if (partial && partial->board && options.partial_views) {
@@ -252,8 +269,9 @@ bool FindStart(const cv::Mat& gray, const ChessboardDetectionOptions& options, s
       return true;
     }
     if (partial) {
-      detection->reason = "no " + board + " found" +
-                          (partial->board ? " whole (--Target.partial_views 0)" : ": " + partial->reason);
+      detection->reason =
+          "no " + board + " found" +
+          (partial->board ? " whole (--Target.partial_views 0)" : ": " + partial->reason);
       return false;
     }
   }
@@ -269,7 +287,8 @@ bool FindStart(const cv::Mat& gray, const ChessboardDetectionOptions& options, s
 
 }  // namespace
 
-ChessboardDetection DetectChessboard(const cv::Mat& gray, const ChessboardDetectionOptions& options) {
+ChessboardDetection DetectChessboard(const cv::Mat& gray,
+                                     const ChessboardDetectionOptions& options) {
   options.Check();
   PORTCAL_CHECK(gray.type() == CV_8UC1);
   ChessboardDetection detection;
@@ -293,8 +312,8 @@ ChessboardDetection DetectChessboard(const cv::Mat& gray, const ChessboardDetect
   CornerRefinementOptions refinement = options.refinement;
   refinement.max_shift_px /= scale;
   std::vector<CornerFailure> failures;
-  const auto refined =
-      RefineChessboardCorners(gray, start, options.cols, options.rows, refinement, &failures, &seen);
+  const auto refined = RefineChessboardCorners(gray, start, options.cols, options.rows, refinement,
+                                               &failures, &seen);
   detection.corners.resize(refined.size());
   std::set<int> rows, cols;
   for (size_t i = 0; i < refined.size(); ++i) {

@@ -1,10 +1,10 @@
 // Chessboard detection: a count of X-junctions first turns away images that
 // cannot hold the board (x_corner_count.h); coarse corners from OpenCV on a
 // downscaled image (findChessboardCorners, then at full resolution, then
-// findChessboardCornersSB as a fallback), put in portcal's canonical order (right-handed, corner 0's
-// outer diagonal square black), then refined at full resolution by the
-// ideal-pattern fit (corner_refinement.h). A board cut by the image's
-// border: its part in view (partial_chessboard.h).
+// findChessboardCornersSB as a fallback), put in portcal's canonical order (right-handed, corner
+// 0's outer diagonal square black), then refined at full resolution by the ideal-pattern fit
+// (corner_refinement.h). A board cut by the image's border: its part in view
+// (partial_chessboard.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -61,6 +61,7 @@ struct ChessboardDetection {
   std::string note;
 };
 
-ChessboardDetection DetectChessboard(const cv::Mat& gray, const ChessboardDetectionOptions& options);
+ChessboardDetection DetectChessboard(const cv::Mat& gray,
+                                     const ChessboardDetectionOptions& options);
 
 }  // namespace portcal

@@ -1,7 +1,6 @@
 #include "pipelines/target/corner_refinement.h"
 
 #include <Eigen/Cholesky>
-
 #include <cmath>
 
 #include "colmap_ext/cost/corner_pattern_model.h"
@@ -25,7 +24,8 @@ void CornerRefinementOptions::Check() const {
     throw OptionError("max_num_iterations", std::to_string(max_num_iterations), ">= 1");
   }
   if (!std::isfinite(max_level_drift)) {
-    throw OptionError("--Target.max_level_drift", std::to_string(max_level_drift), "a fraction (< 0: never)");
+    throw OptionError("--Target.max_level_drift", std::to_string(max_level_drift),
+                      "a fraction (< 0: never)");
   }
   if (!(corner_tolerance_px > 0)) {
     throw OptionError("corner_tolerance_px", std::to_string(corner_tolerance_px), "> 0");
@@ -34,12 +34,18 @@ void CornerRefinementOptions::Check() const {
 
 const char* CornerFailureText(CornerFailure failure) {
   switch (failure) {
-    case CornerFailure::kNone: return "refined";
-    case CornerFailure::kNearImageBorder: return "window beyond the image";
-    case CornerFailure::kNoContrast: return "no contrast";
-    case CornerFailure::kDiverged: return "fit diverged";
-    case CornerFailure::kMovedTooFar: return "moved too far from the detection";
-    case CornerFailure::kNotSeen: return "out of view";
+    case CornerFailure::kNone:
+      return "refined";
+    case CornerFailure::kNearImageBorder:
+      return "window beyond the image";
+    case CornerFailure::kNoContrast:
+      return "no contrast";
+    case CornerFailure::kDiverged:
+      return "fit diverged";
+    case CornerFailure::kMovedTooFar:
+      return "moved too far from the detection";
+    case CornerFailure::kNotSeen:
+      return "out of view";
   }
   return "unknown";
 }
@@ -50,7 +56,8 @@ double NearestNeighbourDistance(const std::vector<Eigen::Vector2d>& corners, int
                                 int index) {
   const int r = index / cols, c = index % cols;
   double best = 1e300;
-  for (const auto& [dr, dc] : {std::pair{0, 1}, std::pair{0, -1}, std::pair{1, 0}, std::pair{-1, 0}}) {
+  for (const auto& [dr, dc] :
+       {std::pair{0, 1}, std::pair{0, -1}, std::pair{1, 0}, std::pair{-1, 0}}) {
     const int rr = r + dr, cc = c + dc;
     if (rr < 0 || cc < 0 || rr >= rows || cc >= cols) continue;
     best = std::min(best, (corners[rr * cols + cc] - corners[index]).norm());
@@ -84,7 +91,7 @@ using Matrix7d = Eigen::Matrix<double, 7, 7>;
 
 // How the model is integrated over each pixel in a fit.
 struct Integration {
-  bool area = false;  // false: the pixel's centre only
+  bool area = false;                               // false: the pixel's centre only
   PixelRule corner_rule = PixelRule::Midpoint(4);  // where both edges vary over a pixel
 };
 
@@ -92,17 +99,19 @@ struct Integration {
 // entries, 1 for the mean and its sign for the contrast: their sums are
 // gathered apart, which saves a rank-one update for most pixels of a sharp
 // corner's window.
-double Linearise(const std::vector<WindowPixel>& window, const Vector7d& p, const Integration& integration,
-                 Matrix7d* jtj, Vector7d* jtr) {
-  const CornerPatternModel model(p.data(), integration.area ? integration.corner_rule : PixelRule::Midpoint(1));
+double Linearise(const std::vector<WindowPixel>& window, const Vector7d& p,
+                 const Integration& integration, Matrix7d* jtj, Vector7d* jtr) {
+  const CornerPatternModel model(
+      p.data(), integration.area ? integration.corner_rule : PixelRule::Midpoint(1));
   jtj->setZero();
   jtr->setZero();
   double cost = 0;
   double flat_count = 0, flat_sign_sum = 0, flat_residual_sum = 0, flat_signed_residual_sum = 0;
   Vector7d gradient;
   for (const WindowPixel& pixel : window) {
-    const double value = integration.area ? model.EvaluateArea(pixel.x, pixel.y, pixel.region, gradient.data())
-                                          : model.Evaluate(pixel.x, pixel.y, gradient.data());
+    const double value = integration.area
+                             ? model.EvaluateArea(pixel.x, pixel.y, pixel.region, gradient.data())
+                             : model.Evaluate(pixel.x, pixel.y, gradient.data());
     const double r = value - pixel.gray;
     cost += 0.5 * r * r;
     if (integration.area && pixel.region == CornerPatternModel::kFlat) {
@@ -176,7 +185,8 @@ double FitCornerPattern(const std::vector<WindowPixel>& window, const Integratio
 // of their erfs is averaged by Gauss-Legendre while the edges are smooth at
 // the pixel's scale, and by 8 x 8 sub-samples when they are sharp (a few
 // pixels only then).
-double FitOverPixelAreas(const CornerRefinementOptions& options, std::vector<WindowPixel>* window, Vector7d* p) {
+double FitOverPixelAreas(const CornerRefinementOptions& options, std::vector<WindowPixel>* window,
+                         Vector7d* p) {
   const CornerPatternModel start(p->data());
   const double span = start.PixelSpan();
   const Integration integration{true, span <= 1.5 ? PixelRule::GaussLegendre(3)
@@ -184,17 +194,20 @@ double FitOverPixelAreas(const CornerRefinementOptions& options, std::vector<Win
                                                   : PixelRule::Midpoint(8)};
   constexpr double margin = 0.5;  // erf's units: sqrt(2) sigma pixels
   for (WindowPixel& pixel : *window) pixel.region = start.Classify(pixel.x, pixel.y, margin);
-  double cost = FitCornerPattern(*window, integration, options.max_num_iterations, options.corner_tolerance_px, p);
+  double cost = FitCornerPattern(*window, integration, options.max_num_iterations,
+                                 options.corner_tolerance_px, p);
   for (int refit = 0; refit < 2 && cost >= 0; ++refit) {
     const CornerPatternModel end(p->data());
     bool changed = false;
     for (WindowPixel& pixel : *window) {
       if ((end.Classify(pixel.x, pixel.y, 0) & ~pixel.region) == 0) continue;
-      pixel.region = static_cast<CornerPatternModel::Region>(pixel.region | end.Classify(pixel.x, pixel.y, margin));
+      pixel.region = static_cast<CornerPatternModel::Region>(
+          pixel.region | end.Classify(pixel.x, pixel.y, margin));
       changed = true;
     }
     if (!changed) break;
-    cost = FitCornerPattern(*window, integration, options.max_num_iterations, options.corner_tolerance_px, p);
+    cost = FitCornerPattern(*window, integration, options.max_num_iterations,
+                            options.corner_tolerance_px, p);
   }
   return cost;
 }
@@ -203,9 +216,10 @@ double FitOverPixelAreas(const CornerRefinementOptions& options, std::vector<Win
 // radius `half` about `centre`, their grays brought to the levels at
 // `shading_centre` by `shading` if given; empty where the window leaves
 // the image.
-std::vector<WindowPixel> WindowAbout(const cv::Mat& gray, const Eigen::Vector2d& centre, double half,
-                                     const LocalShading* shading = nullptr,
-                                     const Eigen::Vector2d& shading_centre = Eigen::Vector2d::Zero()) {
+std::vector<WindowPixel> WindowAbout(
+    const cv::Mat& gray, const Eigen::Vector2d& centre, double half,
+    const LocalShading* shading = nullptr,
+    const Eigen::Vector2d& shading_centre = Eigen::Vector2d::Zero()) {
   const int c0 = static_cast<int>(std::floor(centre.x() - half));
   const int r0 = static_cast<int>(std::floor(centre.y() - half));
   const int c1 = static_cast<int>(std::ceil(centre.x() + half));
@@ -218,7 +232,8 @@ std::vector<WindowPixel> WindowAbout(const cv::Mat& gray, const Eigen::Vector2d&
       const Eigen::Vector2d p(c + 0.5, r + 0.5);
       if ((p - centre).norm() > half) continue;
       const double value = gray.at<uint8_t>(r, c);
-      window.push_back({p.x(), p.y(), shading != nullptr ? shading->Flatten(value, p - shading_centre) : value});
+      window.push_back(
+          {p.x(), p.y(), shading != nullptr ? shading->Flatten(value, p - shading_centre) : value});
     }
   }
   return window;
@@ -229,18 +244,22 @@ std::vector<WindowPixel> WindowAbout(const cv::Mat& gray, const Eigen::Vector2d&
 // levels and edge angles. kNone, or why the fit cannot go on.
 CornerFailure FitAtPixelCentres(const cv::Mat& gray, const std::vector<WindowPixel>& window,
                                 const Eigen::Vector2d& start, double half, double normal_angle1,
-                                double normal_angle2, const CornerRefinementOptions& options, Vector7d* params) {
+                                double normal_angle2, const CornerRefinementOptions& options,
+                                Vector7d* params) {
   if (window.size() < 12) return CornerFailure::kNearImageBorder;
   double sum = 0;
   for (const WindowPixel& pixel : window) sum += pixel.gray;
   // Levels: the mean, and the contrast's sign from the quadrant between the
   // two edge normals.
-  *params << start.x(), start.y(), normal_angle1, normal_angle2, sum / window.size(), 0, std::log(0.8);
+  *params << start.x(), start.y(), normal_angle1, normal_angle2, sum / window.size(), 0,
+      std::log(0.8);
   const Eigen::Vector2d probe =
-      start + 0.5 * half * (Eigen::Vector2d(std::cos(normal_angle1), std::sin(normal_angle1)) +
-                            Eigen::Vector2d(std::cos(normal_angle2), std::sin(normal_angle2)))
-                               .normalized();
-  (*params)[5] = gray.at<uint8_t>(static_cast<int>(probe.y()), static_cast<int>(probe.x())) - (*params)[4];
+      start + 0.5 * half *
+                  (Eigen::Vector2d(std::cos(normal_angle1), std::sin(normal_angle1)) +
+                   Eigen::Vector2d(std::cos(normal_angle2), std::sin(normal_angle2)))
+                      .normalized();
+  (*params)[5] =
+      gray.at<uint8_t>(static_cast<int>(probe.y()), static_cast<int>(probe.x())) - (*params)[4];
   if (std::abs((*params)[5]) < 5) return CornerFailure::kNoContrast;
   // Near the minimum the steps shrink geometrically (the sharp edges'
   // curvature, which Gauss-Newton leaves out), so this stage stops once
@@ -255,12 +274,13 @@ CornerFailure FitAtPixelCentres(const cv::Mat& gray, const std::vector<WindowPix
 
 // The second stage: the pattern integrated over each pixel's area, from
 // the first stage's parameters; the corner, or why not.
-std::optional<RefinedCorner> FitOverAreas(std::vector<WindowPixel>* window, const Eigen::Vector2d& start,
+std::optional<RefinedCorner> FitOverAreas(std::vector<WindowPixel>* window,
+                                          const Eigen::Vector2d& start,
                                           const CornerRefinementOptions& options, Vector7d* params,
                                           CornerFailure* failure) {
   const double final_cost = FitOverPixelAreas(options, window, params);
   const Eigen::Vector2d xy((*params)[0], (*params)[1]);
-  *failure = final_cost < 0 || !params->allFinite()      ? CornerFailure::kDiverged
+  *failure = final_cost < 0 || !params->allFinite()       ? CornerFailure::kDiverged
              : (xy - start).norm() > options.max_shift_px ? CornerFailure::kMovedTooFar
                                                           : CornerFailure::kNone;
   if (*failure != CornerFailure::kNone) return std::nullopt;
@@ -277,13 +297,15 @@ std::optional<RefinedCorner> FitOverAreas(std::vector<WindowPixel>* window, cons
 
 std::optional<RefinedCorner> RefineCorner(const cv::Mat& gray, const Eigen::Vector2d& start,
                                           double half, double normal_angle1, double normal_angle2,
-                                          const CornerRefinementOptions& options, CornerFailure* failure) {
+                                          const CornerRefinementOptions& options,
+                                          CornerFailure* failure) {
   PORTCAL_CHECK(gray.type() == CV_8UC1);
   CornerFailure unused;
   if (failure == nullptr) failure = &unused;
   std::vector<WindowPixel> window = WindowAbout(gray, start, half);
   Vector7d params;
-  *failure = FitAtPixelCentres(gray, window, start, half, normal_angle1, normal_angle2, options, &params);
+  *failure =
+      FitAtPixelCentres(gray, window, start, half, normal_angle1, normal_angle2, options, &params);
   if (*failure != CornerFailure::kNone) return std::nullopt;
   return FitOverAreas(&window, start, options, &params, failure);
 }
@@ -329,10 +351,11 @@ std::vector<std::optional<RefinedCorner>> RefineBoardCorners(const cv::Mat& gray
     corner.half = start.half_window_px;
     corner.options = options;
     corner.options.max_shift_px = start.max_shift_px;
-    corner.failure = start.seen ? FitAtPixelCentres(gray, WindowAbout(gray, start.xy, start.half_window_px), start.xy,
-                                                    start.half_window_px, start.normal_angle1, start.normal_angle2,
-                                                    corner.options, &corner.params)
-                                : CornerFailure::kNotSeen;
+    corner.failure =
+        start.seen ? FitAtPixelCentres(gray, WindowAbout(gray, start.xy, start.half_window_px),
+                                       start.xy, start.half_window_px, start.normal_angle1,
+                                       start.normal_angle2, corner.options, &corner.params)
+                   : CornerFailure::kNotSeen;
   }
   // The second stage over windows brought to each corner's own levels
   // where the board's levels drift across them.
@@ -343,15 +366,18 @@ std::vector<std::optional<RefinedCorner>> RefineBoardCorners(const cv::Mat& gray
     GridCorner& corner = grid[index];
     if (corner.failure != CornerFailure::kNone) continue;
     const Eigen::Vector2d xy(corner.params[0], corner.params[1]);
-    const std::optional<LocalShading> local = shading ? std::optional(shading->At(xy)) : std::nullopt;
+    const std::optional<LocalShading> local =
+        shading ? std::optional(shading->At(xy)) : std::nullopt;
     // A drift of a quarter of the contrast across one window is no shading
     // but a field fitted to wild levels (a handful of corners, one a
     // reflection): such a window is left as it is.
     const double drift = local ? local->Drift(corner.half, 2 * std::abs(corner.params[5])) : 0;
     const bool flatten = local && drift > options.max_level_drift && drift < 0.25;
     std::vector<WindowPixel> window =
-        flatten ? WindowAbout(gray, corner.start, corner.half, &*local, xy) : WindowAbout(gray, corner.start, corner.half);
-    refined[index] = FitOverAreas(&window, corner.start, corner.options, &corner.params, &corner.failure);
+        flatten ? WindowAbout(gray, corner.start, corner.half, &*local, xy)
+                : WindowAbout(gray, corner.start, corner.half);
+    refined[index] =
+        FitOverAreas(&window, corner.start, corner.options, &corner.params, &corner.failure);
   }
   if (failures != nullptr) {
     failures->clear();
@@ -362,7 +388,8 @@ std::vector<std::optional<RefinedCorner>> RefineBoardCorners(const cv::Mat& gray
 
 std::vector<std::optional<RefinedCorner>> RefineChessboardCorners(
     const cv::Mat& gray, const std::vector<Eigen::Vector2d>& corners, int cols, int rows,
-    const CornerRefinementOptions& options, std::vector<CornerFailure>* failures, const std::vector<bool>* seen) {
+    const CornerRefinementOptions& options, std::vector<CornerFailure>* failures,
+    const std::vector<bool>* seen) {
   PORTCAL_CHECK(static_cast<int>(corners.size()) == cols * rows);
   PORTCAL_CHECK(seen == nullptr || seen->size() == corners.size());
   std::vector<CornerStart> starts(corners.size());
@@ -370,11 +397,12 @@ std::vector<std::optional<RefinedCorner>> RefineChessboardCorners(
     const double neighbour_distance = NearestNeighbourDistance(corners, cols, rows, index);
     CornerStart& start = starts[index];
     start.xy = corners[index];
-    start.half_window_px =
-        std::clamp(options.window_fraction * neighbour_distance, options.min_window_px, options.max_window_px);
+    start.half_window_px = std::clamp(options.window_fraction * neighbour_distance,
+                                      options.min_window_px, options.max_window_px);
     start.normal_angle1 = EdgeAngle(corners, cols, rows, index, true);
     start.normal_angle2 = EdgeAngle(corners, cols, rows, index, false);
-    start.max_shift_px = std::max(options.max_shift_px, options.max_shift_fraction * neighbour_distance);
+    start.max_shift_px =
+        std::max(options.max_shift_px, options.max_shift_fraction * neighbour_distance);
     start.seen = seen == nullptr || (*seen)[index];
   }
   return RefineBoardCorners(gray, starts, options, failures);

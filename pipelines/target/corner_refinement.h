@@ -49,15 +49,22 @@ struct CornerRefinementOptions {
 };
 
 struct RefinedCorner {
-  Eigen::Vector2d xy;        // COLMAP pixels
-  double rms_gray = 0;       // fit residual, gray levels
-  double contrast = 0;       // |a| * 2, gray levels
-  double mean_gray = 0;      // m
+  Eigen::Vector2d xy;    // COLMAP pixels
+  double rms_gray = 0;   // fit residual, gray levels
+  double contrast = 0;   // |a| * 2, gray levels
+  double mean_gray = 0;  // m
   double blur_sigma_px = 0;
 };
 
 // Why a corner was not refined.
-enum class CornerFailure { kNone, kNearImageBorder, kNoContrast, kDiverged, kMovedTooFar, kNotSeen };
+enum class CornerFailure {
+  kNone,
+  kNearImageBorder,
+  kNoContrast,
+  kDiverged,
+  kMovedTooFar,
+  kNotSeen
+};
 const char* CornerFailureText(CornerFailure failure);  // e.g. "no contrast"
 
 // Refines one corner from `start` (COLMAP pixels) with a circular window of
@@ -65,7 +72,8 @@ const char* CornerFailureText(CornerFailure failure);  // e.g. "no contrast"
 // fit fails, with the reason in *failure if given.
 std::optional<RefinedCorner> RefineCorner(const cv::Mat& gray, const Eigen::Vector2d& start,
                                           double half_window_px, double normal_angle1,
-                                          double normal_angle2, const CornerRefinementOptions& options,
+                                          double normal_angle2,
+                                          const CornerRefinementOptions& options,
                                           CornerFailure* failure = nullptr);
 
 // Where a board's corner starts its fit from.
@@ -82,10 +90,9 @@ struct CornerStart {
 // where the levels drift across a window by more than `max_level_drift`,
 // with the window brought to the corner's own levels. nullopt for corners
 // whose fit failed, with the reasons in *failures if given.
-std::vector<std::optional<RefinedCorner>> RefineBoardCorners(const cv::Mat& gray,
-                                                             const std::vector<CornerStart>& starts,
-                                                             const CornerRefinementOptions& options = {},
-                                                             std::vector<CornerFailure>* failures = nullptr);
+std::vector<std::optional<RefinedCorner>> RefineBoardCorners(
+    const cv::Mat& gray, const std::vector<CornerStart>& starts,
+    const CornerRefinementOptions& options = {}, std::vector<CornerFailure>* failures = nullptr);
 
 // Refines corners (COLMAP pixel convention) of a grid of rows x cols inner
 // corners, index r * cols + c, in an 8-bit gray image. nullopt for corners

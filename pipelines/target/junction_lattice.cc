@@ -1,11 +1,10 @@
 #include "pipelines/target/junction_lattice.h"
 
-#include <opencv2/calib3d.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace portcal {
 namespace {
@@ -13,7 +12,8 @@ namespace {
 // Mean gray of a small box about `centre`; nullopt where it leaves the image.
 std::optional<double> BoxGray(const cv::Mat& image, const Eigen::Vector2d& centre, double half) {
   const int r = std::max(1, static_cast<int>(half));
-  const int x = static_cast<int>(std::lround(centre.x())), y = static_cast<int>(std::lround(centre.y()));
+  const int x = static_cast<int>(std::lround(centre.x())),
+            y = static_cast<int>(std::lround(centre.y()));
   if (x - r < 0 || y - r < 0 || x + r >= image.cols || y + r >= image.rows) return std::nullopt;
   return cv::mean(image(cv::Rect(x - r, y - r, 2 * r + 1, 2 * r + 1)))[0];
 }
@@ -24,17 +24,20 @@ std::optional<SeenGrid> SeeChessboardGrid(const cv::Mat& image) {
   std::vector<cv::Point2f> points;
   cv::Mat meta;
   const int flags = cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_LARGER;
-  if (!cv::findChessboardCornersSB(image, cv::Size(3, 3), points, flags, meta) || meta.empty()) return std::nullopt;
+  if (!cv::findChessboardCornersSB(image, cv::Size(3, 3), points, flags, meta) || meta.empty())
+    return std::nullopt;
   SeenGrid grid;
   grid.h = meta.rows;
   grid.w = meta.cols;
   for (const cv::Point2f& p : points) grid.points.emplace_back(p.x, p.y);
-  if (static_cast<int>(grid.points.size()) != grid.h * grid.w || grid.h < 3 || grid.w < 3) return std::nullopt;
+  if (static_cast<int>(grid.points.size()) != grid.h * grid.w || grid.h < 3 || grid.w < 3)
+    return std::nullopt;
   return grid;
 }
 
 std::optional<std::vector<cv::Point2f>> WholeBoard(const SeenGrid& grid, int cols, int rows) {
-  const bool as_is = grid.h == rows && grid.w == cols, transposed = grid.h == cols && grid.w == rows;
+  const bool as_is = grid.h == rows && grid.w == cols,
+             transposed = grid.h == cols && grid.w == rows;
   if (!as_is && !transposed) return std::nullopt;
   std::vector<cv::Point2f> corners(cols * rows);
   for (int r = 0; r < rows; ++r) {
@@ -66,12 +69,15 @@ Eigen::Vector2d JunctionLattice::Predict(double i, double j) const {
 
 bool JunctionLattice::Hidden(int i, int j, const cv::Size& size) const {
   const Eigen::Vector2d p = Predict(i, j);
-  const double margin = 0.5 * std::min((Predict(i, j + 1) - p).norm(), (Predict(i + 1, j) - p).norm());
-  return p.x() < margin || p.y() < margin || p.x() > size.width - margin || p.y() > size.height - margin;
+  const double margin =
+      0.5 * std::min((Predict(i, j + 1) - p).norm(), (Predict(i + 1, j) - p).norm());
+  return p.x() < margin || p.y() < margin || p.x() > size.width - margin ||
+         p.y() > size.height - margin;
 }
 
 std::optional<double> JunctionLattice::SquareGray(const cv::Mat& image, int i, int j) const {
-  const double side = std::min((Predict(i, j + 1) - Predict(i, j)).norm(), (Predict(i + 1, j) - Predict(i, j)).norm());
+  const double side = std::min((Predict(i, j + 1) - Predict(i, j)).norm(),
+                               (Predict(i + 1, j) - Predict(i, j)).norm());
   return BoxGray(image, Predict(i + 0.5, j + 0.5), 0.15 * side);
 }
 
@@ -82,7 +88,8 @@ std::optional<double> JunctionLattice::SquareGray(const cv::Mat& image, int i, i
 // a square of the prediction.
 bool JunctionLattice::IsJunction(const cv::Mat& image, int i, int j, Eigen::Vector2d* p) const {
   const Eigen::Vector2d predicted = Predict(i, j);
-  const Eigen::Vector2d u = 0.5 * (Predict(i, j + 1) - Predict(i, j - 1)), v = 0.5 * (Predict(i + 1, j) - Predict(i - 1, j));
+  const Eigen::Vector2d u = 0.5 * (Predict(i, j + 1) - Predict(i, j - 1)),
+                        v = 0.5 * (Predict(i + 1, j) - Predict(i - 1, j));
   const double side = std::min(u.norm(), v.norm());
   double dark_sum = 0, light_sum = 0;
   for (const auto& [di, dj] : {std::pair{0, 0}, {-1, -1}, {-1, 0}, {0, -1}}) {
@@ -94,7 +101,8 @@ bool JunctionLattice::IsJunction(const cv::Mat& image, int i, int j, Eigen::Vect
     (dark ? dark_sum : light_sum) += 0.5 * *gray;
   }
   if (light_sum - dark_sum < 0.5 * (light_ - dark_)) return false;
-  std::vector<cv::Point2f> corner = {cv::Point2f(static_cast<float>(predicted.x()), static_cast<float>(predicted.y()))};
+  std::vector<cv::Point2f> corner = {
+      cv::Point2f(static_cast<float>(predicted.x()), static_cast<float>(predicted.y()))};
   const int half = std::max(2, static_cast<int>(0.2 * side));
   cv::cornerSubPix(image, corner, cv::Size(half, half), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 20, 0.01));
@@ -120,7 +128,8 @@ std::vector<SeenGrid> RegularParts(const SeenGrid& grid) {
           for (int j = 0; j < w; ++j) {
             part.points.push_back(grid.At(i0 + i, j0 + j));
             lattice.emplace_back(static_cast<float>(j), static_cast<float>(i));
-            image.emplace_back(static_cast<float>(part.points.back().x()), static_cast<float>(part.points.back().y()));
+            image.emplace_back(static_cast<float>(part.points.back().x()),
+                               static_cast<float>(part.points.back().y()));
           }
         }
         const cv::Mat homography = cv::findHomography(lattice, image);
@@ -129,13 +138,15 @@ std::vector<SeenGrid> RegularParts(const SeenGrid& grid) {
         cv::perspectiveTransform(lattice, predicted, homography);
         const double step = std::min(cv::norm(image[1] - image[0]), cv::norm(image[w] - image[0]));
         double worst = 0;
-        for (size_t k = 0; k < image.size(); ++k) worst = std::max(worst, cv::norm(predicted[k] - image[k]) / step);
+        for (size_t k = 0; k < image.size(); ++k)
+          worst = std::max(worst, cv::norm(predicted[k] - image[k]) / step);
         // 3 x 3 parts before the smaller ones, each kind by regularity.
         if (worst < 0.1) parts.emplace_back(worst + (h * w == 9 ? 0 : 1), std::move(part));
       }
     }
   }
-  std::stable_sort(parts.begin(), parts.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  std::stable_sort(parts.begin(), parts.end(),
+                   [](const auto& x, const auto& y) { return x.first < y.first; });
   std::vector<SeenGrid> regular;
   for (auto& [score, part] : parts) regular.push_back(std::move(part));
   return regular;
@@ -170,7 +181,8 @@ std::optional<JunctionLattice> JunctionLattice::Seeded(const cv::Mat& image, con
   lattice.light_ = std::max(even, odd);
   if (lattice.light_ - lattice.dark_ < 10) return std::nullopt;
   for (const auto& [parity, gray] : squares) {
-    if ((gray < lattice.Threshold()) != ((parity == 0) == lattice.dark_at_origin_)) return std::nullopt;
+    if ((gray < lattice.Threshold()) != ((parity == 0) == lattice.dark_at_origin_))
+      return std::nullopt;
   }
   return lattice;
 }

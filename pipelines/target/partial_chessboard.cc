@@ -1,10 +1,9 @@
 #include "pipelines/target/partial_chessboard.h"
 
-#include <opencv2/calib3d.hpp>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <opencv2/calib3d.hpp>
 
 namespace portcal {
 namespace {
@@ -22,7 +21,9 @@ struct Placement {
 
 struct Board {
   int cols, rows;
-  bool Has(const Eigen::Vector2i& q) const { return q.x() >= 0 && q.y() >= 0 && q.x() < rows && q.y() < cols; }
+  bool Has(const Eigen::Vector2i& q) const {
+    return q.x() >= 0 && q.y() >= 0 && q.x() < rows && q.y() < cols;
+  }
 };
 
 struct LatticeBounds {
@@ -47,13 +48,15 @@ struct Square {
   double gray;
 };
 
-std::vector<Square> SampleSquares(const cv::Mat& image, const JunctionLattice& lattice, const LatticeBounds& b) {
+std::vector<Square> SampleSquares(const cv::Mat& image, const JunctionLattice& lattice,
+                                  const LatticeBounds& b) {
   std::vector<Square> squares;
   for (int i = b.i0 - 1; i <= b.i1; ++i) {
     for (int j = b.j0 - 1; j <= b.j1; ++j) {
       // Only squares touching a seen junction: the ring around what is seen.
       bool near = false;
-      for (const auto& [di, dj] : {std::pair{0, 0}, {0, 1}, {1, 0}, {1, 1}}) near = near || lattice.Seen(i + di, j + dj);
+      for (const auto& [di, dj] : {std::pair{0, 0}, {0, 1}, {1, 0}, {1, 1}})
+        near = near || lattice.Seen(i + di, j + dj);
       if (!near) continue;
       const auto gray = lattice.SquareGray(image, i, j);
       if (gray) squares.push_back({i, j, *gray});
@@ -62,10 +65,12 @@ std::vector<Square> SampleSquares(const cv::Mat& image, const JunctionLattice& l
   return squares;
 }
 
-bool ColoursMatch(const Placement& place, const std::vector<Square>& squares, double threshold, const Board& board) {
+bool ColoursMatch(const Placement& place, const std::vector<Square>& squares, double threshold,
+                  const Board& board) {
   int checked = 0, wrong = 0;
   for (const Square& square : squares) {
-    const Eigen::Vector2i q00 = place.Map(square.i, square.j), q11 = place.Map(square.i + 1, square.j + 1);
+    const Eigen::Vector2i q00 = place.Map(square.i, square.j),
+                          q11 = place.Map(square.i + 1, square.j + 1);
     // Square (sr, sc) lies between corner rows sr - 1 and sr, columns
     // sc - 1 and sc; square (0, 0), corner 0's outer diagonal one, is black.
     const int sr = std::max(q00.x(), q11.x()), sc = std::max(q00.y(), q11.y());
@@ -97,9 +102,16 @@ std::vector<Placement> FittingPlacements(const cv::Mat& image, const JunctionLat
   const Eigen::Vector2d origin = lattice.Predict(bounds.i0, bounds.j0);
   const Eigen::Vector2d vi = lattice.Predict(bounds.i0 + 1, bounds.j0) - origin;
   const Eigen::Vector2d vj = lattice.Predict(bounds.i0, bounds.j0 + 1) - origin;
-  const std::array<std::array<int, 4>, 8> turns = {{{1, 0, 0, 1}, {-1, 0, 0, -1}, {1, 0, 0, -1}, {-1, 0, 0, 1},
-                                                    {0, 1, 1, 0}, {0, -1, -1, 0}, {0, 1, -1, 0}, {0, -1, 1, 0}}};
-  const int reach = std::abs(bounds.i0) + std::abs(bounds.i1) + std::abs(bounds.j0) + std::abs(bounds.j1) + 1;
+  const std::array<std::array<int, 4>, 8> turns = {{{1, 0, 0, 1},
+                                                    {-1, 0, 0, -1},
+                                                    {1, 0, 0, -1},
+                                                    {-1, 0, 0, 1},
+                                                    {0, 1, 1, 0},
+                                                    {0, -1, -1, 0},
+                                                    {0, 1, -1, 0},
+                                                    {0, -1, 1, 0}}};
+  const int reach =
+      std::abs(bounds.i0) + std::abs(bounds.i1) + std::abs(bounds.j0) + std::abs(bounds.j1) + 1;
   std::vector<Placement> fitting;
   for (const auto& [a, b, e, f] : turns) {
     // Along a row (+c) and down a column (+r) in the image: right-handed.
@@ -108,7 +120,9 @@ std::vector<Placement> FittingPlacements(const cv::Mat& image, const JunctionLat
     for (int r0 = -reach; r0 <= board.rows + reach; ++r0) {
       for (int c0 = -reach; c0 <= board.cols + reach; ++c0) {
         const Placement place{a, b, e, f, r0, c0};
-        if (!board.Has(place.Map(bounds.i0, bounds.j0)) || !board.Has(place.Map(bounds.i1, bounds.j1))) continue;
+        if (!board.Has(place.Map(bounds.i0, bounds.j0)) ||
+            !board.Has(place.Map(bounds.i1, bounds.j1)))
+          continue;
         if (ColoursMatch(place, squares, lattice.Threshold(), board) &&
             SeenWhereInView(place, lattice, board, image.size())) {
           fitting.push_back(place);
@@ -121,16 +135,19 @@ std::vector<Placement> FittingPlacements(const cv::Mat& image, const JunctionLat
 
 // The board turned by 180 degrees takes corner (r, c) to
 // (rows - 1 - r, cols - 1 - c).
-bool TurnedByHalf(const Placement& p, const Placement& q, const JunctionLattice& lattice, const Board& board) {
+bool TurnedByHalf(const Placement& p, const Placement& q, const JunctionLattice& lattice,
+                  const Board& board) {
   for (const auto& [ij, point] : lattice.points()) {
-    if (q.Map(ij.first, ij.second) != Eigen::Vector2i(board.rows - 1, board.cols - 1) - p.Map(ij.first, ij.second)) {
+    if (q.Map(ij.first, ij.second) !=
+        Eigen::Vector2i(board.rows - 1, board.cols - 1) - p.Map(ij.first, ij.second)) {
       return false;
     }
   }
   return true;
 }
 
-PartialChessboard PlaceOnBoard(const Placement& place, const JunctionLattice& lattice, const Board& board) {
+PartialChessboard PlaceOnBoard(const Placement& place, const JunctionLattice& lattice,
+                               const Board& board) {
   PartialChessboard result;
   result.corners.resize(board.cols * board.rows);
   result.seen.assign(board.cols * board.rows, false);
@@ -139,7 +156,8 @@ PartialChessboard PlaceOnBoard(const Placement& place, const JunctionLattice& la
       const Eigen::Vector2i ij = place.Unmap(r, c);
       const auto it = lattice.points().find({ij.x(), ij.y()});
       result.seen[r * board.cols + c] = it != lattice.points().end();
-      result.corners[r * board.cols + c] = result.seen[r * board.cols + c] ? it->second : lattice.Predict(ij.x(), ij.y());
+      result.corners[r * board.cols + c] =
+          result.seen[r * board.cols + c] ? it->second : lattice.Predict(ij.x(), ij.y());
     }
   }
   return result;
@@ -147,14 +165,16 @@ PartialChessboard PlaceOnBoard(const Placement& place, const JunctionLattice& la
 
 }  // namespace
 
-PartialPlacement PlaceOnChessboard(const cv::Mat& image, const JunctionLattice& lattice, int cols, int rows) {
+PartialPlacement PlaceOnChessboard(const cv::Mat& image, const JunctionLattice& lattice, int cols,
+                                   int rows) {
   PartialPlacement placement;
   const Board board{cols, rows};
   const LatticeBounds bounds = BoundsOf(lattice);
   const int num_rows = bounds.i1 - bounds.i0 + 1, num_cols = bounds.j1 - bounds.j0 + 1;
-  const bool too_large = !((num_rows <= rows && num_cols <= cols) || (num_rows <= cols && num_cols <= rows));
-  const std::string seen = std::to_string(lattice.points().size()) + " junctions over " + std::to_string(num_cols) +
-                           "x" + std::to_string(num_rows) + " seen";
+  const bool too_large =
+      !((num_rows <= rows && num_cols <= cols) || (num_rows <= cols && num_cols <= rows));
+  const std::string seen = std::to_string(lattice.points().size()) + " junctions over " +
+                           std::to_string(num_cols) + "x" + std::to_string(num_rows) + " seen";
   const std::string looked_for = std::to_string(cols) + "x" + std::to_string(rows) + " board";
   if (too_large) {
     placement.reason = seen + ": more than the " + looked_for + " has (another board)";
@@ -162,13 +182,16 @@ PartialPlacement PlaceOnChessboard(const cv::Mat& image, const JunctionLattice& 
   }
   const std::vector<Placement> fitting = FittingPlacements(image, lattice, bounds, board);
   if (fitting.empty()) {
-    placement.reason = seen + ", but they fit nowhere on the " + looked_for +
-                       " with its cut sides at the image's border (another board, or one partly hidden)";
+    placement.reason =
+        seen + ", but they fit nowhere on the " + looked_for +
+        " with its cut sides at the image's border (another board, or one partly hidden)";
     return placement;
   }
-  const bool symmetric = fitting.size() == 2 && TurnedByHalf(fitting[0], fitting[1], lattice, board);
+  const bool symmetric =
+      fitting.size() == 2 && TurnedByHalf(fitting[0], fitting[1], lattice, board);
   if (fitting.size() > 1 && !symmetric) {
-    placement.reason = seen + ", which " + std::to_string(fitting.size()) + " places on the " + looked_for +
+    placement.reason = seen + ", which " + std::to_string(fitting.size()) + " places on the " +
+                       looked_for +
                        " fit (its part cannot be told: more of the board must be seen)";
     return placement;
   }

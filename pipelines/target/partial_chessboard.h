@@ -43,6 +43,7 @@ struct PartialPlacement {
   std::string reason;
 };
 
-PartialPlacement PlaceOnChessboard(const cv::Mat& image, const JunctionLattice& lattice, int cols, int rows);
+PartialPlacement PlaceOnChessboard(const cv::Mat& image, const JunctionLattice& lattice, int cols,
+                                   int rows);
 
 }  // namespace portcal

@@ -2,17 +2,18 @@
 
 #include <algorithm>
 #include <array>
-#include <limits>
-#include <vector>
 #include <cmath>
+#include <limits>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "colmap_ext/util/error.h"
 
 namespace portcal {
 
 void XCornerCountOptions::Check() const {
-  if (ring_radius_px < 2) throw OptionError("ring_radius_px", std::to_string(ring_radius_px), ">= 2");
+  if (ring_radius_px < 2)
+    throw OptionError("ring_radius_px", std::to_string(ring_radius_px), ">= 2");
   if (!(min_normalised_response > 0 && min_normalised_response < 1)) {
     throw OptionError("min_normalised_response", std::to_string(min_normalised_response), "(0, 1)");
   }
@@ -40,7 +41,8 @@ cv::Mat JunctionMask(const cv::Mat& gray, const XCornerCountOptions& options, do
   cv::copyMakeBorder(smooth, padded, r, r, r, r, cv::BORDER_REPLICATE);
   cv::Mat padded16;
   padded.convertTo(padded16, CV_16S);
-  std::array<cv::Mat, 16> ring;  // views of the samples (16-bit: same-type arithmetic is vectorised)
+  std::array<cv::Mat, 16>
+      ring;  // views of the samples (16-bit: same-type arithmetic is vectorised)
   for (int k = 0; k < 16; ++k) {
     const int dx = static_cast<int>(std::lround(r * std::cos(2 * M_PI * (k + phase) / 16)));
     const int dy = static_cast<int>(std::lround(r * std::sin(2 * M_PI * (k + phase) / 16)));
@@ -50,7 +52,8 @@ cv::Mat JunctionMask(const cv::Mat& gray, const XCornerCountOptions& options, do
   // opposite samples unlike (an edge); less the ring's mean against the
   // centre (a line or a spot), all times 16.
   std::array<cv::Mat, 8> opposite_sum;
-  cv::Mat sum(gray.size(), CV_16S, cv::Scalar(0)), value(gray.size(), CV_16S, cv::Scalar(0)), difference;
+  cv::Mat sum(gray.size(), CV_16S, cv::Scalar(0)), value(gray.size(), CV_16S, cv::Scalar(0)),
+      difference;
   for (int k = 0; k < 8; ++k) {
     cv::add(ring[k], ring[k + 8], opposite_sum[k]);
     cv::add(sum, opposite_sum[k], sum);
@@ -136,8 +139,8 @@ int CountAtScale(const cv::Mat& gray, const XCornerCountOptions& options, int en
   for (const double phase : {0.0, 0.5}) {
     if (best >= enough) break;
     cv::Mat labels, stats, centroids;
-    const int num_labels =
-        cv::connectedComponentsWithStats(JunctionMask(gray, options, phase), labels, stats, centroids, 8, CV_32S);
+    const int num_labels = cv::connectedComponentsWithStats(JunctionMask(gray, options, phase),
+                                                            labels, stats, centroids, 8, CV_32S);
     // More spots than a textured scene at this size gives (~500) would
     // make the search slow; so many cannot be judged, they pass.
     if (num_labels > kMaxJunctions) return std::numeric_limits<int>::max();

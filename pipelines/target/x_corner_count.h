@@ -17,7 +17,6 @@
 #pragma once
 
 #include <limits>
-
 #include <opencv2/core.hpp>
 
 namespace portcal {

@@ -26,16 +26,19 @@ DepthError Summarise(double depth, Eigen::MatrixXd grid) {
     double sum = 0;
     for (const double v : values) sum += v;
     error.mean_px = sum / static_cast<double>(values.size());
-    error.p95_px = values[static_cast<size_t>(std::floor(0.95 * static_cast<double>(values.size() - 1)))];
+    error.p95_px =
+        values[static_cast<size_t>(std::floor(0.95 * static_cast<double>(values.size() - 1)))];
   }
   error.grid = std::move(grid);
   return error;
 }
 
 // The worst error over `depths` of the pinhole at `design_depth`.
-double WorstError(const HousedCamera& camera, double design_depth, const std::vector<double>& depths,
-                  const Eigen::Matrix3d& pinhole_from_cam, const FieldOfViewOptions& field_of_view) {
-  const VirtualPinhole pinhole = FitVirtualPinhole(camera, design_depth, pinhole_from_cam, field_of_view);
+double WorstError(const HousedCamera& camera, double design_depth,
+                  const std::vector<double>& depths, const Eigen::Matrix3d& pinhole_from_cam,
+                  const FieldOfViewOptions& field_of_view) {
+  const VirtualPinhole pinhole =
+      FitVirtualPinhole(camera, design_depth, pinhole_from_cam, field_of_view);
   return MeasureApproximationError(pinhole, depths, 24, 1).worst_px;
 }
 
@@ -45,21 +48,25 @@ std::vector<double> SampleDepths(const DepthRange& range, int count, double desi
   count = std::max(2, count);
   std::vector<double> depths;
   const double log_near = std::log(range.near), log_far = std::log(range.far);
-  for (int i = 0; i < count; ++i) depths.push_back(std::exp(log_near + (log_far - log_near) * i / (count - 1)));
+  for (int i = 0; i < count; ++i)
+    depths.push_back(std::exp(log_near + (log_far - log_near) * i / (count - 1)));
   depths.front() = range.near;
   depths.back() = range.far;
   const bool inside = design_depth > range.near && design_depth < range.far;
-  const bool listed = std::any_of(depths.begin(), depths.end(),
-                                  [&](double d) { return std::abs(d - design_depth) < 1e-9 * design_depth; });
+  const bool listed = std::any_of(depths.begin(), depths.end(), [&](double d) {
+    return std::abs(d - design_depth) < 1e-9 * design_depth;
+  });
   if (inside && !listed) depths.push_back(design_depth);
   std::sort(depths.begin(), depths.end());
   return depths;
 }
 
-ApproximationError MeasureApproximationError(const VirtualPinhole& pinhole, const std::vector<double>& depths,
-                                             int grid_cols, int num_threads) {
+ApproximationError MeasureApproximationError(const VirtualPinhole& pinhole,
+                                             const std::vector<double>& depths, int grid_cols,
+                                             int num_threads) {
   const int rows = GridRows(pinhole.pinhole, grid_cols);
-  std::vector<Eigen::MatrixXd> grids(depths.size(), Eigen::MatrixXd::Constant(rows, grid_cols, -1.0));
+  std::vector<Eigen::MatrixXd> grids(depths.size(),
+                                     Eigen::MatrixXd::Constant(rows, grid_cols, -1.0));
   const double cell_w = static_cast<double>(pinhole.pinhole.width) / grid_cols;
   const double cell_h = static_cast<double>(pinhole.pinhole.height) / rows;
   ParallelFor(static_cast<size_t>(rows), num_threads, [&](size_t r) {
@@ -82,7 +89,8 @@ ApproximationError MeasureApproximationError(const VirtualPinhole& pinhole, cons
   return result;
 }
 
-double ChooseDesignDepth(const HousedCamera& camera, const DepthRange& range, const Eigen::Matrix3d& pinhole_from_cam,
+double ChooseDesignDepth(const HousedCamera& camera, const DepthRange& range,
+                         const Eigen::Matrix3d& pinhole_from_cam,
                          const FieldOfViewOptions& field_of_view) {
   if (!camera.housing) return range.near;
   // The error grows away from the design depth on both sides (it is zero

@@ -39,13 +39,15 @@ std::vector<double> SampleDepths(const DepthRange& range, int count, double desi
 
 // The error at each of `depths` on a `grid_cols` wide grid (rows in the
 // output's aspect), rows computed on `num_threads` threads.
-ApproximationError MeasureApproximationError(const VirtualPinhole& pinhole, const std::vector<double>& depths,
-                                             int grid_cols, int num_threads);
+ApproximationError MeasureApproximationError(const VirtualPinhole& pinhole,
+                                             const std::vector<double>& depths, int grid_cols,
+                                             int num_threads);
 
 // The design depth in `range` whose pinhole (fitted as `field_of_view`
 // says) has the smallest worst error over the range: golden-section search
 // in log depth on a coarse grid. In air, the near end (any depth is exact).
-double ChooseDesignDepth(const HousedCamera& camera, const DepthRange& range, const Eigen::Matrix3d& pinhole_from_cam,
+double ChooseDesignDepth(const HousedCamera& camera, const DepthRange& range,
+                         const Eigen::Matrix3d& pinhole_from_cam,
                          const FieldOfViewOptions& field_of_view);
 
 }  // namespace portcal

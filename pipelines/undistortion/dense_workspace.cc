@@ -27,13 +27,15 @@ std::string RunScript(bool geometric) {
       << "colmap stereo_fusion --workspace_path . --workspace_format COLMAP --input_type "
       << (geometric ? "geometric" : "photometric") << " --output_path ./fused.ply\n"
       << "colmap poisson_mesher --input_path ./fused.ply --output_path ./meshed-poisson.ply\n"
-      << "colmap delaunay_mesher --input_path . --input_type dense --output_path ./meshed-delaunay.ply\n";
+      << "colmap delaunay_mesher --input_path . --input_type dense --output_path "
+         "./meshed-delaunay.ply\n";
   return out.str();
 }
 
 }  // namespace
 
-SparseModel PinholeModel(const SparseModel& model, const std::map<camera_t, VirtualPinhole>& pinholes) {
+SparseModel PinholeModel(const SparseModel& model,
+                         const std::map<camera_t, VirtualPinhole>& pinholes) {
   SparseModel result;
   for (const auto& [camera_id, camera] : model.cameras) {
     const auto it = pinholes.find(camera_id);

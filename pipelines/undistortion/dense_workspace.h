@@ -19,7 +19,8 @@ namespace portcal {
 // where the undistorted image shows it (as COLMAP's undistorter, also
 // outside the output image; one without a ray leaves its point's track),
 // points kept while they have a track, no housings.
-SparseModel PinholeModel(const SparseModel& model, const std::map<camera_t, VirtualPinhole>& pinholes);
+SparseModel PinholeModel(const SparseModel& model,
+                         const std::map<camera_t, VirtualPinhole>& pinholes);
 
 // sparse/, stereo/ and the scripts into `dir` (which exists).
 void WriteDenseWorkspace(const SparseModel& pinhole_model, const std::filesystem::path& dir);

@@ -23,15 +23,18 @@ struct RemapTables {
 };
 
 // Exact per pixel, rows on `num_threads` threads; `progress` counts rows.
-RemapTables ComputeRemapTables(const VirtualPinhole& pinhole, int num_threads, ProgressSink& progress);
+RemapTables ComputeRemapTables(const VirtualPinhole& pinhole, int num_threads,
+                               ProgressSink& progress);
 
 // The undistorted image: bilinear, black where the output shows nothing.
 // Throws InputError when `image`'s size is not the tables' camera's.
-cv::Mat ApplyRemapTables(const RemapTables& tables, const cv::Mat& image, const cv::Size& source_size);
+cv::Mat ApplyRemapTables(const RemapTables& tables, const cv::Mat& image,
+                         const cv::Size& source_size);
 
 // FileStorage (YAML; gzip-compressed when `path` ends in .gz): map_x,
 // map_y (float32, the output's size), camera_matrix and image_size of the
 // virtual pinhole, source_size, design_depth; atomically.
-void WriteRemapTables(const RemapTables& tables, const VirtualPinhole& pinhole, const std::filesystem::path& path);
+void WriteRemapTables(const RemapTables& tables, const VirtualPinhole& pinhole,
+                      const std::filesystem::path& path);
 
 }  // namespace portcal

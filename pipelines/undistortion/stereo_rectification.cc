@@ -13,10 +13,13 @@ RectifyingRotations RectifyingRotationsOf(const Rigid3d& cam2_from_cam1) {
   const Eigen::Vector3d centre2 = -(cam1_from_cam2 * cam2_from_cam1.translation);
   if (!(centre2.norm() > 0)) throw InputError("cam2_from_cam1: zero baseline, nothing to rectify");
   const Eigen::Vector3d x = centre2.normalized();
-  const Eigen::Vector3d mean_axis = Eigen::Vector3d::UnitZ() + cam1_from_cam2 * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d mean_axis =
+      Eigen::Vector3d::UnitZ() + cam1_from_cam2 * Eigen::Vector3d::UnitZ();
   Eigen::Vector3d y = mean_axis.cross(x);
   if (!(y.norm() > 1e-6 * mean_axis.norm())) {
-    throw InputError("cam2_from_cam1: the baseline runs along the cameras' optical axes; no rectification exists");
+    throw InputError(
+        "cam2_from_cam1: the baseline runs along the cameras' optical axes; no rectification "
+        "exists");
   }
   y.normalize();
   const Eigen::Vector3d z = x.cross(y);
@@ -38,20 +41,23 @@ void ScaleFocal(double focal, Camera* pinhole) {
   p[0] = p[1] = focal;
   p[2] *= sx;
   p[3] *= sy;
-  pinhole->width = static_cast<uint64_t>(std::max(1.0, std::round(static_cast<double>(pinhole->width) * sx)));
-  pinhole->height = static_cast<uint64_t>(std::max(1.0, std::round(static_cast<double>(pinhole->height) * sy)));
+  pinhole->width =
+      static_cast<uint64_t>(std::max(1.0, std::round(static_cast<double>(pinhole->width) * sx)));
+  pinhole->height =
+      static_cast<uint64_t>(std::max(1.0, std::round(static_cast<double>(pinhole->height) * sy)));
 }
 
 }  // namespace
 
-std::pair<VirtualPinhole, VirtualPinhole> FitRectifiedPinholes(const HousedCamera& camera1, const HousedCamera& camera2,
-                                                               const RectifyingRotations& rotations,
-                                                               double design_depth1, double design_depth2,
-                                                               const FieldOfViewOptions& options) {
-  VirtualPinhole first = FitVirtualPinhole(camera1, design_depth1, rotations.rect_from_cam1, options);
-  VirtualPinhole second = FitVirtualPinhole(camera2, design_depth2, rotations.rect_from_cam2, options);
-  const double focal =
-      0.25 * (first.pinhole.params[0] + first.pinhole.params[1] + second.pinhole.params[0] + second.pinhole.params[1]);
+std::pair<VirtualPinhole, VirtualPinhole> FitRectifiedPinholes(
+    const HousedCamera& camera1, const HousedCamera& camera2, const RectifyingRotations& rotations,
+    double design_depth1, double design_depth2, const FieldOfViewOptions& options) {
+  VirtualPinhole first =
+      FitVirtualPinhole(camera1, design_depth1, rotations.rect_from_cam1, options);
+  VirtualPinhole second =
+      FitVirtualPinhole(camera2, design_depth2, rotations.rect_from_cam2, options);
+  const double focal = 0.25 * (first.pinhole.params[0] + first.pinhole.params[1] +
+                               second.pinhole.params[0] + second.pinhole.params[1]);
   ScaleFocal(focal, &first.pinhole);
   ScaleFocal(focal, &second.pinhole);
   // One principal row and height: the rows both images show (blank_pixels

@@ -28,9 +28,8 @@ RectifyingRotations RectifyingRotationsOf(const Rigid3d& cam2_from_cam1);
 // and one height; the widths and principal columns stay each camera's own
 // (the framing `options.blank_pixels` asks for), so the disparity of a
 // point is x1 - x2 - (cx1 - cx2).
-std::pair<VirtualPinhole, VirtualPinhole> FitRectifiedPinholes(const HousedCamera& camera1, const HousedCamera& camera2,
-                                                               const RectifyingRotations& rotations,
-                                                               double design_depth1, double design_depth2,
-                                                               const FieldOfViewOptions& options);
+std::pair<VirtualPinhole, VirtualPinhole> FitRectifiedPinholes(
+    const HousedCamera& camera1, const HousedCamera& camera2, const RectifyingRotations& rotations,
+    double design_depth1, double design_depth2, const FieldOfViewOptions& options);
 
 }  // namespace portcal

@@ -25,7 +25,8 @@ struct CameraUndistortion {
 
 // The loud part: each camera whose approximation errs by more than
 // `max_error_px` somewhere over its range.
-std::vector<std::string> UndistortionWarnings(const std::vector<CameraUndistortion>& cameras, double max_error_px);
+std::vector<std::string> UndistortionWarnings(const std::vector<CameraUndistortion>& cameras,
+                                              double max_error_px);
 
 std::string UndistortionReportText(const std::vector<CameraUndistortion>& cameras,
                                    const std::vector<std::string>& warnings);
@@ -33,6 +34,7 @@ std::string UndistortionReportYaml(const std::vector<CameraUndistortion>& camera
                                    const std::vector<std::string>& warnings);
 // The page: the text, then per camera behind a port an error map per depth
 // (colour bar shared by the camera's maps).
-HtmlReport UndistortionHtml(const std::vector<CameraUndistortion>& cameras, const std::vector<std::string>& warnings);
+HtmlReport UndistortionHtml(const std::vector<CameraUndistortion>& cameras,
+                            const std::vector<std::string>& warnings);
 
 }  // namespace portcal

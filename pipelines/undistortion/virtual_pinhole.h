@@ -34,7 +34,8 @@ struct VirtualPinhole {
   // The point at depth `depth` on the ray of `source_pixel` (in water
   // behind a port), in the real camera's frame; nullopt where the pixel
   // has no ray or its ray does not reach that depth.
-  std::optional<Eigen::Vector3d> PointAtDepth(const Eigen::Vector2d& source_pixel, double depth) const;
+  std::optional<Eigen::Vector3d> PointAtDepth(const Eigen::Vector2d& source_pixel,
+                                              double depth) const;
   // A point in the real camera's frame -> the pinhole's pixel (COLMAP's
   // convention); nullopt behind the pinhole.
   std::optional<Eigen::Vector2d> PinholePixel(const Eigen::Vector3d& point_in_cam) const;
@@ -72,7 +73,8 @@ struct FieldOfViewOptions {
 // camera's falls, and an output size that frames the camera's image as
 // `options` ask. Throws NumericalError when the camera's border has no rays.
 VirtualPinhole FitVirtualPinhole(const HousedCamera& source, double design_depth,
-                                 const Eigen::Matrix3d& pinhole_from_cam, const FieldOfViewOptions& options);
+                                 const Eigen::Matrix3d& pinhole_from_cam,
+                                 const FieldOfViewOptions& options);
 
 // The largest depth (z, metres) the housing's outer surface reaches over
 // the image's rays: a design depth or a depth range must lie beyond it.

@@ -9,7 +9,6 @@
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Dense>
-
 #include <memory>
 #include <random>
 
@@ -35,8 +34,8 @@ Housing BenchHousing(bool dome) {
                              "bench");
   }
   const double tilt = 5.0 * M_PI / 180.0;
-  return Housing::FromName("FLATPORT", {std::sin(tilt), 0, std::cos(tilt), 0.02, 0.014, 1.0,
-                                        1.473, 1.334}, "bench");
+  return Housing::FromName(
+      "FLATPORT", {std::sin(tilt), 0, std::cos(tilt), 0.02, 0.014, 1.0, 1.473, 1.334}, "bench");
 }
 
 // Points seen at known pixels: back-projected from a pixel grid at 0.4-3 m.
@@ -148,7 +147,8 @@ void ReprojectionErrorWithJacobians(benchmark::State& state, bool dome) {
   double pose[7] = {0, 0, 0, 1, 0, 0, 0};
   std::vector<double> intrinsics = camera.params, port = housing.params;
   double jacobian_storage[4][2 * 8];
-  double* jacobians[4] = {jacobian_storage[0], jacobian_storage[1], jacobian_storage[2], jacobian_storage[3]};
+  double* jacobians[4] = {jacobian_storage[0], jacobian_storage[1], jacobian_storage[2],
+                          jacobian_storage[3]};
   double residual[2];
   size_t i = 0;
   for (auto _ : state) {
@@ -167,8 +167,12 @@ BENCHMARK(BM_FlatPortProjectExact);
 BENCHMARK(BM_FlatPortProjectIterative);
 BENCHMARK(BM_DomePortProjectExact);
 BENCHMARK(BM_DomePortProjectIterative);
-void BM_FlatPortErrorWithJacobians(benchmark::State& state) { ReprojectionErrorWithJacobians(state, false); }
-void BM_DomePortErrorWithJacobians(benchmark::State& state) { ReprojectionErrorWithJacobians(state, true); }
+void BM_FlatPortErrorWithJacobians(benchmark::State& state) {
+  ReprojectionErrorWithJacobians(state, false);
+}
+void BM_DomePortErrorWithJacobians(benchmark::State& state) {
+  ReprojectionErrorWithJacobians(state, true);
+}
 BENCHMARK(BM_FlatPortErrorWithJacobians);
 BENCHMARK(BM_DomePortErrorWithJacobians);
 

@@ -17,8 +17,8 @@
 #include "colmap_ext/io/ground_truth.h"
 #include "pipelines/detection/target_detector.h"
 #include "pipelines/detection/target_pose.h"
-#include "pipelines/live/hands_free.h"
 #include "pipelines/guidance/live_estimator.h"
+#include "pipelines/live/hands_free.h"
 #include "pipelines/live/live_overlay.h"
 #include "pipelines/live/live_server.h"
 #include "pipelines/live/live_session.h"
@@ -78,13 +78,15 @@ BENCHMARK(BM_LiveDetect)->Unit(benchmark::kMillisecond);
 void BM_LiveOverlay(benchmark::State& state) {
   LiveSnapshot snapshot;
   snapshot.frame = Frame();
-  for (const BoardPoint& p : DetectTarget(Frame(), Target()).points) snapshot.corners[static_cast<int>(p.point_id)] = p.xy;
+  for (const BoardPoint& p : DetectTarget(Frame(), Target()).points)
+    snapshot.corners[static_cast<int>(p.point_id)] = p.xy;
   const TargetShape shape = Shape();
   LiveEstimatorOptions options;
   options.camera = BenchCamera();
   options.guidance.distance_min_m = 0.4;
   options.guidance.distance_max_m = 1.2;
-  snapshot.estimate = std::make_shared<LiveEstimate>(LiveEstimator(options, shape).Estimate({}, nullptr));
+  snapshot.estimate =
+      std::make_shared<LiveEstimate>(LiveEstimator(options, shape).Estimate({}, nullptr));
   const LivePageOptions page;
   size_t bytes = 0;
   for (auto _ : state) bytes = EncodeOverlayJpeg(snapshot, shape, page).size();
@@ -103,8 +105,8 @@ std::vector<CalibrationView> Views(int n) {
   sampling.distance_max_m = 1.2;
   std::vector<CalibrationView> views;
   for (int v = 0; v < n; ++v) {
-    const Rigid3d pose =
-        SampleTargetView(camera, nullptr, shape.outline, shape.center, -Eigen::Vector3d::UnitZ(), sampling, &rng);
+    const Rigid3d pose = SampleTargetView(camera, nullptr, shape.outline, shape.center,
+                                          -Eigen::Vector3d::UnitZ(), sampling, &rng);
     CalibrationView view;
     view.image_name = "v" + std::to_string(v);
     for (const Eigen::Vector3d& p : shape.points) {

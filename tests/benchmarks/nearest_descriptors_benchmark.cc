@@ -17,7 +17,8 @@ UnitDescriptorRows Descriptors(int rows, unsigned seed) {
   std::uniform_int_distribution<int> spike(0, 9);
   UnitDescriptorRows d(rows, 128);
   for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < 128; ++c) d(r, c) = static_cast<float>(byte(rng) + (spike(rng) == 0 ? 120 : 0));
+    for (int c = 0; c < 128; ++c)
+      d(r, c) = static_cast<float>(byte(rng) + (spike(rng) == 0 ? 120 : 0));
     d.row(r).normalize();
   }
   return d;
@@ -40,7 +41,8 @@ void BM_NearestDescriptors(benchmark::State& state) {
     benchmark::DoNotOptimize(n1.data());
   }
   state.counters["gflops"] =
-      benchmark::Counter(2.0 * n * n * 128, benchmark::Counter::kIsIterationInvariantRate, benchmark::Counter::kIs1000);
+      benchmark::Counter(2.0 * n * n * 128, benchmark::Counter::kIsIterationInvariantRate,
+                         benchmark::Counter::kIs1000);
 }
 
 BENCHMARK_TEMPLATE(BM_NearestDescriptors, false)->Arg(4300)->Unit(benchmark::kMillisecond);

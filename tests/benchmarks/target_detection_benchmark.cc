@@ -33,7 +33,8 @@ struct RenderedFrame {
 
 // One rendered 1080p view of the target described by `target_yaml`.
 RenderedFrame Render(const std::string& name, const std::string& target_yaml) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("portcal_bench_" + name);
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("portcal_bench_" + name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "set.yaml") << R"(name: bench
@@ -52,7 +53,8 @@ render: {spp: 4, blur_sigma: 0.8, noise_sigma: 2.0}
   RunSynthesize(options, progress);
   const GroundTruth truth = ReadGroundTruth(dir / "set/ground_truth.yaml");
   RenderedFrame result;
-  result.gray = cv::imread((dir / "set" / truth.images[0].cam1.file).string(), cv::IMREAD_GRAYSCALE);
+  result.gray =
+      cv::imread((dir / "set" / truth.images[0].cam1.file).string(), cv::IMREAD_GRAYSCALE);
   result.truth = truth.images[0].cam1;
   std::filesystem::remove_all(dir);
   return result;
@@ -60,7 +62,8 @@ render: {spp: 4, blur_sigma: 0.8, noise_sigma: 2.0}
 
 const RenderedFrame& BoardFrame() {
   static const RenderedFrame frame =
-      Render("chessboard", "target: {type: chessboard, cols: 10, rows: 7, square_size: 0.03, margin: 0.02}\n");
+      Render("chessboard",
+             "target: {type: chessboard, cols: 10, rows: 7, square_size: 0.03, margin: 0.02}\n");
   return frame;
 }
 
@@ -125,10 +128,12 @@ MarkerBoardOptions MarkerOptions(const std::string& type, bool precise) {
 }
 
 const RenderedFrame& MarkerFrame(const std::string& type) {
-  static const RenderedFrame grid = Render(
-      "aruco_grid", "target: {type: aruco_grid, markers_x: 6, markers_y: 4, marker_size: 0.04, marker_separation: 0.01}\n");
-  static const RenderedFrame board = Render(
-      "charuco", "target: {type: charuco, squares_x: 9, squares_y: 6, square_size: 0.03, marker_size: 0.022}\n");
+  static const RenderedFrame grid = Render("aruco_grid",
+                                           "target: {type: aruco_grid, markers_x: 6, markers_y: 4, "
+                                           "marker_size: 0.04, marker_separation: 0.01}\n");
+  static const RenderedFrame board = Render("charuco",
+                                            "target: {type: charuco, squares_x: 9, squares_y: 6, "
+                                            "square_size: 0.03, marker_size: 0.022}\n");
   return type == "charuco" ? board : grid;
 }
 
@@ -147,7 +152,8 @@ void DetectMarkers(benchmark::State& state, const std::string& type, bool precis
       continue;
     }
     for (const auto& marker : frame.truth.markers) {
-      if (marker.id == point.point_id / 4) errors.push_back((point.xy - marker.corners_px[point.point_id % 4]).norm());
+      if (marker.id == point.point_id / 4)
+        errors.push_back((point.xy - marker.corners_px[point.point_id % 4]).norm());
     }
   }
   ErrorCounters(errors, state);
@@ -168,8 +174,12 @@ void BM_ArucoGridFrame(benchmark::State& state) { DetectMarkers(state, "aruco_gr
 void BM_ArucoGridFrameQuick(benchmark::State& state) { DetectMarkers(state, "aruco_grid", false); }
 void BM_CharucoFrame(benchmark::State& state) { DetectMarkers(state, "charuco", true); }
 void BM_CharucoFrameQuick(benchmark::State& state) { DetectMarkers(state, "charuco", false); }
-void BM_FrameWithoutArucoGrid(benchmark::State& state) { MarkersWithoutBoard(state, "aruco_grid", true); }
-void BM_FrameWithoutArucoGridQuick(benchmark::State& state) { MarkersWithoutBoard(state, "aruco_grid", false); }
+void BM_FrameWithoutArucoGrid(benchmark::State& state) {
+  MarkersWithoutBoard(state, "aruco_grid", true);
+}
+void BM_FrameWithoutArucoGridQuick(benchmark::State& state) {
+  MarkersWithoutBoard(state, "aruco_grid", false);
+}
 
 // The live detector: every target type found quick, and its pose from
 // the known camera, in one call each; the pose's error against the truth.
@@ -193,7 +203,8 @@ void LiveFrame(benchmark::State& state, const std::string& type) {
     return;
   }
   const Rigid3d& truth = frame.truth.cam_from_target;
-  state.counters["position_error_mm"] = 1e3 * (pose->cam_from_target.translation - truth.translation).norm();
+  state.counters["position_error_mm"] =
+      1e3 * (pose->cam_from_target.translation - truth.translation).norm();
   state.counters["rotation_error_deg"] =
       pose->cam_from_target.rotation.angularDistance(truth.rotation) * 180 / M_PI;
   state.counters["rms_px"] = pose->rms_px;

@@ -16,8 +16,9 @@ namespace {
 
 struct Pair {
   Camera camera = Camera::FromModelName("PINHOLE", 700, 960, 540);
-  Rigid3d cam2_from_cam1{Eigen::Quaterniond(Eigen::AngleAxisd(0.1, Eigen::Vector3d(0.2, 1, 0.1).normalized())),
-                         Eigen::Vector3d(-0.5, 0.02, 0.05)};
+  Rigid3d cam2_from_cam1{
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.1, Eigen::Vector3d(0.2, 1, 0.1).normalized())),
+      Eigen::Vector3d(-0.5, 0.02, 0.05)};
   FeatureKeypoints keypoints1, keypoints2;
   FeatureMatches matches;
   std::vector<Eigen::Vector2d> inliers1, inliers2;  // normalised, the true matches
@@ -28,7 +29,9 @@ Pair MakePair(int num_matches, double chance_fraction) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0, 1);
   std::normal_distribution<double> noise(0, 0.5);
-  const auto inside = [](const Eigen::Vector2d& p) { return p.x() >= 0 && p.x() <= 960 && p.y() >= 0 && p.y() <= 540; };
+  const auto inside = [](const Eigen::Vector2d& p) {
+    return p.x() >= 0 && p.x() <= 960 && p.y() >= 0 && p.y() <= 540;
+  };
   while (static_cast<int>(pair.matches.size()) < num_matches) {
     const Eigen::Vector3d x(-2 + 4 * u(rng), -1 + 2 * u(rng), 3 + 3 * u(rng));
     const auto p1 = pair.camera.ImgFromCam(x);
@@ -56,8 +59,9 @@ Pair MakePair(int num_matches, double chance_fraction) {
 void BM_VerifyTwoView(benchmark::State& state) {
   const Pair pair = MakePair(static_cast<int>(state.range(0)), 0.3);
   for (auto _ : state) {
-    const TwoViewGeometry geometry = VerifyTwoView(pair.camera, pair.keypoints1, pair.camera, pair.keypoints2,
-                                                   pair.matches, TwoViewVerificationOptions());
+    const TwoViewGeometry geometry =
+        VerifyTwoView(pair.camera, pair.keypoints1, pair.camera, pair.keypoints2, pair.matches,
+                      TwoViewVerificationOptions());
     benchmark::DoNotOptimize(geometry.cam2_from_cam1.translation.data());
   }
 }
@@ -65,9 +69,9 @@ void BM_VerifyTwoView(benchmark::State& state) {
 // From a start 1 degree off, as RANSAC's five-match pose is.
 void BM_RefineRelativePose(benchmark::State& state) {
   const Pair pair = MakePair(static_cast<int>(state.range(0)), 0.3);
-  const Rigid3d start(
-      pair.cam2_from_cam1.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 180, Eigen::Vector3d::UnitY())),
-      pair.cam2_from_cam1.translation.normalized());
+  const Rigid3d start(pair.cam2_from_cam1.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(
+                                                         M_PI / 180, Eigen::Vector3d::UnitY())),
+                      pair.cam2_from_cam1.translation.normalized());
   for (auto _ : state) {
     const auto refined = RefineRelativePose(pair.inliers1, pair.inliers2, start, 1.0 / 700);
     benchmark::DoNotOptimize(refined);

@@ -19,8 +19,11 @@ VirtualPinhole BenchPinhole(bool dome) {
   camera.params = {1300, 1296, 975.5, 528.0, -0.12, 0.05, 0.0007, -0.0004};
   const double tilt = 5.0 * M_PI / 180.0;
   const Housing housing =
-      dome ? Housing::FromName("DOMEPORT", {0.002, -0.001, 0.004, 0.05, 0.006, 1.0, 1.473, 1.334}, "b")
-           : Housing::FromName("FLATPORT", {std::sin(tilt), 0, std::cos(tilt), 0.02, 0.014, 1.0, 1.473, 1.334}, "b");
+      dome ? Housing::FromName("DOMEPORT", {0.002, -0.001, 0.004, 0.05, 0.006, 1.0, 1.473, 1.334},
+                               "b")
+           : Housing::FromName("FLATPORT",
+                               {std::sin(tilt), 0, std::cos(tilt), 0.02, 0.014, 1.0, 1.473, 1.334},
+                               "b");
   return FitVirtualPinhole({camera, housing}, 2.0, Eigen::Matrix3d::Identity(), {});
 }
 
@@ -31,8 +34,10 @@ void BM_ComputeRemapTables(benchmark::State& state) {
     RemapTables tables = ComputeRemapTables(pinhole, static_cast<int>(state.range(1)), progress);
     benchmark::DoNotOptimize(tables.map_x.data);
   }
-  state.SetLabel(std::string(state.range(0) == 1 ? "dome" : "flat") + ", " + std::to_string(state.range(1)) +
-                 " threads, " + std::to_string(pinhole.pinhole.width) + " x " + std::to_string(pinhole.pinhole.height));
+  state.SetLabel(std::string(state.range(0) == 1 ? "dome" : "flat") + ", " +
+                 std::to_string(state.range(1)) + " threads, " +
+                 std::to_string(pinhole.pinhole.width) + " x " +
+                 std::to_string(pinhole.pinhole.height));
 }
 BENCHMARK(BM_ComputeRemapTables)
     ->Args({0, 1})
@@ -61,17 +66,23 @@ void BM_ApplyRemapTables(benchmark::State& state) {
   cv::convertMaps(tables.map_x, tables.map_y, fixed_xy, fixed_fraction, CV_16SC2);
   for (auto _ : state) {
     if (fixed) {
-      cv::remap(image, output, fixed_xy, fixed_fraction, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+      cv::remap(image, output, fixed_xy, fixed_fraction, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                cv::Scalar::all(0));
     } else {
       output = ApplyRemapTables(tables, image, image.size());
     }
     benchmark::DoNotOptimize(output.data);
   }
-  state.SetLabel(std::string(state.range(0) == 1 ? "gray" : "colour") + (fixed ? ", fixed-point" : ", float") +
-                 " tables, 1 thread");
+  state.SetLabel(std::string(state.range(0) == 1 ? "gray" : "colour") +
+                 (fixed ? ", fixed-point" : ", float") + " tables, 1 thread");
   cv::setNumThreads(-1);
 }
-BENCHMARK(BM_ApplyRemapTables)->Args({1, 1})->Args({1, 0})->Args({3, 1})->Args({3, 0})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ApplyRemapTables)
+    ->Args({1, 1})
+    ->Args({1, 0})
+    ->Args({3, 1})
+    ->Args({3, 0})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace portcal

@@ -45,12 +45,14 @@ using testing::RawDatabase;
 // The report page test's boards: RADIAL 480 x 360, six views, a board of
 // `cols` x 6 corners of 25 mm (odd for the rig: see report_page_test).
 fs::path BoardSet(const std::string& name, const std::string& housing_and_rig, int cols) {
-  return testing::SharedRenderedImages(
-      "name: " + name + "\nseed: 7\nnum_images: 6\n" +
-      "camera: {model: RADIAL, width: 480, height: 360, params: [400.0, 243.0, 178.0, -0.06, 0.01]}\n" +
-      housing_and_rig + "target: {type: chessboard, cols: " + std::to_string(cols) +
-      ", rows: 6, square_size: 0.025, margin: 0.015}\n" +
-      "poses: {distance: [0.3, 0.6], tilt_max_deg: 40, roll_max_deg: 30}\nrender: {spp: 2, noise_sigma: 1.0}\n");
+  return testing::SharedRenderedImages("name: " + name + "\nseed: 7\nnum_images: 6\n" +
+                                       "camera: {model: RADIAL, width: 480, height: 360, params: "
+                                       "[400.0, 243.0, 178.0, -0.06, 0.01]}\n" +
+                                       housing_and_rig +
+                                       "target: {type: chessboard, cols: " + std::to_string(cols) +
+                                       ", rows: 6, square_size: 0.025, margin: 0.015}\n" +
+                                       "poses: {distance: [0.3, 0.6], tilt_max_deg: 40, "
+                                       "roll_max_deg: 30}\nrender: {spp: 2, noise_sigma: 1.0}\n");
 }
 
 void Extract(const fs::path& images, const fs::path& database, bool per_folder, int cols) {
@@ -98,14 +100,18 @@ void ReadOnlyStages(const fs::path& dir, const fs::path& database, CalibratorRes
 CalibratorResults RunCalibrators(const fs::path& dir, std::optional<ColmapVersion> version) {
   std::map<std::string, std::string> colmap_rows;
   for (const std::string name : {"air", "dome", "rig"}) {
-    if (version) colmap_rows[name] = testing::WriteFixtureAndSnapshot(dir / (name + ".db"), *version);
+    if (version)
+      colmap_rows[name] = testing::WriteFixtureAndSnapshot(dir / (name + ".db"), *version);
   }
   Extract(BoardSet("air", "housing: null\n", 8), dir / "air.db", false, 8);
   Extract(BoardSet("dome",
-                   "housing: {model: DOMEPORT, params: [0.003, -0.002, 0.005, 0.05, 0.006, 1.0, 1.473, 1.334]}\n", 8),
+                   "housing: {model: DOMEPORT, params: [0.003, -0.002, 0.005, 0.05, 0.006, 1.0, "
+                   "1.473, 1.334]}\n",
+                   8),
           dir / "dome.db", false, 8);
   Extract(BoardSet("rig",
-                   "housing: null\nstereo:\n  cam2_from_cam1: {rotation_axis_angle_deg: [0.0, 1.0, 0.0, -4.0], "
+                   "housing: null\nstereo:\n  cam2_from_cam1: {rotation_axis_angle_deg: [0.0, 1.0, "
+                   "0.0, -4.0], "
                    "translation: [-0.08, 0.0, 0.004]}\n",
                    9),
           dir / "rig.db", true, 9);
@@ -120,7 +126,8 @@ CalibratorResults RunCalibrators(const fs::path& dir, std::optional<ColmapVersio
   housing.database_path = (dir / "dome.db").string();
   housing.in_air_database_path = (dir / "air.db").string();
   housing.output_path = (dir / "dome").string();
-  housing.housing = Housing::FromName("DOMEPORT", {0, 0, 0, 0.05, 0.006, 1.0, 1.473, 1.334}, "test");
+  housing.housing =
+      Housing::FromName("DOMEPORT", {0, 0, 0, 0.05, 0.006, 1.0, 1.473, 1.334}, "test");
   housing.update_database = true;
   const HousingCalibrationResult housed = RunHousingCalibrator(housing, NoProgress());
   results.housing_params = housed.housing.params;
@@ -147,9 +154,11 @@ CalibratorResults RunCalibrators(const fs::path& dir, std::optional<ColmapVersio
   return results;
 }
 
-void ExpectSame(const std::vector<double>& a, const std::vector<double>& b, const std::string& what) {
+void ExpectSame(const std::vector<double>& a, const std::vector<double>& b,
+                const std::string& what) {
   ASSERT_EQ(a.size(), b.size()) << what;
-  for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], 1e-9 * (1 + std::abs(b[i]))) << what << " " << i;
+  for (size_t i = 0; i < a.size(); ++i)
+    EXPECT_NEAR(a[i], b[i], 1e-9 * (1 + std::abs(b[i]))) << what << " " << i;
 }
 
 void ExpectSameResults(const CalibratorResults& results, const CalibratorResults& reference) {
@@ -158,10 +167,12 @@ void ExpectSameResults(const CalibratorResults& results, const CalibratorResults
   EXPECT_EQ(results.cross_check_points, reference.cross_check_points);
   ASSERT_EQ(results.suggested_positions.size(), reference.suggested_positions.size());
   for (size_t i = 0; i < results.suggested_positions.size(); ++i) {
-    EXPECT_LT((results.suggested_positions[i] - reference.suggested_positions[i]).norm(), 1e-9) << "suggestion " << i;
+    EXPECT_LT((results.suggested_positions[i] - reference.suggested_positions[i]).norm(), 1e-9)
+        << "suggestion " << i;
   }
   ExpectSame(results.housing_params, reference.housing_params, "housing_calibrator's housing");
-  ExpectSame(results.housed_camera_params, reference.housed_camera_params, "housing_calibrator's camera");
+  ExpectSame(results.housed_camera_params, reference.housed_camera_params,
+             "housing_calibrator's camera");
   EXPECT_LT((results.rig_translation - reference.rig_translation).norm(), 1e-9);
   EXPECT_LT((results.rig_rotation - reference.rig_rotation).norm(), 1e-9);
 }
@@ -178,7 +189,8 @@ TEST(ColmapVersionsCalibrators, ReadEachVersionsLayoutAsPortcalsOwn) {
     // camera (after COLMAP's two), its intrinsics into that camera's row.
     RawDatabase dome(dir / "dome.db");
     EXPECT_EQ(dome.Int("SELECT count(*) FROM images;"), 8);
-    EXPECT_EQ(dome.Dump("SELECT camera_id, model FROM portcal_housings;"), "3|1|\n");  // 1: DOMEPORT
+    EXPECT_EQ(dome.Dump("SELECT camera_id, model FROM portcal_housings;"),
+              "3|1|\n");  // 1: DOMEPORT
   }
 }
 
@@ -202,8 +214,10 @@ TEST(ColmapVersionsCalibrators, LiveCalibratorKeepsFramesAsEachVersionDoes) {
     if (layout.rigs_and_frames) {
       // Each kept image in a frame of its own, in the rig whose reference
       // sensor is its camera.
-      EXPECT_EQ(db.Int("SELECT count(*) FROM images JOIN frame_data ON data_id = image_id AND sensor_type = 0 AND "
-                       "sensor_id = camera_id JOIN frames USING(frame_id) JOIN rigs USING(rig_id) WHERE image_id > 2 "
+      EXPECT_EQ(db.Int("SELECT count(*) FROM images JOIN frame_data ON data_id = image_id AND "
+                       "sensor_type = 0 AND "
+                       "sensor_id = camera_id JOIN frames USING(frame_id) JOIN rigs USING(rig_id) "
+                       "WHERE image_id > 2 "
                        "AND ref_sensor_id = camera_id;"),
                 2);
     }
@@ -215,8 +229,10 @@ TEST(ColmapVersionsCalibrators, LiveCalibratorKeepsFramesAsEachVersionDoes) {
 fs::path MarkedTargetSet() {
   return testing::SharedRenderedImages(
       std::string("name: versions_mapping\nnum_images: 6\nseed: 5\n") +
-      "camera: {model: SIMPLE_RADIAL, width: 640, height: 360, params: [500.0, 320.0, 180.0, -0.02]}\n"
-      "housing: {model: FLATPORT, params: [0.0174524, 0.0, 0.9998477, 0.01, 0.008, 1.0, 1.473, 1.334]}\n" +
+      "camera: {model: SIMPLE_RADIAL, width: 640, height: 360, params: [500.0, 320.0, 180.0, "
+      "-0.02]}\n"
+      "housing: {model: FLATPORT, params: [0.0174524, 0.0, 0.9998477, 0.01, 0.008, 1.0, 1.473, "
+      "1.334]}\n" +
       testing::kTwoFaceTargetYaml +
       "poses: {distance: [0.45, 0.9], tilt_max_deg: 35, roll_max_deg: 60, visibility: markers, "
       "border_margin_px: 10, max_view_angle_deg: 60}\n"

@@ -93,7 +93,8 @@ void ExpectConventions(RawDatabase* db, const ColmapLayout& layout, const std::s
                       std::to_string(camera) + ";"),
               1)
         << version;
-    EXPECT_EQ(db->Int("SELECT count(*) FROM frames JOIN frame_data USING(frame_id) JOIN rigs USING(rig_id) WHERE "
+    EXPECT_EQ(db->Int("SELECT count(*) FROM frames JOIN frame_data USING(frame_id) JOIN rigs "
+                      "USING(rig_id) WHERE "
                       "data_id=" +
                       std::to_string(c) + " AND ref_sensor_id=" + std::to_string(camera) + ";"),
               1)
@@ -106,18 +107,20 @@ void ExpectConventions(RawDatabase* db, const ColmapLayout& layout, const std::s
   const std::string position_c = DoublesHex({0.2, 0, 2});
   switch (layout.pose_priors) {
     case ColmapLayout::PosePriors::kNone:
-      EXPECT_EQ(db->Dump("SELECT prior_qw, prior_tx, prior_ty, prior_tz FROM images WHERE name='c.png';"),
-                "NULL|0.2|0.0|2.0|\n")
+      EXPECT_EQ(
+          db->Dump("SELECT prior_qw, prior_tx, prior_ty, prior_tz FROM images WHERE name='c.png';"),
+          "NULL|0.2|0.0|2.0|\n")
           << version;
       break;
     case ColmapLayout::PosePriors::kPerImage:
-      EXPECT_EQ(
-          db->Dump("SELECT position, coordinate_system FROM pose_priors WHERE image_id=" + std::to_string(c) + ";"),
-          position_c + "|1|\n")
+      EXPECT_EQ(db->Dump("SELECT position, coordinate_system FROM pose_priors WHERE image_id=" +
+                         std::to_string(c) + ";"),
+                position_c + "|1|\n")
           << version;
       break;
     default:
-      EXPECT_EQ(db->Dump("SELECT corr_sensor_id, corr_sensor_type, position, coordinate_system FROM pose_priors "
+      EXPECT_EQ(db->Dump("SELECT corr_sensor_id, corr_sensor_type, position, coordinate_system "
+                         "FROM pose_priors "
                          "WHERE corr_data_id=" +
                          std::to_string(c) + ";"),
                 std::to_string(camera) + "|0|" + position_c + "|1|\n")
@@ -125,8 +128,8 @@ void ExpectConventions(RawDatabase* db, const ColmapLayout& layout, const std::s
   }
   // Two-view geometries: COLMAP 4 leaves NULL what was not estimated, 3.x
   // writes zeros; neither writes both forms.
-  const int64_t nulls =
-      db->Int("SELECT count(*) FROM two_view_geometries WHERE F IS NULL OR E IS NULL OR qvec IS NULL;");
+  const int64_t nulls = db->Int(
+      "SELECT count(*) FROM two_view_geometries WHERE F IS NULL OR E IS NULL OR qvec IS NULL;");
   const int64_t zeros = db->Int(
       "SELECT count(*) FROM two_view_geometries WHERE rows > 0 AND (E = zeroblob(72) OR "
       "F = zeroblob(72) OR H = zeroblob(72));");
@@ -196,9 +199,12 @@ TEST_P(ColmapVersions, CalibrationStagesKeepColmapsRowsAndWriteAsTheVersionDoes)
   EXPECT_EQ(db.Int("SELECT count(*) FROM images;"), 8) << name;
   // The calibration went into the board's camera, an OPENCV one of its own.
   const int64_t camera = db.Int("SELECT camera_id FROM images WHERE image_id = 3;");
-  EXPECT_EQ(db.Int("SELECT model FROM cameras WHERE camera_id = " + std::to_string(camera) + ";"), 4) << name;
+  EXPECT_EQ(db.Int("SELECT model FROM cameras WHERE camera_id = " + std::to_string(camera) + ";"),
+            4)
+      << name;
   if (layout.rigs_and_frames) {
-    EXPECT_EQ(db.Int("SELECT count(*) FROM frame_data JOIN frames USING(frame_id) JOIN rigs USING(rig_id) WHERE "
+    EXPECT_EQ(db.Int("SELECT count(*) FROM frame_data JOIN frames USING(frame_id) JOIN rigs "
+                     "USING(rig_id) WHERE "
                      "ref_sensor_id = " +
                      std::to_string(camera) + " AND sensor_id = " + std::to_string(camera) + ";"),
               6)
@@ -213,7 +219,8 @@ TEST_P(ColmapVersions, CalibrationStagesKeepColmapsRowsAndWriteAsTheVersionDoes)
 fs::path MarkerSet() {
   return SharedRenderedImages(
       std::string("name: versions_markers\nnum_images: 3\nseed: 3\n") +
-      "camera: {model: RADIAL, width: 480, height: 270, params: [330.0, 240.0, 135.0, 0, 0]}\nhousing: null\n" +
+      "camera: {model: RADIAL, width: 480, height: 270, params: [330.0, 240.0, 135.0, 0, "
+      "0]}\nhousing: null\n" +
       testing::kTwoFaceTargetYaml +
       "poses: {distance: [0.4, 0.7], tilt_max_deg: 30, roll_max_deg: 30, visibility: markers}\n"
       "render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}\n");
@@ -262,13 +269,15 @@ INSTANTIATE_TEST_SUITE_P(AllVersions, ColmapVersions, ::testing::ValuesIn(AllCol
 // with their priors as portcal reads them.
 std::string Content(const fs::path& path) {
   RawDatabase db(path);
-  std::string content = db.Dump("SELECT * FROM cameras;") + db.Dump("SELECT * FROM keypoints;") +
-                        db.Dump("SELECT image_id, rows, cols, data FROM descriptors;") +
-                        db.Dump("SELECT * FROM matches;") + db.Dump("SELECT * FROM user_notes;") +
-                        db.Dump("SELECT pair_id, rows, cols, data, config FROM two_view_geometries;");
+  std::string content =
+      db.Dump("SELECT * FROM cameras;") + db.Dump("SELECT * FROM keypoints;") +
+      db.Dump("SELECT image_id, rows, cols, data FROM descriptors;") +
+      db.Dump("SELECT * FROM matches;") + db.Dump("SELECT * FROM user_notes;") +
+      db.Dump("SELECT pair_id, rows, cols, data, config FROM two_view_geometries;");
   Database database(path, Database::OpenMode::kReadOnly);
   for (const DatabaseImage& image : database.ReadAllImages()) {
-    content += std::to_string(image.image_id) + " " + image.name + " " + std::to_string(image.camera_id);
+    content +=
+        std::to_string(image.image_id) + " " + image.name + " " + std::to_string(image.camera_id);
     if (const auto position = image.PriorPosition()) {
       content += " " + Hex(position->data(), 24);
     }
@@ -308,7 +317,8 @@ TEST(ColmapVersionConversion, ThreeEightToFourOneAndBackKeepsEveryRow) {
         EXPECT_EQ(db.Int("SELECT count(*) FROM rigs;"), db.Int("SELECT count(*) FROM cameras;"));
       }
       if (LayoutOf(via).NullForUnset()) {
-        EXPECT_EQ(db.Int("SELECT count(*) FROM two_view_geometries WHERE E = zeroblob(72) OR F = zeroblob(72) OR "
+        EXPECT_EQ(db.Int("SELECT count(*) FROM two_view_geometries WHERE E = zeroblob(72) OR F = "
+                         "zeroblob(72) OR "
                          "H = zeroblob(72) OR length(F) = 0;"),
                   0);
       }
@@ -318,13 +328,16 @@ TEST(ColmapVersionConversion, ThreeEightToFourOneAndBackKeepsEveryRow) {
     down.colmap_version = ColmapVersion::k3_8;
     RunDatabaseConverter(down, NoProgress());
     RawDatabase back(up.output_path);
-    const std::string round_trip = back.Dump("SELECT * FROM cameras;") + back.Dump("SELECT * FROM images;") +
-                                   back.Dump("SELECT * FROM keypoints;") + back.Dump("SELECT * FROM descriptors;") +
-                                   back.Dump("SELECT * FROM matches;") +
-                                   back.Dump("SELECT * FROM two_view_geometries;") +
-                                   back.Dump("SELECT * FROM user_notes;");
+    const std::string round_trip =
+        back.Dump("SELECT * FROM cameras;") + back.Dump("SELECT * FROM images;") +
+        back.Dump("SELECT * FROM keypoints;") + back.Dump("SELECT * FROM descriptors;") +
+        back.Dump("SELECT * FROM matches;") + back.Dump("SELECT * FROM two_view_geometries;") +
+        back.Dump("SELECT * FROM user_notes;");
     EXPECT_EQ(round_trip, original) << "3.8 -> " << ColmapVersionName(via) << " -> 3.8";
-    EXPECT_EQ(back.Int("SELECT count(*) FROM sqlite_master WHERE name IN ('rigs', 'frames', 'pose_priors');"), 0);
+    EXPECT_EQ(
+        back.Int(
+            "SELECT count(*) FROM sqlite_master WHERE name IN ('rigs', 'frames', 'pose_priors');"),
+        0);
   }
 }
 
@@ -334,7 +347,8 @@ void ExpectRefusal(const fs::path& path, ColmapVersion target, const std::string
   std::string before;
   {
     RawDatabase db(path);
-    before = db.Dump("SELECT name, sql FROM sqlite_master ORDER BY name;") + db.Dump("SELECT * FROM descriptors;");
+    before = db.Dump("SELECT name, sql FROM sqlite_master ORDER BY name;") +
+             db.Dump("SELECT * FROM descriptors;");
   }
   try {
     Database database(path);
@@ -344,7 +358,8 @@ void ExpectRefusal(const fs::path& path, ColmapVersion target, const std::string
     EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
   }
   RawDatabase db(path);
-  EXPECT_EQ(db.Dump("SELECT name, sql FROM sqlite_master ORDER BY name;") + db.Dump("SELECT * FROM descriptors;"),
+  EXPECT_EQ(db.Dump("SELECT name, sql FROM sqlite_master ORDER BY name;") +
+                db.Dump("SELECT * FROM descriptors;"),
             before);
 }
 
@@ -363,7 +378,8 @@ TEST(ColmapVersionConversion, WhatThreeXCannotHoldIsRefused) {
     RawDatabase db(dir / "imu.db");
     db.Exec("INSERT INTO rigs VALUES(3, 1, 1);");  // reference sensor 1 of type IMU
   }
-  ExpectRefusal(dir / "imu.db", ColmapVersion::k3_10, "1 rigs whose reference sensor is not a camera");
+  ExpectRefusal(dir / "imu.db", ColmapVersion::k3_10,
+                "1 rigs whose reference sensor is not a camera");
   // ALIKED descriptors.
   WriteFixture(dir / "aliked.db", ColmapVersion::k4_1);
   {
@@ -394,7 +410,8 @@ TEST(ColmapVersionConversion, CreatorMakesEachVersionsLayout) {
     for (const std::string& sql : ColmapSchemaSql(version)) {
       std::string stored = sql;
       stored.erase(stored.find(" IF NOT EXISTS"), 14);
-      EXPECT_EQ(db.Int("SELECT count(*) FROM sqlite_master WHERE sql='" + stored + "';"), 1) << stored;
+      EXPECT_EQ(db.Int("SELECT count(*) FROM sqlite_master WHERE sql='" + stored + "';"), 1)
+          << stored;
     }
   }
 }

@@ -1,6 +1,8 @@
 // The database layer: COLMAP's schema and blob layouts, portcal's tables,
 // transactions that roll back, and clear errors for files that are not
 // databases of the right version, or locked.
+#include "database/database.h"
+
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
@@ -10,7 +12,6 @@
 #include <thread>
 
 #include "colmap_ext/util/error.h"
-#include "database/database.h"
 #include "database/lock_wait.h"
 #include "database/schema.h"
 #include "tests/test_utils.h"
@@ -46,18 +47,18 @@ TEST(Database, CreatesCOLMAP38Schema) {
   ASSERT_EQ(sqlite3_step(stmt), SQLITE_ROW);
   EXPECT_EQ(sqlite3_column_int(stmt, 0), 3800);
   sqlite3_finalize(stmt);
-  sqlite3_prepare_v2(raw, "SELECT name FROM sqlite_master WHERE type='table' ORDER BY name;",
-                     -1, &stmt, nullptr);
+  sqlite3_prepare_v2(raw, "SELECT name FROM sqlite_master WHERE type='table' ORDER BY name;", -1,
+                     &stmt, nullptr);
   std::vector<std::string> tables;
   while (sqlite3_step(stmt) == SQLITE_ROW) {
     tables.emplace_back(reinterpret_cast<const char*>(sqlite3_column_text(stmt, 0)));
   }
   sqlite3_finalize(stmt);
   sqlite3_close(raw);
-  for (const char* table : {"cameras", "images", "keypoints", "descriptors", "matches",
-                            "two_view_geometries", "portcal_housings",
-                            "portcal_target_observations", "portcal_marker_detections",
-                            "portcal_stage_log"}) {
+  for (const char* table :
+       {"cameras", "images", "keypoints", "descriptors", "matches", "two_view_geometries",
+        "portcal_housings", "portcal_target_observations", "portcal_marker_detections",
+        "portcal_stage_log"}) {
     EXPECT_NE(std::find(tables.begin(), tables.end(), table), tables.end()) << table;
   }
 }
@@ -81,8 +82,8 @@ TEST(Database, WritesAndReadsEveryTable) {
   image1.camera_id = camera_id;
   DatabaseImage image2 = image1;
   image2.name = "b.png";
-  image2.cam_from_world_prior = Rigid3d(Eigen::Quaterniond(0.5, 0.5, -0.5, 0.5),
-                                        Eigen::Vector3d(1, 2, 3));
+  image2.cam_from_world_prior =
+      Rigid3d(Eigen::Quaterniond(0.5, 0.5, -0.5, 0.5), Eigen::Vector3d(1, 2, 3));
   const image_t id1 = db.WriteImage(image1);
   const image_t id2 = db.WriteImage(image2);
 
@@ -98,11 +99,13 @@ TEST(Database, WritesAndReadsEveryTable) {
   geometry.F << 1, 2, 3, 4, 5, 6, 7, 8, 9;
   geometry.E = geometry.F * 2;
   geometry.H = Eigen::Matrix3d::Identity() * 3;
-  geometry.cam2_from_cam1 = Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY())),
-                                    Eigen::Vector3d(1, 0, 0));
+  geometry.cam2_from_cam1 =
+      Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY())),
+              Eigen::Vector3d(1, 0, 0));
   geometry.inlier_matches = {{0, 1}};
   db.WriteTwoViewGeometry(id1, id2, geometry);
-  db.WriteHousing(camera_id, Housing::FromName("FLATPORT", {0, 0, 1, 0.02, 0.014, 1, 1.473, 1.334}, "t"));
+  db.WriteHousing(camera_id,
+                  Housing::FromName("FLATPORT", {0, 0, 1, 0.02, 0.014, 1, 1.473, 1.334}, "t"));
   db.WriteTargetObservations(id1, {{5, {100.25, 200.5}, {0.02, 0.04, 0}}});
   MarkerDetection marker;
   marker.dictionary = "DICT_4X4_50";
@@ -239,7 +242,8 @@ TEST(Database, ClearErrorsForBadFiles) {
   EXPECT_NE(message(dir / "missing.db", Database::OpenMode::kReadWrite).find("missing.db"),
             std::string::npos);
   // Not a database.
-  std::ofstream(dir / "text.db") << "this is not an sqlite database, just some text that is long enough to matter";
+  std::ofstream(dir / "text.db")
+      << "this is not an sqlite database, just some text that is long enough to matter";
   const std::string not_db = message(dir / "text.db", Database::OpenMode::kReadWrite);
   EXPECT_NE(not_db.find("text.db"), std::string::npos);
   EXPECT_NE(not_db.find("not a database"), std::string::npos) << not_db;
@@ -253,7 +257,8 @@ TEST(Database, ClearErrorsForBadFiles) {
   // An older one, from before user_version was numbered as now.
   { Database db(dir / "old.db", Database::OpenMode::kCreate); }
   RawSql(dir / "old.db", "PRAGMA user_version = 3600;");
-  EXPECT_NE(message(dir / "old.db", Database::OpenMode::kReadWrite).find("3600"), std::string::npos);
+  EXPECT_NE(message(dir / "old.db", Database::OpenMode::kReadWrite).find("3600"),
+            std::string::npos);
   // portcal tables of another version.
   { Database db(dir / "p.db", Database::OpenMode::kCreate); }
   RawSql(dir / "p.db", "UPDATE portcal_meta SET value='7' WHERE key='schema_version';");
@@ -376,7 +381,8 @@ TEST(Database, AWriterWaitsForAnotherConnectionsLockUpToTheBusyTimeout) {
       Transaction transaction = waiter.BeginTransaction();
       ADD_FAILURE() << "no wait limit";
     } catch (const DatabaseError& e) {
-      EXPECT_NE(std::string(e.what()).find("--Database.busy_timeout"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("--Database.busy_timeout"), std::string::npos)
+          << e.what();
     }
     holding.join();
   }

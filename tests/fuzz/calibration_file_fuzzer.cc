@@ -6,7 +6,7 @@
 #include "tests/fuzz/fuzz_input.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  return portcal::fuzz::ParseAsFile("calibration.yaml", data, size, [](const std::filesystem::path& path) {
-    portcal::ReadCalibrationReport(path);
-  });
+  return portcal::fuzz::ParseAsFile(
+      "calibration.yaml", data, size,
+      [](const std::filesystem::path& path) { portcal::ReadCalibrationReport(path); });
 }

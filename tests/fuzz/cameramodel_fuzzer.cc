@@ -6,8 +6,10 @@
 #include "tests/fuzz/fuzz_input.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  return portcal::fuzz::ParseAsFile("camera.cameramodel", data, size, [](const std::filesystem::path& path) {
-    const portcal::MrcalCameraModelFile file = portcal::ReadMrcalCameraModel(path);
-    if (!file.optimization_inputs_base85.empty()) portcal::ReadMrcalBoardSolve(file, path.string());
-  });
+  return portcal::fuzz::ParseAsFile(
+      "camera.cameramodel", data, size, [](const std::filesystem::path& path) {
+        const portcal::MrcalCameraModelFile file = portcal::ReadMrcalCameraModel(path);
+        if (!file.optimization_inputs_base85.empty())
+          portcal::ReadMrcalBoardSolve(file, path.string());
+      });
 }

@@ -31,7 +31,8 @@ void InsertRow(sqlite3* db, const char* sql, const std::string& kinds, FieldRead
     if (kinds[k] == 'd') sqlite3_bind_double(stmt, index, in->Take<double>());
     if (kinds[k] == 'b') {
       blobs[k] = in->TakeBytes(4096);
-      sqlite3_bind_blob(stmt, index, blobs[k].data(), static_cast<int>(blobs[k].size()), SQLITE_STATIC);
+      sqlite3_bind_blob(stmt, index, blobs[k].data(), static_cast<int>(blobs[k].size()),
+                        SQLITE_STATIC);
     }
   }
   sqlite3_step(stmt);  // a row the schema refuses (NOT NULL, a key twice) is simply not there
@@ -39,28 +40,35 @@ void InsertRow(sqlite3* db, const char* sql, const std::string& kinds, FieldRead
 }
 
 void Fill(sqlite3* db, FieldReader* in) {
-  sqlite3_exec(db,
-               "BEGIN; DELETE FROM cameras; DELETE FROM images; DELETE FROM keypoints; DELETE FROM descriptors; "
-               "DELETE FROM matches; DELETE FROM two_view_geometries; DELETE FROM portcal_housings; "
-               "DELETE FROM portcal_unmasked_features; DELETE FROM portcal_target_observations; "
-               "DELETE FROM portcal_target_detections; DELETE FROM portcal_marker_detections;",
-               nullptr, nullptr, nullptr);
+  sqlite3_exec(
+      db,
+      "BEGIN; DELETE FROM cameras; DELETE FROM images; DELETE FROM keypoints; DELETE FROM "
+      "descriptors; "
+      "DELETE FROM matches; DELETE FROM two_view_geometries; DELETE FROM portcal_housings; "
+      "DELETE FROM portcal_unmasked_features; DELETE FROM portcal_target_observations; "
+      "DELETE FROM portcal_target_detections; DELETE FROM portcal_marker_detections;",
+      nullptr, nullptr, nullptr);
   InsertRow(db, "INSERT INTO cameras VALUES (1, ?1, ?2, ?3, ?4, 0)", "iiib", in);
-  sqlite3_exec(db,
-               "INSERT INTO images(image_id, name, camera_id) VALUES (1, 'a.png', 1), (2, 'b.png', 1);"
-               "INSERT INTO portcal_target_detections VALUES (1, 'chessboard', 1, 1, ''), (2, 'chessboard', 1, 1, '');",
-               nullptr, nullptr, nullptr);
+  sqlite3_exec(
+      db,
+      "INSERT INTO images(image_id, name, camera_id) VALUES (1, 'a.png', 1), (2, 'b.png', 1);"
+      "INSERT INTO portcal_target_detections VALUES (1, 'chessboard', 1, 1, ''), (2, 'chessboard', "
+      "1, 1, '');",
+      nullptr, nullptr, nullptr);
   InsertRow(db, "INSERT INTO keypoints VALUES (1, ?1, ?2, ?3)", "iib", in);
   InsertRow(db, "INSERT INTO keypoints VALUES (2, ?1, ?2, ?3)", "iib", in);
   InsertRow(db, "INSERT INTO descriptors VALUES (1, ?1, ?2, ?3)", "iib", in);
   InsertRow(db, "INSERT INTO matches VALUES (2147483649, ?1, ?2, ?3)", "iib", in);
-  InsertRow(db, "INSERT INTO two_view_geometries VALUES (2147483649, ?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
-            "iibibbbbb", in);
+  InsertRow(
+      db, "INSERT INTO two_view_geometries VALUES (2147483649, ?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
+      "iibibbbbb", in);
   InsertRow(db, "INSERT INTO portcal_housings VALUES (1, ?1, ?2)", "ib", in);
   InsertRow(db, "INSERT INTO portcal_unmasked_features VALUES (2, ?1, ?2, ?3)", "ibb", in);
-  InsertRow(db, "INSERT INTO portcal_target_observations VALUES (1, ?1, ?2, ?3, ?4, ?5, ?6)", "iddddd", in);
+  InsertRow(db, "INSERT INTO portcal_target_observations VALUES (1, ?1, ?2, ?3, ?4, ?5, ?6)",
+            "iddddd", in);
   InsertRow(db,
-            "INSERT INTO portcal_marker_detections VALUES (NULL, 1, 'DICT_4X4_50', ?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
+            "INSERT INTO portcal_marker_detections VALUES (NULL, 1, 'DICT_4X4_50', ?1, ?2, ?3, ?4, "
+            "?5, ?6, ?7, ?8, ?9)",
             "idddddddd", in);
   sqlite3_exec(db, "COMMIT", nullptr, nullptr, nullptr);
 }

@@ -22,8 +22,8 @@ namespace fuzz {
 inline const std::filesystem::path& WorkFolder() {
   static const std::filesystem::path folder = [] {
     const char* tmp = std::getenv("TMPDIR");
-    std::filesystem::path path = std::filesystem::path(tmp ? tmp : "/tmp") /
-                                 ("portcal_fuzz_" + std::to_string(getpid()));
+    std::filesystem::path path =
+        std::filesystem::path(tmp ? tmp : "/tmp") / ("portcal_fuzz_" + std::to_string(getpid()));
     std::filesystem::create_directories(path);
     std::atexit([] {
       std::error_code ignored;
@@ -99,7 +99,8 @@ class FieldReader {
 
 template <typename Parse>
 int ParseAsFile(const std::string& name, const uint8_t* data, size_t size, Parse&& parse) {
-  const std::filesystem::path path = WriteFile(name, std::string(reinterpret_cast<const char*>(data), size));
+  const std::filesystem::path path =
+      WriteFile(name, std::string(reinterpret_cast<const char*>(data), size));
   try {
     parse(path);
   } catch (const InputError&) {

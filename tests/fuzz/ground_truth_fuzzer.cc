@@ -4,7 +4,7 @@
 #include "tests/fuzz/fuzz_input.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  return portcal::fuzz::ParseAsFile("ground_truth.yaml", data, size, [](const std::filesystem::path& path) {
-    portcal::ReadGroundTruth(path);
-  });
+  return portcal::fuzz::ParseAsFile(
+      "ground_truth.yaml", data, size,
+      [](const std::filesystem::path& path) { portcal::ReadGroundTruth(path); });
 }

@@ -6,8 +6,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const auto path = portcal::fuzz::WriteFile(
-      "housings.txt",
-      std::string(reinterpret_cast<const char*>(data), size));
+      "housings.txt", std::string(reinterpret_cast<const char*>(data), size));
   try {
     portcal::ReadHousingsText(path);
   } catch (const portcal::InputError&) {

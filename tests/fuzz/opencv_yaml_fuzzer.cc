@@ -3,8 +3,9 @@
 #include "tests/fuzz/fuzz_input.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  return portcal::fuzz::ParseAsFile("camera.yaml", data, size, [](const std::filesystem::path& path) {
-    portcal::IsOpenCvOrRosCameraYaml(path);
-    portcal::ReadOpenCvCameraYaml(path);
-  });
+  return portcal::fuzz::ParseAsFile("camera.yaml", data, size,
+                                    [](const std::filesystem::path& path) {
+                                      portcal::IsOpenCvOrRosCameraYaml(path);
+                                      portcal::ReadOpenCvCameraYaml(path);
+                                    });
 }

@@ -12,10 +12,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   options.camera_params = "800,790,320.5,240.5,-0.1,0.02,0.001,-0.001";
   options.width = 640;
   options.height = 480;
-  options.housing = portcal::Housing::FromName("FLATPORT", {0, 0, 1, 0.01, 0.005, 1.0, 1.49, 1.333}, "fuzz");
+  options.housing =
+      portcal::Housing::FromName("FLATPORT", {0, 0, 1, 0.01, 0.005, 1.0, 1.49, 1.333}, "fuzz");
   options.unproject = data[0] & 1;
   options.points_path =
-      portcal::fuzz::WriteFile("points.txt", std::string(reinterpret_cast<const char*>(data + 1), size - 1)).string();
+      portcal::fuzz::WriteFile("points.txt",
+                               std::string(reinterpret_cast<const char*>(data + 1), size - 1))
+          .string();
   portcal::NullProgress progress;
   try {
     portcal::RunProjectPoints(options, progress);

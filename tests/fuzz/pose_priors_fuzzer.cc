@@ -3,7 +3,7 @@
 #include "tests/fuzz/fuzz_input.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  return portcal::fuzz::ParseAsFile("priors.txt", data, size, [](const std::filesystem::path& path) {
-    portcal::ReadPositionsFile(path.string());
-  });
+  return portcal::fuzz::ParseAsFile(
+      "priors.txt", data, size,
+      [](const std::filesystem::path& path) { portcal::ReadPositionsFile(path.string()); });
 }

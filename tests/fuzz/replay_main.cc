@@ -43,15 +43,18 @@ int main(int argc, char** argv) {
   size_t files = 0, runs = 0;
   for (int i = 1; i < argc; ++i) {
     std::vector<std::filesystem::path> paths;
-    if (!std::filesystem::exists(argv[i])) continue;  // no regressions yet: git keeps no empty folder
+    if (!std::filesystem::exists(argv[i]))
+      continue;  // no regressions yet: git keeps no empty folder
     if (std::filesystem::is_directory(argv[i])) {
-      for (const auto& entry : std::filesystem::directory_iterator(argv[i])) paths.push_back(entry.path());
+      for (const auto& entry : std::filesystem::directory_iterator(argv[i]))
+        paths.push_back(entry.path());
     } else {
       paths.emplace_back(argv[i]);
     }
     for (const std::filesystem::path& path : paths) {
       std::ifstream in(path, std::ios::binary);
-      const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      const std::string bytes((std::istreambuf_iterator<char>(in)),
+                              std::istreambuf_iterator<char>());
       runs += RunVariants(bytes);
       ++files;
     }

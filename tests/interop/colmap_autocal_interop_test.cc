@@ -24,10 +24,12 @@ using testing::RunCommand;
 
 // Small in-air views of the folded 3-D target with two ArUco markers.
 void RenderSet(const fs::path& dir, int num_images) {
-  std::ofstream(dir / "set.yaml") << "name: interop\nnum_images: " << num_images << R"(
+  std::ofstream(dir / "set.yaml")
+      << "name: interop\nnum_images: " << num_images << R"(
 camera: {model: SIMPLE_RADIAL, width: 800, height: 450, params: [620.0, 400.0, 225.0, -0.02]}
 housing: null
-)" << testing::kTwoFaceTargetYaml << R"(poses: {distance: [0.45, 0.9], tilt_max_deg: 35, roll_max_deg: 60, visibility: markers, border_margin_px: 10, max_view_angle_deg: 60}
+)" << testing::kTwoFaceTargetYaml
+      << R"(poses: {distance: [0.45, 0.9], tilt_max_deg: 35, roll_max_deg: 60, visibility: markers, border_margin_px: 10, max_view_angle_deg: 60}
 render: {spp: 4, noise_sigma: 1.0, white: 220, black: 30, background: 110}
 )";
   SynthesizeOptions options;
@@ -45,14 +47,15 @@ TEST(ColmapAutoCalibrationInterop, PortcalFeaturesAreReconstructedByColmapMapper
   RenderSet(dir.path(), 8);
   const std::string db = (dir / "db.db").string();
   const std::string images = (dir / "set" / "images").string();
-  auto result = RunCommand(Portcal() + " feature_extractor --database_path " + db + " --image_path " + images +
-                           " --ImageReader.single_camera 1");
+  auto result = RunCommand(Portcal() + " feature_extractor --database_path " + db +
+                           " --image_path " + images + " --ImageReader.single_camera 1");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   result = RunCommand(Portcal() + " exhaustive_matcher --database_path " + db);
   ASSERT_EQ(result.exit_code, 0) << result.output;
   fs::create_directories(dir / "colmap_sparse");
-  result = RunCommand(colmap + " mapper --database_path " + db + " --image_path " + images + " --output_path " +
-                      (dir / "colmap_sparse").string() + " --Mapper.num_threads 2");
+  result =
+      RunCommand(colmap + " mapper --database_path " + db + " --image_path " + images +
+                 " --output_path " + (dir / "colmap_sparse").string() + " --Mapper.num_threads 2");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const SparseModel model = ReadSparseModel(dir / "colmap_sparse" / "0");
   EXPECT_EQ(model.images.size(), 8u);
@@ -65,11 +68,13 @@ TEST(ColmapAutoCalibrationInterop, ColmapExtractedDatabaseThroughPortcalStages) 
   RenderSet(dir.path(), 8);
   const std::string db = (dir / "db.db").string();
   const std::string images = (dir / "set" / "images").string();
-  auto result = RunCommand(colmap + " feature_extractor --database_path " + db + " --image_path " + images +
-                           " --ImageReader.camera_model SIMPLE_RADIAL --ImageReader.single_camera 1"
-                           " --SiftExtraction.use_gpu 0 --SiftExtraction.num_threads 2");
+  auto result =
+      RunCommand(colmap + " feature_extractor --database_path " + db + " --image_path " + images +
+                 " --ImageReader.camera_model SIMPLE_RADIAL --ImageReader.single_camera 1"
+                 " --SiftExtraction.use_gpu 0 --SiftExtraction.num_threads 2");
   ASSERT_EQ(result.exit_code, 0) << result.output;
-  result = RunCommand(Portcal() + " feature_masker --database_path " + db + " --image_path " + images);
+  result =
+      RunCommand(Portcal() + " feature_masker --database_path " + db + " --image_path " + images);
   ASSERT_EQ(result.exit_code, 0) << result.output;
   {
     Database database(db, Database::OpenMode::kReadOnly);
@@ -79,8 +84,9 @@ TEST(ColmapAutoCalibrationInterop, ColmapExtractedDatabaseThroughPortcalStages) 
   }
   result = RunCommand(Portcal() + " exhaustive_matcher --database_path " + db);
   ASSERT_EQ(result.exit_code, 0) << result.output;
-  result = RunCommand(Portcal() + " refractive_mapper --database_path " + db + " --image_path " + images +
-                      " --output_path " + (dir / "sparse").string() + " --Markers.side_length 0.06");
+  result = RunCommand(Portcal() + " refractive_mapper --database_path " + db + " --image_path " +
+                      images + " --output_path " + (dir / "sparse").string() +
+                      " --Markers.side_length 0.06");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   // colmap reads portcal's model.
   fs::create_directories(dir / "txt");
@@ -96,9 +102,11 @@ TEST(AutoCalibrationStages, RerunSkipsAndFailedStageLeavesTheDatabaseAsItWas) {
   RenderSet(dir.path(), 3);
   const std::string db = (dir / "db.db").string();
   const std::string images = (dir / "set" / "images").string();
-  auto result = RunCommand(Portcal() + " feature_extractor --database_path " + db + " --image_path " + images);
+  auto result = RunCommand(Portcal() + " feature_extractor --database_path " + db +
+                           " --image_path " + images);
   ASSERT_EQ(result.exit_code, 0) << result.output;
-  result = RunCommand(Portcal() + " feature_extractor --database_path " + db + " --image_path " + images);
+  result = RunCommand(Portcal() + " feature_extractor --database_path " + db + " --image_path " +
+                      images);
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_NE(result.output.find("3 skipped"), std::string::npos) << result.output;
   // A masker pointed at the wrong images fails naming the image and writes
@@ -111,16 +119,17 @@ TEST(AutoCalibrationStages, RerunSkipsAndFailedStageLeavesTheDatabaseAsItWas) {
   EXPECT_NE(result.output.find("img_"), std::string::npos) << result.output;
   EXPECT_EQ(testing::ReadFileToString(db), after_rerun);
   // Bad option values are named.
-  result = RunCommand(Portcal() + " feature_masker --database_path " + db + " --image_path " + images +
-                      " --Mask.enlargement_factor 0.5");
+  result = RunCommand(Portcal() + " feature_masker --database_path " + db + " --image_path " +
+                      images + " --Mask.enlargement_factor 0.5");
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--Mask.enlargement_factor"), std::string::npos) << result.output;
   // Markers of another dictionary: no image has one, and masking would
   // remove every feature; an error instead, the database as it was.
-  result = RunCommand(Portcal() + " feature_masker --database_path " + db + " --image_path " + images +
-                      " --Markers.dictionary DICT_5X5_100");
+  result = RunCommand(Portcal() + " feature_masker --database_path " + db + " --image_path " +
+                      images + " --Markers.dictionary DICT_5X5_100");
   EXPECT_NE(result.exit_code, 0);
-  EXPECT_NE(result.output.find("no DICT_5X5_100 marker in any of the 3 images"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("no DICT_5X5_100 marker in any of the 3 images"), std::string::npos)
+      << result.output;
   EXPECT_NE(result.output.find("--Markers.dictionary"), std::string::npos) << result.output;
   EXPECT_EQ(testing::ReadFileToString(db), after_rerun);
   result = RunCommand(Portcal() + " refractive_mapper --database_path " + db + " --output_path " +

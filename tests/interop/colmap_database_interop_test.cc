@@ -8,8 +8,8 @@
 //    mapper, which recovers the true camera centres.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
@@ -75,8 +75,9 @@ cv::Mat RenderView(const cv::Mat& texture, const Rigid3d& cam_from_world) {
   cv::Mat map_x(kHeight, kWidth, CV_32F), map_y(kHeight, kWidth, CV_32F);
   for (int r = 0; r < kHeight; ++r) {
     for (int col = 0; col < kWidth; ++col) {
-      const Eigen::Vector3d d = world_from_cam.rotation *
-          Eigen::Vector3d((col + 0.5 - kWidth / 2.0) / kFocal, (r + 0.5 - kHeight / 2.0) / kFocal, 1);
+      const Eigen::Vector3d d =
+          world_from_cam.rotation * Eigen::Vector3d((col + 0.5 - kWidth / 2.0) / kFocal,
+                                                    (r + 0.5 - kHeight / 2.0) / kFocal, 1);
       double best = 1e9;
       Eigen::Vector3d hit(0, 0, 0);
       for (const double slope : {0.7, -0.7}) {  // the X < 0 and X > 0 halves
@@ -111,8 +112,8 @@ void RenderImages(const fs::path& dir, int num_views) {
 TEST(ColmapDatabaseInterop, SchemaIsCharacterForCharacterCOLMAPs) {
   PORTCAL_REQUIRE_COLMAP(colmap);
   testing::TempDir dir;
-  const auto result = RunCommand(colmap + " database_creator --database_path " +
-                                 (dir / "colmap.db").string());
+  const auto result =
+      RunCommand(colmap + " database_creator --database_path " + (dir / "colmap.db").string());
   ASSERT_EQ(result.exit_code, 0) << result.output;
   { Database db(dir / "portcal.db", Database::OpenMode::kCreate); }
   const auto schema = [&](const std::string& name) {
@@ -122,8 +123,9 @@ TEST(ColmapDatabaseInterop, SchemaIsCharacterForCharacterCOLMAPs) {
         .output;
   };
   EXPECT_EQ(schema("portcal.db"), schema("colmap.db"));
-  EXPECT_EQ(RunCommand("sqlite3 " + (dir / "portcal.db").string() + " 'PRAGMA user_version;'").output,
-            "3800\n");
+  EXPECT_EQ(
+      RunCommand("sqlite3 " + (dir / "portcal.db").string() + " 'PRAGMA user_version;'").output,
+      "3800\n");
 }
 
 // The database is created by portcal (true) or by colmap itself (false);
@@ -143,8 +145,8 @@ TEST_P(ColmapFillsDatabase, PortcalReadsEverythingColmapWrote) {
     result = RunCommand(testing::PortcalBinary() + " database_creator --database_path " + db_path);
     ASSERT_EQ(result.exit_code, 0) << result.output;
   }
-  result = RunCommand(colmap + " feature_extractor --database_path " + db_path +
-                      " --image_path " + (dir / "images").string() +
+  result = RunCommand(colmap + " feature_extractor --database_path " + db_path + " --image_path " +
+                      (dir / "images").string() +
                       " --ImageReader.camera_model SIMPLE_RADIAL --ImageReader.single_camera 1"
                       " --SiftExtraction.use_gpu 0 --SiftExtraction.num_threads 2");
   ASSERT_EQ(result.exit_code, 0) << result.output;
@@ -197,8 +199,8 @@ TEST_P(ColmapFillsDatabase, PortcalReadsEverythingColmapWrote) {
         const Eigen::Vector3d x2(k2[m.point2D_idx2].x, k2[m.point2D_idx2].y, 1);
         const Eigen::Vector3d Fx1 = geometry.F * x1, Ftx2 = geometry.F.transpose() * x2;
         const double e = x2.dot(Fx1);
-        sampson.push_back(std::sqrt(e * e / (Fx1.head<2>().squaredNorm() +
-                                             Ftx2.head<2>().squaredNorm())));
+        sampson.push_back(
+            std::sqrt(e * e / (Fx1.head<2>().squaredNorm() + Ftx2.head<2>().squaredNorm())));
       }
       EXPECT_LT(*std::max_element(sampson.begin(), sampson.end()), kColmapMaxErrorPx)
           << "pair " << id1 << "/" << id2;
@@ -209,8 +211,8 @@ TEST_P(ColmapFillsDatabase, PortcalReadsEverythingColmapWrote) {
 
   fs::create_directories(dir / "sparse");
   result = RunCommand(colmap + " mapper --database_path " + db_path + " --image_path " +
-                      (dir / "images").string() + " --output_path " +
-                      (dir / "sparse").string() + " --Mapper.num_threads 2");
+                      (dir / "images").string() + " --output_path " + (dir / "sparse").string() +
+                      " --Mapper.num_threads 2");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const SparseModel model = ReadSparseModel(dir / "sparse" / "0");
   EXPECT_GE(model.images.size(), 5u);
@@ -280,8 +282,8 @@ TEST_P(ColmapMapperOnPortcalRows, ReconstructsTheTrueCameras) {
         FeatureMatches matches;
         for (size_t p = 0; p < points.size(); ++p) {
           if (index[a][p] >= 0 && index[b][p] >= 0) {
-            matches.push_back({static_cast<uint32_t>(index[a][p]),
-                               static_cast<uint32_t>(index[b][p])});
+            matches.push_back(
+                {static_cast<uint32_t>(index[a][p]), static_cast<uint32_t>(index[b][p])});
           }
         }
         db.WriteMatches(image_ids[a], image_ids[b], matches);
@@ -309,10 +311,10 @@ TEST_P(ColmapMapperOnPortcalRows, ReconstructsTheTrueCameras) {
   }
   fs::create_directories(dir / "sparse");
   fs::create_directories(dir / "no_images");
-  const auto result = RunCommand(
-      colmap + " mapper --database_path " + (dir / "db.db").string() + " --image_path " +
-      (dir / "no_images").string() + " --output_path " + (dir / "sparse").string() +
-      " --Mapper.num_threads 2 --Mapper.extract_colors 0");
+  const auto result =
+      RunCommand(colmap + " mapper --database_path " + (dir / "db.db").string() + " --image_path " +
+                 (dir / "no_images").string() + " --output_path " + (dir / "sparse").string() +
+                 " --Mapper.num_threads 2 --Mapper.extract_colors 0");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const SparseModel model = ReadSparseModel(dir / "sparse" / "0");
   ASSERT_EQ(model.images.size(), static_cast<size_t>(num_views));

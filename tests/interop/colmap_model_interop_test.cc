@@ -41,8 +41,7 @@ SparseModel TwoViewModel(const Camera& camera, int num_points, uint32_t seed) {
     const Eigen::Vector3d xyz(1.2 * uniform(rng), 0.9 * uniform(rng), 3.0 + uniform(rng));
     std::vector<Eigen::Vector2d> pixels;
     for (const auto& [id, image] : model.images) {
-      const std::optional<Eigen::Vector2d> pixel =
-          camera.ImgFromCam(image.cam_from_world * xyz);
+      const std::optional<Eigen::Vector2d> pixel = camera.ImgFromCam(image.cam_from_world * xyz);
       if (pixel && pixel->x() > 0 && pixel->y() > 0 && pixel->x() < camera.width &&
           pixel->y() < camera.height) {
         pixels.push_back(*pixel);
@@ -99,10 +98,9 @@ TEST(ColmapModelInterop, EveryCameraModelProjectsLikeColmap) {
     }
     WriteSparseModel(model, dir / "in", ModelFormat::kBinary);
     fs::create_directories(dir / "out");
-    const auto result = RunCommand(colmap + " point_filtering --input_path " +
-                                   (dir / "in").string() + " --output_path " +
-                                   (dir / "out").string() +
-                                   " --min_track_len 2 --min_tri_angle 0 --max_reproj_error 1e-6");
+    const auto result = RunCommand(
+        colmap + " point_filtering --input_path " + (dir / "in").string() + " --output_path " +
+        (dir / "out").string() + " --min_track_len 2 --min_tri_angle 0 --max_reproj_error 1e-6");
     ASSERT_EQ(result.exit_code, 0) << result.output;
     const SparseModel filtered = ReadSparseModel(dir / "out");
     EXPECT_EQ(filtered.points3D.size(), model.points3D.size() - moved.size()) << name;
@@ -154,9 +152,9 @@ TEST(ColmapModelInterop, ColmapConvertsPortcalsBinaryToTheSameText) {
   WriteSparseModel(model, dir / "bin", ModelFormat::kBinary);
   WriteSparseModel(model, dir / "portcal_txt", ModelFormat::kText);
   fs::create_directories(dir / "colmap_txt");
-  const auto result = RunCommand(colmap + " model_converter --input_path " +
-                                 (dir / "bin").string() + " --output_path " +
-                                 (dir / "colmap_txt").string() + " --output_type TXT");
+  const auto result =
+      RunCommand(colmap + " model_converter --input_path " + (dir / "bin").string() +
+                 " --output_path " + (dir / "colmap_txt").string() + " --output_type TXT");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   // Same values (bit-exact: 17 digits on both sides)...
   const SparseModel colmap_model = ReadSparseModel(dir / "colmap_txt");
@@ -191,21 +189,21 @@ TEST(ColmapModelInterop, ColmapConvertsPortcalsTextToTheSameBinary) {
   WriteSparseModel(model, dir / "txt", ModelFormat::kText);
   WriteSparseModel(model, dir / "portcal_bin", ModelFormat::kBinary);
   fs::create_directories(dir / "colmap_bin");
-  const auto result = RunCommand(colmap + " model_converter --input_path " +
-                                 (dir / "txt").string() + " --output_path " +
-                                 (dir / "colmap_bin").string() + " --output_type BIN");
+  const auto result =
+      RunCommand(colmap + " model_converter --input_path " + (dir / "txt").string() +
+                 " --output_path " + (dir / "colmap_bin").string() + " --output_type BIN");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   // Same sizes; and read back and rewritten in portcal's (sorted) record
   // order, COLMAP's files are byte-identical to portcal's.
   for (const char* name : {"cameras.bin", "images.bin", "points3D.bin"}) {
-    EXPECT_EQ(fs::file_size(dir / "colmap_bin" / name),
-              fs::file_size(dir / "portcal_bin" / name)) << name;
+    EXPECT_EQ(fs::file_size(dir / "colmap_bin" / name), fs::file_size(dir / "portcal_bin" / name))
+        << name;
   }
-  WriteSparseModel(ReadSparseModel(dir / "colmap_bin"), dir / "rewritten",
-                   ModelFormat::kBinary);
+  WriteSparseModel(ReadSparseModel(dir / "colmap_bin"), dir / "rewritten", ModelFormat::kBinary);
   for (const char* name : {"cameras.bin", "images.bin", "points3D.bin"}) {
     EXPECT_TRUE(ReadFileToString(dir / "rewritten" / name) ==
-                ReadFileToString(dir / "portcal_bin" / name)) << name;
+                ReadFileToString(dir / "portcal_bin" / name))
+        << name;
   }
 }
 
@@ -213,13 +211,13 @@ TEST(ColmapModelInterop, HousingsSidecarDoesNotDisturbColmap) {
   PORTCAL_REQUIRE_COLMAP(colmap);
   testing::TempDir dir;
   SparseModel model = RichModel();
-  model.housings[3] = Housing::FromName(
-      "DOMEPORT", {0.001, 0.0, 0.002, 0.05, 0.006, 1.0, 1.473, 1.334}, "test");
+  model.housings[3] =
+      Housing::FromName("DOMEPORT", {0.001, 0.0, 0.002, 0.05, 0.006, 1.0, 1.473, 1.334}, "test");
   WriteSparseModel(model, dir / "bin", ModelFormat::kBinary);
   fs::create_directories(dir / "out");
-  const auto result = RunCommand(colmap + " model_converter --input_path " +
-                                 (dir / "bin").string() + " --output_path " +
-                                 (dir / "out").string() + " --output_type TXT");
+  const auto result =
+      RunCommand(colmap + " model_converter --input_path " + (dir / "bin").string() +
+                 " --output_path " + (dir / "out").string() + " --output_type TXT");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_EQ(ReadSparseModel(dir / "out").cameras.size(), 2u);
 }

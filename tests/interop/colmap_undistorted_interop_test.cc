@@ -54,9 +54,10 @@ TEST(ColmapUndistortedInterop, WorkspaceModelReadsInColmap) {
     image.cam_from_world = truth.images[id - 1].cam1.cam_from_target;
   }
   WriteSparseModel(model, dir / "model", ModelFormat::kBinary);
-  const testing::CommandResult undistort = RunCommand(
-      testing::PortcalBinary() + " image_undistorter --input_path " + Quoted(dir / "model") + " --image_path " +
-      Quoted(dir / "set" / "images") + " --output_path " + Quoted(dir / "out") + " --Undistort.distance 2");
+  const testing::CommandResult undistort =
+      RunCommand(testing::PortcalBinary() + " image_undistorter --input_path " +
+                 Quoted(dir / "model") + " --image_path " + Quoted(dir / "set" / "images") +
+                 " --output_path " + Quoted(dir / "out") + " --Undistort.distance 2");
   ASSERT_EQ(undistort.exit_code, 0) << undistort.output;
   const testing::CommandResult analyzed =
       RunCommand(colmap + " model_analyzer --path " + Quoted(dir / "out" / "sparse"));
@@ -64,10 +65,11 @@ TEST(ColmapUndistortedInterop, WorkspaceModelReadsInColmap) {
   EXPECT_NE(analyzed.output.find("Registered images: 2"), std::string::npos) << analyzed.output;
   fs::create_directories(dir / "txt");
   const testing::CommandResult converted =
-      RunCommand(colmap + " model_converter --input_path " + Quoted(dir / "out" / "sparse") + " --output_path " +
-                 Quoted(dir / "txt") + " --output_type TXT");
+      RunCommand(colmap + " model_converter --input_path " + Quoted(dir / "out" / "sparse") +
+                 " --output_path " + Quoted(dir / "txt") + " --output_type TXT");
   ASSERT_EQ(converted.exit_code, 0) << converted.output;
-  EXPECT_NE(testing::ReadFileToString(dir / "txt" / "cameras.txt").find("1 PINHOLE "), std::string::npos);
+  EXPECT_NE(testing::ReadFileToString(dir / "txt" / "cameras.txt").find("1 PINHOLE "),
+            std::string::npos);
 }
 
 // Camera centres of `estimate` aligned to the truth's by a similarity
@@ -87,7 +89,8 @@ double AlignedCentreRms(const SparseModel& estimate, const GroundTruth& truth, i
   for (size_t i = 0; i < ours.size(); ++i)
     a.col(static_cast<Eigen::Index>(i)) = ours[i], b.col(static_cast<Eigen::Index>(i)) = theirs[i];
   const Eigen::Matrix4d transform = Eigen::umeyama(a, b, true);
-  const Eigen::Matrix3Xd aligned = (transform.topLeftCorner<3, 3>() * a).colwise() + transform.topRightCorner<3, 1>();
+  const Eigen::Matrix3Xd aligned =
+      (transform.topLeftCorner<3, 3>() * a).colwise() + transform.topRightCorner<3, 1>();
   return std::sqrt((aligned - b).colwise().squaredNorm().mean());
 }
 
@@ -106,10 +109,10 @@ TEST(ColmapUndistortedInterop, ColmapMapperRecoversTheSurveyAtTheDesignDistance)
   calibration.camera = truth.camera;
   calibration.housing = truth.housing;
   WriteCalibrationReport(calibration, dir / "cal");
-  const testing::CommandResult undistort =
-      RunCommand(testing::PortcalBinary() + " image_undistorter --input_path " +
-                 Quoted(dir / "cal" / "calibration.yaml") + " --image_path " + Quoted(dir / "set" / "images") +
-                 " --output_path " + Quoted(dir / "out") + " --Undistort.distance 2");
+  const testing::CommandResult undistort = RunCommand(
+      testing::PortcalBinary() + " image_undistorter --input_path " +
+      Quoted(dir / "cal" / "calibration.yaml") + " --image_path " + Quoted(dir / "set" / "images") +
+      " --output_path " + Quoted(dir / "out") + " --Undistort.distance 2");
   ASSERT_EQ(undistort.exit_code, 0) << undistort.output;
   const Camera pinhole = ReadSparseModel(dir / "out" / "sparse").cameras.at(1);
   std::string params;
@@ -119,12 +122,14 @@ TEST(ColmapUndistortedInterop, ColmapMapperRecoversTheSurveyAtTheDesignDistance)
   fs::create_directories(dir / "colmap");
   for (const std::string& command :
        {colmap + " feature_extractor --database_path " + database + " --image_path " + images +
-            " --ImageReader.camera_model PINHOLE --ImageReader.single_camera 1 --ImageReader.camera_params " + params +
-            " --SiftExtraction.use_gpu 0 --SiftExtraction.num_threads 2",
+            " --ImageReader.camera_model PINHOLE --ImageReader.single_camera 1 "
+            "--ImageReader.camera_params " +
+            params + " --SiftExtraction.use_gpu 0 --SiftExtraction.num_threads 2",
         colmap + " exhaustive_matcher --database_path " + database +
             " --SiftMatching.use_gpu 0 --SiftMatching.num_threads 2",
-        colmap + " mapper --database_path " + database + " --image_path " + images + " --output_path " +
-            Quoted(dir / "colmap") + " --Mapper.ba_refine_focal_length 0 --Mapper.ba_refine_principal_point 0" +
+        colmap + " mapper --database_path " + database + " --image_path " + images +
+            " --output_path " + Quoted(dir / "colmap") +
+            " --Mapper.ba_refine_focal_length 0 --Mapper.ba_refine_principal_point 0" +
             " --Mapper.ba_refine_extra_params 0 --Mapper.num_threads 2"}) {
     const testing::CommandResult result = RunCommand(command);
     ASSERT_EQ(result.exit_code, 0) << command << "\n" << result.output;
@@ -132,8 +137,10 @@ TEST(ColmapUndistortedInterop, ColmapMapperRecoversTheSurveyAtTheDesignDistance)
   const SparseModel reconstruction = ReadSparseModel(dir / "colmap" / "0");
   int num_matched = 0;
   const double rms = AlignedCentreRms(reconstruction, truth, &num_matched);
-  std::printf("colmap mapper on the undistorted survey: %d of 24 images, camera centres %.2f mm RMS from the truth\n",
-              num_matched, 1000 * rms);
+  std::printf(
+      "colmap mapper on the undistorted survey: %d of 24 images, camera centres %.2f mm RMS from "
+      "the truth\n",
+      num_matched, 1000 * rms);
   EXPECT_EQ(num_matched, 24);
   EXPECT_LT(rms, 0.01);
 }

@@ -35,19 +35,23 @@ for a, b in zip(near, far):
     print('%.9g %.9g' % (a, b))
 )";
 
-void ExpectEqualsMrcal(const fs::path& images, const std::string& target_flags, const fs::path& dir) {
+void ExpectEqualsMrcal(const fs::path& images, const std::string& target_flags,
+                       const fs::path& dir) {
   const std::string portcal = testing::PortcalBinary();
   const std::string db = (dir / "db.db").string(), out = (dir / "cal").string();
   const testing::CommandResult extract = testing::RunCommand(
-      portcal + " target_extractor --log_level warn --database_path " + db + " --image_path " + images.string() +
-      " --ImageReader.camera_model OPENCV --ImageReader.single_camera 1 " + target_flags);
+      portcal + " target_extractor --log_level warn --database_path " + db + " --image_path " +
+      images.string() + " --ImageReader.camera_model OPENCV --ImageReader.single_camera 1 " +
+      target_flags);
   ASSERT_EQ(extract.exit_code, 0) << extract.output;
-  const testing::CommandResult calibrate = testing::RunCommand(
-      portcal + " camera_calibrator --log_level warn --database_path " + db + " --output_path " + out);
+  const testing::CommandResult calibrate =
+      testing::RunCommand(portcal + " camera_calibrator --log_level warn --database_path " + db +
+                          " --output_path " + out);
   ASSERT_EQ(calibrate.exit_code, 0) << calibrate.output;
   ASSERT_TRUE(fs::exists(dir / "cal/camera.cameramodel"));
 
-  const YAML::Node grid = YAML::LoadFile((dir / "cal/calibration.yaml").string())["projection_uncertainty"];
+  const YAML::Node grid =
+      YAML::LoadFile((dir / "cal/calibration.yaml").string())["projection_uncertainty"];
   ASSERT_TRUE(grid) << "calibration.yaml has no projection_uncertainty";
   ASSERT_TRUE(grid["determined"].as<bool>());
   EXPECT_EQ(grid["of"].as<std::string>(), "intrinsics");
@@ -61,9 +65,10 @@ void ExpectEqualsMrcal(const fs::path& images, const std::string& target_flags, 
   }
   pixels.close();
   std::ofstream(dir / "script.py") << kMrcalScript;
-  const testing::CommandResult mrcal = testing::RunCommand(
-      "/usr/bin/python3 " + (dir / "script.py").string() + " " + (dir / "cal/camera.cameramodel").string() + " " +
-      std::to_string(depth) + " " + (dir / "pixels.txt").string() + " 2>&1");
+  const testing::CommandResult mrcal =
+      testing::RunCommand("/usr/bin/python3 " + (dir / "script.py").string() + " " +
+                          (dir / "cal/camera.cameramodel").string() + " " + std::to_string(depth) +
+                          " " + (dir / "pixels.txt").string() + " 2>&1");
   ASSERT_EQ(mrcal.exit_code, 0) << mrcal.output;
   std::istringstream lines(mrcal.output);
   double worst_ratio[2] = {1, 1}, sum[2][2] = {{0, 0}, {0, 0}};
@@ -77,43 +82,50 @@ void ExpectEqualsMrcal(const fs::path& images, const std::string& target_flags, 
       ASSERT_GT(near[c], 0) << "cell " << r << "," << c;
       const double ratios[2] = {near[c] / mrcal_near, far[c] / mrcal_far};
       for (int k = 0; k < 2; ++k) {
-        EXPECT_NEAR(ratios[k], 1.0, 0.10) << "cell " << r << "," << c << (k ? " at infinity" : " at the distance")
-                                          << ": portcal " << (k ? far[c] : near[c]) << " px, mrcal "
-                                          << (k ? mrcal_far : mrcal_near) << " px";
+        EXPECT_NEAR(ratios[k], 1.0, 0.10)
+            << "cell " << r << "," << c << (k ? " at infinity" : " at the distance") << ": portcal "
+            << (k ? far[c] : near[c]) << " px, mrcal " << (k ? mrcal_far : mrcal_near) << " px";
         if (std::abs(ratios[k] - 1) > std::abs(worst_ratio[k] - 1)) worst_ratio[k] = ratios[k];
       }
       sum[0][0] += near[c], sum[0][1] += mrcal_near, sum[1][0] += far[c], sum[1][1] += mrcal_far;
     }
   }
   const double n = static_cast<double>(xs.size() * ys.size());
-  std::printf("projection uncertainty at %.3f m, mean over %zux%zu cells: portcal %.4f px, mrcal %.4f px (worst "
-              "cell ratio %.3f); at infinity: portcal %.4f px, mrcal %.4f px (worst cell ratio %.3f)\n",
-              depth, xs.size(), ys.size(), sum[0][0] / n, sum[0][1] / n, worst_ratio[0], sum[1][0] / n,
-              sum[1][1] / n, worst_ratio[1]);
+  std::printf(
+      "projection uncertainty at %.3f m, mean over %zux%zu cells: portcal %.4f px, mrcal %.4f px "
+      "(worst "
+      "cell ratio %.3f); at infinity: portcal %.4f px, mrcal %.4f px (worst cell ratio %.3f)\n",
+      depth, xs.size(), ys.size(), sum[0][0] / n, sum[0][1] / n, worst_ratio[0], sum[1][0] / n,
+      sum[1][1] / n, worst_ratio[1]);
 }
 
-bool MrcalImports() { return testing::RunCommand("/usr/bin/python3 -c 'import mrcal' 2>&1").exit_code == 0; }
+bool MrcalImports() {
+  return testing::RunCommand("/usr/bin/python3 -c 'import mrcal' 2>&1").exit_code == 0;
+}
 
 TEST(MrcalUncertainty, RealInAirSetEqualsMrcal) {
   PORTCAL_REQUIRE_SHARED(shared);
-  if (!MrcalImports()) GTEST_SKIP() << "mrcal's Python module is not importable by /usr/bin/python3";
+  if (!MrcalImports())
+    GTEST_SKIP() << "mrcal's Python module is not importable by /usr/bin/python3";
   const fs::path images = shared / "datasets/real-dome/air";
   if (!fs::exists(images)) GTEST_SKIP() << images << " is absent";
   testing::TempDir dir;
-  ExpectEqualsMrcal(images, "--Target.cols 8 --Target.rows 6 --Target.square_size 0.03", dir.path());
+  ExpectEqualsMrcal(images, "--Target.cols 8 --Target.rows 6 --Target.square_size 0.03",
+                    dir.path());
 }
 
 TEST(MrcalUncertainty, RenderedSetEqualsMrcal) {
   PORTCAL_REQUIRE_SHARED(shared);
-  if (!MrcalImports()) GTEST_SKIP() << "mrcal's Python module is not importable by /usr/bin/python3";
+  if (!MrcalImports())
+    GTEST_SKIP() << "mrcal's Python module is not importable by /usr/bin/python3";
   const fs::path set = shared / "datasets/rendered/chess_air_distorted";
   if (!fs::exists(set / "images")) GTEST_SKIP() << set << " is absent";
   const YAML::Node target = YAML::LoadFile((set / "ground_truth.yaml").string())["target"];
   testing::TempDir dir;
   ExpectEqualsMrcal(set / "images",
-                    "--Target.cols " + target["inner_corners_cols"].as<std::string>() + " --Target.rows " +
-                        target["inner_corners_rows"].as<std::string>() + " --Target.square_size " +
-                        target["square_size"].as<std::string>(),
+                    "--Target.cols " + target["inner_corners_cols"].as<std::string>() +
+                        " --Target.rows " + target["inner_corners_rows"].as<std::string>() +
+                        " --Target.square_size " + target["square_size"].as<std::string>(),
                     dir.path());
 }
 

@@ -3,6 +3,7 @@
 // to a user who gets the input wrong: the expected exit code (never a crash),
 // a message with the expected words (the file, image, option or key at
 // fault), and, for a failure, every file as it was and no file left behind.
+#include <gtest/gtest.h>
 #include <sqlite3.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -13,8 +14,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "tests/test_utils.h"
 
@@ -53,7 +52,8 @@ std::vector<CatalogueCase> ReadCatalogue() {
     if (line.empty() || line[0] == '#') continue;
     const std::vector<std::string> fields = Split(line, '\t');
     if (fields.size() != 5) {
-      ADD_FAILURE() << PORTCAL_CATALOGUE_PATH << ":" << line_number << ": expected 5 tab-separated fields";
+      ADD_FAILURE() << PORTCAL_CATALOGUE_PATH << ":" << line_number
+                    << ": expected 5 tab-separated fields";
       continue;
     }
     CatalogueCase row;
@@ -89,8 +89,10 @@ std::string Differences(const std::map<std::string, std::string>& before,
   std::string differences;
   for (const auto& [name, bytes] : after) {
     auto it = before.find(name);
-    if (it == before.end()) differences += " left behind: " + name + ";";
-    else if (it->second != bytes) differences += " changed: " + name + ";";
+    if (it == before.end())
+      differences += " left behind: " + name + ";";
+    else if (it->second != bytes)
+      differences += " changed: " + name + ";";
   }
   for (const auto& [name, bytes] : before) {
     if (!after.count(name)) differences += " removed: " + name + ";";
@@ -120,8 +122,9 @@ class BadInputCatalogue : public ::testing::TestWithParam<CatalogueCase> {
  protected:
   static void SetUpTestSuite() {
     root_ = new testing::TempDir();
-    const std::string command = std::string("bash ") + PORTCAL_FIXTURE_SCRIPT + " " + testing::PortcalBinary() +
-                                " " + (root_->path() / "fixture").string();
+    const std::string command = std::string("bash ") + PORTCAL_FIXTURE_SCRIPT + " " +
+                                testing::PortcalBinary() + " " +
+                                (root_->path() / "fixture").string();
     const testing::CommandResult made = testing::RunCommand(command);
     ASSERT_EQ(made.exit_code, 0) << made.output;
   }
@@ -137,10 +140,12 @@ testing::TempDir* BadInputCatalogue::root_ = nullptr;
 // {as_other_user}: the command run as 'nobody' when the tests run as root,
 // for whom a file's missing write permission means nothing.
 std::string Expand(const std::string& text) {
-  const std::string other_user = geteuid() == 0 ? "setpriv --reuid=65534 --regid=65534 --clear-groups" : "";
+  const std::string other_user =
+      geteuid() == 0 ? "setpriv --reuid=65534 --regid=65534 --clear-groups" : "";
   const std::string board = "--Target.cols 9 --Target.rows 6 --Target.square_size 0.03";
-  return Replace(Replace(Replace(text, "{portcal}", testing::PortcalBinary()), "{as_other_user}", other_user),
-                 "{board}", board);
+  return Replace(
+      Replace(Replace(text, "{portcal}", testing::PortcalBinary()), "{as_other_user}", other_user),
+      "{board}", board);
 }
 
 TEST_P(BadInputCatalogue, KeepsItsPromise) {
@@ -156,8 +161,10 @@ TEST_P(BadInputCatalogue, KeepsItsPromise) {
 
   const bool locks = row.setup.rfind("@lock ", 0) == 0;
   if (!locks && !row.setup.empty()) {
-    std::ofstream(scripts / "setup.sh") << "set -e\ncd '" << work.string() << "'\n" << Expand(row.setup) << "\n";
-    const testing::CommandResult setup = testing::RunCommand("bash " + (scripts / "setup.sh").string());
+    std::ofstream(scripts / "setup.sh") << "set -e\ncd '" << work.string() << "'\n"
+                                        << Expand(row.setup) << "\n";
+    const testing::CommandResult setup =
+        testing::RunCommand("bash " + (scripts / "setup.sh").string());
     ASSERT_EQ(setup.exit_code, 0) << "setup of " << row.id << ": " << setup.output;
   }
   const std::map<std::string, std::string> before = Snapshot(work);
@@ -165,14 +172,17 @@ TEST_P(BadInputCatalogue, KeepsItsPromise) {
   // POSIX locks on it, SQLite's among them.
   std::unique_ptr<WriteLock> lock;
   if (locks) lock = std::make_unique<WriteLock>(work / row.setup.substr(6));
-  std::ofstream(scripts / "run.sh") << "cd '" << work.string() << "'\n" << Expand(row.command) << "\n";
-  const testing::CommandResult result = testing::RunCommand("bash " + (scripts / "run.sh").string());
+  std::ofstream(scripts / "run.sh") << "cd '" << work.string() << "'\n"
+                                    << Expand(row.command) << "\n";
+  const testing::CommandResult result =
+      testing::RunCommand("bash " + (scripts / "run.sh").string());
   lock.reset();
 
   EXPECT_EQ(result.exit_code, row.exit_code) << row.command << "\n" << result.output;
   for (const std::string& word : row.words) {
     EXPECT_NE(result.output.find(word), std::string::npos)
-        << "'" << word << "' not in the message of: " << row.command << "\n" << result.output;
+        << "'" << word << "' not in the message of: " << row.command << "\n"
+        << result.output;
   }
   if (row.exit_code != 0) {
     EXPECT_EQ(Differences(before, Snapshot(work)), "") << row.command << "\n" << result.output;
@@ -181,7 +191,9 @@ TEST_P(BadInputCatalogue, KeepsItsPromise) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Rows, BadInputCatalogue, ::testing::ValuesIn(ReadCatalogue()),
-                         [](const ::testing::TestParamInfo<CatalogueCase>& info) { return info.param.id; });
+                         [](const ::testing::TestParamInfo<CatalogueCase>& info) {
+                           return info.param.id;
+                         });
 
 }  // namespace
 }  // namespace portcal

@@ -32,7 +32,8 @@ TEST(Cli, HelpListsTheCommands) {
   }
   // Every name is followed by at least two spaces before its summary
   // (refractive_bundle_adjuster once ran into it).
-  EXPECT_NE(result.output.find("  refractive_bundle_adjuster  "), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("  refractive_bundle_adjuster  "), std::string::npos)
+      << result.output;
   EXPECT_EQ(RunCommand(Portcal("")).exit_code, 2);
   const auto unknown = RunCommand(Portcal("frobnicate"));
   EXPECT_EQ(unknown.exit_code, 2);
@@ -78,9 +79,9 @@ TEST(Cli, ProjectPointsMatchesTheLibraryAndReportsInvalidPoints) {
       "--Camera.width 1920 --Camera.height 1080";
   const std::string housing =
       "--Housing.model DOMEPORT --Housing.params '0.01 0.006 0.002 0.05 0.006 1 1.473 1.334'";
-  const auto result = RunCommand(Portcal("project_points --log_level error --points_path " +
-                                         (dir / "points.txt").string() + " " + camera + " " +
-                                         housing));
+  const auto result =
+      RunCommand(Portcal("project_points --log_level error --points_path " +
+                         (dir / "points.txt").string() + " " + camera + " " + housing));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   std::istringstream lines(result.output);
   std::string first, second, third;
@@ -89,8 +90,8 @@ TEST(Cli, ProjectPointsMatchesTheLibraryAndReportsInvalidPoints) {
   std::getline(lines, third);
   Camera cam = Camera::FromModelName("RADIAL", 1297.3655, 1920, 1080);
   cam.params = {1297.3655, 960, 540, -0.1, 0.01};
-  const Housing dome = Housing::FromName(
-      "DOMEPORT", {0.01, 0.006, 0.002, 0.05, 0.006, 1, 1.473, 1.334}, "test");
+  const Housing dome =
+      Housing::FromName("DOMEPORT", {0.01, 0.006, 0.002, 0.05, 0.006, 1, 1.473, 1.334}, "test");
   const Eigen::Vector2d expected = *ProjectPoint(cam, &dome, Eigen::Vector3d(0.1, -0.05, 1.2));
   double x, y;
   std::istringstream(first) >> x >> y;
@@ -101,9 +102,10 @@ TEST(Cli, ProjectPointsMatchesTheLibraryAndReportsInvalidPoints) {
 
   // Unproject: the pixel's ray passes through the point.
   std::ofstream(dir / "pixels.txt") << first << "\n";
-  const auto rays = RunCommand(Portcal("project_points --log_level error --unproject 1 "
-                                       "--points_path " + (dir / "pixels.txt").string() +
-                                       " " + camera + " " + housing));
+  const auto rays =
+      RunCommand(Portcal("project_points --log_level error --unproject 1 "
+                         "--points_path " +
+                         (dir / "pixels.txt").string() + " " + camera + " " + housing));
   ASSERT_EQ(rays.exit_code, 0) << rays.output;
   Eigen::Vector3d origin, direction;
   std::istringstream(rays.output) >> origin.x() >> origin.y() >> origin.z() >> direction.x() >>
@@ -118,12 +120,12 @@ TEST(Cli, ErrorsNameTheFileAndLine) {
   const std::string camera =
       "--Camera.model PINHOLE --Camera.params 800,800,320,240 --Camera.width 640 "
       "--Camera.height 480";
-  auto result = RunCommand(Portcal("project_points --points_path " + (dir / "bad.txt").string() +
-                                   " " + camera));
+  auto result = RunCommand(
+      Portcal("project_points --points_path " + (dir / "bad.txt").string() + " " + camera));
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.output.find("bad.txt:2"), std::string::npos) << result.output;
-  result = RunCommand(Portcal("project_points --points_path " + (dir / "none.txt").string() +
-                              " " + camera));
+  result = RunCommand(
+      Portcal("project_points --points_path " + (dir / "none.txt").string() + " " + camera));
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.output.find("none.txt"), std::string::npos) << result.output;
   result = RunCommand(Portcal("project_points --points_path " + (dir / "bad.txt").string() +
@@ -141,7 +143,8 @@ TEST(Cli, ErrorsNameTheFileAndLine) {
 TEST(Cli, ProjectPointsTakesTheCameraFromAModelOrACalibrationFile) {
   testing::TempDir dir;
   std::ofstream(dir / "points.txt") << "0 0 2\n";
-  const std::string points = "project_points --log_level error --points_path " + (dir / "points.txt").string();
+  const std::string points =
+      "project_points --log_level error --points_path " + (dir / "points.txt").string();
   Camera camera;
   camera.model_id = CameraModelNameToId("PINHOLE");
   camera.width = 640;
@@ -193,13 +196,15 @@ TEST(Cli, DatabaseCreatorRefusesAFileThatIsNoDatabaseAndLeavesItAlone) {
   testing::TempDir dir;
   const std::string text(2000, 'x');
   std::ofstream(dir / "notes.db") << text;
-  const auto result = RunCommand(Portcal("database_creator --database_path " +
-                                         (dir / "notes.db").string()));
+  const auto result =
+      RunCommand(Portcal("database_creator --database_path " + (dir / "notes.db").string()));
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.output.find("notes.db"), std::string::npos) << result.output;
   EXPECT_EQ(testing::ReadFileToString(dir / "notes.db"), text);
   EXPECT_EQ(RunCommand(Portcal("database_creator --log_level error --database_path " +
-                               (dir / "new.db").string())).exit_code, 0);
+                               (dir / "new.db").string()))
+                .exit_code,
+            0);
   EXPECT_TRUE(fs::exists(dir / "new.db"));
 }
 
@@ -222,8 +227,7 @@ TEST(Cli, ModelConverterImportsTheForksCameras) {
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.output.find("missing"), std::string::npos);
   result = RunCommand(Portcal("model_converter --input_path " + (dir / "fork").string() +
-                              " --output_path " + (dir / "out3").string() +
-                              " --output_type PLY"));
+                              " --output_path " + (dir / "out3").string() + " --output_type PLY"));
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.output.find("--output_type"), std::string::npos);
 }
@@ -239,21 +243,22 @@ TEST(Cli, ModelConverterExportsAndImportsOneCamera) {
   std::ofstream(dir / "model" / "images.txt") << "";
   std::ofstream(dir / "model" / "points3D.txt") << "";
   const std::string input = " --input_path " + (dir / "model").string();
-  auto result = RunCommand(Portcal("model_converter" + input + " --output_type CAMERAMODEL --output_path " +
-                                   (dir / "c.cameramodel").string()));
+  auto result =
+      RunCommand(Portcal("model_converter" + input + " --output_type CAMERAMODEL --output_path " +
+                         (dir / "c.cameramodel").string()));
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.output.find("--camera_id"), std::string::npos) << result.output;
   for (const char* type : {"CAMERAMODEL", "OPENCV_YAML", "ROS_YAML"}) {
     const std::string out = (dir / (std::string("c_") + type)).string() +
                             (std::string(type) == "CAMERAMODEL" ? ".cameramodel" : ".yaml");
-    result = RunCommand(Portcal("model_converter --log_level error" + input + " --camera_id 1 --output_type " +
-                                type + " --output_path " + out));
+    result = RunCommand(Portcal("model_converter --log_level error" + input +
+                                " --camera_id 1 --output_type " + type + " --output_path " + out));
     ASSERT_EQ(result.exit_code, 0) << result.output;
     EXPECT_TRUE(fs::exists(out)) << type;
   }
   result = RunCommand(Portcal("model_converter --log_level error --input_path " +
-                              (dir / "c_CAMERAMODEL.cameramodel").string() + " --output_type TXT --output_path " +
-                              (dir / "back").string()));
+                              (dir / "c_CAMERAMODEL.cameramodel").string() +
+                              " --output_type TXT --output_path " + (dir / "back").string()));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const SparseModel back = ReadSparseModel(dir / "back");
   ASSERT_EQ(back.cameras.size(), 1u);
@@ -268,12 +273,13 @@ TEST(Cli, CrossCheckNamesWhatIsMissing) {
   auto result = RunCommand(Portcal("cross_check --database_path " + (dir / "db.db").string()));
   EXPECT_EQ(result.exit_code, 2) << result.output;
   result = RunCommand(Portcal("cross_check --database_path " + (dir / "db.db").string() +
-                              " --input_calibration " + (dir / "nope.yaml").string() + " --output_path " +
-                              (dir / "out").string()));
+                              " --input_calibration " + (dir / "nope.yaml").string() +
+                              " --output_path " + (dir / "out").string()));
   EXPECT_EQ(result.exit_code, 1) << result.output;
   EXPECT_NE(result.output.find("nope.yaml"), std::string::npos) << result.output;
-  result = RunCommand(Portcal("cross_check --database_path a --input_calibration b --output_path c "
-                              "--CrossCheck.folds 1"));
+  result =
+      RunCommand(Portcal("cross_check --database_path a --input_calibration b --output_path c "
+                         "--CrossCheck.folds 1"));
   EXPECT_EQ(result.exit_code, 1) << result.output;
   EXPECT_NE(result.output.find("--CrossCheck.folds"), std::string::npos) << result.output;
 }
@@ -289,7 +295,8 @@ TEST(Cli, TypedOptionsNameTheFlagAtFault) {
       {"--Housing.model CYLINDER --Housing.params 0,0,1,0.01,0.01,1,1.5,1.33", "CYLINDER"},
       {"--AutoCalibration.refine_intrinsics 2", "--AutoCalibration.refine_intrinsics"},
       {"--AutoCalibration.matcher spatial", "--AutoCalibration.matcher"},
-      {"--Housing.model DOMEPORT --Housing.params 0,0,0,43.552,3.75,1,1.495,1.333", "portcal takes metres"},
+      {"--Housing.model DOMEPORT --Housing.params 0,0,0,43.552,3.75,1,1.495,1.333",
+       "portcal takes metres"},
   };
   for (const auto& [flags, named] : cases) {
     const auto result = RunCommand(Portcal(base + flags));
@@ -329,12 +336,15 @@ TEST(Cli, SharedFlagGroupsReadTheSameInEveryCommand) {
     return folded;
   };
   const std::vector<std::pair<std::string, std::vector<std::string>>> groups = {
-      {"Markers.side_length", {"refractive_mapper", "refractive_bundle_adjuster", "auto_calibrator"}},
-      {"Markers.side_sigma", {"refractive_mapper", "refractive_bundle_adjuster", "auto_calibrator"}},
+      {"Markers.side_length",
+       {"refractive_mapper", "refractive_bundle_adjuster", "auto_calibrator"}},
+      {"Markers.side_sigma",
+       {"refractive_mapper", "refractive_bundle_adjuster", "auto_calibrator"}},
       {"SiftExtraction.peak_threshold", {"feature_extractor", "auto_calibrator"}},
       {"ImageReader.single_camera_per_folder", {"feature_extractor", "target_extractor"}},
       {"SiftMatching.max_ratio", {"exhaustive_matcher", "sequential_matcher", "spatial_matcher"}},
-      {"TwoViewGeometry.max_error", {"exhaustive_matcher", "sequential_matcher", "spatial_matcher"}},
+      {"TwoViewGeometry.max_error",
+       {"exhaustive_matcher", "sequential_matcher", "spatial_matcher"}},
       {"Markers.dictionary", {"feature_masker", "auto_calibrator"}},
       {"Mask.enlargement_factor", {"feature_masker", "auto_calibrator"}},
   };
@@ -346,7 +356,8 @@ TEST(Cli, SharedFlagGroupsReadTheSameInEveryCommand) {
           << "--" << flag << " in " << commands[k] << " and " << commands.front();
     }
   }
-  const auto result = RunCommand(Portcal("auto_calibrator --image_path a --output_path b --Markers.side_sigma 0"));
+  const auto result =
+      RunCommand(Portcal("auto_calibrator --image_path a --output_path b --Markers.side_sigma 0"));
   EXPECT_EQ(result.exit_code, 1) << result.output;
   EXPECT_NE(result.output.find("--Markers.side_sigma"), std::string::npos) << result.output;
 }
@@ -356,8 +367,8 @@ TEST(Cli, SharedFlagGroupsReadTheSameInEveryCommand) {
 // names the options meant, and the database is not touched.
 TEST(Cli, AbbreviatedOrUnknownOptionsAreRefusedWithSuggestions) {
   testing::TempDir dir;
-  const std::string calibrate =
-      "camera_calibrator --database_path " + (dir / "db.db").string() + " --output_path " + (dir / "out").string();
+  const std::string calibrate = "camera_calibrator --database_path " + (dir / "db.db").string() +
+                                " --output_path " + (dir / "out").string();
   auto result = RunCommand(Portcal(calibrate + " --Calibration.estimate 1"));
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(result.output.find("did you mean --Calibration.estimate_board_warp"), std::string::npos)
@@ -365,11 +376,14 @@ TEST(Cli, AbbreviatedOrUnknownOptionsAreRefusedWithSuggestions) {
   EXPECT_FALSE(fs::exists(dir / "db.db"));
   result = RunCommand(Portcal(calibrate + " --Calibration.estimate_bord_warp 1"));
   EXPECT_EQ(result.exit_code, 2) << result.output;
-  EXPECT_NE(result.output.find("--Calibration.estimate_board_warp"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("--Calibration.estimate_board_warp"), std::string::npos)
+      << result.output;
   // The same option under the group of another command.
-  result = RunCommand(Portcal("feature_masker --database_path a --image_path b --Mask.dictionary DICT_4X4_50"));
+  result = RunCommand(
+      Portcal("feature_masker --database_path a --image_path b --Mask.dictionary DICT_4X4_50"));
   EXPECT_EQ(result.exit_code, 2) << result.output;
-  EXPECT_NE(result.output.find("did you mean --Markers.dictionary"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("did you mean --Markers.dictionary"), std::string::npos)
+      << result.output;
 }
 
 // "portcal help CMD" is "portcal CMD -h"; "-h GROUP" shows that group only.
@@ -381,7 +395,8 @@ TEST(Cli, HelpOfACommandAndOfOneGroup) {
   EXPECT_EQ(via_help.output, full.output);
   const auto group = RunCommand(Portcal("camera_calibrator -h Calibration"));
   EXPECT_EQ(group.exit_code, 0) << group.output;
-  EXPECT_NE(group.output.find("--Calibration.estimate_board_warp"), std::string::npos) << group.output;
+  EXPECT_NE(group.output.find("--Calibration.estimate_board_warp"), std::string::npos)
+      << group.output;
   EXPECT_EQ(group.output.find("--database_path"), std::string::npos) << group.output;
   EXPECT_EQ(RunCommand(Portcal("help camera_calibrator Calibration")).output, group.output);
   const auto no_group = RunCommand(Portcal("camera_calibrator -h Nonsense"));
@@ -393,10 +408,12 @@ TEST(Cli, HelpOfACommandAndOfOneGroup) {
 TEST(Cli, PosePriorsNameWhatIsMissing) {
   testing::TempDir dir;
   const std::string db = (dir / "db.db").string();
-  auto result = RunCommand(Portcal("pose_prior_importer --database_path " + db + " --input_path nav.txt"));
+  auto result =
+      RunCommand(Portcal("pose_prior_importer --database_path " + db + " --input_path nav.txt"));
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.output.find("--database_path"), std::string::npos) << result.output;
-  ASSERT_EQ(RunCommand(Portcal("database_creator --log_level error --database_path " + db)).exit_code, 0);
+  ASSERT_EQ(
+      RunCommand(Portcal("database_creator --log_level error --database_path " + db)).exit_code, 0);
   result = RunCommand(Portcal("pose_prior_importer --database_path " + db + " --input_path " +
                               (dir / "missing.txt").string()));
   EXPECT_EQ(result.exit_code, 1);
@@ -404,7 +421,8 @@ TEST(Cli, PosePriorsNameWhatIsMissing) {
   result = RunCommand(Portcal("spatial_matcher --database_path " + db));
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.output.find("image"), std::string::npos) << result.output;
-  result = RunCommand(Portcal("refractive_bundle_adjuster --input_path a --output_path b --PosePrior.position_sigma 0.02"));
+  result = RunCommand(Portcal(
+      "refractive_bundle_adjuster --input_path a --output_path b --PosePrior.position_sigma 0.02"));
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.output.find("--database_path"), std::string::npos) << result.output;
 }
@@ -424,25 +442,30 @@ TEST(Cli, NothingDoneIsAnErrorNamingTheCause) {
 
   std::ofstream(dir / "points.txt") << "0.1 0.2 1\n";
   // The answers to a full disk (stderr stays with the test).
-  result = RunCommand("(" + Portcal("project_points --points_path " + (dir / "points.txt").string() +
-                                    " --Camera.model PINHOLE --Camera.params 800,800,320,240 --Camera.width 640 "
-                                    "--Camera.height 480") +
-                      " > /dev/full)");
+  result = RunCommand(
+      "(" +
+      Portcal("project_points --points_path " + (dir / "points.txt").string() +
+              " --Camera.model PINHOLE --Camera.params 800,800,320,240 --Camera.width 640 "
+              "--Camera.height 480") +
+      " > /dev/full)");
   EXPECT_EQ(result.exit_code, 1) << result.output;
   EXPECT_NE(result.output.find("standard output"), std::string::npos) << result.output;
 
-  result = RunCommand(Portcal("stereo_calibrator --database_path " + (dir / "t.db").string() + " --output_path " +
-                              (dir / "out").string() + " --Stereo.camera1_id 1 --Stereo.camera2_id 1"));
+  result = RunCommand(Portcal("stereo_calibrator --database_path " + (dir / "t.db").string() +
+                              " --output_path " + (dir / "out").string() +
+                              " --Stereo.camera1_id 1 --Stereo.camera2_id 1"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--Stereo.camera2_id"), std::string::npos) << result.output;
   EXPECT_FALSE(fs::exists(dir / "out"));
 
-  std::ofstream(dir / "bogus.yaml") << "model: BOGUS_MODEL\nwidth: 10\nheight: 10\nparameters: [1]\n";
+  std::ofstream(dir / "bogus.yaml")
+      << "model: BOGUS_MODEL\nwidth: 10\nheight: 10\nparameters: [1]\n";
   result = RunCommand(Portcal("calibration_evaluator --database_path " + (dir / "t.db").string() +
-                              " --input_calibration " + (dir / "bogus.yaml").string() + " --output_path " +
-                              (dir / "eval").string()));
+                              " --input_calibration " + (dir / "bogus.yaml").string() +
+                              " --output_path " + (dir / "eval").string()));
   EXPECT_EQ(result.exit_code, 1);
-  EXPECT_NE(result.output.find("bogus.yaml: model: unknown camera model 'BOGUS_MODEL'"), std::string::npos)
+  EXPECT_NE(result.output.find("bogus.yaml: model: unknown camera model 'BOGUS_MODEL'"),
+            std::string::npos)
       << result.output;
 }
 

@@ -46,16 +46,13 @@ struct CameraModelBase {
   // (fx, fy, cx, cy, extra...).
   static constexpr int FocalCount() { return Model::kSingleFocal ? 1 : 2; }
   static constexpr int ExtraOffset() { return FocalCount() + 2; }
-  static constexpr int NumExtraParams() {
-    return Model::kNumParams - ExtraOffset();
-  }
+  static constexpr int NumExtraParams() { return Model::kNumParams - ExtraOffset(); }
 
   static std::vector<int> FocalLengthIdxs() {
     return Model::kSingleFocal ? std::vector<int>{0} : std::vector<int>{0, 1};
   }
   static std::vector<int> PrincipalPointIdxs() {
-    return Model::kSingleFocal ? std::vector<int>{1, 2}
-                               : std::vector<int>{2, 3};
+    return Model::kSingleFocal ? std::vector<int>{1, 2} : std::vector<int>{2, 3};
   }
   static std::vector<int> ExtraParamsIdxs() {
     std::vector<int> idxs;
@@ -64,8 +61,7 @@ struct CameraModelBase {
   }
 
   // COLMAP's default initialisation: focal, image centre, zero distortion.
-  static std::vector<double> InitializeParams(double focal_length, int width,
-                                              int height) {
+  static std::vector<double> InitializeParams(double focal_length, int width, int height) {
     std::vector<double> params(Model::kNumParams, 0.0);
     params[0] = focal_length;
     if (!Model::kSingleFocal) params[1] = focal_length;
@@ -96,8 +92,8 @@ struct CameraModelBase {
   // Point in the camera frame -> pixel. False if the point is not in front of
   // the camera (w <= 0); outputs are then untouched.
   template <typename T>
-  [[nodiscard]] static bool ImgFromCam(const T* params, const T& u, const T& v,
-                                       const T& w, T* x, T* y) {
+  [[nodiscard]] static bool ImgFromCam(const T* params, const T& u, const T& v, const T& w, T* x,
+                                       T* y) {
     if (!(w > T(0))) return false;
     T ud, vd;
     Model::Distort(params + ExtraOffset(), u / w, v / w, &ud, &vd);
@@ -112,8 +108,7 @@ struct CameraModelBase {
   // exact first derivatives (implicit function theorem: du/dp = -J^-1 dr/dp).
   // False if Newton does not converge (pixel outside the lens' valid region).
   template <typename T>
-  [[nodiscard]] static bool CamFromImg(const T* params, const T& x, const T& y,
-                                       T* u, T* v,
+  [[nodiscard]] static bool CamFromImg(const T* params, const T& x, const T& y, T* u, T* v,
                                        const UndistortionOptions& options = {}) {
     const T xd = (x - Cx(params)) / Fx(params);
     const T yd = (y - Cy(params)) / Fy(params);
@@ -124,8 +119,7 @@ struct CameraModelBase {
     double u0 = ScalarPart(xd);
     double v0 = ScalarPart(yd);
     double jacobian[4];
-    if (!UndistortValues(extra, ScalarPart(xd), ScalarPart(yd), options, &u0,
-                         &v0, jacobian)) {
+    if (!UndistortValues(extra, ScalarPart(xd), ScalarPart(yd), options, &u0, &v0, jacobian)) {
       return false;
     }
     if constexpr (std::is_same_v<T, double>) {
@@ -147,8 +141,8 @@ struct CameraModelBase {
   // Newton on Distort(u, v) = (xd, yd) in doubles. jacobian (row-major 2x2)
   // is d Distort / d(u, v) at the solution.
   static bool UndistortValues(const double* extra, double xd, double yd,
-                              const UndistortionOptions& options, double* u,
-                              double* v, double* jacobian) {
+                              const UndistortionOptions& options, double* u, double* v,
+                              double* jacobian) {
     using Jet2 = ceres::Jet<double, 2>;
     Jet2 extra_jet[Model::kNumParams];
     for (int i = 0; i < NumExtraParams(); ++i) extra_jet[i] = Jet2(extra[i]);

@@ -24,8 +24,7 @@ struct OpenCVFisheyeModel : CameraModelBase<OpenCVFisheyeModel> {
     const T r2 = u * u + v * v;
     const T theta_over_r = AtanROverR(r2);
     const T t2 = r2 * theta_over_r * theta_over_r;
-    const T poly =
-        T(1) + t2 * (extra[0] + t2 * (extra[1] + t2 * (extra[2] + t2 * extra[3])));
+    const T poly = T(1) + t2 * (extra[0] + t2 * (extra[1] + t2 * (extra[2] + t2 * extra[3])));
     const T scale = theta_over_r * poly;
     *ud = u * scale;
     *vd = v * scale;
@@ -79,8 +78,7 @@ struct ThinPrismFisheyeModel : CameraModelBase<ThinPrismFisheyeModel> {
   static constexpr int kId = 10;
   static constexpr const char* kName = "THIN_PRISM_FISHEYE";
   static constexpr int kNumParams = 12;
-  static constexpr const char* kParamsInfo =
-      "fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, sx1, sy1";
+  static constexpr const char* kParamsInfo = "fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, sx1, sy1";
   static constexpr bool kSingleFocal = false;
   static constexpr bool kFisheye = true;
 
@@ -90,8 +88,7 @@ struct ThinPrismFisheyeModel : CameraModelBase<ThinPrismFisheyeModel> {
     const T uu = u * theta_over_r;
     const T vv = v * theta_over_r;
     const T r2 = uu * uu + vv * vv;
-    const T radial =
-        T(1) + r2 * (extra[0] + r2 * (extra[1] + r2 * (extra[4] + r2 * extra[5])));
+    const T radial = T(1) + r2 * (extra[0] + r2 * (extra[1] + r2 * (extra[4] + r2 * extra[5])));
     *ud = uu * radial + extra[6] * r2;
     *vd = vv * radial + extra[7] * r2;
     AddTangentialDistortion(extra[2], extra[3], uu, vv, ud, vd);

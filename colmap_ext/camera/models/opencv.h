@@ -9,8 +9,7 @@ namespace portcal {
 
 // Tangential (decentering) terms shared by both models.
 template <typename T>
-void AddTangentialDistortion(const T& p1, const T& p2, const T& u, const T& v,
-                             T* ud, T* vd) {
+void AddTangentialDistortion(const T& p1, const T& p2, const T& u, const T& v, T* ud, T* vd) {
   const T r2 = u * u + v * v;
   *ud += T(2) * p1 * u * v + p2 * (r2 + T(2) * u * u);
   *vd += T(2) * p2 * u * v + p1 * (r2 + T(2) * v * v);
@@ -40,8 +39,7 @@ struct FullOpenCVModel : CameraModelBase<FullOpenCVModel> {
   static constexpr int kId = 6;
   static constexpr const char* kName = "FULL_OPENCV";
   static constexpr int kNumParams = 12;
-  static constexpr const char* kParamsInfo =
-      "fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6";
+  static constexpr const char* kParamsInfo = "fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6";
   static constexpr bool kSingleFocal = false;
 
   template <typename T>

@@ -14,8 +14,7 @@ struct SimplePinholeModel : CameraModelBase<SimplePinholeModel> {
   static constexpr bool kSingleFocal = true;
 
   template <typename T>
-  static void Distort(const T* /*extra*/, const T& u, const T& v, T* ud,
-                      T* vd) {
+  static void Distort(const T* /*extra*/, const T& u, const T& v, T* ud, T* vd) {
     *ud = u;
     *vd = v;
   }
@@ -30,8 +29,7 @@ struct PinholeModel : CameraModelBase<PinholeModel> {
   static constexpr bool kSingleFocal = false;
 
   template <typename T>
-  static void Distort(const T* /*extra*/, const T& u, const T& v, T* ud,
-                      T* vd) {
+  static void Distort(const T* /*extra*/, const T& u, const T& v, T* ud, T* vd) {
     *ud = u;
     *vd = v;
   }

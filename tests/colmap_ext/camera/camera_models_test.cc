@@ -1,11 +1,12 @@
 // Every COLMAP camera model gets the same checks: ids and names, round trips
 // to 1e-9 px, and autodiff derivatives against central differences.
+#include "colmap_ext/camera/camera_models.h"
+
 #include <gtest/gtest.h>
 
 #include <set>
 
 #include "colmap_ext/camera/camera.h"
-#include "colmap_ext/camera/camera_models.h"
 
 namespace portcal {
 namespace {
@@ -28,8 +29,7 @@ std::vector<double> TestParams() {
       {"FOV", {0.9}},
       {"SIMPLE_RADIAL_FISHEYE", {0.05}},
       {"RADIAL_FISHEYE", {0.05, -0.01}},
-      {"THIN_PRISM_FISHEYE",
-       {0.05, -0.01, 0.001, -0.001, 0.002, -0.0005, 0.0008, -0.0006}},
+      {"THIN_PRISM_FISHEYE", {0.05, -0.01, 0.001, -0.001, 0.002, -0.0005, 0.0008, -0.0006}},
   };
   const auto it = extra.find(Model::kName);
   if (it != extra.end()) {
@@ -52,9 +52,8 @@ template <typename Model>
 class CameraModelTest : public ::testing::Test {};
 
 using AllModels =
-    ::testing::Types<SimplePinholeModel, PinholeModel, SimpleRadialModel,
-                     RadialModel, OpenCVModel, OpenCVFisheyeModel,
-                     FullOpenCVModel, FOVModel, SimpleRadialFisheyeModel,
+    ::testing::Types<SimplePinholeModel, PinholeModel, SimpleRadialModel, RadialModel, OpenCVModel,
+                     OpenCVFisheyeModel, FullOpenCVModel, FOVModel, SimpleRadialFisheyeModel,
                      RadialFisheyeModel, ThinPrismFisheyeModel>;
 TYPED_TEST_SUITE(CameraModelTest, AllModels);
 
@@ -80,8 +79,7 @@ TYPED_TEST(CameraModelTest, UnprojectThenProjectReturnsThePixel) {
         << Model::kName << " pixel " << pixel.transpose();
     for (const double depth : {0.3, 7.0}) {
       double x, y;
-      ASSERT_TRUE(Model::ImgFromCam(params.data(), u * depth, v * depth, depth,
-                                    &x, &y));
+      ASSERT_TRUE(Model::ImgFromCam(params.data(), u * depth, v * depth, depth, &x, &y));
       EXPECT_NEAR(x, pixel.x(), 1e-9) << Model::kName;
       EXPECT_NEAR(y, pixel.y(), 1e-9) << Model::kName;
     }
@@ -126,8 +124,7 @@ TYPED_TEST(CameraModelTest, AutodiffMatchesCentralDifferences) {
   Jet point_jet[3];
   for (int i = 0; i < 3; ++i) point_jet[i] = Jet(point[i], N + i);
   Jet x, y;
-  ASSERT_TRUE(Model::ImgFromCam(params_jet, point_jet[0], point_jet[1],
-                                point_jet[2], &x, &y));
+  ASSERT_TRUE(Model::ImgFromCam(params_jet, point_jet[0], point_jet[1], point_jet[2], &x, &y));
   Jet u, v;
   ASSERT_TRUE(Model::CamFromImg(params_jet, Jet(pixel.x()), Jet(pixel.y()), &u, &v));
 
@@ -143,10 +140,10 @@ TYPED_TEST(CameraModelTest, AutodiffMatchesCentralDifferences) {
       point_minus[k - N] -= h;
     }
     double xp, yp, xm, ym;
-    ASSERT_TRUE(Model::ImgFromCam(plus.data(), point_plus[0], point_plus[1],
-                                  point_plus[2], &xp, &yp));
-    ASSERT_TRUE(Model::ImgFromCam(minus.data(), point_minus[0], point_minus[1],
-                                  point_minus[2], &xm, &ym));
+    ASSERT_TRUE(
+        Model::ImgFromCam(plus.data(), point_plus[0], point_plus[1], point_plus[2], &xp, &yp));
+    ASSERT_TRUE(
+        Model::ImgFromCam(minus.data(), point_minus[0], point_minus[1], point_minus[2], &xm, &ym));
     const double scale = 1e-6 * (1.0 + std::abs(x.v[k]) + std::abs(y.v[k]));
     EXPECT_NEAR(x.v[k], (xp - xm) / (2 * h), 1e-3 * scale + 1e-5) << Model::kName << " d/d" << k;
     EXPECT_NEAR(y.v[k], (yp - ym) / (2 * h), 1e-3 * scale + 1e-5) << Model::kName << " d/d" << k;
@@ -161,10 +158,17 @@ TYPED_TEST(CameraModelTest, AutodiffMatchesCentralDifferences) {
 }
 
 TEST(CameraModels, IdsAndNamesAreCOLMAPs) {
-  const std::vector<std::string> expected = {
-      "SIMPLE_PINHOLE", "PINHOLE", "SIMPLE_RADIAL", "RADIAL", "OPENCV",
-      "OPENCV_FISHEYE", "FULL_OPENCV", "FOV", "SIMPLE_RADIAL_FISHEYE",
-      "RADIAL_FISHEYE", "THIN_PRISM_FISHEYE"};
+  const std::vector<std::string> expected = {"SIMPLE_PINHOLE",
+                                             "PINHOLE",
+                                             "SIMPLE_RADIAL",
+                                             "RADIAL",
+                                             "OPENCV",
+                                             "OPENCV_FISHEYE",
+                                             "FULL_OPENCV",
+                                             "FOV",
+                                             "SIMPLE_RADIAL_FISHEYE",
+                                             "RADIAL_FISHEYE",
+                                             "THIN_PRISM_FISHEYE"};
   std::vector<std::string> names;
   std::set<int> ids;
   ForEachModel(CameraModelList{}, [&](auto model) {
@@ -181,7 +185,8 @@ TEST(CameraModels, IdsAndNamesAreCOLMAPs) {
     EXPECT_EQ(CameraModelNumParams(id), num_params[id]);
     // The fisheye models are those on the equidistant angle (COLMAP's ids
     // 5, 8, 9, 10), by their names.
-    EXPECT_EQ(CameraModelIsFisheye(id), expected[id].find("FISHEYE") != std::string::npos) << expected[id];
+    EXPECT_EQ(CameraModelIsFisheye(id), expected[id].find("FISHEYE") != std::string::npos)
+        << expected[id];
   }
 }
 

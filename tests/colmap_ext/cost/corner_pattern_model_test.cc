@@ -1,5 +1,7 @@
 // The corner model with its derivatives written out (and its tabulated erf)
 // against the autodiff residual it replaces in corner refinement.
+#include "colmap_ext/cost/corner_pattern_model.h"
+
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
@@ -9,7 +11,6 @@
 #include <memory>
 #include <random>
 
-#include "colmap_ext/cost/corner_pattern_model.h"
 #include "colmap_ext/cost/corner_pattern_residual.h"
 #include "colmap_ext/cost/erf_pixel_average.h"
 
@@ -18,7 +19,8 @@ namespace {
 
 // Central differences (step 1e-6) of f in each of the corner model's 7
 // parameters at p.
-std::array<double, 7> CentralDifferences(const double* p, const std::function<double(const double*)>& f) {
+std::array<double, 7> CentralDifferences(const double* p,
+                                         const std::function<double(const double*)>& f) {
   std::array<double, 7> derivatives;
   for (int k = 0; k < 7; ++k) {
     double plus[7], minus[7];
@@ -37,7 +39,8 @@ TEST(TabulatedErf, FollowsErfAndItsSlope) {
   for (double u = -8; u <= 8; u += 1.0 / 1024 + 1e-7) {
     double slope = 0;
     max_value_error = std::max(max_value_error, std::abs(table(u, &slope) - std::erf(u)));
-    max_slope_error = std::max(max_slope_error, std::abs(slope - 2 / std::sqrt(M_PI) * std::exp(-u * u)));
+    max_slope_error =
+        std::max(max_slope_error, std::abs(slope - 2 / std::sqrt(M_PI) * std::exp(-u * u)));
   }
   // Cubic Hermite with nodes 1/64 apart: h^4 / 384 max|erf''''| ~ 1e-9 for
   // the value and (interpolated from its own derivatives) the slope.
@@ -51,7 +54,7 @@ TEST(CornerPatternModel, ValueAndDerivativesMatchTheAutodiffResidual) {
   std::mt19937 rng(4);
   std::uniform_real_distribution<double> u(-1, 1);
   for (int trial = 0; trial < 200; ++trial) {
-    double p[7] = {10 + u(rng), 12 + u(rng), 0.3 + 0.5 * u(rng), 1.9 + 0.5 * u(rng),
+    double p[7] = {10 + u(rng),       12 + u(rng), 0.3 + 0.5 * u(rng),          1.9 + 0.5 * u(rng),
                    120 + 20 * u(rng), 60 * u(rng), std::log(0.8) + 0.6 * u(rng)};
     const double x = 10.5 + std::round(4 * u(rng)), y = 12.5 + std::round(4 * u(rng)), gray = 100;
     const std::unique_ptr<ceres::CostFunction> autodiff(CornerPatternResidual::Create(x, y, gray));
@@ -64,7 +67,8 @@ TEST(CornerPatternModel, ValueAndDerivativesMatchTheAutodiffResidual) {
     // The table's 2e-9 per erf, times the contrast.
     EXPECT_NEAR(value - gray, residual, 1e-6) << trial;
     for (int k = 0; k < 7; ++k) {
-      EXPECT_NEAR(gradient[k], jacobian[k], 1e-4 * (1 + std::abs(jacobian[k]))) << "trial " << trial << ", p" << k;
+      EXPECT_NEAR(gradient[k], jacobian[k], 1e-4 * (1 + std::abs(jacobian[k])))
+          << "trial " << trial << ", p" << k;
     }
     EXPECT_EQ(CornerPatternModel(p).Evaluate(x, y, nullptr), value);
   }
@@ -79,8 +83,10 @@ TEST(CornerPatternModel, OneSampleIsThePatternAtThePixelCentre) {
   const double u1 = (std::cos(p[2]) * (x - p[0]) + std::sin(p[2]) * (y - p[1])) * scale;
   const double u2 = (std::cos(p[3]) * (x - p[0]) + std::sin(p[3]) * (y - p[1])) * scale;
   double gradient[7];
-  EXPECT_NEAR(CornerPatternModel(p, 1).Evaluate(x, y, gradient), 120 + 50 * std::erf(u1) * std::erf(u2), 1e-6);
-  const auto numeric = CentralDifferences(p, [&](const double* q) { return CornerPatternModel(q, 1).Evaluate(x, y, nullptr); });
+  EXPECT_NEAR(CornerPatternModel(p, 1).Evaluate(x, y, gradient),
+              120 + 50 * std::erf(u1) * std::erf(u2), 1e-6);
+  const auto numeric = CentralDifferences(
+      p, [&](const double* q) { return CornerPatternModel(q, 1).Evaluate(x, y, nullptr); });
   for (int k = 0; k < 7; ++k) {
     EXPECT_NEAR(gradient[k], numeric[k], 1e-4 * (1 + std::abs(numeric[k]))) << "p" << k;
   }
@@ -112,9 +118,15 @@ TEST(ErfPixelAverage, MatchesAFinelySampledPixelWithItsDerivatives) {
     // 512^2 midpoint samples: error ~ (a^2 + b^2) / (24 * 512^2) * max|erf''|.
     EXPECT_NEAR(m.value, reference(u0, a, b), 1e-5 + 2e-6 * scale * scale) << "trial " << trial;
     constexpr double h = 1e-5;
-    const double d_u0 = (AverageErfOverPixel(u0 + h, a, b).value - AverageErfOverPixel(u0 - h, a, b).value) / (2 * h);
-    const double d_a = (AverageErfOverPixel(u0, a + h, b).value - AverageErfOverPixel(u0, a - h, b).value) / (2 * h);
-    const double d_b = (AverageErfOverPixel(u0, a, b + h).value - AverageErfOverPixel(u0, a, b - h).value) / (2 * h);
+    const double d_u0 =
+        (AverageErfOverPixel(u0 + h, a, b).value - AverageErfOverPixel(u0 - h, a, b).value) /
+        (2 * h);
+    const double d_a =
+        (AverageErfOverPixel(u0, a + h, b).value - AverageErfOverPixel(u0, a - h, b).value) /
+        (2 * h);
+    const double d_b =
+        (AverageErfOverPixel(u0, a, b + h).value - AverageErfOverPixel(u0, a, b - h).value) /
+        (2 * h);
     EXPECT_NEAR(m.d_u0, d_u0, 1e-4) << "trial " << trial;
     EXPECT_NEAR(m.d_a, d_a, 1e-4) << "trial " << trial;
     EXPECT_NEAR(m.d_b, d_b, 1e-4) << "trial " << trial;
@@ -141,7 +153,8 @@ TEST(CornerPatternModel, PixelAreasMatchAFinelySampledPatternWithTheirDerivative
         constexpr int kSamples = 128;
         for (int i = 0; i < kSamples; ++i) {
           for (int j = 0; j < kSamples; ++j) {
-            reference += centre.Evaluate(x + (i + 0.5) / kSamples - 0.5, y + (j + 0.5) / kSamples - 0.5, nullptr);
+            reference += centre.Evaluate(x + (i + 0.5) / kSamples - 0.5,
+                                         y + (j + 0.5) / kSamples - 0.5, nullptr);
           }
         }
         reference /= kSamples * kSamples;
@@ -154,14 +167,18 @@ TEST(CornerPatternModel, PixelAreasMatchAFinelySampledPatternWithTheirDerivative
         // Where both edges cross a sharp corner's pixel 8 x 8 sub-samples
         // are still a staircase (up to ~1 gray level of 60 here); a few
         // pixels of a window only.
-        const double tolerance = region == CornerPatternModel::kCorner ? (sigma < 0.3 ? 1.0 : 0.05) : 5e-3;
-        EXPECT_NEAR(value, reference, tolerance) << "sigma " << sigma << " pixel " << col << "," << row;
+        const double tolerance =
+            region == CornerPatternModel::kCorner ? (sigma < 0.3 ? 1.0 : 0.05) : 5e-3;
+        EXPECT_NEAR(value, reference, tolerance)
+            << "sigma " << sigma << " pixel " << col << "," << row;
         const PixelRule rule = sigma < 0.3 ? PixelRule::Midpoint(8) : PixelRule::GaussLegendre(5);
-        const auto numeric = CentralDifferences(
-            p, [&](const double* q) { return CornerPatternModel(q, rule).EvaluateArea(x, y, region, nullptr); });
+        const auto numeric = CentralDifferences(p, [&](const double* q) {
+          return CornerPatternModel(q, rule).EvaluateArea(x, y, region, nullptr);
+        });
         for (int k = 0; k < 7; ++k) {
           EXPECT_NEAR(gradient[k], numeric[k], 1e-3 * (1 + std::abs(numeric[k])))
-              << "sigma " << sigma << " p" << k << " region " << region << " pixel " << col << "," << row;
+              << "sigma " << sigma << " p" << k << " region " << region << " pixel " << col << ","
+              << row;
         }
       }
     }

@@ -29,11 +29,10 @@ Scene MakeScene(const std::vector<double>& housing) {
   const Eigen::Quaterniond q(Eigen::AngleAxisd(0.2, Eigen::Vector3d(0.3, 1, -0.2).normalized()));
   scene.cam_from_world = {q.x(), q.y(), q.z(), q.w(), -0.05, 0.1, 0.9};
   const Eigen::Vector3d point_in_cam =
-      q * Eigen::Vector3d(scene.point_in_world.data()) +
-      Eigen::Vector3d(-0.05, 0.1, 0.9);
-  EXPECT_TRUE((ImgFromWater<RadialModel, Port, double>(
-      scene.intrinsics.data(), scene.housing.data(), point_in_cam,
-      &scene.observed.x(), &scene.observed.y())));
+      q * Eigen::Vector3d(scene.point_in_world.data()) + Eigen::Vector3d(-0.05, 0.1, 0.9);
+  EXPECT_TRUE((ImgFromWater<RadialModel, Port, double>(scene.intrinsics.data(),
+                                                       scene.housing.data(), point_in_cam,
+                                                       &scene.observed.x(), &scene.observed.y())));
   return scene;
 }
 
@@ -79,8 +78,8 @@ void CheckErrorJacobians(const std::vector<double>& housing) {
   // Off the optimum so that every Jacobian entry matters.
   scene.point_in_world[0] += 0.003;
   CheckJacobians(Error<RadialModel, Port>::Create(scene.observed, 0.5),
-                 {scene.cam_from_world.data(), scene.point_in_world.data(),
-                  scene.intrinsics.data(), scene.housing.data()},
+                 {scene.cam_from_world.data(), scene.point_in_world.data(), scene.intrinsics.data(),
+                  scene.housing.data()},
                  {7, 3, RadialModel::kNumParams, Port::kNumParams});
 }
 
@@ -96,8 +95,7 @@ TEST(CostFunctions, VirtualCameraErrorJacobiansMatchCentralDifferences) {
 
 template <typename Port, template <typename, typename> class Error>
 Eigen::Vector2d Residual(Scene scene) {
-  std::unique_ptr<ceres::CostFunction> cost(
-      Error<RadialModel, Port>::Create(scene.observed, 1.0));
+  std::unique_ptr<ceres::CostFunction> cost(Error<RadialModel, Port>::Create(scene.observed, 1.0));
   const double* blocks[] = {scene.cam_from_world.data(), scene.point_in_world.data(),
                             scene.intrinsics.data(), scene.housing.data()};
   Eigen::Vector2d residual;
@@ -113,9 +111,8 @@ void CheckErrorsAgree(const std::vector<double>& housing) {
   EXPECT_LT((Residual<Port, VirtualCameraError>(scene)).norm(), 1e-8);
   // Near it they measure the same displacement: same direction, a scale
   // within the refractive magnification (nw / na ~ 1.33) of each other.
-  for (const Eigen::Vector3d& delta :
-       {Eigen::Vector3d(1e-3, 0, 0), Eigen::Vector3d(0, -1e-3, 0),
-        Eigen::Vector3d(7e-4, 7e-4, 0)}) {
+  for (const Eigen::Vector3d& delta : {Eigen::Vector3d(1e-3, 0, 0), Eigen::Vector3d(0, -1e-3, 0),
+                                       Eigen::Vector3d(7e-4, 7e-4, 0)}) {
     Scene moved = scene;
     for (int i = 0; i < 3; ++i) moved.point_in_world[i] += delta[i];
     const Eigen::Vector2d reproj = Residual<Port, RefractiveReprojError>(moved);
@@ -152,11 +149,11 @@ Eigen::Vector3d TriangulateBehindDome() {
     Eigen::Vector2d observed;
     EXPECT_TRUE((ImgFromWater<RadialModel, DomePort, double>(
         intrinsics.data(), housing.data(),
-        Eigen::Vector3d(q * truth + Eigen::Vector3d(pose[4], pose[5], pose[6])),
-        &observed.x(), &observed.y())));
+        Eigen::Vector3d(q * truth + Eigen::Vector3d(pose[4], pose[5], pose[6])), &observed.x(),
+        &observed.y())));
     problem.AddResidualBlock(Error<RadialModel, DomePort>::Create(observed, 1.0), nullptr,
-                             pose.data(), estimate.data(),
-                             const_cast<double*>(intrinsics.data()), housing.data());
+                             pose.data(), estimate.data(), const_cast<double*>(intrinsics.data()),
+                             housing.data());
     problem.SetParameterBlockConstant(pose.data());
   }
   problem.SetParameterBlockConstant(intrinsics.data());

@@ -27,8 +27,7 @@ Camera CameraFromYaml(const YAML::Node& node) {
 std::optional<Housing> HousingFromYaml(const YAML::Node& node) {
   if (!node || node.IsNull()) return std::nullopt;
   return Housing::FromName(node["model"].as<std::string>(),
-                           node["params"].as<std::vector<double>>(),
-                           "ground_truth.yaml housing");
+                           node["params"].as<std::vector<double>>(), "ground_truth.yaml housing");
 }
 
 Rigid3d PoseFromYaml(const YAML::Node& node) {
@@ -41,8 +40,7 @@ Rigid3d PoseFromYaml(const YAML::Node& node) {
 // Max |projected - ground truth| over all corners of one camera's images.
 double MaxCornerError(const Camera& camera, const std::optional<Housing>& housing,
                       const std::vector<Eigen::Vector3d>& corners,
-                      const std::vector<std::pair<Rigid3d, YAML::Node>>& views,
-                      int* num_checked) {
+                      const std::vector<std::pair<Rigid3d, YAML::Node>>& views, int* num_checked) {
   double max_error = 0;
   for (const auto& [cam_from_target, corners_px] : views) {
     for (size_t i = 0; i < corners.size(); ++i) {
@@ -51,8 +49,7 @@ double MaxCornerError(const Camera& camera, const std::optional<Housing>& housin
           ProjectPoint(camera, housing ? &*housing : nullptr, cam_from_target * corners[i]);
       EXPECT_TRUE(pixel.has_value());
       if (!pixel) continue;
-      max_error = std::max(max_error,
-                           (*pixel - Eigen::Vector2d(expected[0], expected[1])).norm());
+      max_error = std::max(max_error, (*pixel - Eigen::Vector2d(expected[0], expected[1])).norm());
       ++*num_checked;
     }
   }

@@ -1,12 +1,13 @@
 // Flat and dome ports: exact forward projection (1e-9 px), Snell's law,
 // total internal reflection, validation, and autodiff derivatives.
+#include "colmap_ext/housing/housing.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/camera/housed_camera.h"
-#include "colmap_ext/housing/housing.h"
 #include "colmap_ext/housing/housing_models.h"
 #include "colmap_ext/housing/port_projection.h"
 
@@ -24,14 +25,14 @@ std::vector<Housing> TestHousings() {
   Eigen::Vector3d oblique(0.05, -0.03, 1.0);
   oblique.normalize();
   return {
-      Housing::FromName("FLATPORT", {std::sin(tilt), 0, std::cos(tilt), 0.02, 0.014,
-                                     1.0, 1.473, 1.334}, "test"),
-      Housing::FromName("FLATPORT", {oblique.x(), oblique.y(), oblique.z(), 0.005,
-                                     0.01, 1.0, 1.49, 1.333}, "test"),
-      Housing::FromName("DOMEPORT", {0.01, 0.006, 0.002, 0.05, 0.006, 1.0, 1.473,
-                                     1.334}, "test"),
-      Housing::FromName("DOMEPORT", {0.0, 0.0, -0.0073, 0.043552, 0.00375, 1.0,
-                                     1.495, 1.333}, "test"),
+      Housing::FromName(
+          "FLATPORT", {std::sin(tilt), 0, std::cos(tilt), 0.02, 0.014, 1.0, 1.473, 1.334}, "test"),
+      Housing::FromName("FLATPORT",
+                        {oblique.x(), oblique.y(), oblique.z(), 0.005, 0.01, 1.0, 1.49, 1.333},
+                        "test"),
+      Housing::FromName("DOMEPORT", {0.01, 0.006, 0.002, 0.05, 0.006, 1.0, 1.473, 1.334}, "test"),
+      Housing::FromName("DOMEPORT", {0.0, 0.0, -0.0073, 0.043552, 0.00375, 1.0, 1.495, 1.333},
+                        "test"),
       Housing::FromName("DOMEPORT", {0, 0, 0, 0.05, 0.006, 1.0, 1.473, 1.334}, "test"),
   };
 }
@@ -55,15 +56,14 @@ TEST(Housing, UnprojectThenProjectReturnsThePixel) {
       EXPECT_NEAR(ray->direction.norm(), 1.0, 1e-14);
       for (const double depth : {0.05, 0.5, 1.0, 4.0, 30.0}) {
         const Eigen::Vector3d point = ray->origin + depth * ray->direction;
-        const std::optional<Eigen::Vector2d> projected =
-            ProjectPoint(camera, &housing, point);
+        const std::optional<Eigen::Vector2d> projected = ProjectPoint(camera, &housing, point);
         ASSERT_TRUE(projected) << housing.ModelName() << " depth " << depth;
         max_error = std::max(max_error, (*projected - pixel).norm());
       }
     }
-    EXPECT_LT(max_error, 1e-9) << housing.ModelName() << " "
-                               << Eigen::Map<const Eigen::VectorXd>(
-                                      housing.params.data(), 8).transpose();
+    EXPECT_LT(max_error, 1e-9)
+        << housing.ModelName() << " "
+        << Eigen::Map<const Eigen::VectorXd>(housing.params.data(), 8).transpose();
   }
 }
 
@@ -76,12 +76,10 @@ TEST(Housing, FlatPortObeysSnellsLaw) {
        {Eigen::Vector3d(0.3, -0.2, 1.0), Eigen::Vector3d(-0.7, 0.4, 1.0),
         Eigen::Vector3d(0.0, 0.0, 1.0)}) {
     Eigen::Vector3d origin, dir_water;
-    ASSERT_TRUE(FlatPort::RayInWater(housing.params.data(), dir_air, &origin,
-                                     &dir_water));
+    ASSERT_TRUE(FlatPort::RayInWater(housing.params.data(), dir_air, &origin, &dir_water));
     const Eigen::Vector3d d = dir_air.normalized();
     const Eigen::Vector3d tangential_air = 1.0 * (d - d.dot(n) * n);
-    const Eigen::Vector3d tangential_water =
-        1.334 * (dir_water - dir_water.dot(n) * n);
+    const Eigen::Vector3d tangential_water = 1.334 * (dir_water - dir_water.dot(n) * n);
     EXPECT_LT((tangential_air - tangential_water).norm(), 1e-15);
     EXPECT_NEAR(n.dot(origin), 0.02 + 0.014, 1e-15);  // on the outer surface
   }
@@ -91,8 +89,7 @@ TEST(Housing, DomeRayStartsOnTheOuterSphere) {
   const Housing housing = TestHousings()[2];
   const Eigen::Vector3d center(0.01, 0.006, 0.002);
   Eigen::Vector3d origin, dir_water;
-  ASSERT_TRUE(DomePort::RayInWater(housing.params.data(),
-                                   Eigen::Vector3d(0.4, 0.3, 1.0), &origin,
+  ASSERT_TRUE(DomePort::RayInWater(housing.params.data(), Eigen::Vector3d(0.4, 0.3, 1.0), &origin,
                                    &dir_water));
   EXPECT_NEAR((origin - center).norm(), 0.056, 1e-15);
 }
@@ -113,10 +110,10 @@ TEST(Housing, TotalInternalReflectionIsReportedNotNaN) {
   const Housing housing =
       Housing::FromName("FLATPORT", {0, 0, 1, 0.02, 0.01, 1.333, 1.5, 1.0}, "tir");
   Eigen::Vector3d origin, dir;
-  EXPECT_TRUE(FlatPort::RayInWater(housing.params.data(),
-                                   Eigen::Vector3d(std::tan(0.8), 0, 1), &origin, &dir));
-  EXPECT_FALSE(FlatPort::RayInWater(housing.params.data(),
-                                    Eigen::Vector3d(std::tan(0.9), 0, 1), &origin, &dir));
+  EXPECT_TRUE(FlatPort::RayInWater(housing.params.data(), Eigen::Vector3d(std::tan(0.8), 0, 1),
+                                   &origin, &dir));
+  EXPECT_FALSE(FlatPort::RayInWater(housing.params.data(), Eigen::Vector3d(std::tan(0.9), 0, 1),
+                                    &origin, &dir));
   Camera camera = Camera::FromModelName("PINHOLE", 300, 1920, 1080);
   EXPECT_FALSE(UnprojectPixel(camera, &housing, Eigen::Vector2d(1900, 540)));
   // Any point beyond the port is still reached, by a ray just below the
@@ -159,9 +156,9 @@ TEST(Housing, ValidationNamesTheProblem) {
   EXPECT_NE(message("BALLPORT", {}).find("BALLPORT"), std::string::npos);
   EXPECT_NE(message("DOMEPORT", {0, 0, 0, 0.05, 0.01, 1, 1.5, 1.33}), "x");
   EXPECT_EQ(message("DOMEPORT", {0, 0, 0, 0.05, 0.01, 1, 1.5, 1.33}), "");
-  EXPECT_NE(message("FLATPORT", {0, 0, 1, 0.02, 0.01, 1, std::nan(""), 1.33})
-                .find("housings.txt:3"),
-            std::string::npos);
+  EXPECT_NE(
+      message("FLATPORT", {0, 0, 1, 0.02, 0.01, 1, std::nan(""), 1.33}).find("housings.txt:3"),
+      std::string::npos);
 }
 
 // d(pixel)/d(intrinsics, housing, point) of the exact forward projection by
@@ -187,11 +184,14 @@ void CheckProjectionDerivatives(const Camera& camera, const Housing& housing,
     const auto eval = [&](double delta, Eigen::Vector2d* pixel) {
       std::vector<double> c = cam_p, h = port_p;
       Eigen::Vector3d X = point_p;
-      if (k < kCam) c[k] += delta;
-      else if (k < kCam + kPort) h[k - kCam] += delta;
-      else X[k - kCam - kPort] += delta;
-      return ImgFromWater<RadialModel, Port, double>(c.data(), h.data(), X,
-                                                     &pixel->x(), &pixel->y());
+      if (k < kCam)
+        c[k] += delta;
+      else if (k < kCam + kPort)
+        h[k - kCam] += delta;
+      else
+        X[k - kCam - kPort] += delta;
+      return ImgFromWater<RadialModel, Port, double>(c.data(), h.data(), X, &pixel->x(),
+                                                     &pixel->y());
     };
     const double h = k < kCam ? 1e-6 * std::max(1.0, std::abs(camera.params[k])) : 1e-7;
     Eigen::Vector2d plus, minus;
@@ -206,22 +206,28 @@ void CheckProjectionDerivatives(const Camera& camera, const Housing& housing,
 TEST(Housing, ImplausibleButValidHousingsSayWhy) {
   // Within the bounds: a port 3 cm away tilted 5 deg, a dome off by 5 mm.
   const double tilt = 5.0 * M_PI / 180.0;
-  EXPECT_FALSE(Housing::FromName("FLATPORT", {std::sin(tilt), 0, std::cos(tilt), 0.03, 0.008, 1, 1.473, 1.334}, "t")
+  EXPECT_FALSE(Housing::FromName("FLATPORT",
+                                 {std::sin(tilt), 0, std::cos(tilt), 0.03, 0.008, 1, 1.473, 1.334},
+                                 "t")
                    .Implausibility());
-  EXPECT_FALSE(Housing::FromName("DOMEPORT", {0.003, -0.002, 0.004, 0.05, 0.006, 1, 1.473, 1.334}, "t")
-                   .Implausibility());
+  EXPECT_FALSE(
+      Housing::FromName("DOMEPORT", {0.003, -0.002, 0.004, 0.05, 0.006, 1, 1.473, 1.334}, "t")
+          .Implausibility());
   // Issue 21's wrong basins: 361 mm away; tilted 11.4 deg; a dome 15 mm off.
-  const auto why_flat = Housing::FromName("FLATPORT", {0, 0, 1, 0.361, 0.008, 1, 1.473, 1.334}, "t").Implausibility();
+  const auto why_flat =
+      Housing::FromName("FLATPORT", {0, 0, 1, 0.361, 0.008, 1, 1.473, 1.334}, "t").Implausibility();
   ASSERT_TRUE(why_flat);
   EXPECT_NE(why_flat->find("361.0 mm"), std::string::npos) << *why_flat;
   const double wrong = 11.4 * M_PI / 180.0;
   const auto why_tilt =
-      Housing::FromName("FLATPORT", {std::sin(wrong), 0, std::cos(wrong), 0.03, 0.008, 1, 1.473, 1.334}, "t")
+      Housing::FromName("FLATPORT",
+                        {std::sin(wrong), 0, std::cos(wrong), 0.03, 0.008, 1, 1.473, 1.334}, "t")
           .Implausibility();
   ASSERT_TRUE(why_tilt);
   EXPECT_NE(why_tilt->find("tilted 11.4 deg"), std::string::npos) << *why_tilt;
   const auto why_dome =
-      Housing::FromName("DOMEPORT", {0.0, 0.009, -0.012, 0.05, 0.006, 1, 1.473, 1.334}, "t").Implausibility();
+      Housing::FromName("DOMEPORT", {0.0, 0.009, -0.012, 0.05, 0.006, 1, 1.473, 1.334}, "t")
+          .Implausibility();
   ASSERT_TRUE(why_dome);
   EXPECT_NE(why_dome->find("15.0 mm"), std::string::npos) << *why_dome;
 }
@@ -238,17 +244,20 @@ TEST(Housing, LengthsGivenInMillimetresAreNamed) {
     }
     return std::string();
   };
-  const Housing dome{Housing::FromName("DOMEPORT", {0, 0, 0, 0.043552, 0.00375, 1, 1.495, 1.333}, "t")};
+  const Housing dome{
+      Housing::FromName("DOMEPORT", {0, 0, 0, 0.043552, 0.00375, 1, 1.495, 1.333}, "t")};
   EXPECT_EQ(message(dome), "");
   Housing dome_mm = dome;
   dome_mm.params[3] = 43.552;
   dome_mm.params[4] = 3.75;
-  EXPECT_NE(message(dome_mm).find("int_radius = 43.552 m: portcal takes metres (43.552 mm is 0.043552 m)"),
+  EXPECT_NE(message(dome_mm).find(
+                "int_radius = 43.552 m: portcal takes metres (43.552 mm is 0.043552 m)"),
             std::string::npos)
       << message(dome_mm);
   Housing centre_mm = dome;
   centre_mm.params[2] = -7.3;  // outside the dome too: the units are named first
-  EXPECT_NE(message(centre_mm).find("Cz = -7.3 m: portcal takes metres"), std::string::npos) << message(centre_mm);
+  EXPECT_NE(message(centre_mm).find("Cz = -7.3 m: portcal takes metres"), std::string::npos)
+      << message(centre_mm);
   const Housing flat{Housing::FromName("FLATPORT", {0, 0, 1, 0.02, 0.014, 1, 1.473, 1.334}, "t")};
   EXPECT_EQ(message(flat), "");
   Housing flat_mm = flat;
@@ -261,16 +270,21 @@ TEST(Housing, LengthsGivenInMillimetresAreNamed) {
 TEST(Housing, InWordsSaysWhereThePortSits) {
   const double tilt = 5.0 * M_PI / 180.0;
   const std::string flat =
-      Housing::FromName("FLATPORT", {-std::sin(tilt), 0, std::cos(tilt), 0.02, 0.014, 1, 1.473, 1.334}, "t")
+      Housing::FromName("FLATPORT",
+                        {-std::sin(tilt), 0, std::cos(tilt), 0.02, 0.014, 1, 1.473, 1.334}, "t")
           .InWords();
-  EXPECT_NE(flat.find("tilted 5.00 deg from the optical axis (5.00 deg towards the image's left, 0.00 deg towards"),
+  EXPECT_NE(flat.find("tilted 5.00 deg from the optical axis (5.00 deg towards the image's left, "
+                      "0.00 deg towards"),
             std::string::npos)
       << flat;
   EXPECT_NE(flat.find("20.00 mm in front of"), std::string::npos) << flat;
   const std::string dome =
-      Housing::FromName("DOMEPORT", {0.004, -0.002, 0.0073, 0.043552, 0.00375, 1, 1.495, 1.333}, "t").InWords();
-  EXPECT_NE(dome.find("4.00 mm right, 2.00 mm up and 7.30 mm ahead of the camera's projection centre"),
-            std::string::npos)
+      Housing::FromName("DOMEPORT", {0.004, -0.002, 0.0073, 0.043552, 0.00375, 1, 1.495, 1.333},
+                        "t")
+          .InWords();
+  EXPECT_NE(
+      dome.find("4.00 mm right, 2.00 mm up and 7.30 mm ahead of the camera's projection centre"),
+      std::string::npos)
       << dome;
 }
 
@@ -278,7 +292,8 @@ TEST(Housing, AtBoundIsTheAdjustmentsFloorOrWall) {
   // A flat port at the 0.1 mm floor of its distance, a dome decentred to
   // 90 % of its radius: bounds, not estimates.
   const auto flat = [](double distance) {
-    return Housing::FromName("FLATPORT", {0.05, 0.0, std::sqrt(1 - 0.0025), distance, 0.01, 1, 1.473, 1.334}, "test");
+    return Housing::FromName(
+        "FLATPORT", {0.05, 0.0, std::sqrt(1 - 0.0025), distance, 0.01, 1, 1.473, 1.334}, "test");
   };
   EXPECT_TRUE(flat(1e-4).AtBound());
   EXPECT_FALSE(flat(0.015).AtBound());
@@ -291,7 +306,8 @@ TEST(Housing, AtBoundIsTheAdjustmentsFloorOrWall) {
 }
 
 TEST(Housing, RefinementNamesWhatAnAdjustmentMayMoveAndHowFar) {
-  const Housing flat = Housing::FromName("FLATPORT", {0, 0, 1, 0.03, 0.008, 1, 1.473, 1.334}, "test");
+  const Housing flat =
+      Housing::FromName("FLATPORT", {0, 0, 1, 0.03, 0.008, 1, 1.473, 1.334}, "test");
   const HousingRefinement f = flat.Refinement();
   EXPECT_EQ(f.orientation, (std::vector<int>{0, 1, 2}));
   EXPECT_EQ(f.position, (std::vector<int>{3}));
@@ -300,7 +316,8 @@ TEST(Housing, RefinementNamesWhatAnAdjustmentMayMoveAndHowFar) {
   EXPECT_EQ(f.bounds[0].lower, 1e-4);
   EXPECT_FALSE(std::isfinite(f.bounds[0].upper));
   EXPECT_EQ(flat.InAirFocalRatio(), 1.0 / 1.334);
-  const Housing dome = Housing::FromName("DOMEPORT", {0.001, 0, 0, 0.05, 0.006, 1, 1.473, 1.334}, "test");
+  const Housing dome =
+      Housing::FromName("DOMEPORT", {0.001, 0, 0, 0.05, 0.006, 1, 1.473, 1.334}, "test");
   const HousingRefinement d = dome.Refinement();
   EXPECT_TRUE(d.orientation.empty());
   EXPECT_EQ(d.position, (std::vector<int>{0, 1, 2}));
@@ -315,7 +332,8 @@ TEST(Housing, RefinementNamesWhatAnAdjustmentMayMoveAndHowFar) {
 // A housing calibration's starts keep the model and the user's constants,
 // move only what the model refines, and stay inside the adjustment's bounds.
 TEST(Housing, StartCandidatesMoveOnlyTheRefinedParametersWithinTheBounds) {
-  const Eigen::Vector3d axis = Eigen::Vector3d(0.05, -0.02, -1).normalized();  // sign as the views give it
+  const Eigen::Vector3d axis =
+      Eigen::Vector3d(0.05, -0.02, -1).normalized();  // sign as the views give it
   for (const Housing& housing :
        {Housing::FromName("FLATPORT", {0, 0, 1, 0.01, 0.008, 1, 1.473, 1.334}, "test"),
         Housing::FromName("DOMEPORT", {0, 0, 0, 0.05, 0.006, 1, 1.473, 1.334}, "test")}) {
@@ -327,12 +345,15 @@ TEST(Housing, StartCandidatesMoveOnlyTheRefinedParametersWithinTheBounds) {
       EXPECT_NO_THROW(start.Validate("start"));
       for (size_t k = 0; k < housing.params.size(); ++k) {
         if (!refinement.IsRefined(static_cast<int>(k))) {
-          EXPECT_EQ(start.params[k], housing.params[k]) << housing.ModelName() << " parameter " << k;
+          EXPECT_EQ(start.params[k], housing.params[k])
+              << housing.ModelName() << " parameter " << k;
         }
       }
       for (const HousingParamBound& bound : start.Refinement().bounds) {
-        EXPECT_GE(start.params[static_cast<size_t>(bound.index)], bound.lower) << housing.ModelName();
-        EXPECT_LE(start.params[static_cast<size_t>(bound.index)], bound.upper) << housing.ModelName();
+        EXPECT_GE(start.params[static_cast<size_t>(bound.index)], bound.lower)
+            << housing.ModelName();
+        EXPECT_LE(start.params[static_cast<size_t>(bound.index)], bound.upper)
+            << housing.ModelName();
       }
     }
     if (!refinement.orientation.empty()) {

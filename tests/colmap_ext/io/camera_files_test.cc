@@ -5,9 +5,9 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <fstream>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/persistence.hpp>
-#include <fstream>
 #include <random>
 
 #include "colmap_ext/io/mrcal_model.h"
@@ -44,7 +44,8 @@ std::vector<Eigen::Vector3d> Points() {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-0.6, 0.6);
   std::vector<Eigen::Vector3d> points;
-  for (int i = 0; i < 200; ++i) points.emplace_back(u(rng), 0.75 * u(rng), 1.0 + 0.5 * (u(rng) + 0.6));
+  for (int i = 0; i < 200; ++i)
+    points.emplace_back(u(rng), 0.75 * u(rng), 1.0 + 0.5 * (u(rng) + 0.6));
   return points;
 }
 
@@ -56,7 +57,8 @@ TEST(MrcalModel, MrcalProjectsExactlyLikePortcalMinusHalfAPixel) {
     for (const Eigen::Vector3d& p : Points()) {
       mrcal_point3_t point = {{p.x(), p.y(), p.z()}};
       mrcal_point2_t q;
-      ASSERT_TRUE(mrcal_project(&q, nullptr, nullptr, &point, 1, &lensmodel, lens.intrinsics.data()));
+      ASSERT_TRUE(
+          mrcal_project(&q, nullptr, nullptr, &point, 1, &lensmodel, lens.intrinsics.data()));
       const Eigen::Vector2d ours = *camera.ImgFromCam(p);
       EXPECT_NEAR(q.x, ours.x() - 0.5, 1e-9) << camera.ModelName();
       EXPECT_NEAR(q.y, ours.y() - 0.5, 1e-9) << camera.ModelName();
@@ -67,8 +69,9 @@ TEST(MrcalModel, MrcalProjectsExactlyLikePortcalMinusHalfAPixel) {
 TEST(MrcalModel, CameraModelFileRoundTripsThroughMrcalsParser) {
   testing::TempDir dir;
   for (const Camera& camera : Cameras()) {
-    const Rigid3d cam_from_ref(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized())),
-                               Eigen::Vector3d(0.1, -0.2, 0.05));
+    const Rigid3d cam_from_ref(
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized())),
+        Eigen::Vector3d(0.1, -0.2, 0.05));
     const auto path = dir / (camera.ModelName() + ".cameramodel");
     WriteMrcalCameraModel(camera, cam_from_ref, path);
     const MrcalCameraModelFile read = ReadMrcalCameraModel(path);
@@ -77,7 +80,8 @@ TEST(MrcalModel, CameraModelFileRoundTripsThroughMrcalsParser) {
     // Full precision: the same projection to 1e-9 px (the model may be the
     // wider one: RADIAL comes back as OPENCV).
     for (const Eigen::Vector3d& p : Points()) {
-      EXPECT_LT((*read.camera.ImgFromCam(p) - *camera.ImgFromCam(p)).norm(), 1e-9) << camera.ModelName();
+      EXPECT_LT((*read.camera.ImgFromCam(p) - *camera.ImgFromCam(p)).norm(), 1e-9)
+          << camera.ModelName();
     }
     EXPECT_LT(read.cam_from_ref.rotation.angularDistance(cam_from_ref.rotation), 1e-12);
     EXPECT_LT((read.cam_from_ref.translation - cam_from_ref.translation).norm(), 1e-12);
@@ -94,8 +98,10 @@ TEST(MrcalModel, ImportsWhatMrcalsPythonWrites) {
   const auto run = testing::RunCommand(
       "/usr/bin/python3 -c \"import mrcal, numpy as np; mrcal.cameramodel(intrinsics=("
       "'LENSMODEL_OPENCV8', np.array([1210., 1215., 800.8, 597.7, -0.12, 0.03, 0.001, -0.0007, "
-      "0.004, 0.01, -0.002, 0.0005])), imagersize=(1600, 1200), extrinsics_rt_toref=np.array([0.1, 0.2, "
-      "0.3, 1., 2., 3.])).write('" + path + "')\" 2>&1");
+      "0.004, 0.01, -0.002, 0.0005])), imagersize=(1600, 1200), extrinsics_rt_toref=np.array([0.1, "
+      "0.2, "
+      "0.3, 1., 2., 3.])).write('" +
+      path + "')\" 2>&1");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const MrcalCameraModelFile read = ReadMrcalCameraModel(path);
   EXPECT_EQ(read.camera.ModelName(), "FULL_OPENCV");
@@ -119,8 +125,9 @@ TEST(MrcalModel, ModelsWithoutCounterpartNameTheNearest) {
     EXPECT_NE(std::string(e.what()).find("nearest"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("OPENCV_FISHEYE"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(CameraFromMrcalLens({"LENSMODEL_CAHVOR", std::vector<double>(9, 1.0)}, 640, 480, "x"),
-               InputError);
+  EXPECT_THROW(
+      CameraFromMrcalLens({"LENSMODEL_CAHVOR", std::vector<double>(9, 1.0)}, 640, 480, "x"),
+      InputError);
   testing::TempDir dir;
   {
     std::ofstream out(dir / "bad.cameramodel");
@@ -132,7 +139,8 @@ TEST(MrcalModel, ModelsWithoutCounterpartNameTheNearest) {
 TEST(OpenCvCameraFile, OpenCvReadsTheYamlAndProjectsLikePortcal) {
   testing::TempDir dir;
   std::vector<Camera> cameras = Cameras();
-  cameras.push_back(MakeCamera("OPENCV_FISHEYE", {610, 612, 801.3, 598.2, 0.05, -0.01, 0.002, -0.0005}));
+  cameras.push_back(
+      MakeCamera("OPENCV_FISHEYE", {610, 612, 801.3, 598.2, 0.05, -0.01, 0.002, -0.0005}));
   for (const Camera& camera : cameras) {
     const auto path = dir / (camera.ModelName() + ".yaml");
     WriteOpenCvCameraYaml(camera, path);
@@ -215,7 +223,8 @@ TEST(NpzArchive, NumpyReadsTheArchive) {
   }
   const auto run = testing::RunCommand(
       "/usr/bin/python3 -c \"import numpy as np; z = np.load('" + (dir / "a.npz").string() +
-      "', allow_pickle=False); print(z['m'].shape, z['m'][1, 2], z['i'].shape, z['i'].dtype, z['b'].item(), "
+      "', allow_pickle=False); print(z['m'].shape, z['m'][1, 2], z['i'].shape, z['i'].dtype, "
+      "z['b'].item(), "
       "z['d'].item(), repr(z['none'].item()), list(z['names']))\" 2>&1");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_EQ(run.output, "(2, 3) 6.5 (0, 6) int32 True 0.03 '' ['a.png', 'image_10.png']\n");

@@ -47,10 +47,14 @@ TEST(NpzReader, Base85DecodesWhatPythonEncodes) {
   EXPECT_EQ(DecodeBase85("|Ni~_`}z", "t"), "\xff\xfe\xfd\xfc\xfb\xfa");
   std::string all;
   for (int i = 0; i < 256; ++i) all += static_cast<char>(i);
-  for (size_t n = 0; n < 9; ++n) EXPECT_EQ(DecodeBase85(EncodeBase85(all.substr(n)), "t"), all.substr(n));
-  EXPECT_NE(ExpectInputError([] { DecodeBase85("Xk\"0{", "model.cameramodel"); }).find("model.cameramodel: byte 2"),
+  for (size_t n = 0; n < 9; ++n)
+    EXPECT_EQ(DecodeBase85(EncodeBase85(all.substr(n)), "t"), all.substr(n));
+  EXPECT_NE(ExpectInputError([] {
+              DecodeBase85("Xk\"0{", "model.cameramodel");
+            }).find("model.cameramodel: byte 2"),
             std::string::npos);
-  EXPECT_NE(ExpectInputError([] { DecodeBase85("~~~~~", "t"); }).find("overflows"), std::string::npos);
+  EXPECT_NE(ExpectInputError([] { DecodeBase85("~~~~~", "t"); }).find("overflows"),
+            std::string::npos);
 }
 
 TEST(NpzReader, ReadsPortcalsOwnArchive) {
@@ -87,7 +91,8 @@ np.lib.format.write_array(v2, np.array([[1.5, 2.5]]), version=(2, 0))
 with zipfile.ZipFile(sys.argv[1], 'a') as z:
     z.writestr('v2.npy', v2.getvalue())
 )";
-  const auto run = testing::RunCommand("/usr/bin/python3 " + script.string() + " " + path.string() + " 2>&1");
+  const auto run =
+      testing::RunCommand("/usr/bin/python3 " + script.string() + " " + path.string() + " 2>&1");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const std::map<std::string, NpyArray> arrays = ReadNpz(testing::ReadFileToString(path), "t");
   std::vector<double> c_order(24);
@@ -100,8 +105,10 @@ with zipfile.ZipFile(sys.argv[1], 'a') as z:
   EXPECT_EQ(arrays.at("s").Strings("t"), std::vector<std::string>{"LENSMODEL_OPENCV4"});
   EXPECT_EQ(arrays.at("v2").shape, (std::vector<int64_t>{1, 2}));
   EXPECT_EQ(arrays.at("v2").Doubles("t"), (std::vector<double>{1.5, 2.5}));
-  EXPECT_NE(ExpectInputError([&] { arrays.at("s").Doubles("s"); }).find("strings where numbers"), std::string::npos);
-  EXPECT_NE(ExpectInputError([&] { arrays.at("f").Integers("f"); }).find("where integers"), std::string::npos);
+  EXPECT_NE(ExpectInputError([&] { arrays.at("s").Doubles("s"); }).find("strings where numbers"),
+            std::string::npos);
+  EXPECT_NE(ExpectInputError([&] { arrays.at("f").Integers("f"); }).find("where integers"),
+            std::string::npos);
 }
 
 // Pickled objects, archives inflating past the bound, damaged bytes and
@@ -119,22 +126,27 @@ header = b"{'descr': '<f8', 'fortran_order': False, 'shape': (1000000, 1000000),
 with zipfile.ZipFile('shape.npz', 'w') as z:
     z.writestr('x.npy', b'\x93NUMPY\x01\x00' + bytes([len(header), 0]) + header + bytes(16))
 )";
-  const auto run =
-      testing::RunCommand("cd " + dir.path().string() + " && /usr/bin/python3 " + script.string() + " 2>&1");
+  const auto run = testing::RunCommand("cd " + dir.path().string() + " && /usr/bin/python3 " +
+                                       script.string() + " 2>&1");
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_NE(ExpectInputError([&] { ReadNpz(testing::ReadFileToString(dir / "pickle.npz"), "p.cameramodel"); })
-                .find("p.cameramodel: 'o': array type '|O' is not read"),
+  EXPECT_NE(ExpectInputError([&] {
+              ReadNpz(testing::ReadFileToString(dir / "pickle.npz"), "p.cameramodel");
+            }).find("p.cameramodel: 'o': array type '|O' is not read"),
             std::string::npos);
-  EXPECT_NE(ExpectInputError([&] { ReadNpz(testing::ReadFileToString(dir / "bomb.npz"), "b"); })
-                .find("more than 256 MiB"),
+  EXPECT_NE(ExpectInputError([&] {
+              ReadNpz(testing::ReadFileToString(dir / "bomb.npz"), "b");
+            }).find("more than 256 MiB"),
             std::string::npos);
 
   NpzArchive npz;
   npz.AddDoubles("m", {2, 3}, {1, 2, 3, 4, 5, 6.5});
   const std::string good = npz.Bytes();
-  EXPECT_NE(ExpectInputError([&] { ReadNpz(good.substr(0, good.size() / 2), "half"); }).find("half: not a zip"),
+  EXPECT_NE(ExpectInputError([&] {
+              ReadNpz(good.substr(0, good.size() / 2), "half");
+            }).find("half: not a zip"),
             std::string::npos);
-  for (size_t at = 0; at < good.size(); ++at) {  // every byte flipped: an error or the same values, never a crash
+  for (size_t at = 0; at < good.size();
+       ++at) {  // every byte flipped: an error or the same values, never a crash
     std::string damaged = good;
     damaged[at] = static_cast<char>(damaged[at] ^ 0x5a);
     try {
@@ -143,8 +155,9 @@ with zipfile.ZipFile('shape.npz', 'w') as z:
     } catch (const InputError&) {
     }
   }
-  EXPECT_NE(ExpectInputError([&] { ReadNpz(testing::ReadFileToString(dir / "shape.npz"), "s"); })
-                .find("shape larger than its data"),
+  EXPECT_NE(ExpectInputError([&] {
+              ReadNpz(testing::ReadFileToString(dir / "shape.npz"), "s");
+            }).find("shape larger than its data"),
             std::string::npos);
 }
 
@@ -153,7 +166,8 @@ with zipfile.ZipFile('shape.npz', 'w') as z:
 // posed in that camera's frame, as mrcal.compose_rt composes them, with the
 // weights, the warp, what was optimised and the image paths.
 TEST(MrcalOptimizationInputs, ReadsOneCameraOfMrcalsTwoCameraSolve) {
-  if (!HavePythonModules("numpy, mrcal")) GTEST_SKIP() << "numpy and mrcal are not importable by /usr/bin/python3";
+  if (!HavePythonModules("numpy, mrcal"))
+    GTEST_SKIP() << "numpy and mrcal are not importable by /usr/bin/python3";
   testing::TempDir dir;
   const fs::path script = dir / "solve.py";
   std::ofstream(script) << R"(import sys, numpy as np, mrcal
@@ -182,7 +196,8 @@ for f in (0, 1):
 print(' '.join('%.17g' % v for v in obs[3].ravel()))
 )";
   const fs::path model_path = dir / "two.cameramodel";
-  const auto run = testing::RunCommand("/usr/bin/python3 " + script.string() + " " + model_path.string() + " 2>&1");
+  const auto run = testing::RunCommand("/usr/bin/python3 " + script.string() + " " +
+                                       model_path.string() + " 2>&1");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   std::istringstream lines(run.output);
   std::string line;
@@ -198,7 +213,8 @@ print(' '.join('%.17g' % v for v in obs[3].ravel()))
   EXPECT_DOUBLE_EQ(solve.spacing, 0.05);
   ASSERT_EQ(solve.frames_rt_toref.size(), 2u);
   for (int f = 0; f < 2; ++f) {
-    for (int k = 0; k < 6; ++k) EXPECT_NEAR(solve.frames_rt_toref[f][k], expected[f][k], 1e-12) << f << " " << k;
+    for (int k = 0; k < 6; ++k)
+      EXPECT_NEAR(solve.frames_rt_toref[f][k], expected[f][k], 1e-12) << f << " " << k;
   }
   ASSERT_EQ(solve.observations.size(), 2u * 36);
   for (size_t k = 0; k < 36; ++k) EXPECT_EQ(solve.observations[36 + k], expected[2][k]) << k;
@@ -216,8 +232,9 @@ TEST(MrcalOptimizationInputs, MissingOrDamagedSolveNamesTheFile) {
   Camera camera = Camera::FromModelName("OPENCV", 500, 640, 480);
   WriteMrcalCameraModel(camera, Rigid3d(), dir / "lens.cameramodel");
   const MrcalCameraModelFile lens = ReadMrcalCameraModel(dir / "lens.cameramodel");
-  EXPECT_NE(ExpectInputError([&] { ReadMrcalBoardSolve(lens, "lens.cameramodel"); })
-                .find("lens.cameramodel: carries no optimization_inputs"),
+  EXPECT_NE(ExpectInputError([&] {
+              ReadMrcalBoardSolve(lens, "lens.cameramodel");
+            }).find("lens.cameramodel: carries no optimization_inputs"),
             std::string::npos);
   MrcalBoardSolve solve;
   solve.width_n = 2;
@@ -233,9 +250,12 @@ TEST(MrcalOptimizationInputs, MissingOrDamagedSolveNamesTheFile) {
   std::ofstream(dir / "damaged.cameramodel") << text;
   const MrcalCameraModelFile damaged = ReadMrcalCameraModel(dir / "damaged.cameramodel");
   EXPECT_EQ(damaged.camera.params, lens.camera.params);
-  EXPECT_NE(ExpectInputError([&] { ReadMrcalBoardSolve(damaged, "damaged.cameramodel"); }).find("damaged.cameramodel"),
+  EXPECT_NE(ExpectInputError([&] {
+              ReadMrcalBoardSolve(damaged, "damaged.cameramodel");
+            }).find("damaged.cameramodel"),
             std::string::npos);
-  const MrcalBoardSolve back = ReadMrcalBoardSolve(ReadMrcalCameraModel(dir / "solve.cameramodel"), "s");
+  const MrcalBoardSolve back =
+      ReadMrcalBoardSolve(ReadMrcalCameraModel(dir / "solve.cameramodel"), "s");
   EXPECT_EQ(back.observations, solve.observations);
   EXPECT_EQ(back.frames_rt_toref, solve.frames_rt_toref);
 }
@@ -253,7 +273,8 @@ TEST(NpzReader, NamesInAnyScriptRoundTrip) {
   NpzArchive npz;
   npz.AddStrings("names", {"café.png", "水中/カメラ 01.png", "plain.png", "lat\xe9in.png"});
   const std::vector<std::string> back = ReadNpz(npz.Bytes(), "t").at("names").Strings("t");
-  EXPECT_EQ(back, (std::vector<std::string>{"café.png", "水中/カメラ 01.png", "plain.png", "lat\xef\xbf\xbdin.png"}));
+  EXPECT_EQ(back, (std::vector<std::string>{"café.png", "水中/カメラ 01.png", "plain.png",
+                                            "lat\xef\xbf\xbdin.png"}));
 }
 
 }  // namespace

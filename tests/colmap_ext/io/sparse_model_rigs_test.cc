@@ -20,7 +20,8 @@ namespace {
 // slightly), an IMU without a calibrated pose, and two frames.
 const char* const kRigsText =
     "# Rig calib list with one line of data per calib:\n"
-    "#   RIG_ID, NUM_SENSORS, REF_SENSOR_TYPE, REF_SENSOR_ID, SENSORS[] as (SENSOR_TYPE, SENSOR_ID, HAS_POSE, "
+    "#   RIG_ID, NUM_SENSORS, REF_SENSOR_TYPE, REF_SENSOR_ID, SENSORS[] as (SENSOR_TYPE, "
+    "SENSOR_ID, HAS_POSE, "
     "[QW, QX, QY, QZ, TX, TY, TZ])\n"
     "# Number of rigs: 1\n"
     "1 3 CAMERA 1 CAMERA 2 1 0.99995000374993748 0 0.0099998333341666645 0 -0.5 0 0 IMU 7 0\n";
@@ -73,7 +74,9 @@ TEST(SparseModelRigs, ColmapTextReadsAndWritesBackByteForByte) {
   const SparseModel binary = ReadSparseModel(dir / "bin");
   WriteSparseModel(binary, dir / "bin2", ModelFormat::kBinary);
   for (const char* file : {"rigs.bin", "frames.bin"}) {
-    EXPECT_EQ(testing::ReadFileToString(dir / "bin" / file), testing::ReadFileToString(dir / "bin2" / file)) << file;
+    EXPECT_EQ(testing::ReadFileToString(dir / "bin" / file),
+              testing::ReadFileToString(dir / "bin2" / file))
+        << file;
   }
   WriteSparseModel(binary, dir / "text2", ModelFormat::kText);
   EXPECT_EQ(testing::ReadFileToString(dir / "text2" / "frames.txt"), kFramesText);

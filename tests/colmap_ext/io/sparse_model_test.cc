@@ -1,10 +1,11 @@
 // Sparse model files: binary and text round trips, the housings sidecar, the
 // refractive fork's cameras.txt, and clear errors on bad files.
+#include "colmap_ext/io/sparse_model.h"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
 
-#include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/error.h"
 #include "tests/test_utils.h"
 
@@ -46,8 +47,8 @@ SparseModel MakeModel() {
   model.images[1].points2D[0].point3D_id = 42;
   model.images[2].points2D[3].point3D_id = 42;
   model.images[5].points2D[1].point3D_id = 42;
-  model.housings[1] = Housing::FromName(
-      "DOMEPORT", {0.01, 0.006, 0.002, 0.05, 0.006, 1.0, 1.473, 1.334}, "test");
+  model.housings[1] =
+      Housing::FromName("DOMEPORT", {0.01, 0.006, 0.002, 0.05, 0.006, 1.0, 1.473, 1.334}, "test");
   return model;
 }
 
@@ -66,8 +67,7 @@ void ExpectSameModel(const SparseModel& a, const SparseModel& b) {
     EXPECT_EQ(image.name, other.name);
     EXPECT_EQ(image.camera_id, other.camera_id);
     EXPECT_EQ(image.cam_from_world.translation, other.cam_from_world.translation);
-    EXPECT_LT(image.cam_from_world.rotation.angularDistance(other.cam_from_world.rotation),
-              1e-15);
+    EXPECT_LT(image.cam_from_world.rotation.angularDistance(other.cam_from_world.rotation), 1e-15);
     ASSERT_EQ(image.points2D.size(), other.points2D.size());
     for (size_t k = 0; k < image.points2D.size(); ++k) {
       EXPECT_EQ(image.points2D[k].xy, other.points2D[k].xy);
@@ -100,7 +100,8 @@ TEST(SparseModel, BinaryAndTextRoundTripsAreExact) {
   WriteSparseModel(ReadSparseModel(dir / "txt"), dir / "bin2", ModelFormat::kBinary);
   for (const char* name : {"cameras.bin", "images.bin", "points3D.bin"}) {
     EXPECT_EQ(testing::ReadFileToString(dir / "bin" / name),
-              testing::ReadFileToString(dir / "bin2" / name)) << name;
+              testing::ReadFileToString(dir / "bin2" / name))
+        << name;
   }
   EXPECT_TRUE(fs::exists(dir / "bin" / "housings.txt"));
 }
@@ -212,9 +213,9 @@ TEST(SparseModel, FailedWriteLeavesNoPartialFile) {
   model.images[2].camera_id = 99;  // invalid: rejected before anything is written
   EXPECT_THROW(WriteSparseModel(model, dir / "out", ModelFormat::kBinary), InputError);
   EXPECT_FALSE(fs::exists(dir / "out" / "cameras.bin"));
-  EXPECT_THROW(WriteFileAtomically(dir / "x.txt", false,
-                                   [](std::ostream&) { throw InputError("boom"); }),
-               InputError);
+  EXPECT_THROW(
+      WriteFileAtomically(dir / "x.txt", false, [](std::ostream&) { throw InputError("boom"); }),
+      InputError);
   EXPECT_FALSE(fs::exists(dir / "x.txt"));
   EXPECT_FALSE(fs::exists(dir / "x.txt.tmp"));
 }

@@ -34,16 +34,19 @@ TEST(ConfinedPath, NamesStayInsideTheFolder) {
   EXPECT_EQ(ConfinedPath(dir / "images", "cam1/new.png", "n"), dir / "images/cam1/new.png");
   EXPECT_EQ(ConfinedPath(dir / "images", "./cam1/a.png", "n"), dir / "images/./cam1/a.png");
 
-  EXPECT_NE(Refusal(dir / "images", "../outside/secret.png").find("image name in test.db '../outside/secret.png' climbs out"),
+  EXPECT_NE(Refusal(dir / "images", "../outside/secret.png")
+                .find("image name in test.db '../outside/secret.png' climbs out"),
             std::string::npos);
   EXPECT_NE(Refusal(dir / "images", "cam1/../../x.png").find("climbs out"), std::string::npos);
   EXPECT_NE(Refusal(dir / "images", "/etc/passwd").find("is absolute"), std::string::npos);
-  EXPECT_NE(Refusal(dir / "images", "a\nb.png").find("'a?b.png' holds a control character"), std::string::npos);
+  EXPECT_NE(Refusal(dir / "images", "a\nb.png").find("'a?b.png' holds a control character"),
+            std::string::npos);
   EXPECT_NE(Refusal(dir / "images", "").find("is empty"), std::string::npos);
 
   fs::create_directory_symlink(dir / "outside", dir / "images/link");
-  EXPECT_NE(Refusal(dir / "images", "link/secret.png").find("leaves the folder through a symbolic link"),
-            std::string::npos);
+  EXPECT_NE(
+      Refusal(dir / "images", "link/secret.png").find("leaves the folder through a symbolic link"),
+      std::string::npos);
   fs::create_directory_symlink(dir / "images/cam1", dir / "images/inner");
   EXPECT_EQ(ConfinedPath(dir / "images", "inner/a.png", "n"), dir / "images/inner/a.png");
   fs::create_directories(dir / "images/folder.png");
@@ -54,8 +57,11 @@ TEST(ConfinedPath, OutputFilesAreNewRegularFiles) {
   testing::TempDir dir;
   std::ofstream(dir / "in.db") << "x";
   fs::create_symlink(dir / "in.db", dir / "alias.db");
-  EXPECT_NO_THROW(CheckOutputFile("--output_path", (dir / "out.txt").string(), {(dir / "in.db").string()}));
-  EXPECT_THROW(CheckOutputFile("--output_path", (dir / "alias.db").string(), {(dir / "in.db").string()}), OptionError);
+  EXPECT_NO_THROW(
+      CheckOutputFile("--output_path", (dir / "out.txt").string(), {(dir / "in.db").string()}));
+  EXPECT_THROW(
+      CheckOutputFile("--output_path", (dir / "alias.db").string(), {(dir / "in.db").string()}),
+      OptionError);
   EXPECT_THROW(CheckOutputFile("--output_path", "/dev/null", {}), OptionError);
   EXPECT_THROW(CheckOutputFile("--output_path", dir.path().string(), {}), OptionError);
 }

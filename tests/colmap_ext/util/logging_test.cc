@@ -1,9 +1,10 @@
 // --log_level and the stderr sink: Ceres' own messages only at debug
 // (marked as Ceres'), portcal's at their level, nothing lost or doubled.
+#include "colmap_ext/util/logging.h"
+
 #include <gtest/gtest.h>
 
 #include "colmap_ext/util/error.h"
-#include "colmap_ext/util/logging.h"
 
 namespace portcal {
 namespace {

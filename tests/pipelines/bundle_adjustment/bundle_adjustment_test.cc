@@ -1,6 +1,8 @@
 // The bundle adjustment's cost blocks and its covariance: the housing
 // block against the full cost, the marginal and clustered covariances
 // against the full one, unobservable directions named.
+#include "pipelines/bundle_adjustment/bundle_adjustment.h"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -9,7 +11,6 @@
 
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
-#include "pipelines/bundle_adjustment/bundle_adjustment.h"
 #include "pipelines/bundle_adjustment/bundle_costs.h"
 #include "pipelines/bundle_adjustment/calibration_covariance.h"
 
@@ -33,10 +34,12 @@ TEST(BundleCosts, HousingBlockCostEqualsTheFullCostWithIntrinsicsHeld) {
     const Eigen::Vector2d observed(610.2, 180.7);
     std::unique_ptr<ceres::CostFunction> narrow(
         CreateReprojectionCost(model, CostBlocks::kPosePointHousing, observed, 0.5));
-    std::unique_ptr<ceres::CostFunction> full(CreateReprojectionCost(model, CostBlocks::kAll, observed, 0.5));
+    std::unique_ptr<ceres::CostFunction> full(
+        CreateReprojectionCost(model, CostBlocks::kAll, observed, 0.5));
     ASSERT_EQ(narrow->parameter_block_sizes(), (std::vector<int32_t>{7, 3, 8}));
     ASSERT_EQ(full->parameter_block_sizes(), (std::vector<int32_t>{7, 3, 5, 8}));
-    const Eigen::Quaterniond rotation(Eigen::AngleAxisd(0.2, Eigen::Vector3d(0.3, -1, 0.2).normalized()));
+    const Eigen::Quaterniond rotation(
+        Eigen::AngleAxisd(0.2, Eigen::Vector3d(0.3, -1, 0.2).normalized()));
     double pose[7] = {rotation.x(), rotation.y(), rotation.z(), rotation.w(), 0.1, -0.05, 0.3};
     double point[3] = {0.3, -0.2, 1.4};
     double housing_params[8];
@@ -58,7 +61,8 @@ TEST(BundleCosts, HousingBlockCostEqualsTheFullCostWithIntrinsicsHeld) {
     const int full_index[3] = {0, 1, 3};
     for (int b = 0; b < 3; ++b) {
       for (int k = 0; k < 2 * sizes[b]; ++k) {
-        EXPECT_NEAR(narrow_jacobians[b][k], full_jacobians[full_index[b]][k], 1e-9 * (1 + std::abs(full_jacobians[full_index[b]][k])))
+        EXPECT_NEAR(narrow_jacobians[b][k], full_jacobians[full_index[b]][k],
+                    1e-9 * (1 + std::abs(full_jacobians[full_index[b]][k])))
             << housing_id << " block " << b << " entry " << k;
       }
     }
@@ -106,8 +110,8 @@ TEST(CalibrationCovariance, MarginalMatchesTheFullCovariance) {
   for (const int max_dense_size : {1200, 0}) {
     SCOPED_TRACE(max_dense_size == 0 ? "sparse" : "dense");
     const MarginalCovariance marginal = ComputeMarginalCovariance(
-        &problem, points, {&a, &b}, {&a, &b}, 1.0, [](const double*, int) { return std::string("?"); }, nullptr,
-        max_dense_size);
+        &problem, points, {&a, &b}, {&a, &b}, 1.0,
+        [](const double*, int) { return std::string("?"); }, nullptr, max_dense_size);
     EXPECT_NEAR(marginal.StdDevs(&a)[0], std::sqrt(va), 1e-9);
     EXPECT_NEAR(marginal.StdDevs(&b)[0], std::sqrt(vb), 1e-9);
     // A line's slope and intercept, both fitted from x >= 0: negatively
@@ -131,8 +135,8 @@ struct FramedPoint {
   bool operator()(const T* q, const T* t, const T* p, T* r) const {
     const Eigen::Quaternion<T> rotation(q[3], q[0], q[1], q[2]);  // Eigen's x, y, z, w storage
     Eigen::Map<Eigen::Matrix<T, 3, 1>> residual(r);
-    residual = rotation * Eigen::Map<const Eigen::Matrix<T, 3, 1>>(p) + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t) -
-               y_.cast<T>();
+    residual = rotation * Eigen::Map<const Eigen::Matrix<T, 3, 1>>(p) +
+               Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t) - y_.cast<T>();
     return true;
   }
   Eigen::Vector3d y_;
@@ -142,10 +146,11 @@ TEST(CalibrationCovariance, ManifoldBlocksMatchTheFullCovariance) {
   std::mt19937 random(7);
   std::normal_distribution<double> noise(0.0, 0.01);
   std::array<Eigen::Quaterniond, 3> rotations = {
-      Eigen::Quaterniond::Identity(), Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 0).normalized())),
+      Eigen::Quaterniond::Identity(),
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 0).normalized())),
       Eigen::Quaterniond(Eigen::AngleAxisd(-0.5, Eigen::Vector3d(0, 1, 1).normalized()))};
-  const std::array<Eigen::Vector3d, 3> translations = {Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 0, 0.5),
-                                                       Eigen::Vector3d(-0.5, 1, 0)};
+  const std::array<Eigen::Vector3d, 3> translations = {
+      Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 0, 0.5), Eigen::Vector3d(-0.5, 1, 0)};
   std::array<Eigen::Vector4d, 3> q;  // x, y, z, w
   std::array<Eigen::Vector3d, 3> t;
   for (int k = 0; k < 3; ++k) {
@@ -160,8 +165,9 @@ TEST(CalibrationCovariance, ManifoldBlocksMatchTheFullCovariance) {
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d error(noise(random), noise(random), noise(random));
       const Eigen::Vector3d y = rotations[k] * truth + translations[k] + error;
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FramedPoint, 3, 4, 3, 3>(new FramedPoint(y)), nullptr,
-                               q[k].data(), t[k].data(), p[i].data());
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<FramedPoint, 3, 4, 3, 3>(new FramedPoint(y)), nullptr,
+          q[k].data(), t[k].data(), p[i].data());
     }
   }
   for (int k = 0; k < 3; ++k) problem.SetManifold(q[k].data(), new ceres::EigenQuaternionManifold);
@@ -188,19 +194,23 @@ TEST(CalibrationCovariance, ManifoldBlocksMatchTheFullCovariance) {
     for (const double* b : wanted) pairs.emplace_back(a, b);
   }
   ASSERT_TRUE(covariance.Compute(pairs, &problem));
-  for (const auto& [max_dense_size, threads] : {std::pair(1200, 1), std::pair(0, 1), std::pair(1200, 2)}) {
-    SCOPED_TRACE(std::string(max_dense_size == 0 ? "sparse" : "dense") + ", threads " + std::to_string(threads));
+  for (const auto& [max_dense_size, threads] :
+       {std::pair(1200, 1), std::pair(0, 1), std::pair(1200, 2)}) {
+    SCOPED_TRACE(std::string(max_dense_size == 0 ? "sparse" : "dense") + ", threads " +
+                 std::to_string(threads));
     const MarginalCovariance marginal = ComputeMarginalCovariance(
-        &problem, points, others, wanted, 1.0, [](const double*, int) { return std::string("?"); }, nullptr,
-        max_dense_size, threads);
+        &problem, points, others, wanted, 1.0, [](const double*, int) { return std::string("?"); },
+        nullptr, max_dense_size, threads);
     for (const double* a : wanted) {
       for (const double* b : wanted) {
         const int na = problem.ParameterBlockSize(a), nb = problem.ParameterBlockSize(b);
         Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> expected(na, nb);
         covariance.GetCovarianceBlock(a, b, expected.data());
-        const Eigen::MatrixXd got = marginal.covariance.block(marginal.offset.at(a), marginal.offset.at(b), na, nb);
-        EXPECT_LT((got - expected).norm(), 1e-8 * expected.norm() + 1e-15) << "expected\n" << expected << "\ngot\n"
-                                                                        << got;
+        const Eigen::MatrixXd got =
+            marginal.covariance.block(marginal.offset.at(a), marginal.offset.at(b), na, nb);
+        EXPECT_LT((got - expected).norm(), 1e-8 * expected.norm() + 1e-15) << "expected\n"
+                                                                           << expected << "\ngot\n"
+                                                                           << got;
       }
     }
     // The held coordinate has no variance.
@@ -229,15 +239,19 @@ TEST(CalibrationCovariance, UnobservableDirectionIsNamedByBothDecompositions) {
   ceres::Problem problem;
   std::vector<double*> points;
   for (int i = 0; i < 10; ++i) {
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SumResidual, 2, 1, 1, 3>(new SumResidual(i)), nullptr,
-                             &a, &b, p[i].data());
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<SumResidual, 2, 1, 1, 3>(new SumResidual(i)), nullptr, &a,
+        &b, p[i].data());
     points.push_back(p[i].data());
   }
-  const auto describe = [&](const double* block, int) { return std::string(block == &a ? "block a" : "block b"); };
+  const auto describe = [&](const double* block, int) {
+    return std::string(block == &a ? "block a" : "block b");
+  };
   for (const int max_dense_size : {1200, 0}) {
     SCOPED_TRACE(max_dense_size == 0 ? "sparse" : "dense");
     try {
-      ComputeMarginalCovariance(&problem, points, {&a, &b}, {&a, &b}, 1.0, describe, nullptr, max_dense_size);
+      ComputeMarginalCovariance(&problem, points, {&a, &b}, {&a, &b}, 1.0, describe, nullptr,
+                                max_dense_size);
       ADD_FAILURE() << "a singular reduced system gave a covariance";
     } catch (const NumericalError& e) {
       const std::string message = e.what();
@@ -299,8 +313,9 @@ TEST(CalibrationCovariance, ClusteredCovarianceSumsEachClustersExactEffect) {
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ClusterSample, 3, 1, 1, 3, 1>(
                                  new ClusterSample(i * 0.1, &y[i])),
                              nullptr, &a, &b, p[i].data(), &offsets[i % kImages]);
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ClusterSecondLook, 1, 3, 1>(new ClusterSecondLook(&z[i])),
-                             nullptr, p[i].data(), &offsets[(i + 1) % kImages]);
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<ClusterSecondLook, 1, 3, 1>(new ClusterSecondLook(&z[i])),
+        nullptr, p[i].data(), &offsets[(i + 1) % kImages]);
   }
   for (double& offset : offsets) problem.SetParameterBlockConstant(&offset);
   ceres::Solver::Options options;
@@ -342,7 +357,8 @@ TEST(CalibrationCovariance, ClusteredCovarianceSumsEachClustersExactEffect) {
     return (second ? (i + 1) % kImages : i % kImages) == k;
   });
   const Eigen::Matrix2d by_track = exact(kSamples, [](int k, int i, bool) { return i == k; });
-  const Eigen::Matrix2d by_both = exact(2 * kSamples, [](int k, int i, bool second) { return k == 2 * i + second; });
+  const Eigen::Matrix2d by_both =
+      exact(2 * kSamples, [](int k, int i, bool second) { return k == 2 * i + second; });
   const Eigen::Matrix2d two_way = by_image + by_track - by_both;
   // Not trivially zero: the clusters' errors moved the line; and positive
   // definite, so no eigenvalue is clipped.
@@ -359,24 +375,28 @@ TEST(CalibrationCovariance, ClusteredCovarianceSumsEachClustersExactEffect) {
   // Dense on one thread, sparse on two (the effects computed on both).
   for (const auto& [max_dense_size, threads] : {std::pair(1200, 1), std::pair(0, 2)}) {
     for (const bool two : {true, false}) {
-      SCOPED_TRACE(std::string(two ? "two-way" : "by image") + (max_dense_size == 0 ? ", sparse" : ", dense"));
+      SCOPED_TRACE(std::string(two ? "two-way" : "by image") +
+                   (max_dense_size == 0 ? ", sparse" : ", dense"));
       clusters.by_track = two;
-      const MarginalCovariance marginal = ComputeMarginalCovariance(&problem, points, {&a, &b}, {&a, &b}, 1.0,
-                                                                    describe, &clusters, max_dense_size, threads);
+      const MarginalCovariance marginal = ComputeMarginalCovariance(
+          &problem, points, {&a, &b}, {&a, &b}, 1.0, describe, &clusters, max_dense_size, threads);
       const Eigen::Matrix2d& expected = two ? two_way : by_image;
       EXPECT_EQ(marginal.num_clusters, kImages);
       EXPECT_EQ(marginal.num_tracks, two ? kSamples : 0);
       ASSERT_EQ(marginal.clustered_covariance.rows(), 2);
       for (int i = 0; i < 2; ++i) {
         for (int j = 0; j < 2; ++j) {
-          EXPECT_NEAR(marginal.clustered_covariance(i, j), expected(i, j), 1e-6 * expected.norm()) << i << "," << j;
+          EXPECT_NEAR(marginal.clustered_covariance(i, j), expected(i, j), 1e-6 * expected.norm())
+              << i << "," << j;
         }
       }
-      EXPECT_NEAR(marginal.ClusteredStdDevs(&a)[0], std::sqrt(expected(0, 0)), 1e-6 * std::sqrt(expected(0, 0)));
+      EXPECT_NEAR(marginal.ClusteredStdDevs(&a)[0], std::sqrt(expected(0, 0)),
+                  1e-6 * std::sqrt(expected(0, 0)));
     }
   }
   // Without clusters there is no clustered covariance.
-  const MarginalCovariance plain = ComputeMarginalCovariance(&problem, points, {&a, &b}, {&a, &b}, 1.0, describe);
+  const MarginalCovariance plain =
+      ComputeMarginalCovariance(&problem, points, {&a, &b}, {&a, &b}, 1.0, describe);
   EXPECT_EQ(plain.clustered_covariance.size(), 0);
   EXPECT_TRUE(plain.ClusteredStdDevs(&a).empty());
 }

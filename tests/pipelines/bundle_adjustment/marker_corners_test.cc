@@ -36,12 +36,13 @@ MarkerScene MakeScene(int marker_id) {
   camera.camera = Camera::FromModelName("PINHOLE", 700, 960, 540);
   camera.camera.camera_id = 1;
   camera.housing = Housing::FromName("FLATPORT", {0, 0, 1, 0.01, 0.010, 1, 1.473, 1.334}, "test");
-  scene.corners = {Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(kSide, 0, 2), Eigen::Vector3d(kSide, kSide, 2),
-                   Eigen::Vector3d(0, kSide, 2)};
+  scene.corners = {Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(kSide, 0, 2),
+                   Eigen::Vector3d(kSide, kSide, 2), Eigen::Vector3d(0, kSide, 2)};
   std::mt19937 rng(11);
   std::normal_distribution<double> noise(0, 0.3);
-  const std::array<Eigen::Vector3d, 4> centres = {Eigen::Vector3d(-0.15, -0.15, 0), Eigen::Vector3d(0.3, -0.1, 0),
-                                                  Eigen::Vector3d(0.2, 0.3, 0), Eigen::Vector3d(-0.1, 0.25, 0)};
+  const std::array<Eigen::Vector3d, 4> centres = {
+      Eigen::Vector3d(-0.15, -0.15, 0), Eigen::Vector3d(0.3, -0.1, 0), Eigen::Vector3d(0.2, 0.3, 0),
+      Eigen::Vector3d(-0.1, 0.25, 0)};
   for (image_t id = 1; id <= 4; ++id) {
     Rigid3d cam_from_world;
     cam_from_world.translation = -centres[id - 1];
@@ -134,7 +135,8 @@ TEST(MarkerCorners, ScaleToMarkersBringsTheModelToTheMarkersSideLength) {
   ASSERT_TRUE(scale.has_value());
   EXPECT_NEAR(*scale * kGrownAt, 1.0, 0.02);
   for (const auto& [id, pose] : r.poses()) {
-    EXPECT_LT((pose.translation - scene.poses.at(id).translation).norm(), 0.02 * 0.5) << "image " << id;
+    EXPECT_LT((pose.translation - scene.poses.at(id).translation).norm(), 0.02 * 0.5)
+        << "image " << id;
   }
   const std::vector<MarkerCorner> corners = TriangulateMarkerCorners(r, kMaxErrorPx);
   ASSERT_EQ(corners.size(), 4u);
@@ -160,7 +162,8 @@ TEST(MarkerCorners, ScaleToMarkersDeletesTheObservationsItLeavesUnprojectable) {
   scene.poses[5] = beside;
   scene.inputs.images[5].image_id = 5;
   scene.inputs.images[5].camera_id = 1;
-  const Eigen::Vector3d point = -kGrownAt * scene.poses.at(1).translation + Eigen::Vector3d(0, 0, 0.045);
+  const Eigen::Vector3d point =
+      -kGrownAt * scene.poses.at(1).translation + Eigen::Vector3d(0, 0, 0.045);
   for (image_t id : {1, 5}) {
     Rigid3d grown = scene.poses.at(id);
     grown.translation *= kGrownAt;
@@ -200,7 +203,8 @@ TEST(MarkerCorners, ScaleToMarkersLeavesAModelWithoutTwoViewsOfAMarker) {
 TEST(MarkerCorners, MarkerScaleRatioIsTheMedianOverSidesAndOptionallyDiagonals) {
   std::vector<MarkerCorner> corners(4);
   const std::array<Eigen::Vector3d, 4> xyz = {Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(0.1, 0, 2),
-                                              Eigen::Vector3d(0.1, 0.2, 2), Eigen::Vector3d(0, 0.2, 2)};
+                                              Eigen::Vector3d(0.1, 0.2, 2),
+                                              Eigen::Vector3d(0, 0.2, 2)};
   for (int c = 0; c < 4; ++c) {
     corners[c].marker_id = 3;
     corners[c].corner = c;

@@ -4,6 +4,8 @@
 // port's distance. The same synthetic survey also serves the bounded
 // adjustment's solver (no line search) and an adjustment's start with an
 // observation that cannot be projected.
+#include "pipelines/bundle_adjustment/position_priors.h"
+
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
@@ -17,7 +19,6 @@
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
 #include "pipelines/bundle_adjustment/bundle_adjustment.h"
-#include "pipelines/bundle_adjustment/position_priors.h"
 #include "pipelines/stages/feature_matcher.h"
 #include "pipelines/stages/pose_prior_importer.h"
 #include "tests/test_utils.h"
@@ -32,13 +33,17 @@ std::string RawPriorColumns(const fs::path& path, const std::string& name) {
   sqlite3* db = nullptr;
   EXPECT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
   sqlite3_stmt* stmt = nullptr;
-  const std::string sql = "SELECT prior_qw, prior_qx, prior_qy, prior_qz, prior_tx, prior_ty, prior_tz "
-                          "FROM images WHERE name='" + name + "';";
+  const std::string sql =
+      "SELECT prior_qw, prior_qx, prior_qy, prior_qz, prior_tx, prior_ty, prior_tz "
+      "FROM images WHERE name='" +
+      name + "';";
   EXPECT_EQ(sqlite3_prepare_v2(db, sql.c_str(), -1, &stmt, nullptr), SQLITE_OK);
   std::string out;
   if (sqlite3_step(stmt) == SQLITE_ROW) {
     for (int i = 0; i < 7; ++i) {
-      out += sqlite3_column_type(stmt, i) == SQLITE_NULL ? "NULL" : std::to_string(sqlite3_column_double(stmt, i));
+      out += sqlite3_column_type(stmt, i) == SQLITE_NULL
+                 ? "NULL"
+                 : std::to_string(sqlite3_column_double(stmt, i));
       out += i < 6 ? " " : "";
     }
   }
@@ -67,7 +72,8 @@ TEST(PositionPrior, StoredAsColmapStoresGpsPositions) {
   const fs::path path = ThreeImageDatabase(dir);
   {
     Database database(path, Database::OpenMode::kReadWrite);
-    database.UpdatePositionPrior(database.ReadImageWithName("b.png")->image_id, Eigen::Vector3d(1.5, -2, 3.25));
+    database.UpdatePositionPrior(database.ReadImageWithName("b.png")->image_id,
+                                 Eigen::Vector3d(1.5, -2, 3.25));
     EXPECT_THROW(database.UpdatePositionPrior(99, Eigen::Vector3d::Zero()), InputError);
   }
   // prior_q NULL, prior_t the position (COLMAP 3.8's EXIF GPS import).
@@ -81,9 +87,11 @@ TEST(PositionPrior, StoredAsColmapStoresGpsPositions) {
   EXPECT_FALSE(database.ReadImageWithName("a.png")->PriorPosition().has_value());
   // A full pose prior's position is its camera centre.
   DatabaseImage posed;
-  posed.cam_from_world_prior = Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ())),
-                                       Eigen::Vector3d(1, 2, 3));
-  EXPECT_LT((*posed.PriorPosition() - posed.cam_from_world_prior->Inverse().translation).norm(), 1e-15);
+  posed.cam_from_world_prior =
+      Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ())),
+              Eigen::Vector3d(1, 2, 3));
+  EXPECT_LT((*posed.PriorPosition() - posed.cam_from_world_prior->Inverse().translation).norm(),
+            1e-15);
 }
 
 TEST(PosePriorImporter, ImportsAllOrNothingAndNamesTheFault) {
@@ -113,14 +121,18 @@ TEST(PosePriorImporter, ImportsAllOrNothingAndNamesTheFault) {
   const std::string malformed = message(write("bad.txt", "# nav\n\na.png 1 2\n"));
   EXPECT_NE(malformed.find("bad.txt:3"), std::string::npos) << malformed;
   EXPECT_NE(message(write("nan.txt", "a.png 1 nan 2\n")).find("nan.txt:1"), std::string::npos);
-  EXPECT_NE(message(write("twice.txt", "a.png 1 2 3\na.png 1 2 3\n")).find("twice"), std::string::npos);
+  EXPECT_NE(message(write("twice.txt", "a.png 1 2 3\na.png 1 2 3\n")).find("twice"),
+            std::string::npos);
 
-  const PosePriorImporterSummary summary = RunPosePriorImporter(write("nav.txt", "# NAME X Y Z\na.png 1 2 3\nc.png -1 0.5 2\n"), NoProgress());
+  const PosePriorImporterSummary summary = RunPosePriorImporter(
+      write("nav.txt", "# NAME X Y Z\na.png 1 2 3\nc.png -1 0.5 2\n"), NoProgress());
   EXPECT_EQ(summary.num_imported, 2);
   EXPECT_EQ(summary.num_images_without, 1);
   EXPECT_EQ(RawPriorColumns(path, "c.png"), "NULL NULL NULL NULL -1.000000 0.500000 2.000000");
   // Rerunning is safe.
-  EXPECT_EQ(RunPosePriorImporter(write("nav.txt", "a.png 1 2 3\nc.png -1 0.5 2\n"), NoProgress()).num_imported, 2);
+  EXPECT_EQ(RunPosePriorImporter(write("nav.txt", "a.png 1 2 3\nc.png -1 0.5 2\n"), NoProgress())
+                .num_imported,
+            2);
 }
 
 TEST(SpatialMatching, PairsTheNearestImagesWithinTheDistance) {
@@ -146,7 +158,8 @@ TEST(SpatialMatching, PairsTheNearestImagesWithinTheDistance) {
   for (const auto& [a, b] : pairs) EXPECT_NE(a, b);
   options.ignore_z = false;
   std::set<std::pair<image_t, image_t>> with_z;
-  for (const auto& [a, b] : SpatialPairs(positions, options)) with_z.insert({std::min(a, b), std::max(a, b)});
+  for (const auto& [a, b] : SpatialPairs(positions, options))
+    with_z.insert({std::min(a, b), std::max(a, b)});
   EXPECT_FALSE(with_z.count({12, 13}));  // 1 m apart in z
 }
 
@@ -158,7 +171,8 @@ struct SyntheticSurvey {
   SfmInputs inputs;
   std::map<image_t, Rigid3d> true_cam_from_world;
   std::vector<std::pair<Eigen::Vector3d, std::vector<TrackElement>>> true_points;
-  Housing true_housing = Housing::FromName("FLATPORT", {0.0523360, 0.0, 0.9986295, 0.02, 0.01, 1.0, 1.473, 1.334}, "t");
+  Housing true_housing = Housing::FromName(
+      "FLATPORT", {0.0523360, 0.0, 0.9986295, 0.02, 0.01, 1.0, 1.473, 1.334}, "t");
   Camera camera = Camera::FromModelName("PINHOLE", 700, 960, 540);
 
   SyntheticSurvey(double pixel_sigma, double navigation_sigma, std::mt19937* rng) {
@@ -175,7 +189,8 @@ struct SyntheticSurvey {
         image.image_id = id;
         image.name = "img_" + std::to_string(id) + ".png";
         image.camera_id = 1;
-        image.position_prior = centre + navigation_sigma * Eigen::Vector3d(noise(*rng), noise(*rng), noise(*rng));
+        image.position_prior =
+            centre + navigation_sigma * Eigen::Vector3d(noise(*rng), noise(*rng), noise(*rng));
       }
     }
     std::uniform_real_distribution<double> x(-1.0, 4.5), y(-0.8, 1.7);
@@ -185,14 +200,16 @@ struct SyntheticSurvey {
       std::vector<TrackElement> track;
       for (auto& [image_id, pose] : true_cam_from_world) {
         const auto pixel = ProjectPoint(camera, &true_housing, pose * world);
-        if (!pixel || pixel->x() < 0 || pixel->y() < 0 || pixel->x() > 960 || pixel->y() > 540) continue;
+        if (!pixel || pixel->x() < 0 || pixel->y() < 0 || pixel->x() > 960 || pixel->y() > 540)
+          continue;
         SfmImage& image = inputs.images.at(image_id);
         track.push_back({image_id, static_cast<point2D_t>(image.keypoints.size())});
         image.keypoints.push_back(*pixel + pixel_sigma * Eigen::Vector2d(noise(*rng), noise(*rng)));
       }
       if (track.size() >= 2) true_points.emplace_back(world, track);
     }
-    for (auto& [image_id, image] : inputs.images) image.correspondences.resize(image.keypoints.size());
+    for (auto& [image_id, image] : inputs.images)
+      image.correspondences.resize(image.keypoints.size());
   }
 
   Reconstruction InArbitraryFrame(const Similarity3d& arbitrary_from_true) const {
@@ -204,7 +221,8 @@ struct SyntheticSurvey {
       const Eigen::Quaterniond rotation = pose.rotation * s.rotation.conjugate();
       r.Register(id, Rigid3d(rotation, s.scale * pose.translation - rotation * s.translation));
     }
-    for (const auto& [xyz, track] : true_points) r.AddPoint(s.scale * (s.rotation * xyz) + s.translation, track);
+    for (const auto& [xyz, track] : true_points)
+      r.AddPoint(s.scale * (s.rotation * xyz) + s.translation, track);
     return r;
   }
 };
@@ -229,11 +247,14 @@ TEST(PositionPriors, AlignmentUndoesTheArbitraryFrameAndIgnoresAJump) {
   EXPECT_NEAR(alignment->new_from_old.scale, 1 / 0.6, 1e-9);
   EXPECT_LT(alignment->rms_m, 1e-9);
   for (const auto& [id, pose] : r.poses()) {
-    EXPECT_LT((pose.Inverse().translation - survey.true_cam_from_world.at(id).Inverse().translation).norm(), 1e-9);
+    EXPECT_LT((pose.Inverse().translation - survey.true_cam_from_world.at(id).Inverse().translation)
+                  .norm(),
+              1e-9);
     EXPECT_LT(pose.rotation.angularDistance(survey.true_cam_from_world.at(id).rotation), 1e-9);
   }
   size_t k = 0;
-  for (const auto& [point_id, point] : r.points()) EXPECT_LT((point.xyz - survey.true_points[k++].first).norm(), 1e-9);
+  for (const auto& [point_id, point] : r.points())
+    EXPECT_LT((point.xyz - survey.true_points[k++].first).norm(), 1e-9);
   // Collinear priors fix no similarity: nothing changes.
   SyntheticSurvey line(0.0, 0.0, &rng);
   for (auto& [id, image] : line.inputs.images) {
@@ -271,7 +292,8 @@ TEST(PositionPriors, GiveTheScaleThatSelfCalibratesTheFlatPortDistance) {
   EXPECT_LT(sd[3], 0.005);
   EXPECT_LT(sd[0], 0.0015);
   for (const auto& [id, pose] : r.poses()) {
-    const Eigen::Vector3d error = pose.Inverse().translation - survey.true_cam_from_world.at(id).Inverse().translation;
+    const Eigen::Vector3d error =
+        pose.Inverse().translation - survey.true_cam_from_world.at(id).Inverse().translation;
     EXPECT_LT(error.norm(), 4 * navigation_sigma) << "image " << id;
   }
 }
@@ -315,8 +337,10 @@ void ExpectSameSolution(const SyntheticSurvey& survey, const Reconstruction& rob
   double worst_error = 0, worst_difference = 0;
   for (const auto& [id, pose] : robust.poses()) {
     const Eigen::Vector3d centre = pose.Inverse().translation;
-    worst_error = std::max(worst_error, (centre - survey.true_cam_from_world.at(id).Inverse().translation).norm());
-    worst_difference = std::max(worst_difference, (centre - other.poses().at(id).Inverse().translation).norm());
+    worst_error = std::max(
+        worst_error, (centre - survey.true_cam_from_world.at(id).Inverse().translation).norm());
+    worst_difference =
+        std::max(worst_difference, (centre - other.poses().at(id).Inverse().translation).norm());
   }
   EXPECT_LT(worst_difference, 0.1 * worst_error);
 }
@@ -335,12 +359,13 @@ TEST(PositionPriors, HeldWeightsEndTheRobustCrawlAtTheSameSolution) {
   SyntheticSurvey survey(0.1, navigation_sigma, &rng);
   ASSERT_GT(AddOutliers(&survey, &rng), 100);
   const BundleAdjustmentOptions ba = OutlierSurveyOptions(navigation_sigma);
-  const auto adjust = [&](Reconstruction* r, double tolerance, bool hold, CalibrationStdDevs* std_devs) {
+  const auto adjust = [&](Reconstruction* r, double tolerance, bool hold,
+                          CalibrationStdDevs* std_devs) {
     BundleAdjustmentOptions options = ba;
     options.function_tolerance = tolerance;
     options.hold_loss_weights = hold;
-    const ceres::Solver::Summary summary = AdjustBundle(r, options, BundleAdjustmentScope(), nullptr, MarkerScale(),
-                                                        std_devs);
+    const ceres::Solver::Summary summary =
+        AdjustBundle(r, options, BundleAdjustmentScope(), nullptr, MarkerScale(), std_devs);
     EXPECT_EQ(summary.termination_type, ceres::CONVERGENCE);
     return static_cast<int>(summary.iterations.size());
   };
@@ -367,9 +392,10 @@ TEST(PositionPriors, HeldWeightsEndTheRobustCrawlAtTheSameSolution) {
   AdjustBundle(&plain, least_squares, BundleAdjustmentScope(), nullptr, MarkerScale());
   const std::vector<double>& t = survey.true_housing.params;
   EXPECT_GT(std::abs(plain.cameras().at(1).housing->params[3] - t[3]), std::abs(b[3] - t[3]));
-  std::cout << "robust " << robust_iterations << " iterations, held " << held_iterations << "; port distance "
-            << a[3] << " / " << b[3] << " / least squares " << plain.cameras().at(1).housing->params[3] << " (truth "
-            << t[3] << ", sd " << sd[3] << ")\n";
+  std::cout << "robust " << robust_iterations << " iterations, held " << held_iterations
+            << "; port distance " << a[3] << " / " << b[3] << " / least squares "
+            << plain.cameras().at(1).housing->params[3] << " (truth " << t[3] << ", sd " << sd[3]
+            << ")\n";
 }
 
 // The robust solve's task in that schedule is to decide the weights, and the
@@ -392,13 +418,15 @@ TEST(PositionPriors, RobustSolveEndsWhenTheWeightsSettle) {
   BundleAdjustmentOptions decide = ba;
   decide.function_tolerance = 1e-12;  // only the weights end it
   decide.max_unsettled_weight_fraction = 0.01;
-  const ceres::Solver::Summary decided = AdjustBundle(&settled, decide, BundleAdjustmentScope(), nullptr, MarkerScale());
+  const ceres::Solver::Summary decided =
+      AdjustBundle(&settled, decide, BundleAdjustmentScope(), nullptr, MarkerScale());
   EXPECT_EQ(decided.termination_type, ceres::USER_SUCCESS);
   // The held solve from there, as the refinement and the mapper's final
   // adjustment run it: undamped at first, Gauss-Newton on a weighted
   // least-squares problem near its minimum, it converges in a few steps.
-  const ceres::Solver::Summary held = AdjustBundle(
-      &settled, ba.WithWeightsHeld(kHeldWeightsTrustRegionRadius), BundleAdjustmentScope(), nullptr, MarkerScale());
+  const ceres::Solver::Summary held =
+      AdjustBundle(&settled, ba.WithWeightsHeld(kHeldWeightsTrustRegionRadius),
+                   BundleAdjustmentScope(), nullptr, MarkerScale());
   EXPECT_EQ(held.termination_type, ceres::CONVERGENCE);
   EXPECT_LE(held.iterations.size(), 4u);
 
@@ -406,16 +434,19 @@ TEST(PositionPriors, RobustSolveEndsWhenTheWeightsSettle) {
   BundleAdjustmentOptions to_1e6 = ba;
   to_1e6.function_tolerance = 1e-6;
   const int iterations_to_1e6 = static_cast<int>(
-      AdjustBundle(&robust, to_1e6, BundleAdjustmentScope(), nullptr, MarkerScale()).iterations.size());
+      AdjustBundle(&robust, to_1e6, BundleAdjustmentScope(), nullptr, MarkerScale())
+          .iterations.size());
   EXPECT_LT(decided.iterations.size(), iterations_to_1e6);
   CalibrationStdDevs std_devs;
   AdjustBundle(&robust, ba, BundleAdjustmentScope(), nullptr, MarkerScale(), &std_devs);
 
   ExpectSameSolution(survey, robust, std_devs, settled);
-  std::cout << "weights settled after " << decided.iterations.size() << " robust iterations (1e-6 stop: "
-            << iterations_to_1e6 << "), held solve " << held.iterations.size() << " iterations; port distance "
-            << settled.cameras().at(1).housing->params[3] << " / robust " << robust.cameras().at(1).housing->params[3]
-            << " (sd " << std_devs.housing.at(1)[3] << ")\n";
+  std::cout << "weights settled after " << decided.iterations.size()
+            << " robust iterations (1e-6 stop: " << iterations_to_1e6 << "), held solve "
+            << held.iterations.size() << " iterations; port distance "
+            << settled.cameras().at(1).housing->params[3] << " / robust "
+            << robust.cameras().at(1).housing->params[3] << " (sd " << std_devs.housing.at(1)[3]
+            << ")\n";
 }
 
 // A bounded port (the distance's floor) would make Ceres run a projected
@@ -434,7 +465,8 @@ TEST(PositionPriors, BoundedPortAdjustmentRunsNoLineSearch) {
   ba.sigma_px = 0.1;
   ba.position_prior_sigma_m = 0.02;
   ba.max_num_iterations = 10;
-  const ceres::Solver::Summary summary = AdjustBundle(&r, ba, BundleAdjustmentScope(), nullptr, MarkerScale());
+  const ceres::Solver::Summary summary =
+      AdjustBundle(&r, ba, BundleAdjustmentScope(), nullptr, MarkerScale());
   ASSERT_TRUE(summary.is_constrained);
   ASSERT_GT(summary.num_successful_steps, 3);
   EXPECT_EQ(summary.num_line_search_steps, 0);
@@ -466,7 +498,8 @@ TEST(PositionPriors, UnprojectableObservationIsNamedAndDeleted) {
   for (const auto& [id, point] : r.points()) {
     for (const TrackElement& e : point.track) {
       ++num_observations;
-      num_unprojectable += !std::isfinite(r.ReprojectionError(e.image_id, e.point2D_idx, point.xyz));
+      num_unprojectable +=
+          !std::isfinite(r.ReprojectionError(e.image_id, e.point2D_idx, point.xyz));
     }
   }
   ASSERT_LT(num_unprojectable, r.points().at(moved).track.size() + 1);
@@ -480,8 +513,8 @@ TEST(PositionPriors, UnprojectableObservationIsNamedAndDeleted) {
     AdjustBundle(&r, ba, BundleAdjustmentScope(), nullptr, MarkerScale());
     ADD_FAILURE() << "the adjustment started from an unprojectable observation";
   } catch (const NumericalError& e) {
-    EXPECT_NE(std::string(e.what()).find("the observation of 3D point " + std::to_string(moved) + " in image '" +
-                                         name + "'"),
+    EXPECT_NE(std::string(e.what()).find("the observation of 3D point " + std::to_string(moved) +
+                                         " in image '" + name + "'"),
               std::string::npos)
         << e.what();
   }
@@ -494,7 +527,8 @@ TEST(PositionPriors, UnprojectableObservationIsNamedAndDeleted) {
   for (const auto& [id, point] : r.points()) num_left += point.track.size();
   // The moved point goes whole if fewer than two observations are left.
   const size_t expected = num_observations - num_unprojectable;
-  EXPECT_TRUE(num_left == expected || (num_left + 1 == expected && !r.points().count(moved))) << num_left;
+  EXPECT_TRUE(num_left == expected || (num_left + 1 == expected && !r.points().count(moved)))
+      << num_left;
   EXPECT_NO_THROW(AdjustBundle(&r, ba, BundleAdjustmentScope(), nullptr, MarkerScale()));
 }
 

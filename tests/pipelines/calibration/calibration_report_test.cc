@@ -3,6 +3,8 @@
 // .cameramodel) read back project exactly like the camera written; the real
 // set's ROS file reads as its numbers say; a file of none of the formats is
 // an error that names the formats and the missing key.
+#include "pipelines/calibration/calibration_report.h"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -13,7 +15,6 @@
 #include "colmap_ext/io/mrcal_model.h"
 #include "colmap_ext/io/opencv_camera_file.h"
 #include "colmap_ext/util/error.h"
-#include "pipelines/calibration/calibration_report.h"
 #include "tests/test_utils.h"
 
 namespace fs = std::filesystem;
@@ -50,8 +51,8 @@ TEST(ReadCalibrationReport, ReadsOpenCvRosAndMrcalFilesAsTheCameraWritten) {
   testing::TempDir dir;
   const std::vector<Camera> cameras = {
       MakeCamera("OPENCV", {2412.1, 2418.7, 752.3, 571.9, -0.37, 0.21, 0.0015, 0.0004}),
-      MakeCamera("FULL_OPENCV",
-                 {2412.1, 2418.7, 752.3, 571.9, -0.37, 0.21, 0.0015, 0.0004, -0.05, 0.01, 0.02, -0.03}),
+      MakeCamera("FULL_OPENCV", {2412.1, 2418.7, 752.3, 571.9, -0.37, 0.21, 0.0015, 0.0004, -0.05,
+                                 0.01, 0.02, -0.03}),
       MakeCamera("RADIAL", {2412.1, 752.3, 571.9, -0.37, 0.21}),
       MakeCamera("PINHOLE", {2412.1, 2418.7, 752.3, 571.9}),
       MakeCamera("OPENCV_FISHEYE", {700.2, 701.1, 719.4, 541.2, 0.06, -0.02, 0.004, -0.001}),
@@ -85,7 +86,8 @@ TEST(ReadCalibrationReport, ReadsTheRealSetsRosCameraInfo) {
   const std::vector<double> expected = {2424.65845, 2430.55993, 765.71063, 570.19265,
                                         -0.370666,  0.205071,   0.001513,  0.000373};
   ASSERT_EQ(read.camera.params.size(), expected.size());
-  for (size_t i = 0; i < expected.size(); ++i) EXPECT_DOUBLE_EQ(read.camera.params[i], expected[i]) << i;
+  for (size_t i = 0; i < expected.size(); ++i)
+    EXPECT_DOUBLE_EQ(read.camera.params[i], expected[i]) << i;
   EXPECT_EQ(read.camera.width, 1440u);
   EXPECT_EQ(read.camera.height, 1080u);
 }
@@ -123,7 +125,8 @@ void ExpectTheCalibmarReport(const CalibrationReport& read) {
   EXPECT_DOUBLE_EQ(read.housing_std_dev[0], 0.0002753845735);
   EXPECT_DOUBLE_EQ(read.housing_std_dev[3], 0.0004740286295);
   EXPECT_DOUBLE_EQ(read.overall_rms_px, 2.61747377);
-  EXPECT_EQ(read.target_description, "aruco grid board, APRILTAG_36h11, 6, 6, 0.088000, 0.300000, 2, bl, hor");
+  EXPECT_EQ(read.target_description,
+            "aruco grid board, APRILTAG_36h11, 6, 6, 0.088000, 0.300000, 2, bl, hor");
 }
 
 TEST(ReadCalibrationReport, ReadsCalibmarsOwnReportWithItsCommentedDeviations) {
@@ -144,7 +147,8 @@ TEST(ReadCalibrationReport, ReadsCalibmarsOwnReportWithItsCommentedDeviations) {
 
 TEST(ReadCalibrationReport, ReadsTheSharedCalibmarReport) {
   PORTCAL_REQUIRE_SHARED(shared);
-  ExpectTheCalibmarReport(ReadCalibrationReport(shared / "datasets/calibmar-reports/calibration_condria.yaml"));
+  ExpectTheCalibmarReport(
+      ReadCalibrationReport(shared / "datasets/calibmar-reports/calibration_condria.yaml"));
 }
 
 // The covariances a later stage propagates are written in full and read
@@ -155,8 +159,10 @@ TEST(ReadCalibrationReport, CovariancesRoundTripAndAMalformedOneIsNamed) {
   report.camera = MakeCamera("RADIAL", {700, 401.3, 298.7, -0.1, 0.02});
   report.parameters_std_dev = {1, 0.5, 0.5, 0.01, 0.02};
   report.parameters_covariance = Eigen::MatrixXd::Identity(5, 5);
-  report.parameters_covariance(0, 3) = report.parameters_covariance(3, 0) = 1.0 / 3.0;  // not a short decimal
-  report.housing = Housing::FromName("DOMEPORT", {0.001, -0.002, 0.003, 0.05, 0.006, 1.0, 1.49, 1.334}, "test");
+  report.parameters_covariance(0, 3) = report.parameters_covariance(3, 0) =
+      1.0 / 3.0;  // not a short decimal
+  report.housing =
+      Housing::FromName("DOMEPORT", {0.001, -0.002, 0.003, 0.05, 0.006, 1.0, 1.49, 1.334}, "test");
   report.housing_std_dev = {1e-4, 1e-4, 2e-4, 0, 0, 0, 0, 0};
   report.housing_covariance = Eigen::MatrixXd::Zero(8, 8);
   report.housing_covariance.topLeftCorner<3, 3>() << 1e-8, 2e-9, 0, 2e-9, 1e-8, 0, 0, 0, 4e-8;
@@ -188,11 +194,13 @@ TEST(ReadCalibrationReport, AFileOfNoKnownFormatNamesTheFormatsAndTheKey) {
     FAIL() << "read a file of no known format";
   } catch (const InputError& e) {
     const std::string what = e.what();
-    for (const char* named : {"calib.yaml", "'model'", "camera_matrix", ".cameramodel", "calibmar"}) {
+    for (const char* named :
+         {"calib.yaml", "'model'", "camera_matrix", ".cameramodel", "calibmar"}) {
       EXPECT_NE(what.find(named), std::string::npos) << named << " not in: " << what;
     }
   }
-  std::ofstream(dir / "ros.yaml") << "image_width: 640\nimage_height: 480\ncamera_matrix:\n  rows: 3\n";
+  std::ofstream(dir / "ros.yaml")
+      << "image_width: 640\nimage_height: 480\ncamera_matrix:\n  rows: 3\n";
   try {
     ReadCalibrationReport(dir / "ros.yaml");
     FAIL() << "read a camera_matrix without data";
@@ -207,9 +215,11 @@ TEST(ReadCalibrationReport, AFileOfNoKnownFormatNamesTheFormatsAndTheKey) {
 // lower RMS): a warning first in the report that names them and the fix.
 TEST(ReportOf, UndeterminedParametersAreAWarningThatNamesThem) {
   HousingCalibrationResult result;
-  result.camera = MakeCamera("OPENCV", {2412.1, 2418.7, 1054.3, 571.9, -0.37, 0.21, 0.0015, 0.0004});
+  result.camera =
+      MakeCamera("OPENCV", {2412.1, 2418.7, 1054.3, 571.9, -0.37, 0.21, 0.0015, 0.0004});
   result.camera_std_dev = {2.1, 2.2, -1, 1.7, 0.001, 0.004, 0.0001, 0.0001};
-  result.housing = Housing::FromName("DOMEPORT", {0.001, -0.002, -0.023, 0.043552, 0.00375, 1, 1.495, 1.333}, "t");
+  result.housing = Housing::FromName(
+      "DOMEPORT", {0.001, -0.002, -0.023, 0.043552, 0.00375, 1, 1.495, 1.333}, "t");
   result.housing_std_dev = {0.0001, 0.0001, -1, 0, 0, 0, 0, 0};
   const CalibrationReport report = ReportOf(result, "chessboard");
   ASSERT_EQ(report.warnings.size(), 1u);
@@ -227,7 +237,8 @@ TEST(ReportOf, UndeterminedParametersAreAWarningThatNamesThem) {
   const CalibrationReport good = ReportOf(result, "chessboard");
   EXPECT_TRUE(good.warnings.empty());
   WriteCalibrationReport(good, dir / "good");
-  EXPECT_NE(testing::ReadFileToString(dir / "good/calibration.txt").find("23.00 mm behind the camera's projection"),
+  EXPECT_NE(testing::ReadFileToString(dir / "good/calibration.txt")
+                .find("23.00 mm behind the camera's projection"),
             std::string::npos);
 }
 
@@ -245,8 +256,10 @@ TEST(BoardWarpNote, SaysTheSagItsSignificanceAndWhatFlatWouldChange) {
   flat.camera.params[2] = 731.9;   // cx: -28.6 px, 7.9 sigma
   flat.overall_rms_px = 0.229;
   const std::string note = BoardWarpNote(warped, flat);
-  for (const char* said : {"sag x -0.084 +- 0.012 mm, y -0.278 +- 0.010 mm", "significant (27.8 sigma)",
-                           "held flat, fx would be 2412.0 px (-21.4 px, 8.2 sigma)", "RMS 0.229 px instead of 0.188"}) {
+  for (const char* said :
+       {"sag x -0.084 +- 0.012 mm, y -0.278 +- 0.010 mm", "significant (27.8 sigma)",
+        "held flat, fx would be 2412.0 px (-21.4 px, 8.2 sigma)",
+        "RMS 0.229 px instead of 0.188"}) {
     EXPECT_NE(note.find(said), std::string::npos) << said << ": " << note;
   }
   warped.board_warp = Eigen::Vector2d(0.01e-3, -0.02e-3);
@@ -268,8 +281,9 @@ namespace {
 TEST(ReadCalibrationReport, ImageNamesOfAnyKindReadBack) {
   CalibrationReport report;
   report.camera = Camera::FromModelName("OPENCV", 500, 640, 480);
-  const std::vector<std::string> names = {"it's.png", "say \"cheese\".png", "back\\slash.png", "two\nlines.png",
-                                          "tab\there.png", "sous l'eau/é.png", "水中.png", "- dash: colon.png"};
+  const std::vector<std::string> names = {
+      "it's.png",      "say \"cheese\".png", "back\\slash.png", "two\nlines.png",
+      "tab\there.png", "sous l'eau/é.png",   "水中.png",        "- dash: colon.png"};
   for (const std::string& name : names) {
     CalibratedView view;
     view.image_name = name;

@@ -38,8 +38,9 @@ struct Rendered {
 
 // Renders the config with `seed`, extracts its chessboard (cols x rows,
 // square metres), and frees the images.
-Rendered RenderAndExtract(const fs::path& config, const fs::path& set, int64_t seed, const std::string& model,
-                          int cols, int rows, double square, bool per_folder = false) {
+Rendered RenderAndExtract(const fs::path& config, const fs::path& set, int64_t seed,
+                          const std::string& model, int cols, int rows, double square,
+                          bool per_folder = false) {
   SynthesizeOptions synthesize;
   synthesize.config_path = config.string();
   synthesize.output_path = set.string();
@@ -65,7 +66,8 @@ Rendered RenderAndExtract(const fs::path& config, const fs::path& set, int64_t s
 }
 
 // z[i]: the normalized errors of parameter names[i] over the seeds.
-void ExpectHonest(const std::vector<std::string>& names, const std::vector<std::vector<double>>& z) {
+void ExpectHonest(const std::vector<std::string>& names,
+                  const std::vector<std::vector<double>>& z) {
   for (size_t i = 0; i < names.size(); ++i) {
     double sum = 0;
     for (double v : z[i]) sum += v * v;
@@ -91,13 +93,14 @@ render: {spp: 4, blur_sigma: 0.5, noise_sigma: 2.0}
 )";
   std::vector<std::vector<double>> z(5);
   for (int seed = 0; seed < kNumCameraSeeds; ++seed) {
-    const Rendered r = RenderAndExtract(dir / "set.yaml", dir / ("set" + std::to_string(seed)), 1000 + seed,
-                                        "RADIAL", 8, 6, 0.025);
+    const Rendered r = RenderAndExtract(dir / "set.yaml", dir / ("set" + std::to_string(seed)),
+                                        1000 + seed, "RADIAL", 8, 6, 0.025);
     const CameraCalibrationResult result = CalibrateCamera(
         r.views.by_camera.begin()->second, Camera::FromModelName("RADIAL", 600, 800, 600), {});
     for (int i = 0; i < 5; ++i) {
       ASSERT_GT(result.params_std_dev[i], 0);
-      z[i].push_back((result.camera.params[i] - r.truth.camera.params[i]) / result.params_std_dev[i]);
+      z[i].push_back((result.camera.params[i] - r.truth.camera.params[i]) /
+                     result.params_std_dev[i]);
     }
   }
   ExpectHonest({"f", "cx", "cy", "k1", "k2"}, z);
@@ -109,16 +112,18 @@ struct HousingSets {
   Rendered in_air, underwater;
 };
 
-HousingSets RenderHousingSets(const fs::path& dir, const std::string& underwater_config, int64_t seed,
-                              double square) {
+HousingSets RenderHousingSets(const fs::path& dir, const std::string& underwater_config,
+                              int64_t seed, double square) {
   std::string in_air_config = underwater_config;
   const size_t housing = in_air_config.find("housing:");
   in_air_config.replace(housing, in_air_config.find('\n', housing) - housing, "housing: null");
   std::ofstream(dir / "air.yaml") << in_air_config;
   std::ofstream(dir / "water.yaml") << underwater_config;
   const std::string tag = std::to_string(seed);
-  return {RenderAndExtract(dir / "air.yaml", dir / ("air" + tag), seed, "SIMPLE_RADIAL", 8, 6, square),
-          RenderAndExtract(dir / "water.yaml", dir / ("water" + tag), seed + 500, "SIMPLE_RADIAL", 8, 6, square)};
+  return {
+      RenderAndExtract(dir / "air.yaml", dir / ("air" + tag), seed, "SIMPLE_RADIAL", 8, 6, square),
+      RenderAndExtract(dir / "water.yaml", dir / ("water" + tag), seed + 500, "SIMPLE_RADIAL", 8, 6,
+                       square)};
 }
 
 // The z-scores of the housing held on the in-air intrinsics, as
@@ -132,13 +137,15 @@ struct HeldZScores {
 // The housing solved jointly with the in-air views (intrinsics calibrated,
 // not given), the board's warp fitted, as housing_calibrator does with
 // --in_air_database_path; and, into `held`, on the in-air intrinsics held.
-HousingCalibrationResult CalibrateJointly(const HousingSets& sets, const Housing& guess, HeldZScores* held,
-                                          const std::vector<int>& params) {
+HousingCalibrationResult CalibrateJointly(const HousingSets& sets, const Housing& guess,
+                                          HeldZScores* held, const std::vector<int>& params) {
   const auto& in_air_views = sets.in_air.views.by_camera.begin()->second;
   const auto& views = sets.underwater.views.by_camera.begin()->second;
-  const CameraCalibrationResult in_air = CalibrateCamera(
-      in_air_views, Camera::FromModelName("SIMPLE_RADIAL", 500, sets.in_air.truth.camera.width,
-                                          sets.in_air.truth.camera.height), {});
+  const CameraCalibrationResult in_air =
+      CalibrateCamera(in_air_views,
+                      Camera::FromModelName("SIMPLE_RADIAL", 500, sets.in_air.truth.camera.width,
+                                            sets.in_air.truth.camera.height),
+                      {});
   HousingCalibrationSettings settings;
   settings.estimate_board_warp = true;
   const HousingCalibrationResult propagated =
@@ -151,13 +158,14 @@ HousingCalibrationResult CalibrateJointly(const HousingSets& sets, const Housing
     held->exact.push_back((exact.housing.params[i] - sets.underwater.truth.housing->params[i]) /
                           exact.housing_std_dev[i]);
   }
-  const InAirViews joint{in_air_views, /*share_board_warp=*/false, {}};  // each set's own sag, the default
+  const InAirViews joint{
+      in_air_views, /*share_board_warp=*/false, {}};  // each set's own sag, the default
   return CalibrateHousing(views, in_air.camera, guess, settings, &joint);
 }
 
 // Appends the z-scores of the housing's `params` and of the focal length.
-void AddZScores(const HousingCalibrationResult& result, const HousingSets& sets, const std::vector<int>& params,
-                std::vector<std::vector<double>>* z) {
+void AddZScores(const HousingCalibrationResult& result, const HousingSets& sets,
+                const std::vector<int>& params, std::vector<std::vector<double>>* z) {
   for (size_t k = 0; k < params.size(); ++k) {
     const int i = params[k];
     ASSERT_GT(result.housing_std_dev[i], 0);
@@ -171,7 +179,8 @@ void AddZScores(const HousingCalibrationResult& result, const HousingSets& sets,
 void PrintRms(const std::string& what, const std::vector<double>& z) {
   double sum = 0, max = 0;
   for (double v : z) sum += v * v, max = std::max(max, std::abs(v));
-  std::cout << "z-score RMS of " << what << ": " << std::sqrt(sum / z.size()) << " (max |z| " << max << ")\n";
+  std::cout << "z-score RMS of " << what << ": " << std::sqrt(sum / z.size()) << " (max |z| " << max
+            << ")\n";
 }
 
 // The held path's propagated standard deviations: honest over all the
@@ -255,18 +264,21 @@ render: {spp: 4, noise_sigma: 2.0}
 )";
   std::vector<std::vector<double>> z(6);
   for (int seed = 0; seed < kNumSeeds; ++seed) {
-    const Rendered r = RenderAndExtract(dir / "set.yaml", dir / ("set" + std::to_string(seed)), 4000 + seed,
-                                        "SIMPLE_RADIAL", 9, 6, 0.025, /*per_folder=*/true);
+    const Rendered r =
+        RenderAndExtract(dir / "set.yaml", dir / ("set" + std::to_string(seed)), 4000 + seed,
+                         "SIMPLE_RADIAL", 9, 6, 0.025, /*per_folder=*/true);
     ASSERT_EQ(r.views.by_camera.size(), 2u);
     const auto& views1 = r.views.by_camera.begin()->second;
     const auto& views2 = std::next(r.views.by_camera.begin())->second;
     std::vector<StereoFrame> frames;
-    for (size_t i = 0; i < std::min(views1.size(), views2.size()); ++i) frames.push_back({views1[i], views2[i]});
-    const StereoCalibrationResult result =
-        CalibrateStereo(frames, {r.truth.camera, std::nullopt}, {r.truth.stereo->camera2, std::nullopt}, {});
+    for (size_t i = 0; i < std::min(views1.size(), views2.size()); ++i)
+      frames.push_back({views1[i], views2[i]});
+    const StereoCalibrationResult result = CalibrateStereo(
+        frames, {r.truth.camera, std::nullopt}, {r.truth.stereo->camera2, std::nullopt}, {});
     // Rotation error as the rotation vector of est * truth^-1 (Ceres'
     // quaternion manifold perturbs on the left), in degrees.
-    const Eigen::AngleAxisd delta(result.cam2_from_cam1.rotation * r.truth.stereo->cam2_from_cam1.rotation.inverse());
+    const Eigen::AngleAxisd delta(result.cam2_from_cam1.rotation *
+                                  r.truth.stereo->cam2_from_cam1.rotation.inverse());
     const Eigen::Vector3d rotation_error = delta.angle() * delta.axis() * 180 / M_PI;
     const Eigen::Vector3d translation_error =
         result.cam2_from_cam1.translation - r.truth.stereo->cam2_from_cam1.translation;

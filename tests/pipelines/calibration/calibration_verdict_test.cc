@@ -2,13 +2,14 @@
 // (calibration.txt opens with it, calibration.yaml parses), and the three
 // kinds of sets the issue names: the real in-air set OK, a rendered set of
 // 6 views CHECK with its bare image corners named.
+#include "pipelines/calibration/calibration_verdict.h"
+
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
 #include <fstream>
 
 #include "pipelines/calibration/calibration_report.h"
-#include "pipelines/calibration/calibration_verdict.h"
 #include "pipelines/stages/camera_calibrator.h"
 #include "tests/database/colmap_fixture.h"
 #include "tests/pipelines/stages/live_test_setup.h"
@@ -112,7 +113,8 @@ TEST(CalibrationVerdict, EachRuleCrossed) {
   report.warnings = {"the focal length is poorly determined: std dev 20 px"};
   EXPECT_EQ(JudgeCalibration(report, everywhere).status, VerdictStatus::kCheck);
   report.warnings.clear();
-  report.notes.push_back("the in-air intrinsics are taken as exact (the calibration file carries no covariance)");
+  report.notes.push_back(
+      "the in-air intrinsics are taken as exact (the calibration file carries no covariance)");
   EXPECT_EQ(JudgeCalibration(report, everywhere).status, VerdictStatus::kCheck);
 }
 
@@ -126,14 +128,16 @@ TEST(CalibrationVerdict, CoverageNamesTheBareCorners) {
   }
   CalibrationVerdict verdict = JudgeCalibration(report, pixels);
   EXPECT_EQ(verdict.status, VerdictStatus::kOk) << verdict.Summary();
-  EXPECT_NE(LineOf(verdict, "coverage")->text.find("top-right corner holds no point"), std::string::npos);
+  EXPECT_NE(LineOf(verdict, "coverage")->text.find("top-right corner holds no point"),
+            std::string::npos);
   pixels.erase(std::remove_if(pixels.begin(), pixels.end(),
                               [](const Eigen::Vector2d& p) { return p.x() < 213 && p.y() > 320; }),
                pixels.end());
   verdict = JudgeCalibration(report, pixels);
   EXPECT_EQ(verdict.status, VerdictStatus::kCheck);
-  EXPECT_NE(LineOf(verdict, "coverage")->text.find("top-right and bottom-left corners hold no point"),
-            std::string::npos)
+  EXPECT_NE(
+      LineOf(verdict, "coverage")->text.find("top-right and bottom-left corners hold no point"),
+      std::string::npos)
       << LineOf(verdict, "coverage")->text;
   std::vector<Eigen::Vector2d> rim;  // the corners and little else
   for (const Eigen::Vector2d& p : Everywhere(640, 480)) {
@@ -150,7 +154,8 @@ TEST(CalibrationVerdict, ReportFilesOpenWithIt) {
   testing::TempDir dir;
   WriteCalibrationReport(report, dir.path());
   const std::string text = testing::ReadFileToString(dir / "calibration.txt");
-  EXPECT_EQ(text.find("Verdict: CHECK\n  CHECK views: 6 views < 10"), text.find("Verdict:")) << text;
+  EXPECT_EQ(text.find("Verdict: CHECK\n  CHECK views: 6 views < 10"), text.find("Verdict:"))
+      << text;
   EXPECT_LT(text.find("Verdict:"), text.find("Camera model"));
   const YAML::Node yaml = YAML::LoadFile((dir / "calibration.yaml").string());
   EXPECT_EQ(yaml["verdict"]["status"].as<std::string>(), "CHECK");
@@ -174,7 +179,8 @@ TEST(CalibrationVerdict, RealInAirSetIsOk) {
   RunCameraCalibrator(options, NoProgress());
   const YAML::Node yaml = YAML::LoadFile((dir / "air/calibration.yaml").string());
   EXPECT_EQ(yaml["verdict"]["status"].as<std::string>(), "OK") << YAML::Dump(yaml["verdict"]);
-  EXPECT_NE(testing::ReadFileToString(dir / "air/report.html").find("<p>Verdict: OK</p>"), std::string::npos);
+  EXPECT_NE(testing::ReadFileToString(dir / "air/report.html").find("<p>Verdict: OK</p>"),
+            std::string::npos);
 }
 
 // The demo's in-air set (workflows/demo.sh: 8 views): CHECK, the views and
@@ -184,9 +190,12 @@ TEST(CalibrationVerdict, DemoSetIsCheckWithItsBareCornersNamed) {
   testing::TempDir dir;
   const fs::path images = testing::SharedRenderedImages(
       "name: demo_air\nseed: 1\nnum_images: 8\n"
-      "camera: {model: RADIAL, width: 960, height: 540, params: [648.68, 480.0, 270.0, -0.08, 0.01]}\n"
-      "housing: null\ntarget: {type: chessboard, cols: 10, rows: 7, square_size: 0.02, margin: 0.015}\n"
-      "poses: {distance: [0.35, 0.9], tilt_max_deg: 45, roll_max_deg: 30}\nrender: {spp: 4, noise_sigma: 1.0}\n");
+      "camera: {model: RADIAL, width: 960, height: 540, params: [648.68, 480.0, 270.0, -0.08, "
+      "0.01]}\n"
+      "housing: null\ntarget: {type: chessboard, cols: 10, rows: 7, square_size: 0.02, margin: "
+      "0.015}\n"
+      "poses: {distance: [0.35, 0.9], tilt_max_deg: 45, roll_max_deg: 30}\nrender: {spp: 4, "
+      "noise_sigma: 1.0}\n");
   TargetExtractorOptions extract;
   extract.database_path = (dir / "few.db").string();
   extract.image_path = images.string();

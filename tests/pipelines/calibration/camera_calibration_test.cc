@@ -48,7 +48,8 @@ TEST(CameraCalibration, SharedInAirRenderWithinTheGroundTruth) {
   testing::TempDir dir;
   Extract(set / "images", dir / "db.db", "RADIAL", 10, 7, 0.02);
   Camera initial = Camera::FromModelName("RADIAL", 1000, 1920, 1080);
-  const CameraCalibrationResult result = CalibrateCamera(ViewsFromDatabase(dir / "db.db"), initial, {});
+  const CameraCalibrationResult result =
+      CalibrateCamera(ViewsFromDatabase(dir / "db.db"), initial, {});
   const std::vector<double>& p = result.camera.params;
   const std::vector<double>& t = truth.camera.params;
   const std::vector<double>& s = result.params_std_dev;
@@ -78,7 +79,8 @@ TEST(CameraCalibration, RealInAirSetAgreesWithOpenCV) {
     object_points.emplace_back();
     image_points.emplace_back();
     for (size_t i = 0; i < view.pixels.size(); ++i) {
-      object_points.back().emplace_back(view.points_in_target[i].x(), view.points_in_target[i].y(), 0);
+      object_points.back().emplace_back(view.points_in_target[i].x(), view.points_in_target[i].y(),
+                                        0);
       image_points.back().emplace_back(view.pixels[i].x() - 0.5, view.pixels[i].y() - 0.5);
     }
   }
@@ -86,13 +88,15 @@ TEST(CameraCalibration, RealInAirSetAgreesWithOpenCV) {
   std::vector<cv::Mat> rvecs, tvecs;
   const double opencv_rms = cv::calibrateCamera(
       object_points, image_points, cv::Size(1440, 1080), k, distortion, rvecs, tvecs,
-      cv::CALIB_FIX_K3, cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 200, 1e-14));
-  const std::vector<double> opencv = {k.at<double>(0, 0), k.at<double>(1, 1), k.at<double>(0, 2) + 0.5,
-                                      k.at<double>(1, 2) + 0.5, distortion.at<double>(0),
-                                      distortion.at<double>(1), distortion.at<double>(2),
-                                      distortion.at<double>(3)};
+      cv::CALIB_FIX_K3,
+      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 200, 1e-14));
+  const std::vector<double> opencv = {k.at<double>(0, 0),       k.at<double>(1, 1),
+                                      k.at<double>(0, 2) + 0.5, k.at<double>(1, 2) + 0.5,
+                                      distortion.at<double>(0), distortion.at<double>(1),
+                                      distortion.at<double>(2), distortion.at<double>(3)};
   for (size_t i = 0; i < opencv.size(); ++i) {
-    EXPECT_LT(std::abs(ours.camera.params[i] - opencv[i]), ours.params_std_dev[i]) << "parameter " << i;
+    EXPECT_LT(std::abs(ours.camera.params[i] - opencv[i]), ours.params_std_dev[i])
+        << "parameter " << i;
   }
   EXPECT_NEAR(ours.overall_rms_px, opencv_rms, 0.01);
 }
@@ -117,13 +121,15 @@ TEST(CameraCalibration, BoardWarpOnTheRealSet) {
 TEST(CameraCalibration, FixedParametersStayAndNamesAreChecked) {
   PORTCAL_REQUIRE_SHARED(shared);
   testing::TempDir dir;
-  Extract(shared / "datasets/rendered/chess_air_distorted/images", dir / "db.db", "RADIAL", 10, 7, 0.02);
+  Extract(shared / "datasets/rendered/chess_air_distorted/images", dir / "db.db", "RADIAL", 10, 7,
+          0.02);
   Camera initial = Camera::FromModelName("RADIAL", 1300, 1920, 1080);
   initial.params[4] = -0.02;
   CameraCalibrationSettings settings;
   settings.fixed_params = {"k2", "principal_point"};
   settings.initialize_from_data = true;
-  const CameraCalibrationResult result = CalibrateCamera(ViewsFromDatabase(dir / "db.db"), initial, settings);
+  const CameraCalibrationResult result =
+      CalibrateCamera(ViewsFromDatabase(dir / "db.db"), initial, settings);
   EXPECT_EQ(result.camera.params[4], -0.02);
   EXPECT_EQ(result.camera.params[1], 960.0);
   EXPECT_EQ(result.params_std_dev[4], 0.0);
@@ -174,8 +180,9 @@ TEST(CalibrationReport, NotesAndTargetSurviveQuotesThroughYaml) {
   report.camera = Camera::FromModelName("RADIAL", 1000, 1600, 1200);
   report.parameters_std_dev = {1, 0, 0, 0.01, 0.01};
   report.target_description = "the diver's board: 'A3'";
-  report.notes = {"principal point held at the image centre: refined, it was off by x +0.50 px (sd 0.20)",
-                  "it's quoted"};
+  report.notes = {
+      "principal point held at the image centre: refined, it was off by x +0.50 px (sd 0.20)",
+      "it's quoted"};
   WriteCalibrationReport(report, dir / "out");
   const CalibrationReport read = ReadCalibrationReport(dir / "out/calibration.yaml");
   EXPECT_EQ(read.notes, report.notes);
@@ -196,23 +203,26 @@ TEST(CameraCalibration, ANonFiniteObservationNamesTheImageAndPoint) {
     image.camera_id = database.WriteCamera(Camera::FromModelName("PINHOLE", 500, 640, 480));
     const image_t image_id = database.WriteImage(image);
     std::vector<TargetObservation> rows(3);
-    for (int i = 0; i < 3; ++i) rows[i] = {i, Eigen::Vector2d(100 + i, 200), Eigen::Vector3d(0.03 * i, 0, 0)};
+    for (int i = 0; i < 3; ++i)
+      rows[i] = {i, Eigen::Vector2d(100 + i, 200), Eigen::Vector3d(0.03 * i, 0, 0)};
     database.WriteTargetObservations(image_id, rows);
     database.WriteTargetDetectionStatus(image_id, {"chessboard 3x1", true, 3, ""});
   }
   // portcal refuses to write it; another tool edits the row.
   sqlite3* raw = nullptr;
   ASSERT_EQ(sqlite3_open((dir / "db.db").string().c_str(), &raw), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(raw, "UPDATE portcal_target_observations SET x = 9e999 WHERE point_id = 2;", nullptr,
-                         nullptr, nullptr),
-            SQLITE_OK);
+  ASSERT_EQ(
+      sqlite3_exec(raw, "UPDATE portcal_target_observations SET x = 9e999 WHERE point_id = 2;",
+                   nullptr, nullptr, nullptr),
+      SQLITE_OK);
   sqlite3_close(raw);
   Database database(dir / "db.db", Database::OpenMode::kReadOnly);
   try {
     ReadTargetViews(&database);
     ADD_FAILURE() << "a non-finite observation was read";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("view_7.png, target point 2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("view_7.png, target point 2"), std::string::npos)
+        << e.what();
   }
 }
 

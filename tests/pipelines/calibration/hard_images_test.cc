@@ -24,9 +24,11 @@ namespace {
 TEST(HardImages, DetectorRefusesWhatIsWrongAndCalibrationHolds) {
   testing::TempDir dir;
   const std::string camera =
-      "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 402.0, 298.0, -0.08, 0.01]}\n"
+      "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 402.0, 298.0, -0.08, "
+      "0.01]}\n"
       "housing: null\n";
-  std::ofstream(dir / "hard.yaml") << "name: hard\nseed: 31\nnum_images: 14\n" << camera << R"(
+  std::ofstream(dir / "hard.yaml") << "name: hard\nseed: 31\nnum_images: 14\n"
+                                   << camera << R"(
 target: {type: chessboard, cols: 9, rows: 6, square_size: 0.025, margin: 0.015}
 poses: {distance: [0.35, 0.9], tilt_max_deg: 45, roll_max_deg: 40}
 render: {spp: 4, blur_sigma: 0.8, noise_sigma: 3.0, white: 200, black: 60}
@@ -35,7 +37,8 @@ vignetting: 0.5
 occlusion: {probability: 0.25, fraction: 0.2}
 )";
   // Another target (a ChArUco board) in the same folder.
-  std::ofstream(dir / "other.yaml") << "name: other\nseed: 32\nnum_images: 2\n" << camera << R"(
+  std::ofstream(dir / "other.yaml") << "name: other\nseed: 32\nnum_images: 2\n"
+                                    << camera << R"(
 target: {type: charuco, squares_x: 6, squares_y: 5, square_size: 0.03, marker_size: 0.022}
 poses: {distance: [0.4, 0.8], tilt_max_deg: 30}
 )";
@@ -79,19 +82,22 @@ poses: {distance: [0.4, 0.8], tilt_max_deg: 30}
   for (const FrameTruth& frame : truth.images) {
     if (!frame.cam1.corners_visible.empty()) continue;  // partly occluded
     ++spared;
-    const auto status =
-        db.ReadTargetDetectionStatus(db.ReadImageWithName(fs::path(frame.cam1.file).filename().string())->image_id);
+    const auto status = db.ReadTargetDetectionStatus(
+        db.ReadImageWithName(fs::path(frame.cam1.file).filename().string())->image_id);
     found_spared += status && status->found;
   }
   EXPECT_EQ(found_spared, spared);
 
   CameraCalibrationSettings settings;
   settings.drop_outlier_views = true;
-  const CameraCalibrationResult result = CalibrateCamera(
-      ReadTargetViews(&db).by_camera.begin()->second, Camera::FromModelName("RADIAL", 700, 800, 600), settings);
+  const CameraCalibrationResult result =
+      CalibrateCamera(ReadTargetViews(&db).by_camera.begin()->second,
+                      Camera::FromModelName("RADIAL", 700, 800, 600), settings);
   for (int i = 0; i < 5; ++i) {
-    EXPECT_LT(std::abs(result.camera.params[i] - truth.camera.params[i]), 4 * result.params_std_dev[i])
-        << "parameter " << i << " " << result.camera.params[i] << " +- " << result.params_std_dev[i];
+    EXPECT_LT(std::abs(result.camera.params[i] - truth.camera.params[i]),
+              4 * result.params_std_dev[i])
+        << "parameter " << i << " " << result.camera.params[i] << " +- "
+        << result.params_std_dev[i];
   }
   for (const CalibratedView& view : result.views) EXPECT_FALSE(view.dropped) << view.image_name;
 }

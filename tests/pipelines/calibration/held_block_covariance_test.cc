@@ -14,10 +14,12 @@ namespace {
 
 // r = A x + B theta - b, one row each.
 struct LinearRow {
-  LinearRow(const Eigen::Vector3d& a, const Eigen::Vector2d& b, double target) : a(a), b(b), target(target) {}
+  LinearRow(const Eigen::Vector3d& a, const Eigen::Vector2d& b, double target)
+      : a(a), b(b), target(target) {}
   template <typename T>
   bool operator()(const T* x, const T* theta, T* residual) const {
-    residual[0] = a[0] * x[0] + a[1] * x[1] + a[2] * x[2] + b[0] * theta[0] + b[1] * theta[1] - target;
+    residual[0] =
+        a[0] * x[0] + a[1] * x[1] + a[2] * x[2] + b[0] * theta[0] + b[1] * theta[1] - target;
     return true;
   }
   Eigen::Vector3d a;
@@ -31,8 +33,8 @@ TEST(HeldBlockCovariance, EqualsTheLinearSensitivityTimesTheHeldCovariance) {
   double x[3] = {0, 0, 0}, theta[2] = {0.3, -0.2};
   ceres::Problem problem;
   for (int r = 0; r < 12; ++r) {
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LinearRow, 1, 3, 2>(
-                                 new LinearRow(a.row(r).transpose(), b.row(r).transpose(), target[r])),
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LinearRow, 1, 3, 2>(new LinearRow(
+                                 a.row(r).transpose(), b.row(r).transpose(), target[r])),
                              nullptr, x, theta);
   }
   problem.SetParameterBlockConstant(theta);

@@ -22,8 +22,8 @@ namespace fs = std::filesystem;
 namespace portcal {
 namespace {
 
-std::vector<CalibrationView> Extract(const fs::path& images, const fs::path& database, int cols, int rows,
-                                     double square) {
+std::vector<CalibrationView> Extract(const fs::path& images, const fs::path& database, int cols,
+                                     int rows, double square) {
   TargetExtractorOptions options;
   options.database_path = database.string();
   options.image_path = images.string();
@@ -57,14 +57,17 @@ TEST(HeldOut, RealDomeMatchesAnUnderwaterLensModel) {
   Split(water, &fit, &held_out);
   const Camera start = Camera::FromModelName("OPENCV", 2400, 1440, 1080);
   const CameraCalibrationResult in_air = CalibrateCamera(air, start, {});
-  const Housing guess = Housing::FromName("DOMEPORT", {0, 0, 0, 0.043552, 0.00375, 1.0, 1.495, 1.333}, "test");
+  const Housing guess =
+      Housing::FromName("DOMEPORT", {0, 0, 0, 0.043552, 0.00375, 1.0, 1.495, 1.333}, "test");
   const HousingCalibrationResult dome = CalibrateHousing(fit, in_air.camera, guess, {});
   const CameraCalibrationResult underwater_lens = CalibrateCamera(fit, start, {});
   const double dome_rms = HeldOutRms(held_out, {dome.camera, dome.housing}, 2);
   const double lens_rms = HeldOutRms(held_out, {underwater_lens.camera, std::nullopt}, 2);
-  std::cout << "real dome held-out RMS: DOMEPORT " << dome_rms << " px, underwater OPENCV " << lens_rms
-            << " px; C = " << Eigen::Map<const Eigen::Vector3d>(dome.housing.params.data()).transpose() * 1000
-            << " mm +- " << Eigen::Map<const Eigen::Vector3d>(dome.housing_std_dev.data()).transpose() * 1000
+  std::cout << "real dome held-out RMS: DOMEPORT " << dome_rms << " px, underwater OPENCV "
+            << lens_rms << " px; C = "
+            << Eigen::Map<const Eigen::Vector3d>(dome.housing.params.data()).transpose() * 1000
+            << " mm +- "
+            << Eigen::Map<const Eigen::Vector3d>(dome.housing_std_dev.data()).transpose() * 1000
             << " mm\n";
   EXPECT_LT(dome_rms, 1.1 * lens_rms);
   for (int i = 0; i < 3; ++i) EXPECT_GT(dome.housing_std_dev[i], 0);
@@ -82,7 +85,8 @@ TEST(HeldOut, TheBoardsSagIsAppliedNotTakenFlat) {
   std::normal_distribution<double> noise(0, 0.05);
   std::vector<CalibrationView> views;
   for (int v = 0; v < 8; ++v) {
-    const Eigen::Quaterniond rotation(Eigen::AngleAxisd(0.3 * std::sin(v), Eigen::Vector3d(1, 0.5 * v - 2, 0).normalized()));
+    const Eigen::Quaterniond rotation(
+        Eigen::AngleAxisd(0.3 * std::sin(v), Eigen::Vector3d(1, 0.5 * v - 2, 0).normalized()));
     const Eigen::Vector3d centre(0.22, 0.16, 0);
     CalibrationView view;
     view.image_name = "view" + std::to_string(v);
@@ -90,8 +94,10 @@ TEST(HeldOut, TheBoardsSagIsAppliedNotTakenFlat) {
       for (int i = 0; i < 12; ++i) {
         const Eigen::Vector3d flat(0.04 * i, 0.04 * j, 0);
         const double u = 2.0 * i / 11 - 1, w = 2.0 * j / 8 - 1;
-        const Eigen::Vector3d bent = flat + Eigen::Vector3d(0, 0, warp.x() * (1 - u * u) + warp.y() * (1 - w * w));
-        const auto pixel = camera.ImgFromCam(rotation * (bent - centre) + Eigen::Vector3d(0.05 * (v % 3 - 1), 0, 1.1));
+        const Eigen::Vector3d bent =
+            flat + Eigen::Vector3d(0, 0, warp.x() * (1 - u * u) + warp.y() * (1 - w * w));
+        const auto pixel = camera.ImgFromCam(rotation * (bent - centre) +
+                                             Eigen::Vector3d(0.05 * (v % 3 - 1), 0, 1.1));
         ASSERT_TRUE(pixel);
         view.points_in_target.push_back(flat);
         view.pixels.push_back(*pixel + Eigen::Vector2d(noise(rng), noise(rng)));
@@ -100,10 +106,13 @@ TEST(HeldOut, TheBoardsSagIsAppliedNotTakenFlat) {
     views.push_back(view);
   }
   const HeldOutEvaluation flat = EvaluateHeldOut(views, {camera, std::nullopt}, 2);
-  const HeldOutEvaluation sagged = EvaluateHeldOut(WithBoardSag(views, warp), {camera, std::nullopt}, 2);
-  std::printf("the true lens on a board sagging 0.25 mm: judged flat %.4f px (pattern %.4f), with its sag %.4f px "
-              "(pattern %.4f, noise alone %.4f)\n",
-              flat.rms_px, flat.systematic_px, sagged.rms_px, sagged.systematic_px, sagged.noise_floor_px);
+  const HeldOutEvaluation sagged =
+      EvaluateHeldOut(WithBoardSag(views, warp), {camera, std::nullopt}, 2);
+  std::printf(
+      "the true lens on a board sagging 0.25 mm: judged flat %.4f px (pattern %.4f), with its sag "
+      "%.4f px "
+      "(pattern %.4f, noise alone %.4f)\n",
+      flat.rms_px, flat.systematic_px, sagged.rms_px, sagged.systematic_px, sagged.noise_floor_px);
   // 0.05 px per coordinate: a 2-D RMS of about 0.07 px less the pose's
   // share, and no pattern beyond what noise leaves.
   EXPECT_LT(sagged.rms_px, 0.08);
@@ -121,15 +130,19 @@ TEST(HeldOut, TheBoardsSagIsAppliedNotTakenFlat) {
 // to the same near views, stays at the noise level far away (0.02 px).
 TEST(HeldOut, FlatPortLensModelFailsAtOtherDistancesHousingModelDoesNot) {
   testing::TempDir dir;
-  const std::string common = R"(camera: {model: OPENCV, width: 960, height: 720, params: [450.0, 450.0, 480.0, 360.0, -0.05, 0.01, 0.0, 0.0]}
+  const std::string common =
+      R"(camera: {model: OPENCV, width: 960, height: 720, params: [450.0, 450.0, 480.0, 360.0, -0.05, 0.01, 0.0, 0.0]}
 housing: {model: FLATPORT, params: [0.0348995, 0.0, 0.9993908, 0.1, 0.02, 1.0, 1.49, 1.334]}
 render: {spp: 4, noise_sigma: 1.0}
 )";
-  std::ofstream(dir / "near.yaml") << "name: near\nseed: 21\nnum_images: 12\n" << common
+  std::ofstream(dir / "near.yaml")
+      << "name: near\nseed: 21\nnum_images: 12\n"
+      << common
       << "target: {type: chessboard, cols: 10, rows: 7, square_size: 0.03, margin: 0.015}\n"
       << "poses: {distance: [0.4, 0.8], tilt_max_deg: 45, roll_max_deg: 30}\n";
-  std::ofstream(dir / "far.yaml") << "name: far\nseed: 22\nnum_images: 8\n" << common
-      << "target: {type: chessboard, cols: 10, rows: 7, square_size: 0.1, margin: 0.05}\n"
+  std::ofstream(dir / "far.yaml")
+      << "name: far\nseed: 22\nnum_images: 8\n"
+      << common << "target: {type: chessboard, cols: 10, rows: 7, square_size: 0.1, margin: 0.05}\n"
       << "poses: {distance: [1.5, 3.0], tilt_max_deg: 40, roll_max_deg: 30}\n";
   NullProgress progress;
   for (const char* name : {"near", "far"}) {

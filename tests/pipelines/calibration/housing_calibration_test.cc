@@ -7,7 +7,6 @@
 
 #include "colmap_ext/camera/housed_camera.h"
 #include "colmap_ext/cost/board_warp.h"
-
 #include "colmap_ext/io/ground_truth.h"
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
@@ -65,25 +64,29 @@ TEST(HousingCalibration, FlatPortNormalAndDistanceFromTheSharedRender) {
   guess.params[3] = 0.05;
   const HousingCalibrationResult result =
       CalibrateHousing(ExtractViews(set / "images", dir / "db.db"), truth.camera, guess, {});
-  const Eigen::Vector3d normal(result.housing.params[0], result.housing.params[1], result.housing.params[2]);
+  const Eigen::Vector3d normal(result.housing.params[0], result.housing.params[1],
+                               result.housing.params[2]);
   const Eigen::Vector3d true_normal(truth.housing->params[0], truth.housing->params[1],
                                     truth.housing->params[2]);
-  const double angle_deg = std::acos(std::min(1.0, normal.normalized().dot(true_normal.normalized()))) * 180 / M_PI;
+  const double angle_deg =
+      std::acos(std::min(1.0, normal.normalized().dot(true_normal.normalized()))) * 180 / M_PI;
   // The normal's tangent-plane standard deviation, as an angle.
-  const double sigma_deg = std::hypot(result.housing_std_dev[0], result.housing_std_dev[1]) * 180 / M_PI;
+  const double sigma_deg =
+      std::hypot(result.housing_std_dev[0], result.housing_std_dev[1]) * 180 / M_PI;
   EXPECT_GT(sigma_deg, 0);
   EXPECT_LT(angle_deg, 0.03 + 3 * sigma_deg);
   EXPECT_LT(std::abs(result.housing.params[3] - truth.housing->params[3]),
             0.19e-3 + 3 * result.housing_std_dev[3]);
   // The axis straight from the views' F matrices is already close.
-  EXPECT_GT(std::abs(result.initial_axis.dot(true_normal.normalized())), std::cos(1.0 * M_PI / 180));
+  EXPECT_GT(std::abs(result.initial_axis.dot(true_normal.normalized())),
+            std::cos(1.0 * M_PI / 180));
 }
 
 // Corners of a board that sags by `warp` (board_warp.h), seen by `camera`
 // in `num_views` poses (tilts up to 35 deg, 0.5-0.8 m), with Gaussian noise
 // of `noise_px`.
-std::vector<CalibrationView> SaggedViews(const HousedCamera& camera, const Eigen::Vector2d& warp, int num_views,
-                                         double noise_px, std::mt19937* rng) {
+std::vector<CalibrationView> SaggedViews(const HousedCamera& camera, const Eigen::Vector2d& warp,
+                                         int num_views, double noise_px, std::mt19937* rng) {
   constexpr int kCols = 9, kRows = 6;
   constexpr double kSquare = 0.03;
   std::vector<Eigen::Vector3d> board;
@@ -96,9 +99,12 @@ std::vector<CalibrationView> SaggedViews(const HousedCamera& camera, const Eigen
   std::normal_distribution<double> noise(0, noise_px);
   std::vector<CalibrationView> views;
   while (static_cast<int>(views.size()) < num_views) {
-    const Eigen::Vector3d axis = Eigen::Vector3d(unit(*rng), unit(*rng), 0.3 * unit(*rng)).normalized();
-    const Eigen::Matrix3d rotation = Eigen::AngleAxisd(0.61 * std::abs(unit(*rng)), axis).toRotationMatrix();
-    const Eigen::Vector3d translation(0.08 * unit(*rng), 0.06 * unit(*rng), 0.65 + 0.15 * unit(*rng));
+    const Eigen::Vector3d axis =
+        Eigen::Vector3d(unit(*rng), unit(*rng), 0.3 * unit(*rng)).normalized();
+    const Eigen::Matrix3d rotation =
+        Eigen::AngleAxisd(0.61 * std::abs(unit(*rng)), axis).toRotationMatrix();
+    const Eigen::Vector3d translation(0.08 * unit(*rng), 0.06 * unit(*rng),
+                                      0.65 + 0.15 * unit(*rng));
     CalibrationView view;
     view.image_name = "view_" + std::to_string(views.size());
     for (const Eigen::Vector3d& p : board) {
@@ -125,10 +131,12 @@ std::vector<CalibrationView> SaggedViews(const HousedCamera& camera, const Eigen
 TEST(HousingCalibration, JointSolveFitsEachSessionsBoardSag) {
   Camera camera = Camera::FromModelName("OPENCV", 700, 800, 600);
   camera.params = {700, 705, 401.3, 298.7, -0.08, 0.02, 0.0005, -0.0003};
-  const Housing dome = Housing::FromName("DOMEPORT", {0.0015, -0.001, -0.004, 0.05, 0.006, 1.0, 1.49, 1.334}, "test");
+  const Housing dome = Housing::FromName(
+      "DOMEPORT", {0.0015, -0.001, -0.004, 0.05, 0.006, 1.0, 1.49, 1.334}, "test");
   const Eigen::Vector2d air_warp(0.2e-3, -0.6e-3), water_warp(-0.8e-3, -0.2e-3);
   std::mt19937 rng(67);
-  const std::vector<CalibrationView> air = SaggedViews({camera, std::nullopt}, air_warp, 15, 0.1, &rng);
+  const std::vector<CalibrationView> air =
+      SaggedViews({camera, std::nullopt}, air_warp, 15, 0.1, &rng);
   const std::vector<CalibrationView> water = SaggedViews({camera, dome}, water_warp, 20, 0.1, &rng);
   Housing guess = dome;
   guess.params[0] = guess.params[1] = guess.params[2] = 0;
@@ -140,12 +148,15 @@ TEST(HousingCalibration, JointSolveFitsEachSessionsBoardSag) {
   const HousingCalibrationResult result = CalibrateHousing(water, start, guess, settings, &own);
   for (int i = 0; i < 3; ++i) {
     ASSERT_GT(result.housing_std_dev[i], 0);
-    EXPECT_LT(std::abs(result.housing.params[i] - dome.params[i]), 3 * result.housing_std_dev[i]) << "C " << i;
+    EXPECT_LT(std::abs(result.housing.params[i] - dome.params[i]), 3 * result.housing_std_dev[i])
+        << "C " << i;
   }
   ASSERT_TRUE(result.in_air_board_warp && result.in_air_board_warp_std_dev);
   for (int i = 0; i < 2; ++i) {
-    EXPECT_LT(std::abs(result.board_warp[i] - water_warp[i]), 3 * result.board_warp_std_dev[i]) << "water " << i;
-    EXPECT_LT(std::abs((*result.in_air_board_warp)[i] - air_warp[i]), 3 * (*result.in_air_board_warp_std_dev)[i])
+    EXPECT_LT(std::abs(result.board_warp[i] - water_warp[i]), 3 * result.board_warp_std_dev[i])
+        << "water " << i;
+    EXPECT_LT(std::abs((*result.in_air_board_warp)[i] - air_warp[i]),
+              3 * (*result.in_air_board_warp_std_dev)[i])
         << "air " << i;
   }
   // Each set's residual sigma estimates the 0.1 px noise; from ~1600

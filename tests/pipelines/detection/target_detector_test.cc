@@ -2,13 +2,14 @@
 // within tenths of a pixel of the truth and the precise one within
 // hundredths, on the same renders; an image without the target refused;
 // the target's pose from the known camera, through its housing.
+#include "pipelines/detection/target_detector.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <opencv2/imgcodecs.hpp>
 
 #include "colmap_ext/io/ground_truth.h"
-#include "pipelines/detection/target_detector.h"
 #include "pipelines/detection/target_pose.h"
 #include "tests/test_utils.h"
 
@@ -19,7 +20,8 @@ namespace fs = std::filesystem;
 
 const char* kTargets[] = {
     "target: {type: chessboard, cols: 8, rows: 6, square_size: 0.03, margin: 0.02}\n",
-    "target: {type: aruco_grid, markers_x: 5, markers_y: 4, marker_size: 0.03, marker_separation: 0.008}\n",
+    "target: {type: aruco_grid, markers_x: 5, markers_y: 4, marker_size: 0.03, marker_separation: "
+    "0.008}\n",
     "target: {type: charuco, squares_x: 7, squares_y: 5, square_size: 0.03, marker_size: 0.022}\n",
 };
 
@@ -30,16 +32,20 @@ struct RenderedSet {
 
 // Four 800 x 600 views (blur 0.8 px, noise 2) of the target, behind
 // `housing_yaml`.
-RenderedSet Render(const testing::TempDir& dir, const std::string& target_yaml, const std::string& housing_yaml) {
+RenderedSet Render(const testing::TempDir& dir, const std::string& target_yaml,
+                   const std::string& housing_yaml) {
   RenderedSet set;
-  set.truth = testing::RenderSet(
-      dir, "name: live\nseed: 21\nnum_images: 4\n"
-           "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 405.0, 296.0, -0.08, 0.01]}\n" +
-               housing_yaml + target_yaml +
-               "poses: {distance: [0.4, 0.7], tilt_max_deg: 35, roll_max_deg: 30}\n"
-               "render: {spp: 4, blur_sigma: 0.8, noise_sigma: 2.0}\n");
+  set.truth =
+      testing::RenderSet(dir,
+                         "name: live\nseed: 21\nnum_images: 4\n"
+                         "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 405.0, "
+                         "296.0, -0.08, 0.01]}\n" +
+                             housing_yaml + target_yaml +
+                             "poses: {distance: [0.4, 0.7], tilt_max_deg: 35, roll_max_deg: 30}\n"
+                             "render: {spp: 4, blur_sigma: 0.8, noise_sigma: 2.0}\n");
   for (const FrameTruth& frame : set.truth.images) {
-    set.images.push_back(cv::imread((dir / "set" / frame.cam1.file).string(), cv::IMREAD_GRAYSCALE));
+    set.images.push_back(
+        cv::imread((dir / "set" / frame.cam1.file).string(), cv::IMREAD_GRAYSCALE));
   }
   return set;
 }
@@ -62,16 +68,19 @@ TargetDetectorOptions Options(const GroundTruth& truth, bool precise) {
 
 // A point's error against the truth (a chessboard's either way round when
 // it looks the same turned by 180 degrees).
-double Error(const BoardPoint& point, const TargetDetection& detection, const ImageTruth& truth, const std::string& type) {
+double Error(const BoardPoint& point, const TargetDetection& detection, const ImageTruth& truth,
+             const std::string& type) {
   if (type == "aruco_grid") {
     for (const auto& marker : truth.markers) {
-      if (marker.id == point.point_id / 4) return (point.xy - marker.corners_px[point.point_id % 4]).norm();
+      if (marker.id == point.point_id / 4)
+        return (point.xy - marker.corners_px[point.point_id % 4]).norm();
     }
     return 1e9;
   }
   double error = (point.xy - *truth.corners_px[point.point_id]).norm();
   if (detection.symmetric) {
-    error = std::min(error, (point.xy - *truth.corners_px[truth.corners_px.size() - 1 - point.point_id]).norm());
+    error = std::min(
+        error, (point.xy - *truth.corners_px[truth.corners_px.size() - 1 - point.point_id]).norm());
   }
   return error;
 }
@@ -105,7 +114,8 @@ TEST_P(TargetDetector, QuickAndPreciseAgainstTheTruth) {
   ASSERT_GE(precise.size(), 4 * 16u);
   const std::string type = set.truth.target.type;
   std::cout << type << " quick: median " << quick[quick.size() / 2] << " max " << quick.back()
-            << " px; precise: median " << precise[precise.size() / 2] << " max " << precise.back() << " px\n";
+            << " px; precise: median " << precise[precise.size() / 2] << " max " << precise.back()
+            << " px\n";
   EXPECT_LT(quick[quick.size() / 2], 0.2) << type;
   EXPECT_LT(quick.back(), 0.6) << type;
   EXPECT_LT(precise[precise.size() / 2], 0.05) << type;
@@ -132,10 +142,12 @@ TEST(TargetDetector, QuickModeRefusesAFrameWithoutTheTarget) {
 // alone, ignoring the port's refraction, it is centimetres off.
 TEST(TargetPose, FromQuickCornersThroughTheHousing) {
   testing::TempDir dir;
-  const RenderedSet set =
-      Render(dir, kTargets[0], "housing: {model: FLATPORT, params: [0.0, 0.0, 1.0, 0.01, 0.008, 1.0, 1.473, 1.334]}\n");
+  const RenderedSet set = Render(
+      dir, kTargets[0],
+      "housing: {model: FLATPORT, params: [0.0, 0.0, 1.0, 0.01, 0.008, 1.0, 1.473, 1.334]}\n");
   ASSERT_TRUE(set.truth.housing.has_value());
-  HousedCamera housed{set.truth.camera, set.truth.housing}, lens_only{set.truth.camera, std::nullopt};
+  HousedCamera housed{set.truth.camera, set.truth.housing},
+      lens_only{set.truth.camera, std::nullopt};
   for (size_t i = 0; i < set.images.size(); ++i) {
     const TargetDetection detection = DetectTarget(set.images[i], Options(set.truth, false));
     ASSERT_TRUE(detection.found) << detection.reason;

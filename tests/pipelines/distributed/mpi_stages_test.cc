@@ -32,13 +32,14 @@ std::string Mpirun() {
 
 // Views of the two-face ArUco target in two folders (a/: 5, b/: 4).
 fs::path RenderSet(const testing::TempDir& dir) {
-  std::ofstream(dir / "set.yaml") << "name: mpi\nnum_images: 9\nseed: 3\n"
-                                     "camera: {model: SIMPLE_RADIAL, width: 480, height: 270, params: [380.0, "
-                                     "240.0, 135.0, -0.02]}\nhousing: null\n"
-                                  << testing::kTwoFaceTargetYaml
-                                  << "poses: {distance: [0.45, 0.9], tilt_max_deg: 35, roll_max_deg: 60, "
-                                     "visibility: markers, border_margin_px: 10, max_view_angle_deg: 60}\n"
-                                     "render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}\n";
+  std::ofstream(dir / "set.yaml")
+      << "name: mpi\nnum_images: 9\nseed: 3\n"
+         "camera: {model: SIMPLE_RADIAL, width: 480, height: 270, params: [380.0, "
+         "240.0, 135.0, -0.02]}\nhousing: null\n"
+      << testing::kTwoFaceTargetYaml
+      << "poses: {distance: [0.45, 0.9], tilt_max_deg: 35, roll_max_deg: 60, "
+         "visibility: markers, border_margin_px: 10, max_view_angle_deg: 60}\n"
+         "render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}\n";
   SynthesizeOptions synthesize;
   synthesize.config_path = (dir / "set.yaml").string();
   synthesize.output_path = (dir / "set").string();
@@ -55,14 +56,17 @@ fs::path RenderSet(const testing::TempDir& dir) {
 
 // Every table's rows but the stage log's (times differ), schema included.
 std::string Rows(const fs::path& database) {
-  const testing::CommandResult tables = RunCommand(
-      "sqlite3 " + database.string() +
-      " \"SELECT name FROM sqlite_master WHERE type='table' AND name != 'portcal_stage_log' ORDER BY name;\"");
+  const testing::CommandResult tables =
+      RunCommand("sqlite3 " + database.string() +
+                 " \"SELECT name FROM sqlite_master WHERE type='table' AND name != "
+                 "'portcal_stage_log' ORDER BY name;\"");
   std::string rows = RunCommand("sqlite3 " + database.string() + " .schema").output;
   std::istringstream names(tables.output);
   for (std::string table; std::getline(names, table);) {
     rows += table + ":\n" +
-            RunCommand("sqlite3 " + database.string() + " \"SELECT * FROM " + table + " ORDER BY 1, 2;\"").output;
+            RunCommand("sqlite3 " + database.string() + " \"SELECT * FROM " + table +
+                       " ORDER BY 1, 2;\"")
+                .output;
   }
   return rows;
 }
@@ -80,15 +84,16 @@ TEST(MpiStages, ExtractionAndMatchingOnTwoRanksWriteOneProcesssRows) {
   for (const std::string& run : {std::string("one"), Mpirun()}) {
     const std::string prefix = run == "one" ? "" : run;
     const std::string db = (dir / (run == "one" ? "one.db" : "mpi.db")).string();
-    RunOrFail(prefix + portcal + " feature_extractor --database_path " + db + " --image_path " + images.string() +
-              " --ImageReader.single_camera_per_folder 1");
+    RunOrFail(prefix + portcal + " feature_extractor --database_path " + db + " --image_path " +
+              images.string() + " --ImageReader.single_camera_per_folder 1");
     RunOrFail(prefix + portcal + " exhaustive_matcher --database_path " + db);
   }
   const std::string one = Rows(dir / "one.db");
   EXPECT_NE(one.find("keypoints:\n1|"), std::string::npos) << one.substr(0, 2000);
   EXPECT_EQ(Rows(dir / "mpi.db"), one);
   for (const auto& entry : fs::directory_iterator(dir.path())) {
-    EXPECT_EQ(entry.path().string().find(".shard-"), std::string::npos) << entry.path() << " left behind";
+    EXPECT_EQ(entry.path().string().find(".shard-"), std::string::npos)
+        << entry.path() << " left behind";
   }
 }
 
@@ -102,22 +107,26 @@ TEST(MpiStages, ARerunOnAColmap41DatabaseAddsWhatOneProcessAdds) {
   fs::rename(images / "b", dir / "b");
   for (const char* name : {"one.db", "mpi.db"}) {
     const std::string db = (dir / name).string();
-    RunOrFail(portcal + " database_creator --database_path " + db + " --Database.colmap_version 4.1");
-    RunOrFail(portcal + " feature_extractor --database_path " + db + " --image_path " + images.string() +
-              " --ImageReader.single_camera 1");
+    RunOrFail(portcal + " database_creator --database_path " + db +
+              " --Database.colmap_version 4.1");
+    RunOrFail(portcal + " feature_extractor --database_path " + db + " --image_path " +
+              images.string() + " --ImageReader.single_camera 1");
   }
   fs::rename(dir / "b", images / "b");
   for (const std::string& run : {std::string("one"), Mpirun()}) {
     const std::string prefix = run == "one" ? "" : run;
     const std::string db = (dir / (run == "one" ? "one.db" : "mpi.db")).string();
-    RunOrFail(prefix + portcal + " feature_extractor --database_path " + db + " --image_path " + images.string() +
-              " --ImageReader.single_camera 1");
-    RunOrFail(prefix + portcal + " sequential_matcher --database_path " + db + " --SequentialMatching.overlap 3");
+    RunOrFail(prefix + portcal + " feature_extractor --database_path " + db + " --image_path " +
+              images.string() + " --ImageReader.single_camera 1");
+    RunOrFail(prefix + portcal + " sequential_matcher --database_path " + db +
+              " --SequentialMatching.overlap 3");
   }
   const std::string one = Rows(dir / "one.db");
   EXPECT_NE(one.find("frame_data:"), std::string::npos);
   EXPECT_EQ(Rows(dir / "mpi.db"), one);
-  EXPECT_EQ(RunCommand("sqlite3 " + (dir / "mpi.db").string() + " 'SELECT count(*) FROM cameras;'").output, "1\n");
+  EXPECT_EQ(RunCommand("sqlite3 " + (dir / "mpi.db").string() + " 'SELECT count(*) FROM cameras;'")
+                .output,
+            "1\n");
 }
 
 TEST(MpiStages, ARankThatFailsLeavesNothing) {
@@ -130,14 +139,16 @@ TEST(MpiStages, ARankThatFailsLeavesNothing) {
   cv::imwrite((images / "b" / "zz_small.png").string(), small);
   const std::string db = (dir / "mpi.db").string();
   const testing::CommandResult result =
-      RunCommand(Mpirun() + testing::PortcalBinary() + " feature_extractor --database_path " + db + " --image_path " +
-                 images.string() + " --ImageReader.single_camera 1 2>&1");
+      RunCommand(Mpirun() + testing::PortcalBinary() + " feature_extractor --database_path " + db +
+                 " --image_path " + images.string() + " --ImageReader.single_camera 1 2>&1");
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("zz_small.png"), std::string::npos) << result.output;
-  EXPECT_NE(result.output.find("another rank of the MPI job failed"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("another rank of the MPI job failed"), std::string::npos)
+      << result.output;
   EXPECT_FALSE(fs::exists(db));
   for (const auto& entry : fs::directory_iterator(dir.path())) {
-    EXPECT_EQ(entry.path().string().find(".shard-"), std::string::npos) << entry.path() << " left behind";
+    EXPECT_EQ(entry.path().string().find(".shard-"), std::string::npos)
+        << entry.path() << " left behind";
   }
 }
 

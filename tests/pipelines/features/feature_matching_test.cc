@@ -25,7 +25,8 @@ UnitDescriptorRows RandomDescriptors(int rows, std::mt19937* rng, bool copies = 
   std::uniform_int_distribution<int> spike(0, 9);
   UnitDescriptorRows d(rows, 128);
   for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < 128; ++c) d(r, c) = static_cast<float>(byte(*rng) + (spike(*rng) == 0 ? 120 : 0));
+    for (int c = 0; c < 128; ++c)
+      d(r, c) = static_cast<float>(byte(*rng) + (spike(*rng) == 0 ? 120 : 0));
     d.row(r).normalize();
   }
   if (copies) {
@@ -53,7 +54,8 @@ TEST(NearestDescriptors, Avx2KernelAgreesWithThePortableProduct) {
   UnitDescriptorRows probe(1, 128);
   probe.setConstant(1.0f / std::sqrt(128.0f));
   std::vector<NearestDescriptors> n1, n2;
-  if (!FindNearestDescriptorsAvx2(probe, probe, &n1, &n2)) GTEST_SKIP() << "this CPU has no AVX2 + FMA";
+  if (!FindNearestDescriptorsAvx2(probe, probe, &n1, &n2))
+    GTEST_SKIP() << "this CPU has no AVX2 + FMA";
   std::mt19937 rng(11);
   // Sizes on and off the kernel's tiles (3 x 4) and chunks (48 columns).
   for (const auto& [rows1, rows2] : std::vector<std::pair<int, int>>{
@@ -102,8 +104,9 @@ struct SyntheticPair {
 
 SyntheticPair MakePair(int num_points, double outlier_fraction, std::mt19937* rng) {
   SyntheticPair pair;
-  pair.cam2_from_cam1 = Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.1, Eigen::Vector3d(0.2, 1, 0.1).normalized())),
-                                Eigen::Vector3d(-0.5, 0.02, 0.05));
+  pair.cam2_from_cam1 =
+      Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.1, Eigen::Vector3d(0.2, 1, 0.1).normalized())),
+              Eigen::Vector3d(-0.5, 0.02, 0.05));
   std::uniform_real_distribution<double> u(0, 1);
   std::normal_distribution<double> noise(0, 0.5);
   while (static_cast<int>(pair.matches.size()) < num_points) {
@@ -130,8 +133,9 @@ SyntheticPair MakePair(int num_points, double outlier_fraction, std::mt19937* rn
 TEST(TwoViewVerification, KeepsTheTrueMatchesOfACalibratedPair) {
   std::mt19937 rng(7);
   const SyntheticPair pair = MakePair(900, 0.3, &rng);
-  const TwoViewGeometry geometry = VerifyTwoView(pair.camera, pair.keypoints1, pair.camera, pair.keypoints2,
-                                                 pair.matches, TwoViewVerificationOptions());
+  const TwoViewGeometry geometry =
+      VerifyTwoView(pair.camera, pair.keypoints1, pair.camera, pair.keypoints2, pair.matches,
+                    TwoViewVerificationOptions());
   EXPECT_EQ(geometry.config, TwoViewGeometryConfig::kCalibrated);
   int true_kept = 0, false_kept = 0, num_true = 0;
   for (bool o : pair.is_outlier) num_true += !o;
@@ -147,19 +151,22 @@ TEST(TwoViewVerification, KeepsTheTrueMatchesOfACalibratedPair) {
   // deviations of 0.062 deg for the rotation and 0.17 deg for the
   // translation's direction (the narrow field of view lets the two trade).
   // Bounds at about 3 of them; a minimal sample's pose was 1.1 deg off here.
-  const double angle = geometry.cam2_from_cam1.rotation.angularDistance(pair.cam2_from_cam1.rotation);
+  const double angle =
+      geometry.cam2_from_cam1.rotation.angularDistance(pair.cam2_from_cam1.rotation);
   EXPECT_LT(angle, 0.2 * M_PI / 180);
   const Eigen::Vector3d t = pair.cam2_from_cam1.translation.normalized();
   EXPECT_GT(geometry.cam2_from_cam1.translation.normalized().dot(t), std::cos(0.5 * M_PI / 180));
   std::cout << "relative pose: rotation " << angle * 180 / M_PI << " deg, translation "
-            << std::acos(std::min(1.0, geometry.cam2_from_cam1.translation.normalized().dot(t))) * 180 / M_PI
+            << std::acos(std::min(1.0, geometry.cam2_from_cam1.translation.normalized().dot(t))) *
+                   180 / M_PI
             << " deg off\n";
 }
 
 // Normalised coordinates of a pair's matches: points 3-6 m in front of
 // camera 1, with `noise` (normalised units) on each coordinate.
-void NormalisedMatches(const Rigid3d& cam2_from_cam1, int num_points, double noise, std::mt19937* rng,
-                       std::vector<Eigen::Vector2d>* points1, std::vector<Eigen::Vector2d>* points2) {
+void NormalisedMatches(const Rigid3d& cam2_from_cam1, int num_points, double noise,
+                       std::mt19937* rng, std::vector<Eigen::Vector2d>* points1,
+                       std::vector<Eigen::Vector2d>* points2) {
   std::uniform_real_distribution<double> u(-1, 1);
   std::normal_distribution<double> n(0, noise);
   for (int i = 0; i < num_points; ++i) {
@@ -171,13 +178,15 @@ void NormalisedMatches(const Rigid3d& cam2_from_cam1, int num_points, double noi
 }
 
 TEST(RelativePoseRefinement, ConvergesToTheExactPoseFromADegreeOff) {
-  const Rigid3d truth(Eigen::Quaterniond(Eigen::AngleAxisd(0.1, Eigen::Vector3d(0.2, 1, 0.1).normalized())),
-                      Eigen::Vector3d(-0.5, 0.02, 0.05).normalized());
+  const Rigid3d truth(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.1, Eigen::Vector3d(0.2, 1, 0.1).normalized())),
+      Eigen::Vector3d(-0.5, 0.02, 0.05).normalized());
   std::mt19937 rng(3);
   std::vector<Eigen::Vector2d> points1, points2;
   NormalisedMatches(truth, 100, 0.0, &rng, &points1, &points2);
-  const Rigid3d start(truth.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 180, Eigen::Vector3d::UnitY())),
-                      (truth.translation + Eigen::Vector3d(0, 0.05, 0.05)).normalized());
+  const Rigid3d start(
+      truth.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 180, Eigen::Vector3d::UnitY())),
+      (truth.translation + Eigen::Vector3d(0, 0.05, 0.05)).normalized());
   const auto refined = RefineRelativePose(points1, points2, start, 0.0);
   ASSERT_TRUE(refined);
   // Exact matches: only the solver's stop separates it from the truth.
@@ -194,7 +203,8 @@ TEST(RelativePoseRefinement, FewerThanFiveMatchesOrNoBaselineAreNotRefined) {
   EXPECT_FALSE(RefineRelativePose(points1, points2, truth, 0.0));
   NormalisedMatches(truth, 20, 0.0, &rng, &points1, &points2);
   EXPECT_TRUE(RefineRelativePose(points1, points2, truth, 0.0));
-  EXPECT_FALSE(RefineRelativePose(points1, points2, Rigid3d(), 0.0));  // zero translation: no direction to refine
+  EXPECT_FALSE(RefineRelativePose(points1, points2, Rigid3d(),
+                                  0.0));  // zero translation: no direction to refine
   points2.pop_back();
   EXPECT_FALSE(RefineRelativePose(points1, points2, truth, 0.0));
 }
@@ -203,8 +213,9 @@ TEST(TwoViewVerification, RejectsTheChanceMatchesOfUnrelatedImages) {
   std::mt19937 rng(9);
   for (int trial = 0; trial < 5; ++trial) {
     const SyntheticPair pair = MakePair(70, 1.0, &rng);
-    const TwoViewGeometry geometry = VerifyTwoView(pair.camera, pair.keypoints1, pair.camera, pair.keypoints2,
-                                                   pair.matches, TwoViewVerificationOptions());
+    const TwoViewGeometry geometry =
+        VerifyTwoView(pair.camera, pair.keypoints1, pair.camera, pair.keypoints2, pair.matches,
+                      TwoViewVerificationOptions());
     EXPECT_EQ(geometry.config, TwoViewGeometryConfig::kDegenerate) << "trial " << trial;
     EXPECT_TRUE(geometry.inlier_matches.empty()) << "trial " << trial;
   }

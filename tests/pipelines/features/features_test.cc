@@ -18,8 +18,8 @@ cv::Mat Blob(const Eigen::Vector2d& center, double sigma) {
   for (int r = 0; r < image.rows; ++r) {
     for (int c = 0; c < image.cols; ++c) {
       const double dx = c + 0.5 - center.x(), dy = r + 0.5 - center.y();
-      image.at<uint8_t>(r, c) =
-          cv::saturate_cast<uint8_t>(40 + 180 * std::exp(-(dx * dx + dy * dy) / (2 * sigma * sigma)));
+      image.at<uint8_t>(r, c) = cv::saturate_cast<uint8_t>(
+          40 + 180 * std::exp(-(dx * dx + dy * dy) / (2 * sigma * sigma)));
     }
   }
   return image;
@@ -28,7 +28,8 @@ cv::Mat Blob(const Eigen::Vector2d& center, double sigma) {
 TEST(Sift, KeypointOfABlobIsAtItsCentreInColmapPixels) {
   // OpenCV 4.6 reports first-octave keypoints 0.25 px off; portcal undoes it
   // (a control without the correction would be off by ~0.25 px).
-  for (const Eigen::Vector2d& center : {Eigen::Vector2d(100.5, 100.5), Eigen::Vector2d(100.8, 100.1)}) {
+  for (const Eigen::Vector2d& center :
+       {Eigen::Vector2d(100.5, 100.5), Eigen::Vector2d(100.8, 100.1)}) {
     const SiftFeatures features = ExtractSift(Blob(center, 4.0), SiftExtractionOptions());
     ASSERT_FALSE(features.keypoints.empty());
     double best = 1e9;
@@ -47,7 +48,8 @@ TEST(Sift, DescriptorsAreRootSiftQuantisedLikeColmap) {
   double norm = 0, l1 = 0;
   for (int k = 0; k < 128; ++k) l1 += descriptor[k];
   for (int k = 0; k < 128; ++k) {
-    EXPECT_EQ(out[k], static_cast<uint8_t>(std::min(255.0, std::round(512 * std::sqrt(descriptor[k] / l1)))));
+    EXPECT_EQ(out[k], static_cast<uint8_t>(
+                          std::min(255.0, std::round(512 * std::sqrt(descriptor[k] / l1)))));
     norm += (out[k] / 512.0) * (out[k] / 512.0);
   }
   EXPECT_NEAR(std::sqrt(norm), 1.0, 0.01);  // unit length before quantisation
@@ -66,12 +68,14 @@ TEST(DescriptorMatching, FindsMutualNearestNeighboursAndRejectsAmbiguousOnes) {
   std::vector<int> perm(50);
   for (int i = 0; i < 50; ++i) perm[i] = (i * 17 + 5) % 50;
   for (int i = 0; i < 50; ++i) {
-    for (int c = 0; c < 128; ++c) b(perm[i], c) = static_cast<uint8_t>(std::min(255, a(i, c) + (c % 3 == 0)));
+    for (int c = 0; c < 128; ++c)
+      b(perm[i], c) = static_cast<uint8_t>(std::min(255, a(i, c) + (c % 3 == 0)));
   }
   for (const char* method : {"brute_force", "kdtree"}) {
     DescriptorMatchingOptions options;
     options.method = method;
-    const FeatureMatches matches = MatchDescriptors(ToUnitDescriptors(a), ToUnitDescriptors(b), options);
+    const FeatureMatches matches =
+        MatchDescriptors(ToUnitDescriptors(a), ToUnitDescriptors(b), options);
     EXPECT_EQ(matches.size(), 48u) << method;
     for (const FeatureMatch& m : matches) {
       EXPECT_GE(m.point2D_idx1, 2u) << method;

@@ -23,7 +23,8 @@ namespace {
 class RenderingObserver {
  public:
   explicit RenderingObserver(const HousedCamera& truth)
-      : rays_(truth.camera, truth.HousingOrNull(), 2, 2), target_(BuildTarget(BoardOptions(), PrintLevels())) {
+      : rays_(truth.camera, truth.HousingOrNull(), 2, 2),
+        target_(BuildTarget(BoardOptions(), PrintLevels())) {
     render_.spp = 2;
     render_.blur_sigma_px = 0.6;
     render_.noise_sigma = 2.0;
@@ -32,8 +33,10 @@ class RenderingObserver {
     detector_.square_size_m = 0.03;
   }
 
-  std::optional<CalibrationView> operator()(const Rigid3d& cam_from_target, std::mt19937_64* rng) const {
-    const cv::Mat image = RenderImage(rays_, {{target_.object.get(), cam_from_target}}, render_, (*rng)());
+  std::optional<CalibrationView> operator()(const Rigid3d& cam_from_target,
+                                            std::mt19937_64* rng) const {
+    const cv::Mat image =
+        RenderImage(rays_, {{target_.object.get(), cam_from_target}}, render_, (*rng)());
     const TargetDetection detection = DetectTarget(image, detector_);
     if (!detection.found || detection.points.size() != 54) return std::nullopt;
     CalibrationView view;
@@ -65,21 +68,28 @@ void ExpectFewerViews(bool housing, double goal_px) {
   const HousedCamera truth{simulated::TrueCamera(),
                            housing ? std::optional<Housing>(simulated::TruePort()) : std::nullopt};
   const RenderingObserver observer(truth);
-  const simulated::Observer observe = [&](const Rigid3d& pose, std::mt19937_64* rng) { return observer(pose, rng); };
+  const simulated::Observer observe = [&](const Rigid3d& pose, std::mt19937_64* rng) {
+    return observer(pose, rng);
+  };
   double guided = 0, random = 0;
   const int seeds = 2;
   for (uint64_t seed = 1; seed <= seeds; ++seed) {
     guided += simulated::ViewsToReach(housing, true, goal_px, 30, seed, observe);
     random += simulated::ViewsToReach(housing, false, goal_px, 30, seed, observe);
   }
-  std::printf("rendered, %s: views to reach %.2f px: suggested %.1f, random %.1f (mean of %d seeds)\n",
-              housing ? "flat port" : "camera", goal_px, guided / seeds, random / seeds, seeds);
+  std::printf(
+      "rendered, %s: views to reach %.2f px: suggested %.1f, random %.1f (mean of %d seeds)\n",
+      housing ? "flat port" : "camera", goal_px, guided / seeds, random / seeds, seeds);
   EXPECT_LT(guided, 0.67 * random);
 }
 
-TEST(ClosedLoopRendered, CameraCalibrationNeedsFewerViewsWithSuggestions) { ExpectFewerViews(false, 0.15); }
+TEST(ClosedLoopRendered, CameraCalibrationNeedsFewerViewsWithSuggestions) {
+  ExpectFewerViews(false, 0.15);
+}
 
-TEST(ClosedLoopRendered, HousingCalibrationNeedsFewerViewsWithSuggestions) { ExpectFewerViews(true, 0.08); }
+TEST(ClosedLoopRendered, HousingCalibrationNeedsFewerViewsWithSuggestions) {
+  ExpectFewerViews(true, 0.08);
+}
 
 }  // namespace
 }  // namespace portcal

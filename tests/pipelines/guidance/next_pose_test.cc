@@ -29,13 +29,14 @@ constexpr double kDeg = M_PI / 180.0;
 
 // The corners seen at a pose with Gaussian noise; empty when one leaves the
 // image (the detector refuses a cut board).
-std::optional<CalibrationView> Observe(const Camera& camera, const TargetShape& target, const Rigid3d& pose,
-                                       double sigma, std::mt19937_64* rng) {
+std::optional<CalibrationView> Observe(const Camera& camera, const TargetShape& target,
+                                       const Rigid3d& pose, double sigma, std::mt19937_64* rng) {
   std::normal_distribution<double> noise(0, sigma);
   CalibrationView view;
   for (const Eigen::Vector3d& p : target.points) {
     const auto pixel = camera.ImgFromCam(pose * p);
-    if (!pixel || pixel->x() < 0 || pixel->y() < 0 || pixel->x() > camera.width || pixel->y() > camera.height) {
+    if (!pixel || pixel->x() < 0 || pixel->y() < 0 || pixel->x() > camera.width ||
+        pixel->y() > camera.height) {
       return std::nullopt;
     }
     view.points_in_target.push_back(p);
@@ -56,7 +57,8 @@ CalibrationUnknowns Unknowns(const Camera& camera) {
 Camera LensOfModel(const std::string& model) {
   if (model == "OPENCV") return TrueCamera();
   Camera camera = Camera::FromModelName(model, 500, 640, 480);
-  if (model == "OPENCV_FISHEYE") camera.params = {402, 398, 321.5, 242.0, 0.03, -0.012, 0.004, -0.001};
+  if (model == "OPENCV_FISHEYE")
+    camera.params = {402, 398, 321.5, 242.0, 0.03, -0.012, 0.004, -0.001};
   if (model == "RADIAL") camera.params = {502, 322.5, 238.0, -0.18, 0.05};
   return camera;
 }
@@ -64,11 +66,13 @@ Camera LensOfModel(const std::string& model) {
 // A camera point held to the targets' frames, as mrcal's own Monte Carlo
 // test maps it: into every target frame with the true pose, back with the
 // re-solved one, averaged.
-Eigen::Vector3d MovedWithTheFrames(const Eigen::Vector3d& point, const std::vector<Rigid3d>& true_poses,
+Eigen::Vector3d MovedWithTheFrames(const Eigen::Vector3d& point,
+                                   const std::vector<Rigid3d>& true_poses,
                                    const std::vector<CalibratedView>& solved) {
   Eigen::Vector3d moved = Eigen::Vector3d::Zero();
   for (size_t i = 0; i < true_poses.size(); ++i) {
-    moved += solved[i].cam_from_target * (true_poses[i].Inverse() * point) / static_cast<double>(true_poses.size());
+    moved += solved[i].cam_from_target * (true_poses[i].Inverse() * point) /
+             static_cast<double>(true_poses.size());
   }
   return moved;
 }
@@ -92,19 +96,21 @@ void ExpectPredictionMatchesTheSpread(const std::string& model) {
   const TargetShape board = Board();
   const NextPoseOptions options = Options();
   std::vector<Rigid3d> poses;
-  for (const PoseSuggestion& s : OpeningPoses(Unknowns(truth), board, options)) poses.push_back(s.cam_from_target);
+  for (const PoseSuggestion& s : OpeningPoses(Unknowns(truth), board, options))
+    poses.push_back(s.cam_from_target);
   std::mt19937_64 rng(7);
   ViewSamplingOptions sampling;
   sampling.distance_min_m = 0.3;
   sampling.distance_max_m = 0.9;
   sampling.border_margin_px = 20;
   while (poses.size() < 9) {
-    poses.push_back(SampleTargetView(truth, nullptr, board.outline, board.center, -Eigen::Vector3d::UnitZ(),
-                                     sampling, &rng));
+    poses.push_back(SampleTargetView(truth, nullptr, board.outline, board.center,
+                                     -Eigen::Vector3d::UnitZ(), sampling, &rng));
   }
   const int p = static_cast<int>(truth.params.size());
   CalibrationInformation information = CalibrationInformation::Zero(p);
-  for (const Rigid3d& pose : poses) information += ViewInformation(Unknowns(truth), board.points, pose);
+  for (const Rigid3d& pose : poses)
+    information += ViewInformation(Unknowns(truth), board.points, pose);
   const ProjectionUncertaintyModel uncertainty(Unknowns(truth), options.Uncertainty());
   const ProjectionUncertainty predicted = uncertainty.Evaluate(information);
   ASSERT_TRUE(predicted.determined);
@@ -114,8 +120,8 @@ void ExpectPredictionMatchesTheSpread(const std::string& model) {
   std::vector<Eigen::Vector3d> points;
   for (int r = 0; r < grid.grid_rows; ++r) {
     for (int c = 0; c < grid.grid_cols; ++c) {
-      const Eigen::Vector3d ray = *truth.CamFromImg(Eigen::Vector2d((c + 0.5) * 640 / grid.grid_cols,
-                                                                    (r + 0.5) * 480 / grid.grid_rows));
+      const Eigen::Vector3d ray = *truth.CamFromImg(
+          Eigen::Vector2d((c + 0.5) * 640 / grid.grid_cols, (r + 0.5) * 480 / grid.grid_rows));
       points.push_back(ray * grid.working_distance_m / ray.z());
     }
   }
@@ -134,9 +140,11 @@ void ExpectPredictionMatchesTheSpread(const std::string& model) {
     }
   }
   const double empirical = MeanWorstSpread(scatter);
-  std::printf("%s projection uncertainty (mean-frames): predicted %.4f px, spread of %d calibrations %.4f px "
-              "(ratio %.2f)\n",
-              model.c_str(), predicted.mean_px, trials, empirical, empirical / predicted.mean_px);
+  std::printf(
+      "%s projection uncertainty (mean-frames): predicted %.4f px, spread of %d calibrations %.4f "
+      "px "
+      "(ratio %.2f)\n",
+      model.c_str(), predicted.mean_px, trials, empirical, empirical / predicted.mean_px);
   // 100 trials give a standard deviation known to about 1/sqrt(2 * 100)
   // = 7 % (at one point; the grid's points are correlated, so its mean is
   // hardly steadier); 20 %, as the issue asks, allows near three of those.
@@ -159,7 +167,8 @@ TEST(ProjectionUncertainty, PredictionMatchesTheSpreadOfRepeatedCalibrationsRadi
 // The corners seen through lens and port, with noise; empty when one
 // leaves the image.
 std::optional<CalibrationView> ObserveHoused(const HousedCamera& camera, const TargetShape& target,
-                                             const Rigid3d& pose, double sigma, std::mt19937_64* rng) {
+                                             const Rigid3d& pose, double sigma,
+                                             std::mt19937_64* rng) {
   std::normal_distribution<double> noise(0, sigma);
   CalibrationView view;
   for (const Eigen::Vector3d& p : target.points) {
@@ -171,7 +180,8 @@ std::optional<CalibrationView> ObserveHoused(const HousedCamera& camera, const T
     view.points_in_target.push_back(p);
     view.pixels.push_back(*pixel + Eigen::Vector2d(noise(*rng), noise(*rng)));
   }
-  view.image_name = "view" + std::to_string(view.pixels.size()) + "_" + std::to_string((*rng)() % 100000);
+  view.image_name =
+      "view" + std::to_string(view.pixels.size()) + "_" + std::to_string((*rng)() % 100000);
   return view;
 }
 
@@ -187,28 +197,30 @@ TEST(ProjectionUncertainty, PredictionMatchesTheSpreadOfRepeatedHousingCalibrati
   const TargetShape board = Board();
   const NextPoseOptions options = Options();
   std::vector<Rigid3d> poses;
-  for (const PoseSuggestion& s : OpeningPoses(unknowns, board, options)) poses.push_back(s.cam_from_target);
+  for (const PoseSuggestion& s : OpeningPoses(unknowns, board, options))
+    poses.push_back(s.cam_from_target);
   std::mt19937_64 rng(11);
   ViewSamplingOptions sampling;
   sampling.distance_min_m = 0.3;
   sampling.distance_max_m = 0.9;
   sampling.border_margin_px = 20;
   while (poses.size() < 9) {
-    poses.push_back(SampleTargetView(truth.camera, truth.HousingOrNull(), board.outline, board.center,
-                                     -Eigen::Vector3d::UnitZ(), sampling, &rng));
+    poses.push_back(SampleTargetView(truth.camera, truth.HousingOrNull(), board.outline,
+                                     board.center, -Eigen::Vector3d::UnitZ(), sampling, &rng));
   }
   CalibrationInformation information = CalibrationInformation::Zero(unknowns.NumUnknowns());
   for (const Rigid3d& pose : poses) information += ViewInformation(unknowns, board.points, pose);
   const ProjectionUncertaintyOptions grid = options.Uncertainty();
-  const ProjectionUncertainty predicted = ProjectionUncertaintyModel(unknowns, grid).Evaluate(information);
+  const ProjectionUncertainty predicted =
+      ProjectionUncertaintyModel(unknowns, grid).Evaluate(information);
   ASSERT_TRUE(predicted.determined);
   std::vector<Eigen::Vector3d> points;
   for (int r = 0; r < grid.grid_rows; ++r) {
     for (int c = 0; c < grid.grid_cols; ++c) {
-      const Ray3d ray = *truth.Unproject(Eigen::Vector2d((c + 0.5) * 640 / grid.grid_cols,
-                                                         (r + 0.5) * 480 / grid.grid_rows));
-      points.push_back(ray.origin +
-                       (grid.working_distance_m - ray.origin.z()) / ray.direction.z() * ray.direction);
+      const Ray3d ray = *truth.Unproject(
+          Eigen::Vector2d((c + 0.5) * 640 / grid.grid_cols, (r + 0.5) * 480 / grid.grid_rows));
+      points.push_back(ray.origin + (grid.working_distance_m - ray.origin.z()) / ray.direction.z() *
+                                        ray.direction);
     }
   }
   const int trials = 100;
@@ -217,19 +229,24 @@ TEST(ProjectionUncertainty, PredictionMatchesTheSpreadOfRepeatedHousingCalibrati
   settings.initialize_from_data = false;
   for (int t = 0; t < trials; ++t) {
     std::vector<CalibrationView> views;
-    for (const Rigid3d& pose : poses) views.push_back(*ObserveHoused(truth, board, pose, 0.2, &rng));
-    const HousingCalibrationResult solved = CalibrateHousing(views, truth.camera, *truth.housing, settings);
+    for (const Rigid3d& pose : poses)
+      views.push_back(*ObserveHoused(truth, board, pose, 0.2, &rng));
+    const HousingCalibrationResult solved =
+        CalibrateHousing(views, truth.camera, *truth.housing, settings);
     const HousedCamera camera{truth.camera, solved.housing};
     for (size_t k = 0; k < points.size(); ++k) {
       const Eigen::Vector2d error =
-          *camera.Project(MovedWithTheFrames(points[k], poses, solved.views)) - *truth.Project(points[k]);
+          *camera.Project(MovedWithTheFrames(points[k], poses, solved.views)) -
+          *truth.Project(points[k]);
       scatter[k] += error * error.transpose() / trials;
     }
   }
   const double empirical = MeanWorstSpread(scatter);
-  std::printf("flat port projection uncertainty (mean-frames): predicted %.4f px, spread of %d calibrations %.4f px "
-              "(ratio %.2f)\n",
-              predicted.mean_px, trials, empirical, empirical / predicted.mean_px);
+  std::printf(
+      "flat port projection uncertainty (mean-frames): predicted %.4f px, spread of %d "
+      "calibrations %.4f px "
+      "(ratio %.2f)\n",
+      predicted.mean_px, trials, empirical, empirical / predicted.mean_px);
   EXPECT_GT(empirical / predicted.mean_px, 0.8) << empirical << " vs " << predicted.mean_px;
   EXPECT_LT(empirical / predicted.mean_px, 1.2) << empirical << " vs " << predicted.mean_px;
 }
@@ -239,14 +256,15 @@ std::pair<double, double> MeanViewsToReach(bool housing, double goal_px, int max
   double guided = 0, random = 0;
   const int seeds = 3;
   for (uint64_t seed = 1; seed <= seeds; ++seed) {
-    const HousedCamera truth{TrueCamera(), housing ? std::optional<Housing>(simulated::TruePort()) : std::nullopt};
+    const HousedCamera truth{
+        TrueCamera(), housing ? std::optional<Housing>(simulated::TruePort()) : std::nullopt};
     const simulated::Observer observe = [&](const Rigid3d& pose, std::mt19937_64* rng) {
       return ObserveHoused(truth, Board(), pose, 0.2, rng);
     };
     const int with = simulated::ViewsToReach(housing, true, goal_px, max_views, seed, observe);
     const int without = simulated::ViewsToReach(housing, false, goal_px, max_views, seed, observe);
-    LOG(INFO) << (housing ? "housing" : "camera") << " seed " << seed << ": suggested " << with << " views, random "
-              << without;
+    LOG(INFO) << (housing ? "housing" : "camera") << " seed " << seed << ": suggested " << with
+              << " views, random " << without;
     guided += with;
     random += without;
   }

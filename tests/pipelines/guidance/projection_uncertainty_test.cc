@@ -32,13 +32,15 @@ std::vector<Eigen::Vector3d> BoardPoints() {
 
 std::vector<Rigid3d> Poses() {
   std::vector<Rigid3d> poses;
-  const double angles[][3] = {{0, 0, 0}, {0.5, 0, 0.1}, {0, -0.5, 0}, {0.3, 0.4, -0.2}, {-0.4, 0.2, 0.3}};
+  const double angles[][3] = {
+      {0, 0, 0}, {0.5, 0, 0.1}, {0, -0.5, 0}, {0.3, 0.4, -0.2}, {-0.4, 0.2, 0.3}};
   for (const auto& a : angles) {
     const Eigen::Quaterniond q = Eigen::AngleAxisd(a[0], Eigen::Vector3d::UnitX()) *
                                  Eigen::AngleAxisd(a[1], Eigen::Vector3d::UnitY()) *
                                  Eigen::AngleAxisd(a[2], Eigen::Vector3d::UnitZ());
     // The board's centre (0.12, 0.075) at ~0.5 m, a little off the axis.
-    poses.emplace_back(q, Eigen::Vector3d(0.02 * a[1], -0.03 * a[0], 0.5) - q * Eigen::Vector3d(0.12, 0.075, 0));
+    poses.emplace_back(
+        q, Eigen::Vector3d(0.02 * a[1], -0.03 * a[0], 0.5) - q * Eigen::Vector3d(0.12, 0.075, 0));
   }
   return poses;
 }
@@ -46,12 +48,14 @@ std::vector<Rigid3d> Poses() {
 // The dense Jacobian of every corner of every view: columns the poses' 6
 // tangent each, then the unknowns (intrinsics not held or the housing's
 // refined parameters, then the board warp).
-Eigen::MatrixXd DenseJacobian(const CalibrationUnknowns& unknowns, const std::vector<Rigid3d>& poses) {
+Eigen::MatrixXd DenseJacobian(const CalibrationUnknowns& unknowns,
+                              const std::vector<Rigid3d>& poses) {
   ceres::Problem problem;
   std::vector<PoseBlock> blocks;
   for (const Rigid3d& pose : poses) blocks.push_back(ToPose(pose));
   std::vector<double> intrinsics = unknowns.camera.camera.params;
-  std::vector<double> housing = unknowns.camera.housing ? unknowns.camera.housing->params : std::vector<double>();
+  std::vector<double> housing =
+      unknowns.camera.housing ? unknowns.camera.housing->params : std::vector<double>();
   std::array<double, 2> warp = {0, 0};
   if (unknowns.board_warp) warp = {unknowns.board_warp->value.x(), unknowns.board_warp->value.y()};
   const std::vector<Eigen::Vector3d> points = BoardPoints();
@@ -60,16 +64,19 @@ Eigen::MatrixXd DenseJacobian(const CalibrationUnknowns& unknowns, const std::ve
     for (PoseBlock& block : blocks) {
       for (const Eigen::Vector3d& p : points) {
         if (!unknowns.camera.housing) {
-          const Eigen::Vector2d uv =
-              unknowns.board_warp ? BoardWarpUv(p, unknowns.board_warp->extent) : Eigen::Vector2d(1, 1);
-          problem.AddResidualBlock(BoardReprojectionError<CameraModel>::Create(p, uv, Eigen::Vector2d::Zero()),
-                                   nullptr, block.data(), intrinsics.data(), warp.data());
+          const Eigen::Vector2d uv = unknowns.board_warp
+                                         ? BoardWarpUv(p, unknowns.board_warp->extent)
+                                         : Eigen::Vector2d(1, 1);
+          problem.AddResidualBlock(
+              BoardReprojectionError<CameraModel>::Create(p, uv, Eigen::Vector2d::Zero()), nullptr,
+              block.data(), intrinsics.data(), warp.data());
           continue;
         }
         VisitHousingModel(unknowns.camera.housing->model_id, [&](auto port_tag) {
-          using Functor = BoardThroughPortError<CameraModel, decltype(port_tag), PortErrorKind::kReprojection>;
-          problem.AddResidualBlock(Functor::Create(p, Eigen::Vector2d::Zero()), nullptr, block.data(),
-                                   intrinsics.data(), housing.data());
+          using Functor =
+              BoardThroughPortError<CameraModel, decltype(port_tag), PortErrorKind::kReprojection>;
+          problem.AddResidualBlock(Functor::Create(p, Eigen::Vector2d::Zero()), nullptr,
+                                   block.data(), intrinsics.data(), housing.data());
         });
       }
     }
@@ -85,7 +92,8 @@ Eigen::MatrixXd DenseJacobian(const CalibrationUnknowns& unknowns, const std::ve
   } else {
     const int n = static_cast<int>(intrinsics.size());
     if (!unknowns.fixed_intrinsics.empty()) {
-      problem.SetManifold(intrinsics.data(), new ceres::SubsetManifold(n, unknowns.fixed_intrinsics));
+      problem.SetManifold(intrinsics.data(),
+                          new ceres::SubsetManifold(n, unknowns.fixed_intrinsics));
     }
     options.parameter_blocks.push_back(intrinsics.data());
     if (unknowns.board_warp) options.parameter_blocks.push_back(warp.data());
@@ -105,20 +113,22 @@ Eigen::Matrix<double, 2, 6> PoseJacobian(const CalibrationUnknowns& unknowns, co
   ceres::Problem problem;
   PoseBlock block = ToPose(pose);
   std::vector<double> intrinsics = unknowns.camera.camera.params;
-  std::vector<double> housing = unknowns.camera.housing ? unknowns.camera.housing->params : std::vector<double>();
+  std::vector<double> housing =
+      unknowns.camera.housing ? unknowns.camera.housing->params : std::vector<double>();
   std::array<double, 2> warp = {0, 0};
   VisitCameraModel(unknowns.camera.camera.model_id, [&](auto camera_tag) {
     using CameraModel = decltype(camera_tag);
     if (!unknowns.camera.housing) {
-      problem.AddResidualBlock(BoardReprojectionError<CameraModel>::Create(point_in_target, Eigen::Vector2d(1, 1),
-                                                                           Eigen::Vector2d::Zero()),
+      problem.AddResidualBlock(BoardReprojectionError<CameraModel>::Create(
+                                   point_in_target, Eigen::Vector2d(1, 1), Eigen::Vector2d::Zero()),
                                nullptr, block.data(), intrinsics.data(), warp.data());
       return;
     }
     VisitHousingModel(unknowns.camera.housing->model_id, [&](auto port_tag) {
-      using Functor = BoardThroughPortError<CameraModel, decltype(port_tag), PortErrorKind::kReprojection>;
-      problem.AddResidualBlock(Functor::Create(point_in_target, Eigen::Vector2d::Zero()), nullptr, block.data(),
-                               intrinsics.data(), housing.data());
+      using Functor =
+          BoardThroughPortError<CameraModel, decltype(port_tag), PortErrorKind::kReprojection>;
+      problem.AddResidualBlock(Functor::Create(point_in_target, Eigen::Vector2d::Zero()), nullptr,
+                               block.data(), intrinsics.data(), housing.data());
     });
   });
   problem.SetManifold(block.data(), PoseManifold());
@@ -139,12 +149,12 @@ Eigen::Matrix<double, 2, 6> PoseJacobian(const CalibrationUnknowns& unknowns, co
 double DenseWorstDirection(const CalibrationUnknowns& unknowns, const std::vector<Rigid3d>& poses,
                            const Eigen::Vector3d& point_in_cam, double sigma) {
   const Eigen::MatrixXd jacobian = DenseJacobian(unknowns, poses);
-  const Eigen::MatrixXd covariance =
-      sigma * sigma * (jacobian.transpose() * jacobian).inverse();
+  const Eigen::MatrixXd covariance = sigma * sigma * (jacobian.transpose() * jacobian).inverse();
   const int n = static_cast<int>(poses.size());
   Eigen::MatrixXd g = Eigen::MatrixXd::Zero(2, jacobian.cols());
   for (int i = 0; i < n; ++i) {
-    g.middleCols(6 * i, 6) = PoseJacobian(unknowns, poses[i], poses[i].Inverse() * point_in_cam) / n;
+    g.middleCols(6 * i, 6) =
+        PoseJacobian(unknowns, poses[i], poses[i].Inverse() * point_in_cam) / n;
   }
   const ProjectionJacobians at_point = ProjectionJacobian(unknowns, {point_in_cam});
   g.rightCols(unknowns.NumUnknowns()) = at_point.unknowns;
@@ -164,19 +174,24 @@ void ExpectEqualsDense(const CalibrationUnknowns& unknowns) {
   options.grid_rows = 3;
   options.working_distance_m = 0.7;
   options.pixel_sigma_px = 0.3;
-  const ProjectionUncertainty model = ProjectionUncertaintyModel(unknowns, options).Evaluate(information);
+  const ProjectionUncertainty model =
+      ProjectionUncertaintyModel(unknowns, options).Evaluate(information);
   ASSERT_TRUE(model.determined);
-  const Eigen::VectorXd xs = UncertaintyGridColumns(static_cast<double>(unknowns.camera.camera.width), 4);
-  const Eigen::VectorXd ys = UncertaintyGridRows(static_cast<double>(unknowns.camera.camera.height), 3);
+  const Eigen::VectorXd xs =
+      UncertaintyGridColumns(static_cast<double>(unknowns.camera.camera.width), 4);
+  const Eigen::VectorXd ys =
+      UncertaintyGridRows(static_cast<double>(unknowns.camera.camera.height), 3);
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 4; ++c) {
       const std::optional<Ray3d> ray = unknowns.camera.Unproject(Eigen::Vector2d(xs[c], ys[r]));
       ASSERT_TRUE(ray);
       for (const double depth : {options.working_distance_m, 1e6}) {
-        const Eigen::Vector3d point = ray->origin + (depth - ray->origin.z()) / ray->direction.z() * ray->direction;
+        const Eigen::Vector3d point =
+            ray->origin + (depth - ray->origin.z()) / ray->direction.z() * ray->direction;
         const double dense = DenseWorstDirection(unknowns, poses, point, options.pixel_sigma_px);
         const double fast = depth < 1e3 ? model.map_px(r, c) : model.map_at_infinity_px(r, c);
-        EXPECT_NEAR(fast, dense, 1e-5 * dense) << "cell " << r << "," << c << " at " << depth << " m";
+        EXPECT_NEAR(fast, dense, 1e-5 * dense)
+            << "cell " << r << "," << c << " at " << depth << " m";
       }
     }
   }
@@ -201,7 +216,8 @@ TEST(MeanFrames, EqualsTheDenseDefinitionWithHeldParametersAndABoardWarp) {
   CalibrationUnknowns unknowns;
   unknowns.camera.camera = Lens();
   unknowns.fixed_intrinsics = {6, 7};  // p1, p2 held
-  unknowns.board_warp = BoardWarpUnknown{Eigen::Vector2d(0.001, -0.0005), Eigen::Vector4d(0, 0.24, 0, 0.15)};
+  unknowns.board_warp =
+      BoardWarpUnknown{Eigen::Vector2d(0.001, -0.0005), Eigen::Vector4d(0, 0.24, 0, 0.15)};
   EXPECT_EQ(unknowns.NumUnknowns(), 8);
   ExpectEqualsDense(unknowns);
 }
@@ -222,7 +238,8 @@ TEST(MeanFrames, InformationAddsUpViewByView) {
   const std::vector<Rigid3d> poses = Poses();
   CalibrationInformation first = CalibrationInformation::Zero(8), rest = first;
   first += ViewInformation(unknowns, BoardPoints(), poses[0]);
-  for (size_t i = 1; i < poses.size(); ++i) rest += ViewInformation(unknowns, BoardPoints(), poses[i]);
+  for (size_t i = 1; i < poses.size(); ++i)
+    rest += ViewInformation(unknowns, BoardPoints(), poses[i]);
   const CalibrationInformation all = first + rest;
   EXPECT_EQ(all.num_views, 5);
   EXPECT_TRUE(all.reduced.isApprox(first.reduced + rest.reduced));

@@ -12,8 +12,8 @@
 #include <random>
 
 #include "pipelines/calibration/camera_calibration.h"
-#include "pipelines/guidance/next_pose.h"
 #include "pipelines/guidance/live_estimator.h"
+#include "pipelines/guidance/next_pose.h"
 #include "pipelines/synthetic/view_sampler.h"
 
 namespace portcal::simulated {
@@ -47,8 +47,10 @@ inline NextPoseOptions Options() {
 inline Rigid3d WithHumanError(const Rigid3d& pose, std::mt19937_64* rng) {
   std::uniform_real_distribution<double> unit(-1, 1);
   Eigen::Vector3d axis(unit(*rng), unit(*rng), unit(*rng));
-  const Eigen::Quaterniond turn(Eigen::AngleAxisd(5 * M_PI / 180 * std::abs(unit(*rng)), axis.normalized()));
-  const Eigen::Vector3d shift = 0.05 * std::abs(unit(*rng)) * Eigen::Vector3d(unit(*rng), unit(*rng), unit(*rng)).normalized();
+  const Eigen::Quaterniond turn(
+      Eigen::AngleAxisd(5 * M_PI / 180 * std::abs(unit(*rng)), axis.normalized()));
+  const Eigen::Vector3d shift = 0.05 * std::abs(unit(*rng)) *
+                                Eigen::Vector3d(unit(*rng), unit(*rng), unit(*rng)).normalized();
   // The target turned about its origin (a corner) and moved.
   return Rigid3d(pose.rotation * turn, pose.translation + shift);
 }
@@ -57,20 +59,25 @@ inline Rigid3d WithHumanError(const Rigid3d& pose, std::mt19937_64* rng) {
 // the start the person gives: on the axis, 5 mm.
 inline Housing TruePort() {
   const Eigen::Vector3d normal = Eigen::Vector3d(0.0175, -0.0052, 1.0).normalized();
-  return Housing::FromName("FLATPORT", {normal.x(), normal.y(), normal.z(), 0.012, 0.008, 1.0, 1.49, 1.334}, "test");
+  return Housing::FromName(
+      "FLATPORT", {normal.x(), normal.y(), normal.z(), 0.012, 0.008, 1.0, 1.49, 1.334}, "test");
 }
-inline Housing StartPort() { return Housing::FromName("FLATPORT", {0, 0, 1, 0.005, 0.008, 1.0, 1.49, 1.334}, "test"); }
+inline Housing StartPort() {
+  return Housing::FromName("FLATPORT", {0, 0, 1, 0.005, 0.008, 1.0, 1.49, 1.334}, "test");
+}
 
 // Views a simulated person needs until the true projection uncertainty
 // drops below `goal_px`, capped at `max_views`: guided (the live
 // estimator's suggestion, held with a person's error) or random poses from
 // the same ranges. A camera calibration, or with `housing` a flat port's.
 // What a view held at a pose shows (nullopt: the target is not found).
-using Observer = std::function<std::optional<CalibrationView>(const Rigid3d& cam_from_target, std::mt19937_64* rng)>;
+using Observer = std::function<std::optional<CalibrationView>(const Rigid3d& cam_from_target,
+                                                              std::mt19937_64* rng)>;
 
 inline int ViewsToReach(bool housing, bool guided, double goal_px, int max_views, uint64_t seed,
                         const Observer& observe) {
-  const HousedCamera truth{TrueCamera(), housing ? std::optional<Housing>(TruePort()) : std::nullopt};
+  const HousedCamera truth{TrueCamera(),
+                           housing ? std::optional<Housing>(TruePort()) : std::nullopt};
   const TargetShape board = Board();
   LiveEstimatorOptions estimator_options;
   estimator_options.guidance = Options();
@@ -78,11 +85,13 @@ inline int ViewsToReach(bool housing, bool guided, double goal_px, int max_views
   estimator_options.prior_pixel_sigma_px = 0.2;
   // Nothing known yet: COLMAP's default focal length, no distortion; or
   // the in-air camera and a port on the axis.
-  estimator_options.camera = housing ? TrueCamera() : Camera::FromModelName("OPENCV", 1.2 * 640, 640, 480);
+  estimator_options.camera =
+      housing ? TrueCamera() : Camera::FromModelName("OPENCV", 1.2 * 640, 640, 480);
   if (housing) estimator_options.housing = StartPort();
   const LiveEstimator estimator(estimator_options, board);
   CalibrationUnknowns true_unknowns = estimator.Unknowns(truth);
-  const ProjectionUncertaintyModel true_model(true_unknowns, estimator_options.guidance.Uncertainty());
+  const ProjectionUncertaintyModel true_model(true_unknowns,
+                                              estimator_options.guidance.Uncertainty());
   std::mt19937_64 rng(seed);
   ViewSamplingOptions sampling;
   sampling.distance_min_m = estimator_options.guidance.distance_min_m;
@@ -91,15 +100,18 @@ inline int ViewsToReach(bool housing, bool guided, double goal_px, int max_views
   sampling.border_margin_px = estimator_options.guidance.border_margin_px;
   std::shared_ptr<LiveEstimate> estimate;
   std::vector<CalibrationView> views;
-  CalibrationInformation true_information = CalibrationInformation::Zero(true_unknowns.NumUnknowns());
+  CalibrationInformation true_information =
+      CalibrationInformation::Zero(true_unknowns.NumUnknowns());
   for (int n = 1; n <= max_views; ++n) {
-    if (guided) estimate = std::make_shared<LiveEstimate>(estimator.Estimate(views, estimate.get()));
+    if (guided)
+      estimate = std::make_shared<LiveEstimate>(estimator.Estimate(views, estimate.get()));
     std::optional<CalibrationView> view;
     Rigid3d held;
     for (int attempt = 0; attempt < 20 && !view; ++attempt) {
-      held = guided && estimate->next ? WithHumanError(estimate->next->cam_from_target, &rng)
-                                      : SampleTargetView(truth.camera, truth.HousingOrNull(), board.outline,
-                                                         board.center, -Eigen::Vector3d::UnitZ(), sampling, &rng);
+      held = guided && estimate->next
+                 ? WithHumanError(estimate->next->cam_from_target, &rng)
+                 : SampleTargetView(truth.camera, truth.HousingOrNull(), board.outline,
+                                    board.center, -Eigen::Vector3d::UnitZ(), sampling, &rng);
       view = observe(held, &rng);
     }
     if (!view) continue;

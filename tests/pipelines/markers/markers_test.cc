@@ -15,7 +15,7 @@ TEST(FeatureMasker, EnlargedQuadContainsItsScaledNeighbourhoodOnly) {
                                                Eigen::Vector2d(20, 20), Eigen::Vector2d(10, 20)};
   EXPECT_TRUE(InsideEnlargedQuad(quad, 1.0, Eigen::Vector2d(15, 15)));
   EXPECT_FALSE(InsideEnlargedQuad(quad, 1.0, Eigen::Vector2d(21, 15)));
-  EXPECT_TRUE(InsideEnlargedQuad(quad, 3.0, Eigen::Vector2d(29.9, 15)));   // centre 15 + 1.5 x 10
+  EXPECT_TRUE(InsideEnlargedQuad(quad, 3.0, Eigen::Vector2d(29.9, 15)));  // centre 15 + 1.5 x 10
   EXPECT_FALSE(InsideEnlargedQuad(quad, 3.0, Eigen::Vector2d(30.1, 15)));
 }
 
@@ -45,24 +45,26 @@ cv::Mat RenderQuad(const std::array<Eigen::Vector2d, 4>& truth, double blur, dou
 std::array<cv::Point2d, 4> RoughStart(const std::array<Eigen::Vector2d, 4>& truth, bool far) {
   std::array<cv::Point2d, 4> corners;
   for (int c = 0; c < 4; ++c) {
-    const Eigen::Vector2d off = far ? Eigen::Vector2d(c % 2 ? 1.5 : -1.5, c < 2 ? 1.2 : -1.2)
-                                    : Eigen::Vector2d(0.6, -0.4);
-    corners[c] = cv::Point2d(truth[c].x() - 0.5 + off.x(), truth[c].y() - 0.5 + off.y());  // OpenCV pixels
+    const Eigen::Vector2d off =
+        far ? Eigen::Vector2d(c % 2 ? 1.5 : -1.5, c < 2 ? 1.2 : -1.2) : Eigen::Vector2d(0.6, -0.4);
+    corners[c] =
+        cv::Point2d(truth[c].x() - 0.5 + off.x(), truth[c].y() - 0.5 + off.y());  // OpenCV pixels
   }
   return corners;
 }
 
 // Sampling at 1/8 px leaves ~0.01 px of aliasing on an edge's position.
-void ExpectCorners(const std::array<cv::Point2d, 4>& corners, const std::array<Eigen::Vector2d, 4>& truth,
-                   double tolerance) {
+void ExpectCorners(const std::array<cv::Point2d, 4>& corners,
+                   const std::array<Eigen::Vector2d, 4>& truth, double tolerance) {
   for (int c = 0; c < 4; ++c) {
     EXPECT_NEAR(corners[c].x + 0.5, truth[c].x(), tolerance) << c;
     EXPECT_NEAR(corners[c].y + 0.5, truth[c].y(), tolerance) << c;
   }
 }
 
-const std::array<Eigen::Vector2d, 4> kMarker = {Eigen::Vector2d(40.3, 45.2), Eigen::Vector2d(118.9, 38.7),
-                                                Eigen::Vector2d(124.6, 117.5), Eigen::Vector2d(43.1, 121.8)};
+const std::array<Eigen::Vector2d, 4> kMarker = {
+    Eigen::Vector2d(40.3, 45.2), Eigen::Vector2d(118.9, 38.7), Eigen::Vector2d(124.6, 117.5),
+    Eigen::Vector2d(43.1, 121.8)};
 
 // The band model's derivatives written out against central differences of
 // its cost: J^T r is the cost's gradient, and J^T J's diagonal the sum of
@@ -125,8 +127,9 @@ TEST(MarkerEdgeRefinement, FindsTheCornersOfAShadedMarker) {
 // start 1.9 px off: the bands laid about the start hold the edge
 // off-centre; laid again about the fitted corners, they find it.
 TEST(MarkerEdgeRefinement, FindsTheCornersOfAForeshortenedMarkerFromAFarStart) {
-  const std::array<Eigen::Vector2d, 4> oblique = {Eigen::Vector2d(30.4, 60.2), Eigen::Vector2d(130.7, 52.9),
-                                                  Eigen::Vector2d(132.1, 78.3), Eigen::Vector2d(31.6, 84.8)};
+  const std::array<Eigen::Vector2d, 4> oblique = {
+      Eigen::Vector2d(30.4, 60.2), Eigen::Vector2d(130.7, 52.9), Eigen::Vector2d(132.1, 78.3),
+      Eigen::Vector2d(31.6, 84.8)};
   const cv::Mat gray = RenderQuad(oblique, 0.7, 0);
   std::array<cv::Point2d, 4> corners = RoughStart(oblique, true);
   ASSERT_TRUE(RefineMarkerCorners(gray, MarkerEdgeRefinementOptions(), &corners));
@@ -136,8 +139,9 @@ TEST(MarkerEdgeRefinement, FindsTheCornersOfAForeshortenedMarkerFromAFarStart) {
 // Modules of ~1.7 px across the long sides: the band would hold the bits
 // (and the edge's blur); refused, corners untouched.
 TEST(MarkerEdgeRefinement, RefusesAMarkerTooForeshortenedToFit) {
-  const std::array<Eigen::Vector2d, 4> edge_on = {Eigen::Vector2d(30.4, 60.2), Eigen::Vector2d(130.7, 57.9),
-                                                  Eigen::Vector2d(131.1, 68.3), Eigen::Vector2d(30.6, 70.5)};
+  const std::array<Eigen::Vector2d, 4> edge_on = {
+      Eigen::Vector2d(30.4, 60.2), Eigen::Vector2d(130.7, 57.9), Eigen::Vector2d(131.1, 68.3),
+      Eigen::Vector2d(30.6, 70.5)};
   const cv::Mat gray = RenderQuad(edge_on, 0.7, 0);
   std::array<cv::Point2d, 4> corners = RoughStart(edge_on, false);
   const std::array<cv::Point2d, 4> start = corners;

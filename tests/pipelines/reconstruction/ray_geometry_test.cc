@@ -1,12 +1,13 @@
 // Ray geometry behind a housing: triangulation of refracted rays,
 // generalized absolute pose with outliers, the focal length from markers.
+#include "pipelines/reconstruction/ray_geometry.h"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/housing/housing.h"
-#include "pipelines/reconstruction/ray_geometry.h"
 
 namespace portcal {
 namespace {
@@ -14,7 +15,8 @@ namespace {
 // Rays of a camera behind a tilted flat port, for generalized pose tests.
 struct PortRig {
   Camera camera = Camera::FromModelName("PINHOLE", 800, 1000, 800);
-  Housing housing = Housing::FromName("FLATPORT", {0.0871557, 0.0, 0.9961947, 0.03, 0.01, 1.0, 1.49, 1.334}, "test");
+  Housing housing = Housing::FromName(
+      "FLATPORT", {0.0871557, 0.0, 0.9961947, 0.03, 0.01, 1.0, 1.49, 1.334}, "test");
 };
 
 TEST(RayGeometry, TriangulatesRefractedRaysExactly) {
@@ -39,8 +41,9 @@ TEST(RayGeometry, TriangulatesRefractedRaysExactly) {
 
 TEST(RayGeometry, GeneralizedAbsolutePoseRecoversThePoseBehindAPortWithOutliers) {
   const PortRig rig;
-  const Rigid3d truth(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 0.5).normalized())),
-                      Eigen::Vector3d(0.1, -0.2, 0.4));
+  const Rigid3d truth(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 0.5).normalized())),
+      Eigen::Vector3d(0.1, -0.2, 0.4));
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);
   std::vector<Ray3d> rays;
@@ -57,7 +60,8 @@ TEST(RayGeometry, GeneralizedAbsolutePoseRecoversThePoseBehindAPortWithOutliers)
     points.push_back(world);
   }
   std::vector<char> inliers;
-  const auto pose = EstimateGeneralizedAbsolutePose(rays, points, GeneralizedAbsolutePoseOptions(), &inliers);
+  const auto pose =
+      EstimateGeneralizedAbsolutePose(rays, points, GeneralizedAbsolutePoseOptions(), &inliers);
   ASSERT_TRUE(pose);
   // The inliers are exact, so only the solver's stop separates the pose
   // from the truth: OpenGV's nonlinear refinement stops when a step is
@@ -77,8 +81,9 @@ TEST(RayGeometry, FocalLengthFromMarkerQuads) {
   std::uniform_real_distribution<double> u(-1, 1);
   std::vector<MarkerQuad> quads;
   for (int m = 0; m < 30; ++m) {
-    const Eigen::Matrix3d R = Eigen::AngleAxisd(0.6 * u(rng), Eigen::Vector3d(u(rng), u(rng), 0.3).normalized())
-                                  .toRotationMatrix();
+    const Eigen::Matrix3d R =
+        Eigen::AngleAxisd(0.6 * u(rng), Eigen::Vector3d(u(rng), u(rng), 0.3).normalized())
+            .toRotationMatrix();
     const Eigen::Vector3d t(0.2 * u(rng), 0.1 * u(rng), 0.8 + 0.2 * u(rng));
     MarkerQuad quad;
     const double s = 0.05;

@@ -27,7 +27,8 @@ namespace portcal {
 namespace {
 
 constexpr const char* kCamera =
-    "camera: {model: RADIAL, width: 480, height: 360, params: [400.0, 243.0, 178.0, -0.06, 0.01]}\n";
+    "camera: {model: RADIAL, width: 480, height: 360, params: [400.0, 243.0, 178.0, -0.06, "
+    "0.01]}\n";
 // A stereo rig's board has an odd number of columns: an even by even
 // board looks the same turned half round, and the two cameras could number
 // its corners the other way round.
@@ -37,11 +38,13 @@ constexpr const char* kRest =
 
 // Renders `name` (its housing / stereo lines given) and extracts its board
 // (cols x 6 corners).
-fs::path RenderAndExtract(const testing::TempDir& dir, const std::string& name, const std::string& extra,
-                          bool per_folder = false, int cols = 8) {
+fs::path RenderAndExtract(const testing::TempDir& dir, const std::string& name,
+                          const std::string& extra, bool per_folder = false, int cols = 8) {
   std::ofstream(dir / (name + ".yaml"))
-      << "name: " << name << "\nseed: 7\nnum_images: 6\n" << kCamera << extra << "target: {type: chessboard, cols: "
-      << cols << ", rows: 6, square_size: 0.025, margin: 0.015}\n" << kRest;
+      << "name: " << name << "\nseed: 7\nnum_images: 6\n"
+      << kCamera << extra << "target: {type: chessboard, cols: " << cols
+      << ", rows: 6, square_size: 0.025, margin: 0.015}\n"
+      << kRest;
   SynthesizeOptions synthesize;
   synthesize.config_path = (dir / (name + ".yaml")).string();
   synthesize.output_path = (dir / name).string();
@@ -62,14 +65,15 @@ fs::path RenderAndExtract(const testing::TempDir& dir, const std::string& name, 
 struct PageLoad {
   int loaded = -1, total = -1;
   int overflows = -1, overlaps = -1;
-  std::string layout;   // the first few offenders
-  std::string verdict;  // "Verdict: OK", ... or "none"
+  std::string layout;          // the first few offenders
+  std::string verdict;         // "Verdict: OK", ... or "none"
   bool verdict_first = false;  // before the first section heading
 };
 
 // The page in `report_dir` as chromium loads it: how many of its images
 // loaded. With `screenshot`, also a picture of the page.
-PageLoad LoadInChromium(const testing::TempDir& dir, const fs::path& report_dir, const fs::path& screenshot = {}) {
+PageLoad LoadInChromium(const testing::TempDir& dir, const fs::path& report_dir,
+                        const fs::path& screenshot = {}) {
   std::string page = testing::ReadFileToString(report_dir / "report.html");
   const std::string check =
       "<script>window.addEventListener('load', () => { const images = [...document.images]; "
@@ -78,7 +82,8 @@ PageLoad LoadInChromium(const testing::TempDir& dir, const fs::path& report_dir,
       "d.textContent = 'loaded ' + ok + ' of ' + images.length; "
       // Layout: text that overflows its box or the page, and boxes of text
       // or pictures that overlap (neither inside the other).
-      "const items = [...document.querySelectorAll('h1,h2,p,li,figcaption,pre,img')]; const bad = []; "
+      "const items = [...document.querySelectorAll('h1,h2,p,li,figcaption,pre,img')]; const bad = "
+      "[]; "
       "const width = document.documentElement.clientWidth; "
       "for (const e of items) { const r = e.getBoundingClientRect(); "
       "  if ((e.tagName !== 'IMG' && e.scrollWidth > e.clientWidth + 1) || r.right > width + 1) "
@@ -89,22 +94,27 @@ PageLoad LoadInChromium(const testing::TempDir& dir, const fs::path& report_dir,
       "  const p = a.getBoundingClientRect(), q = b.getBoundingClientRect(); "
       "  const w = Math.min(p.right, q.right) - Math.max(p.left, q.left), "
       "        h = Math.min(p.bottom, q.bottom) - Math.max(p.top, q.top); "
-      "  if (w > 1 && h > 1) { ++overlaps; bad.push('overlap ' + a.tagName + '/' + b.tagName + ' ' + "
+      "  if (w > 1 && h > 1) { ++overlaps; bad.push('overlap ' + a.tagName + '/' + b.tagName + ' ' "
+      "+ "
       "    (a.textContent || a.src).slice(0, 40)); } } "
-      "d.textContent += '; layout ' + (bad.length - overlaps) + ' overflows ' + overlaps + ' overlaps: ' + "
+      "d.textContent += '; layout ' + (bad.length - overlaps) + ' overflows ' + overlaps + ' "
+      "overlaps: ' + "
       "  bad.slice(0, 5).join(' | '); "
       "const v = document.getElementById('verdict'); "
-      "d.textContent += '; verdict ' + (v ? v.querySelector('p').textContent : 'none') + ' first ' + "
+      "d.textContent += '; verdict ' + (v ? v.querySelector('p').textContent : 'none') + ' first ' "
+      "+ "
       "  (v !== null && v.compareDocumentPosition(document.querySelector('h2')) === 4); "
       "document.body.appendChild(d); });</script>";
   page.insert(page.rfind("</body>"), check);
   std::ofstream(report_dir / "report_check.html") << page;
   const std::string chromium =
-      "timeout 90 chromium --headless --no-sandbox --disable-gpu --no-first-run --disable-background-networking "
-      "--disable-component-update --disable-sync --user-data-dir=" + (dir / "profile").string() +
-      " --window-size=1200,2400 --virtual-time-budget=5000 ";
-  const testing::CommandResult dom = testing::RunCommand(
-      chromium + "--dump-dom 'file://" + (report_dir / "report_check.html").string() + "' 2>/dev/null");
+      "timeout 90 chromium --headless --no-sandbox --disable-gpu --no-first-run "
+      "--disable-background-networking "
+      "--disable-component-update --disable-sync --user-data-dir=" +
+      (dir / "profile").string() + " --window-size=1200,2400 --virtual-time-budget=5000 ";
+  const testing::CommandResult dom =
+      testing::RunCommand(chromium + "--dump-dom 'file://" +
+                          (report_dir / "report_check.html").string() + "' 2>/dev/null");
   if (!screenshot.empty()) {
     fs::create_directories(screenshot.parent_path());
     testing::RunCommand(chromium + "--screenshot=" + screenshot.string() + " 'file://" +
@@ -117,7 +127,8 @@ PageLoad LoadInChromium(const testing::TempDir& dir, const fs::path& report_dir,
     load.total = std::stoi(match[2]);
   }
   if (std::regex_search(dom.output, match,
-                        std::regex("layout ([0-9]+) overflows ([0-9]+) overlaps: ([^;]*); verdict ([^<]*?) first (true|false)"))) {
+                        std::regex("layout ([0-9]+) overflows ([0-9]+) overlaps: ([^;]*); verdict "
+                                   "([^<]*?) first (true|false)"))) {
     load.overflows = std::stoi(match[1]);
     load.overlaps = std::stoi(match[2]);
     load.layout = match[3];
@@ -140,7 +151,8 @@ void ExpectAllLoaded(const testing::TempDir& dir, const fs::path& report_dir, in
 
 // A self-calibration's model from target views at their poses: the board's
 // corners as the points, the views as the images.
-SparseModel ModelOfViews(const std::vector<CalibrationView>& views, const HousingCalibrationResult& result) {
+SparseModel ModelOfViews(const std::vector<CalibrationView>& views,
+                         const HousingCalibrationResult& result) {
   SparseModel model;
   model.cameras[1] = result.camera;
   model.housings[1] = result.housing;
@@ -153,7 +165,8 @@ SparseModel ModelOfViews(const std::vector<CalibrationView>& views, const Housin
     image.cam_from_world = result.views[v].cam_from_target;
     for (size_t i = 0; i < views[v].pixels.size(); ++i) {
       const Eigen::Vector3d& x = views[v].points_in_target[i];
-      const auto [it, added] = ids.emplace(std::make_pair(x.x(), x.y()), static_cast<point3D_t>(ids.size() + 1));
+      const auto [it, added] =
+          ids.emplace(std::make_pair(x.x(), x.y()), static_cast<point3D_t>(ids.size() + 1));
       model.points3D[it->second].xyz = x;
       model.points3D[it->second].track.push_back({image.image_id, static_cast<point2D_t>(i)});
       image.points2D.push_back({views[v].pixels[i], it->second});
@@ -169,8 +182,9 @@ TEST(ReportPage, EveryCalibratorsPageLoadsEveryPicture) {
   }
   const testing::TempDir dir;
   const fs::path air = RenderAndExtract(dir, "air", "housing: null\n");
-  const fs::path dome = RenderAndExtract(
-      dir, "dome", "housing: {model: DOMEPORT, params: [0.003, -0.002, 0.005, 0.05, 0.006, 1.0, 1.473, 1.334]}\n");
+  const fs::path dome = RenderAndExtract(dir, "dome",
+                                         "housing: {model: DOMEPORT, params: [0.003, -0.002, "
+                                         "0.005, 0.05, 0.006, 1.0, 1.473, 1.334]}\n");
   const fs::path stereo = RenderAndExtract(
       dir, "stereo",
       "housing: null\nstereo:\n  cam2_from_cam1: {rotation_axis_angle_deg: [0.0, 1.0, 0.0, -4.0], "
@@ -190,9 +204,12 @@ TEST(ReportPage, EveryCalibratorsPageLoadsEveryPicture) {
   housing.database_path = dome.string();
   housing.in_air_database_path = air.string();
   housing.output_path = (dir / "out/dome").string();
-  housing.housing = Housing::FromName("DOMEPORT", {0, 0, 0, 0.05, 0.006, 1.0, 1.473, 1.334}, "test");
+  housing.housing =
+      Housing::FromName("DOMEPORT", {0, 0, 0, 0.05, 0.006, 1.0, 1.473, 1.334}, "test");
   const HousingCalibrationResult housing_result = RunHousingCalibrator(housing, NoProgress());
-  ExpectAllLoaded(dir, dir / "out/dome", 10, fs::current_path() / "artifacts/report_housing.png");  // no thumbnails, + the housing
+  ExpectAllLoaded(
+      dir, dir / "out/dome", 10,
+      fs::current_path() / "artifacts/report_housing.png");  // no thumbnails, + the housing
 
   CalibrationEvaluatorOptions evaluator;
   evaluator.database_path = dome.string();

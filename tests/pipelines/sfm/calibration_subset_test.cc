@@ -27,13 +27,15 @@ std::map<image_pair_t, int> Pairs(int gap = 0) {
   for (int i = 1; i <= kNumImages; ++i) {
     for (int d = 1; d <= 5 && i + d <= kNumImages; ++d) {
       if (gap > 0 && i < gap && i + d >= gap) continue;
-      pairs[ImagePairToPairId(static_cast<image_t>(i), static_cast<image_t>(i + d))] = 500 - 80 * (d - 1);
+      pairs[ImagePairToPairId(static_cast<image_t>(i), static_cast<image_t>(i + d))] =
+          500 - 80 * (d - 1);
     }
   }
   return pairs;
 }
 
-void ExpectChained(const CalibrationSubset& subset, const std::map<image_pair_t, int>& pairs, int min_inliers) {
+void ExpectChained(const CalibrationSubset& subset, const std::map<image_pair_t, int>& pairs,
+                   int min_inliers) {
   for (size_t k = 1; k < subset.images.size(); ++k) {
     const auto it = pairs.find(ImagePairToPairId(subset.images[k - 1], subset.images[k]));
     ASSERT_NE(it, pairs.end()) << subset.images[k - 1] << " - " << subset.images[k];

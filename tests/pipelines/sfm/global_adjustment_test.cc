@@ -28,7 +28,8 @@ IncrementalMapperOptions HousingRefiningOptions() {
 }
 
 // The stop of a robust solve that no settled-weights test ends.
-void ExpectCostChangeStop(const BundleAdjustmentOptions& ba, const IncrementalMapperOptions& options) {
+void ExpectCostChangeStop(const BundleAdjustmentOptions& ba,
+                          const IncrementalMapperOptions& options) {
   EXPECT_EQ(ba.max_unsettled_weight_fraction, 0);
   EXPECT_FALSE(ba.hold_loss_weights);
   EXPECT_EQ(ba.initial_trust_region_radius, BundleAdjustmentOptions().initial_trust_region_radius);
@@ -42,7 +43,8 @@ TEST(GlobalAdjustmentOptions, RefineWhatTheMapperSaysOnceTheModelIsLargeEnough) 
   EXPECT_TRUE(small.refine_focal_length && small.refine_extra_params && small.refine_housing);
   EXPECT_FALSE(small.refine_principal_point);
   EXPECT_EQ(small.max_num_extra_params, 1);  // below ba_full_intrinsics_min_images
-  const BundleAdjustmentOptions large = GlobalAdjustmentOptions(options, options.ba_full_intrinsics_min_images, true);
+  const BundleAdjustmentOptions large =
+      GlobalAdjustmentOptions(options, options.ba_full_intrinsics_min_images, true);
   EXPECT_EQ(large.max_num_extra_params, BundleAdjustmentOptions().max_num_extra_params);
   const BundleAdjustmentOptions held = GlobalAdjustmentOptions(options, 100, false);
   EXPECT_FALSE(held.refine_focal_length || held.refine_extra_params || held.refine_housing);
@@ -51,12 +53,14 @@ TEST(GlobalAdjustmentOptions, RefineWhatTheMapperSaysOnceTheModelIsLargeEnough) 
 
 TEST(GlobalAdjustmentOptions, GrowthStopsAtSettledWeightsOnlyWithTheCalibrationHeld) {
   const IncrementalMapperOptions options = HousingRefiningOptions();
-  const BundleAdjustmentOptions carrying = GlobalAdjustmentOptions(options, 100, false, AdjustmentEnd::kGrowing);
+  const BundleAdjustmentOptions carrying =
+      GlobalAdjustmentOptions(options, 100, false, AdjustmentEnd::kGrowing);
   EXPECT_EQ(carrying.max_unsettled_weight_fraction, options.ba_global_max_unsettled_weights);
   EXPECT_FALSE(carrying.hold_loss_weights);
   // One that refines the calibration decides whether the port has settled:
   // it converges.
-  ExpectCostChangeStop(GlobalAdjustmentOptions(options, 100, true, AdjustmentEnd::kGrowing), options);
+  ExpectCostChangeStop(GlobalAdjustmentOptions(options, 100, true, AdjustmentEnd::kGrowing),
+                       options);
   // 0 turns the settled-weights stop off.
   IncrementalMapperOptions off = options;
   off.ba_global_max_unsettled_weights = 0;
@@ -65,23 +69,27 @@ TEST(GlobalAdjustmentOptions, GrowthStopsAtSettledWeightsOnlyWithTheCalibrationH
 
 TEST(GlobalAdjustmentOptions, FinalPairDecidesTheWeightsThenHoldsThem) {
   const IncrementalMapperOptions options = HousingRefiningOptions();
-  const BundleAdjustmentOptions deciding = GlobalAdjustmentOptions(options, 100, true, AdjustmentEnd::kWeightsSettled);
+  const BundleAdjustmentOptions deciding =
+      GlobalAdjustmentOptions(options, 100, true, AdjustmentEnd::kWeightsSettled);
   EXPECT_EQ(deciding.max_unsettled_weight_fraction, options.ba_global_max_unsettled_weights);
   EXPECT_FALSE(deciding.hold_loss_weights);
   EXPECT_TRUE(deciding.refine_housing);
 
-  const BundleAdjustmentOptions held = GlobalAdjustmentOptions(options, 100, true, AdjustmentEnd::kHeldWeightsSolve);
+  const BundleAdjustmentOptions held =
+      GlobalAdjustmentOptions(options, 100, true, AdjustmentEnd::kHeldWeightsSolve);
   EXPECT_TRUE(held.hold_loss_weights);
   // With the weights held the settled-weights test would end the solve at
   // its first step.
   EXPECT_EQ(held.max_unsettled_weight_fraction, 0);
   EXPECT_EQ(held.initial_trust_region_radius, kHeldWeightsTrustRegionRadius);
-  EXPECT_GT(held.initial_trust_region_radius, 1e3 * BundleAdjustmentOptions().initial_trust_region_radius);
+  EXPECT_GT(held.initial_trust_region_radius,
+            1e3 * BundleAdjustmentOptions().initial_trust_region_radius);
   EXPECT_TRUE(held.refine_housing && held.refine_focal_length);
   EXPECT_EQ(held.function_tolerance, options.ba_global_function_tolerance);
   EXPECT_NO_THROW(held.Check());
   // The refinement's held solve is the same but for its radius option.
-  const BundleAdjustmentOptions refinement = deciding.WithWeightsHeld(kHeldWeightsTrustRegionRadius);
+  const BundleAdjustmentOptions refinement =
+      deciding.WithWeightsHeld(kHeldWeightsTrustRegionRadius);
   EXPECT_EQ(refinement.hold_loss_weights, held.hold_loss_weights);
   EXPECT_EQ(refinement.max_unsettled_weight_fraction, held.max_unsettled_weight_fraction);
   EXPECT_EQ(refinement.initial_trust_region_radius, held.initial_trust_region_radius);

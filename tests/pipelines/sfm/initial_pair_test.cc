@@ -39,8 +39,9 @@ SfmInputs SixImages() {
   inputs.images[3].markers = {Marker(7)};
   inputs.images[3].markers[0].dictionary = "DICT_6X6_250";
   inputs.images[4].markers = {Marker(8)};
-  inputs.pair_inliers = {{ImagePairToPairId(5, 6), 900}, {ImagePairToPairId(1, 3), 800}, {ImagePairToPairId(3, 4), 700},
-                         {ImagePairToPairId(1, 2), 600}, {ImagePairToPairId(2, 5), 500}, {ImagePairToPairId(2, 4), 10}};
+  inputs.pair_inliers = {{ImagePairToPairId(5, 6), 900}, {ImagePairToPairId(1, 3), 800},
+                         {ImagePairToPairId(3, 4), 700}, {ImagePairToPairId(1, 2), 600},
+                         {ImagePairToPairId(2, 5), 500}, {ImagePairToPairId(2, 4), 10}};
   inputs.planar_pairs = {ImagePairToPairId(5, 6)};
   return inputs;
 }
@@ -48,7 +49,8 @@ SfmInputs SixImages() {
 std::map<camera_t, HousedCamera> OneCamera(bool housed) {
   HousedCamera camera;
   camera.camera = Camera::FromModelName("RADIAL", 700, 960, 540);
-  if (housed) camera.housing = Housing::FromName("FLATPORT", {0, 0, 1, 0.01, 0.01, 1, 1.473, 1.334}, "test");
+  if (housed)
+    camera.housing = Housing::FromName("FLATPORT", {0, 0, 1, 0.01, 0.01, 1, 1.473, 1.334}, "test");
   return {{1, camera}};
 }
 
@@ -80,9 +82,11 @@ TEST(RankInitialPairs, BehindAHousingPairsSeeingOneMarkerComeFirst) {
   EXPECT_EQ(RankInitialPairs(inputs, OneCamera(true), WithMarkers(0.15), {}, {}),
             Pairs({{1, 2}, {1, 3}, {3, 4}, {2, 5}, {5, 6}}));
   // Pairs with used images or already tried drop out as before.
-  EXPECT_EQ(RankInitialPairs(inputs, OneCamera(true), WithMarkers(0.15), {}, {ImagePairToPairId(1, 2)}),
-            Pairs({{1, 3}, {3, 4}, {2, 5}, {5, 6}}));
-  EXPECT_EQ(RankInitialPairs(inputs, OneCamera(true), WithMarkers(0.15), {3}, {}), Pairs({{1, 2}, {2, 5}, {5, 6}}));
+  EXPECT_EQ(
+      RankInitialPairs(inputs, OneCamera(true), WithMarkers(0.15), {}, {ImagePairToPairId(1, 2)}),
+      Pairs({{1, 3}, {3, 4}, {2, 5}, {5, 6}}));
+  EXPECT_EQ(RankInitialPairs(inputs, OneCamera(true), WithMarkers(0.15), {3}, {}),
+            Pairs({{1, 2}, {2, 5}, {5, 6}}));
 }
 
 TEST(RankInitialPairs, MarkerPairsTakeAtMostHalfTheTrials) {

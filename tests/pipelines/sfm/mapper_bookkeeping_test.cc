@@ -72,7 +72,8 @@ TEST(Reconstruction, VisiblePointCountsFollowEveryObservationChange) {
   size_t points_seen = 0;
   const auto expect_counts = [&](const std::string& after) {
     for (image_t id = 1; id <= kImages; ++id) {
-      ASSERT_EQ(r.NumVisiblePoints(id), VisiblePointsByWalk(r, id)) << "image " << id << " after " << after;
+      ASSERT_EQ(r.NumVisiblePoints(id), VisiblePointsByWalk(r, id))
+          << "image " << id << " after " << after;
     }
     // The points of each pair of images and of a single image (an image not
     // registered sees none).
@@ -104,7 +105,8 @@ TEST(Reconstruction, VisiblePointCountsFollowEveryObservationChange) {
         r.AddPoint(Eigen::Vector3d::Zero(), track);
         ++operations;
       }
-    } else if (what <= 5 && r.IsRegistered(id) && r.PointOf(id, k) == kInvalidPoint3DId && !r.points().empty()) {
+    } else if (what <= 5 && r.IsRegistered(id) && r.PointOf(id, k) == kInvalidPoint3DId &&
+               !r.points().empty()) {
       auto it = r.points().begin();
       std::advance(it, std::uniform_int_distribution<size_t>(0, r.points().size() - 1)(rng));
       r.AddObservation(it->first, {id, k});
@@ -145,7 +147,8 @@ TEST(CameraChange, FocalLengthScalesTheImageAboutThePrincipalPointAtAnyDepth) {
   const double corner = std::hypot(479.5, 269.5);
   for (const double depth : {0.5, 2.0, 30.0}) {
     EXPECT_LT(MaxImageShiftPx(Pinhole(700), Pinhole(700), depth), 1e-9);  // the round trip
-    EXPECT_NEAR(MaxImageShiftPx(Pinhole(700), Pinhole(700 * 1.001), depth), 0.001 * corner, 1e-9) << depth;
+    EXPECT_NEAR(MaxImageShiftPx(Pinhole(700), Pinhole(700 * 1.001), depth), 0.001 * corner, 1e-9)
+        << depth;
   }
 }
 
@@ -154,8 +157,8 @@ TEST(CameraChange, AFlatPortsDistanceMovesTheImageLessWithDepth) {
   // falls off as 1 / depth.
   const auto behind_port = [](double distance) {
     HousedCamera camera = Pinhole(700);
-    camera.housing = Housing::FromName("FLATPORT", {0.05, 0.0, std::sqrt(1 - 0.0025), distance, 0.01, 1, 1.473, 1.334},
-                                       "test");
+    camera.housing = Housing::FromName(
+        "FLATPORT", {0.05, 0.0, std::sqrt(1 - 0.0025), distance, 0.01, 1, 1.473, 1.334}, "test");
     return camera;
   };
   const double near = MaxImageShiftPx(behind_port(0.020), behind_port(0.021), 1.0);
@@ -174,7 +177,8 @@ TEST(IncrementalMapperOptions, BadSettlingOptionsAreNamed) {
     options.Check();
     ADD_FAILURE() << "accepted -0.1";
   } catch (const OptionError& e) {
-    EXPECT_NE(std::string(e.what()).find("--Mapper.ba_calibration_settled_px"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--Mapper.ba_calibration_settled_px"), std::string::npos)
+        << e.what();
   }
   options.ba_calibration_settled_px = 0.25;
   options.ba_calibration_settled_min_images = 1;
@@ -182,7 +186,8 @@ TEST(IncrementalMapperOptions, BadSettlingOptionsAreNamed) {
     options.Check();
     ADD_FAILURE() << "accepted a minimum of 1 image";
   } catch (const OptionError& e) {
-    EXPECT_NE(std::string(e.what()).find("--Mapper.ba_calibration_settled_min_images"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("--Mapper.ba_calibration_settled_min_images"),
+              std::string::npos)
         << e.what();
   }
 }
@@ -196,7 +201,9 @@ TEST(IncrementalMapperOptions, GlobalFunctionToleranceIsAFractionAndNamedWhenBad
       options.Check();
       ADD_FAILURE() << "accepted " << bad;
     } catch (const OptionError& e) {
-      EXPECT_NE(std::string(e.what()).find("--Mapper.ba_global_function_tolerance"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("--Mapper.ba_global_function_tolerance"),
+                std::string::npos)
+          << e.what();
     }
   }
 }
@@ -211,7 +218,8 @@ TEST(IncrementalMapperOptions, GlobalUnsettledWeightsAreAFractionAndNamedWhenBad
       options.Check();
       ADD_FAILURE() << "accepted " << bad;
     } catch (const OptionError& e) {
-      EXPECT_NE(std::string(e.what()).find("--Mapper.ba_global_max_unsettled_weights"), std::string::npos)
+      EXPECT_NE(std::string(e.what()).find("--Mapper.ba_global_max_unsettled_weights"),
+                std::string::npos)
           << e.what();
     }
   }
@@ -226,7 +234,8 @@ TEST(IncrementalMapperOptions, NegativeRestartsAreNamed) {
     options.Check();
     ADD_FAILURE() << "accepted -1";
   } catch (const OptionError& e) {
-    EXPECT_NE(std::string(e.what()).find("--Mapper.init_max_restarts"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--Mapper.init_max_restarts"), std::string::npos)
+        << e.what();
   }
 }
 

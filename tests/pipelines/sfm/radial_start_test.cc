@@ -22,7 +22,8 @@ Scene MakeScene(const HousedCamera& truth, int num_images, double sigma_px, uint
   std::uniform_real_distribution<double> u(-1, 1);
   std::normal_distribution<double> noise(0, sigma_px);
   std::vector<Eigen::Vector3d> points;
-  for (int i = 0; i < 1500; ++i) points.emplace_back(0.45 * u(rng), 0.3 * u(rng), 0.8 + 0.2 * u(rng));
+  for (int i = 0; i < 1500; ++i)
+    points.emplace_back(0.45 * u(rng), 0.3 * u(rng), 0.8 + 0.2 * u(rng));
   Scene scene;
   scene.truth = truth;
   scene.inputs.cameras[1] = truth;
@@ -31,11 +32,13 @@ Scene MakeScene(const HousedCamera& truth, int num_images, double sigma_px, uint
   std::vector<std::vector<int>> index(num_images, std::vector<int>(points.size(), -1));
   for (int v = 0; v < num_images; ++v) {
     const double angle = 0.35 * (v - 0.5 * (num_images - 1)) / num_images;
-    const Eigen::Matrix3d R = Eigen::AngleAxisd(angle, Eigen::Vector3d(0.2 * u(rng), 1, 0.1 * u(rng)).normalized())
-                                  .toRotationMatrix();
+    const Eigen::Matrix3d R =
+        Eigen::AngleAxisd(angle, Eigen::Vector3d(0.2 * u(rng), 1, 0.1 * u(rng)).normalized())
+            .toRotationMatrix();
     // Orbiting the cloud's centre, looking at it.
     const Eigen::Vector3d target(0, 0, 0.8);
-    const Eigen::Vector3d centre = target - R.transpose() * target + Eigen::Vector3d(0, 0.03 * u(rng), 0);
+    const Eigen::Vector3d centre =
+        target - R.transpose() * target + Eigen::Vector3d(0, 0.03 * u(rng), 0);
     SfmImage image;
     image.image_id = static_cast<image_t>(v + 1);
     image.name = "v" + std::to_string(v);
@@ -78,7 +81,8 @@ TEST(RadialStart, FindsTheFirstRadialTermOfAWideLensBehindAFlatPort) {
   HousedCamera truth;
   truth.camera = Camera::FromModelName("OPENCV", 905, 1920, 1080);
   truth.camera.params = {905, 902, 981, 527, -0.3, 0, 0.0012, 0.0009};
-  truth.housing = Housing::FromName("FLATPORT", {0.0436194, 0, 0.9990482, 0.03, 0.008, 1, 1.473, 1.334}, "test");
+  truth.housing = Housing::FromName(
+      "FLATPORT", {0.0436194, 0, 0.9990482, 0.03, 0.008, 1, 1.473, 1.334}, "test");
   const Scene scene = MakeScene(truth, 6, 0.3, 3);
   // All but k1 known: the estimate is the lens's k1 to the grid's step
   // (0.025). The trimmed residual is not smooth in k at that scale (the

@@ -20,7 +20,9 @@ namespace {
 // beside it on the next line (100).
 std::map<image_pair_t, int> SurveyGraph(int lines, int per_line) {
   std::map<image_pair_t, int> pairs;
-  const auto id = [per_line](int line, int k) { return static_cast<image_t>(1 + line * per_line + k); };
+  const auto id = [per_line](int line, int k) {
+    return static_cast<image_t>(1 + line * per_line + k);
+  };
   for (int line = 0; line < lines; ++line) {
     for (int k = 0; k < per_line; ++k) {
       if (k + 1 < per_line) pairs[ImagePairToPairId(id(line, k), id(line, k + 1))] = 500;
@@ -75,15 +77,18 @@ SparseModel RowModel(int images, int points, std::mt19937* rng) {
     image.image_id = static_cast<image_t>(i);
     image.name = std::to_string(i);
     image.camera_id = 1;
-    const Eigen::Quaterniond rotation(Eigen::AngleAxisd(0.1 * i, Eigen::Vector3d(0.2, 1, 0.1).normalized()));
-    image.cam_from_world = Rigid3d(rotation, -(rotation * Eigen::Vector3d(0.5 * i, 0.1 * i * i, 0)));
+    const Eigen::Quaterniond rotation(
+        Eigen::AngleAxisd(0.1 * i, Eigen::Vector3d(0.2, 1, 0.1).normalized()));
+    image.cam_from_world =
+        Rigid3d(rotation, -(rotation * Eigen::Vector3d(0.5 * i, 0.1 * i * i, 0)));
     image.points2D.resize(static_cast<size_t>(points));
     model.images[image.image_id] = image;
   }
   for (int p = 0; p < points; ++p) {
     Point3D point;
     point.xyz = Eigen::Vector3d(5 * u(*rng), 2 * u(*rng), 3 + u(*rng));
-    for (int i = 1; i <= images; ++i) point.track.push_back({static_cast<image_t>(i), static_cast<point2D_t>(p)});
+    for (int i = 1; i <= images; ++i)
+      point.track.push_back({static_cast<image_t>(i), static_cast<point2D_t>(p)});
     model.points3D[static_cast<point3D_t>(p + 1)] = point;
   }
   return model;
@@ -95,8 +100,10 @@ SparseModel Cluster(const SparseModel& whole, image_t first, image_t last, const
   SparseModel part;
   for (image_t id = first; id <= last; ++id) {
     Image image = whole.images.at(id);
-    const Eigen::Quaterniond rotation = (image.cam_from_world.rotation * s.rotation.conjugate()).normalized();
-    image.cam_from_world = Rigid3d(rotation, s.scale * image.cam_from_world.translation - rotation * s.translation);
+    const Eigen::Quaterniond rotation =
+        (image.cam_from_world.rotation * s.rotation.conjugate()).normalized();
+    image.cam_from_world =
+        Rigid3d(rotation, s.scale * image.cam_from_world.translation - rotation * s.translation);
     part.images[id] = image;
   }
   for (const auto& [id, point] : whole.points3D) {
@@ -106,7 +113,8 @@ SparseModel Cluster(const SparseModel& whole, image_t first, image_t last, const
     for (const TrackElement& e : point.track) {
       if (e.image_id >= first && e.image_id <= last) cut.track.push_back(e);
     }
-    for (const TrackElement& e : cut.track) part.images.at(e.image_id).points2D[e.point2D_idx].point3D_id = id;
+    for (const TrackElement& e : cut.track)
+      part.images.at(e.image_id).points2D[e.point2D_idx].point3D_id = id;
     part.points3D[id] = cut;
   }
   return part;
@@ -117,11 +125,13 @@ TEST(ModelMerger, ClustersInTheirOwnFramesMergeIntoTheWholeDespiteBadPoints) {
   const SparseModel whole = RowModel(12, 400, &rng);
   Similarity3d identity, moved;
   moved.scale = 0.37;
-  moved.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(2.0, Eigen::Vector3d(1, 2, -1).normalized()));
+  moved.rotation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(2.0, Eigen::Vector3d(1, 2, -1).normalized()));
   moved.translation = Eigen::Vector3d(3, -7, 11);
   // Images 1-7 and 5-12 (three shared); the second cluster's frame is
   // another, and 20 of its points are triangulated 0.5 m off.
-  std::vector<SparseModel> clusters = {Cluster(whole, 5, 12, moved), Cluster(whole, 1, 7, identity)};
+  std::vector<SparseModel> clusters = {Cluster(whole, 5, 12, moved),
+                                       Cluster(whole, 1, 7, identity)};
   for (auto& [id, point] : clusters[0].points3D) {
     if (id % 20 == 0) point.xyz += Eigen::Vector3d(0.5, 0, 0);
   }
@@ -151,7 +161,8 @@ TEST(ModelMerger, ClustersInTheirOwnFramesMergeIntoTheWholeDespiteBadPoints) {
     }
   }
   // A cluster sharing no image stays out, named.
-  std::vector<SparseModel> apart = {Cluster(whole, 1, 5, identity), Cluster(whole, 8, 12, identity)};
+  std::vector<SparseModel> apart = {Cluster(whole, 1, 5, identity),
+                                    Cluster(whole, 8, 12, identity)};
   for (auto& [id, point] : apart[1].points3D) point.track.clear();
   for (auto& [id, image] : apart[1].images) {
     for (Point2D& p : image.points2D) p.point3D_id = kInvalidPoint3DId;

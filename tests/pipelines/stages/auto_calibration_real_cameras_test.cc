@@ -37,15 +37,19 @@ render: {spp: 4, noise_sigma: 1.0, white: 220, black: 30, background: 110}
 // A wide-angle lens (k1 = -0.3) with its principal point (10, -7.5) px off
 // the centre.
 const char* kWideLens =
-    "camera: {model: OPENCV, width: 960, height: 540, params: [452.0, 450.5, 490.0, 262.5, -0.30, 0.09, 0.0012, "
+    "camera: {model: OPENCV, width: 960, height: 540, params: [452.0, 450.5, 490.0, 262.5, -0.30, "
+    "0.09, 0.0012, "
     "0.0009]}\n";
 // A fisheye (about 100 deg across) with its principal point (-8, 6) px off.
 const char* kFisheye =
-    "camera: {model: OPENCV_FISHEYE, width: 960, height: 540, params: [380.0, 379.0, 472.0, 276.0, 0.06, -0.02, "
+    "camera: {model: OPENCV_FISHEYE, width: 960, height: 540, params: [380.0, 379.0, 472.0, 276.0, "
+    "0.06, -0.02, "
     "0.004, -0.001]}\n";
 const char* kFlatPortTilted =
-    "housing: {model: FLATPORT, params: [0.0436194, 0.0, 0.9990482, 0.03, 0.008, 1.0, 1.473, 1.334]}\n";
-const char* kFlatPortGuess = "0,0,1,0.03,0.008,1,1.473,1.334";  // untilted, the distance roughly known
+    "housing: {model: FLATPORT, params: [0.0436194, 0.0, 0.9990482, 0.03, 0.008, 1.0, 1.473, "
+    "1.334]}\n";
+const char* kFlatPortGuess =
+    "0,0,1,0.03,0.008,1,1.473,1.334";  // untilted, the distance roughly known
 const char* kDomeDecentred =
     "housing: {model: DOMEPORT, params: [0.003, -0.002, 0.004, 0.05, 0.006, 1.0, 1.473, 1.334]}\n";
 const char* kDomeGuess = "0,0,0,0.05,0.006,1,1.473,1.334";
@@ -63,7 +67,8 @@ struct MemberRun {
 
 fs::path Render(const fs::path& dir, const FamilyMember& m) {
   const std::string housing = m.housing_yaml.empty() ? "housing: null\n" : m.housing_yaml;
-  std::ofstream(dir / "set.yaml") << "name: member\n" << kViews << m.camera_yaml << housing << m.target_yaml;
+  std::ofstream(dir / "set.yaml") << "name: member\n"
+                                  << kViews << m.camera_yaml << housing << m.target_yaml;
   SynthesizeOptions synthesize;
   synthesize.config_path = (dir / "set.yaml").string();
   synthesize.output_path = (dir / "set").string();
@@ -130,7 +135,8 @@ void ExpectIntrinsicsGoals(const CalibrationReport& r, const GroundTruth& truth)
 void ExpectFlatPortGoals(const CalibrationReport& r, const GroundTruth& truth) {
   ASSERT_TRUE(r.housing);
   const Eigen::Vector3d normal(r.housing->params[0], r.housing->params[1], r.housing->params[2]);
-  const Eigen::Vector3d true_normal(truth.housing->params[0], truth.housing->params[1], truth.housing->params[2]);
+  const Eigen::Vector3d true_normal(truth.housing->params[0], truth.housing->params[1],
+                                    truth.housing->params[2]);
   const double angle = std::acos(std::min(1.0, normal.normalized().dot(true_normal.normalized())));
   const double angle_sigma = std::hypot(r.housing_std_dev[0], r.housing_std_dev[1]);
   EXPECT_LT(angle, 0.05 * kDegree);
@@ -142,8 +148,9 @@ void ExpectFlatPortGoals(const CalibrationReport& r, const GroundTruth& truth) {
 
 TEST(AutoCalibrationRealCameras, WideOffCentreLensBehindATiltedFlatPortAndTheSameTwice) {
   testing::TempDir dir;
-  const FamilyMember wide{kWideLens, kFlatPortTilted, testing::kTwoFaceTargetYaml, "OPENCV", "FLATPORT",
-                          kFlatPortGuess, 1};
+  const FamilyMember wide{kWideLens, kFlatPortTilted, testing::kTwoFaceTargetYaml,
+                          "OPENCV",  "FLATPORT",      kFlatPortGuess,
+                          1};
   // One thread: bitwise repeatable (see the second run below).
   const MemberRun run = RenderAndCalibrate(dir.path(), wide, 1);
   const CalibrationReport& r = run.result.refined.report;
@@ -160,19 +167,21 @@ TEST(AutoCalibrationRealCameras, WideOffCentreLensBehindATiltedFlatPortAndTheSam
   // they finish, which moves the 9th digit; under CI's load that once
   // flipped which observations passed a threshold, and two runs differed
   // by 0.04 sigma in the port distance (docs/dev/auto_calibration_notes.md).
-  const AutoCalibratorSummary again = Calibrate(wide, dir.path() / "set" / "images", dir.path() / "again", 1);
+  const AutoCalibratorSummary again =
+      Calibrate(wide, dir.path() / "set" / "images", dir.path() / "again", 1);
   for (size_t i = 0; i < r.camera.params.size(); ++i) {
     EXPECT_EQ(again.refined.report.camera.params[i], r.camera.params[i]) << "parameter " << i;
   }
   for (size_t i = 0; i < 4; ++i) {
-    EXPECT_EQ(again.refined.report.housing->params[i], r.housing->params[i]) << "housing parameter " << i;
+    EXPECT_EQ(again.refined.report.housing->params[i], r.housing->params[i])
+        << "housing parameter " << i;
   }
 }
 
 TEST(AutoCalibrationRealCameras, WideOffCentreLensInAirWithAThreeFaceTarget) {
   testing::TempDir dir;
-  const MemberRun run =
-      RenderAndCalibrate(dir.path(), {kWideLens, "", testing::kThreeFaceTargetYaml, "OPENCV", "", "", 2});
+  const MemberRun run = RenderAndCalibrate(
+      dir.path(), {kWideLens, "", testing::kThreeFaceTargetYaml, "OPENCV", "", "", 2});
   const CalibrationReport& r = run.result.refined.report;
   EXPECT_FALSE(r.housing);
   // Measured: df -0.18 / -0.14 px, dc (-0.10, +0.18) px.
@@ -185,9 +194,9 @@ TEST(AutoCalibrationRealCameras, OffCentreFisheyeBehindATiltedFlatPort) {
   // pinhole models) this render's k1 started at 0.35 for 0.06 and the port
   // ended 207 mm away (warned); a fisheye model starts at k = 0.
   testing::TempDir dir;
-  const MemberRun run = RenderAndCalibrate(
-      dir.path(), {kFisheye, kFlatPortTilted, testing::kTwoFaceTargetYaml, "OPENCV_FISHEYE", "FLATPORT",
-                   kFlatPortGuess, 1});
+  const MemberRun run =
+      RenderAndCalibrate(dir.path(), {kFisheye, kFlatPortTilted, testing::kTwoFaceTargetYaml,
+                                      "OPENCV_FISHEYE", "FLATPORT", kFlatPortGuess, 1});
   const CalibrationReport& r = run.result.refined.report;
   // Measured: df -0.16 / -0.19 px, dc (-0.43, +0.32) px (1.6 sigma in cx),
   // normal 0.036 deg, distance +1.37 mm.
@@ -203,20 +212,25 @@ TEST(AutoCalibrationRealCameras, OffCentreFisheyeBehindADecentredDomeSaysWhatItC
   // 2 mm). The report must say so first, and the errors stay within 3
   // sigma.
   testing::TempDir dir;
-  const MemberRun run = RenderAndCalibrate(
-      dir.path(), {kFisheye, kDomeDecentred, testing::kThreeFaceTargetYaml, "OPENCV_FISHEYE", "DOMEPORT",
-                   kDomeGuess, 1});
+  const MemberRun run =
+      RenderAndCalibrate(dir.path(), {kFisheye, kDomeDecentred, testing::kThreeFaceTargetYaml,
+                                      "OPENCV_FISHEYE", "DOMEPORT", kDomeGuess, 1});
   const CalibrationReport& r = run.result.refined.report;
   ASSERT_TRUE(r.housing);
   PrintErrors(r, run.truth);
   for (int i : {0, 1, 2, 3}) {
-    EXPECT_LT(std::abs(r.camera.params[i] - run.truth.camera.params[i]), 3 * r.parameters_std_dev[i]) << i;
+    EXPECT_LT(std::abs(r.camera.params[i] - run.truth.camera.params[i]),
+              3 * r.parameters_std_dev[i])
+        << i;
   }
   for (int k : {0, 1, 2}) {
-    EXPECT_LT(std::abs(r.housing->params[k] - run.truth.housing->params[k]), 3 * r.housing_std_dev[k]) << "C" << k;
+    EXPECT_LT(std::abs(r.housing->params[k] - run.truth.housing->params[k]),
+              3 * r.housing_std_dev[k])
+        << "C" << k;
   }
   bool said = false;
-  for (const std::string& w : r.warnings) said |= w.find("and Cz are correlated") != std::string::npos;
+  for (const std::string& w : r.warnings)
+    said |= w.find("and Cz are correlated") != std::string::npos;
   EXPECT_TRUE(said) << "no warning of the f-Cz trade";
   // Its focal length's sd (1 % of it) comes from the same trade: one start,
   // not three (their models were identical).
@@ -227,7 +241,8 @@ CalibrationReport FlatPortReport(double focal, double focal_std_dev, double port
   CalibrationReport r;
   r.camera = Camera::FromModelName("RADIAL", focal, 1920, 1080);
   r.parameters_std_dev = {focal_std_dev, 0.5, 0.5, 0.001, 0.001};
-  r.housing = Housing::FromName("FLATPORT", {0, 0, 1, port_distance, 0.008, 1, 1.473, 1.334}, "test");
+  r.housing =
+      Housing::FromName("FLATPORT", {0, 0, 1, port_distance, 0.008, 1, 1.473, 1.334}, "test");
   r.housing_std_dev = {0.001, 0.001, 0, 0.001, 0, 0, 0, 0};
   CalibratedView view;
   view.image_name = "a.png";
@@ -244,7 +259,8 @@ TEST(AutoCalibrationRealCameras, AFocalLengthTheMarkersRuleOutIsAnError) {
     FAIL() << "no error";
   } catch (const NumericalError& e) {
     EXPECT_NE(std::string(e.what()).find("markers' estimate 1260"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("--ImageReader.camera_params"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--ImageReader.camera_params"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -252,7 +268,8 @@ TEST(AutoCalibrationRealCameras, WhatTheViewsLeaveUndeterminedIsAWarningFirstInT
   CalibrationReport r = FlatPortReport(1310, 20, 0.39);  // sigma 1.5 % of f
   JudgeAutoCalibration(1300.0, &r);
   ASSERT_EQ(r.warnings.size(), 1u);
-  EXPECT_NE(r.warnings[0].find("focal length is poorly determined"), std::string::npos) << r.warnings[0];
+  EXPECT_NE(r.warnings[0].find("focal length is poorly determined"), std::string::npos)
+      << r.warnings[0];
   testing::TempDir dir;
   WriteCalibrationReport(r, dir.path());
   std::ifstream text(dir.path() / "calibration.txt");

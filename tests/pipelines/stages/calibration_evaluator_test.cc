@@ -59,12 +59,16 @@ TEST(CalibrationEvaluator, AWrongLensShowsInTheRmsAndInThePattern) {
   f.options.input_calibration = f.Calibration("truth", 0, 0.03);
   const HeldOutEvaluation right = RunCalibrationEvaluator(f.options, NoProgress()).evaluation;
   const std::string right_status =
-      YAML::LoadFile(f.options.output_path + "/evaluation.yaml")["verdict"]["status"].as<std::string>();
+      YAML::LoadFile(f.options.output_path + "/evaluation.yaml")["verdict"]["status"]
+          .as<std::string>();
   f.options.input_calibration = f.Calibration("wrong", 0.02, 0.03);
   const HeldOutEvaluation wrong = RunCalibrationEvaluator(f.options, NoProgress()).evaluation;
-  const YAML::Node wrong_verdict = YAML::LoadFile(f.options.output_path + "/evaluation.yaml")["verdict"];
-  std::printf("held out: true lens %.4f px (pattern %.4f, noise alone %.4f); k1 + 0.02: %.4f px (pattern %.4f)\n",
-              right.rms_px, right.systematic_px, right.noise_floor_px, wrong.rms_px, wrong.systematic_px);
+  const YAML::Node wrong_verdict =
+      YAML::LoadFile(f.options.output_path + "/evaluation.yaml")["verdict"];
+  std::printf(
+      "held out: true lens %.4f px (pattern %.4f, noise alone %.4f); k1 + 0.02: %.4f px (pattern "
+      "%.4f)\n",
+      right.rms_px, right.systematic_px, right.noise_floor_px, wrong.rms_px, wrong.systematic_px);
   EXPECT_EQ(right.views.size(), 12u);
   EXPECT_EQ(right.num_points, 12 * 54);
   // The rendered corners' noise is a few hundredths of a pixel.
@@ -87,8 +91,11 @@ TEST(CalibrationEvaluator, AWrongLensShowsInTheRmsAndInThePattern) {
   EXPECT_EQ(right_status, "OK");
   EXPECT_EQ(wrong_verdict["status"].as<std::string>(), "CHECK");
   ASSERT_GE(wrong_verdict["reasons"].size(), 1u);
-  EXPECT_EQ(wrong_verdict["reasons"][0].as<std::string>().rfind("held out: ", 0), 0u) << YAML::Dump(wrong_verdict);
-  EXPECT_EQ(testing::ReadFileToString(fs::path(f.options.output_path) / "evaluation.txt").rfind("Verdict: CHECK", 0), 0u);
+  EXPECT_EQ(wrong_verdict["reasons"][0].as<std::string>().rfind("held out: ", 0), 0u)
+      << YAML::Dump(wrong_verdict);
+  EXPECT_EQ(testing::ReadFileToString(fs::path(f.options.output_path) / "evaluation.txt")
+                .rfind("Verdict: CHECK", 0),
+            0u);
 }
 
 TEST(CalibrationEvaluator, CrossValidationHoldsEachViewOutOnce) {

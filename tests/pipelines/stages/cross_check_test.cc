@@ -2,6 +2,8 @@
 // difference (against mrcal's own Python implementation), the difference the
 // covariances predict (against Monte Carlo), a warped board caught and
 // explained, and the shared sets (rendered: agreement; real: the report).
+#include "pipelines/stages/cross_check.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
@@ -14,7 +16,6 @@
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/crosscheck/mrcal_calibration.h"
 #include "pipelines/stages/camera_calibrator.h"
-#include "pipelines/stages/cross_check.h"
 #include "pipelines/stages/target_extractor.h"
 #include "tests/test_utils.h"
 
@@ -55,7 +56,8 @@ std::vector<CalibrationView> SyntheticViews(const Camera& camera, const Eigen::V
       for (int i = 0; i < kBoardW; ++i) {
         const double ur = 2.0 * i / (kBoardW - 1) - 1, vr = 2.0 * j / (kBoardH - 1) - 1;
         const Eigen::Vector3d flat(i * kSpacing, j * kSpacing, 0);
-        const Eigen::Vector3d bent = flat + Eigen::Vector3d(0, 0, warp.x() * (1 - ur * ur) + warp.y() * (1 - vr * vr));
+        const Eigen::Vector3d bent =
+            flat + Eigen::Vector3d(0, 0, warp.x() * (1 - ur * ur) + warp.y() * (1 - vr * vr));
         const auto pixel = camera.ImgFromCam(rotation * (bent - centre) + position);
         if (!pixel || pixel->x() < 0 || pixel->y() < 0 || pixel->x() > camera.width ||
             pixel->y() > camera.height) {
@@ -70,7 +72,8 @@ std::vector<CalibrationView> SyntheticViews(const Camera& camera, const Eigen::V
   return views;
 }
 
-void WriteDatabase(const fs::path& path, const Camera& camera, const std::vector<CalibrationView>& views) {
+void WriteDatabase(const fs::path& path, const Camera& camera,
+                   const std::vector<CalibrationView>& views) {
   Database db(path, Database::OpenMode::kCreate);
   const camera_t camera_id = db.WriteCamera(camera);
   for (const CalibrationView& view : views) {
@@ -98,7 +101,7 @@ void WriteDatabase(const fs::path& path, const Camera& camera, const std::vector
 // Stores the views, calibrates them with portcal's camera_calibrator (flat
 // board) and returns cross_check options on the result.
 CrossCheckOptions CalibratedForCheck(const fs::path& dir, const std::vector<CalibrationView>& views,
-                                       bool drop_outlier_views = false) {
+                                     bool drop_outlier_views = false) {
   WriteDatabase(dir / "db.db", TruthCamera(), views);
   CameraCalibratorOptions calibrate;
   calibrate.database_path = (dir / "db.db").string();
@@ -133,7 +136,8 @@ TEST(CrossCheck, MrcalAndPortcalAgreeOnAFlatBoard) {
   const auto views = SyntheticViews(truth, Eigen::Vector2d::Zero(), 0.1, 20, 1);
   const CameraCalibrationResult portcal =
       CalibrateCamera(views, Camera::FromModelName("OPENCV", 900, 1280, 960), {});
-  const MrcalCalibrationResult mrcal = CalibrateWithMrcal(views, portcal.camera, Poses(portcal), {});
+  const MrcalCalibrationResult mrcal =
+      CalibrateWithMrcal(views, portcal.camera, Poses(portcal), {});
   EXPECT_EQ(mrcal.lensmodel, "LENSMODEL_OPENCV4");
   for (int i = 0; i < 6; ++i) {
     EXPECT_LT(std::abs(mrcal.camera.params[i] - truth.params[i]), 4 * mrcal.params_std_dev[i]) << i;
@@ -155,7 +159,8 @@ TEST(CrossCheck, MrcalAndPortcalAgreeOnAFlatBoard) {
 TEST(CrossCheck, PredictedDifferenceMatchesMonteCarlo) {
   const Camera truth = TruthCamera();
   const auto views = SyntheticViews(truth, Eigen::Vector2d::Zero(), 0.3, 8, 2);
-  const CameraCalibrationResult fit = CalibrateCamera(views, Camera::FromModelName("OPENCV", 900, 1280, 960), {});
+  const CameraCalibrationResult fit =
+      CalibrateCamera(views, Camera::FromModelName("OPENCV", 900, 1280, 960), {});
   const Eigen::MatrixXd& c = fit.params_covariance;
   ProjectionDiffOptions options;
   options.gridn_width = 16;
@@ -186,7 +191,8 @@ TEST(CrossCheck, PredictedDifferenceMatchesMonteCarlo) {
   // 300 samples: ~4 % Monte-Carlo scatter; 15 % allows for it and the
   // linearisation.
   EXPECT_NEAR(empirical_mean / predicted.predicted_mean_px, 1.0, 0.15)
-      << "empirical " << empirical_mean << " px, predicted " << predicted.predicted_mean_px << " px";
+      << "empirical " << empirical_mean << " px, predicted " << predicted.predicted_mean_px
+      << " px";
 }
 
 // mrcal's Python projection_diff (focus region, no uncertainties) on the
@@ -206,8 +212,10 @@ TEST(CrossCheck, ProjectionDiffEqualsMrcalsPython) {
   WriteMrcalCameraModel(b, Rigid3d(), dir / "b.cameramodel");
   const auto run = RunPython(dir.path(),
                              "import mrcal, numpy as np\n"
-                             "m = [mrcal.cameramodel('" + (dir / "a.cameramodel").string() +
-                                 "'), mrcal.cameramodel('" + (dir / "b.cameramodel").string() + "')]\n"
+                             "m = [mrcal.cameramodel('" +
+                                 (dir / "a.cameramodel").string() + "'), mrcal.cameramodel('" +
+                                 (dir / "b.cameramodel").string() +
+                                 "')]\n"
                                  "d = mrcal.projection_diff(m, use_uncertainties=False)[0]\n"
                                  "print('%.9f %.9f' % (np.mean(d), np.max(d)))\n");
   ASSERT_EQ(run.exit_code, 0) << run.output;
@@ -217,7 +225,8 @@ TEST(CrossCheck, ProjectionDiffEqualsMrcalsPython) {
   const ProjectionDiff ours = ComputeProjectionDiff({a, {}}, {b, {}}, {});
   EXPECT_GT(mrcal_mean, 0.1);  // a real difference to compare
   EXPECT_NEAR(ours.mean_px, mrcal_mean, 1e-4 * mrcal_mean);
-  EXPECT_NEAR(ours.max_px, mrcal_max, 1e-4 * mrcal_max) << "mean " << ours.mean_px << " vs " << mrcal_mean;
+  EXPECT_NEAR(ours.max_px, mrcal_max, 1e-4 * mrcal_max)
+      << "mean " << ours.mean_px << " vs " << mrcal_mean;
 }
 
 // What mrcal's Python makes of camera.cameramodel's optimization_inputs:
@@ -234,7 +243,9 @@ struct MrcalEvaluation {
 MrcalEvaluation EvaluateWithMrcal(const fs::path& model, const fs::path& dir) {
   const std::string script =
       "import mrcal, numpy as np\n"
-      "m = mrcal.cameramodel('" + model.string() + "')\n"
+      "m = mrcal.cameramodel('" +
+      model.string() +
+      "')\n"
       "oi = m.optimization_inputs()\n"
       "if oi is None: print(0); raise SystemExit\n"
       "b, x, J, f = mrcal.optimizer_callback(**oi)\n"
@@ -247,7 +258,8 @@ MrcalEvaluation EvaluateWithMrcal(const fs::path& model, const fs::path& dir) {
       "i0 = mrcal.state_index_intrinsics(0, **oi); n = oi['intrinsics'].shape[1]\n"
       "sd = np.sqrt(np.diag(inv) * s2)[i0:i0 + n]\n"
       "step = -(inv @ (J.T @ x))[i0:i0 + n]\n"
-      "print(1, np.sqrt((r ** 2).sum() / len(r)), np.max(np.abs(step) / sd), ' '.join(str(v) for v in sd * D[i0:i0 + n]))\n";
+      "print(1, np.sqrt((r ** 2).sum() / len(r)), np.max(np.abs(step) / sd), ' '.join(str(v) for v "
+      "in sd * D[i0:i0 + n]))\n";
   const auto run = RunPython(dir, script);
   EXPECT_EQ(run.exit_code, 0) << run.output;
   std::istringstream in(run.output);
@@ -304,7 +316,8 @@ TEST(CrossCheck, WarpedBoardIsCaughtAndExplained) {
   testing::TempDir dir;
   const Camera truth = TruthCamera();
   const Eigen::Vector2d warp(0.0, 0.5e-3);
-  CrossCheckOptions options = CalibratedForCheck(dir.path(), SyntheticViews(truth, warp, 0.1, 18, 4));
+  CrossCheckOptions options =
+      CalibratedForCheck(dir.path(), SyntheticViews(truth, warp, 0.1, 18, 4));
   options.folds = 2;
   const CrossCheckResult result = RunCrossCheck(options, NoProgress());
   EXPECT_FALSE(result.pass) << result.Verdict();
@@ -321,8 +334,9 @@ TEST(CrossCheck, WarpedBoardIsCaughtAndExplained) {
   ASSERT_EQ(result.cross_validations.size(), 2u);
   EXPECT_GT(result.cross_validations[0].worst_ratio, 0.0);
   EXPECT_LT(result.cross_validations[1].worst_ratio, 2.0);
-  for (const char* file : {"cross_check.txt", "cross_check.yaml", "projection_diff.png",
-                           "projection_diff_rerun.png", "cross_validation_diff.png", "mrcal.cameramodel"}) {
+  for (const char* file :
+       {"cross_check.txt", "cross_check.yaml", "projection_diff.png", "projection_diff_rerun.png",
+        "cross_validation_diff.png", "mrcal.cameramodel"}) {
     EXPECT_TRUE(fs::exists(dir / "check" / file)) << file;
   }
   const std::string text = testing::ReadFileToString(dir / "check/cross_check.txt");
@@ -340,7 +354,8 @@ TEST(CrossCheck, ViewsDroppedByTheInputStayOut) {
   std::mt19937 rng(8);
   std::normal_distribution<double> blur(0, 3.0);
   for (Eigen::Vector2d& pixel : views[4].pixels) pixel += Eigen::Vector2d(blur(rng), blur(rng));
-  const CrossCheckResult result = RunCrossCheck(CalibratedForCheck(dir.path(), views, true), NoProgress());
+  const CrossCheckResult result =
+      RunCrossCheck(CalibratedForCheck(dir.path(), views, true), NoProgress());
   EXPECT_EQ(result.num_views, 11);
   EXPECT_TRUE(result.pass) << result.Verdict();
   EXPECT_TRUE(result.causes.empty()) << result.causes.front();
@@ -373,8 +388,8 @@ TEST(CrossCheck, BadOptionsAndModelsAreNamed) {
   }
 }
 
-CrossCheckResult CheckSharedSet(const fs::path& images, const std::string& model, int cols, int rows,
-                                double square, const fs::path& dir, int folds) {
+CrossCheckResult CheckSharedSet(const fs::path& images, const std::string& model, int cols,
+                                int rows, double square, const fs::path& dir, int folds) {
   TargetExtractorOptions extract;
   extract.database_path = (dir / "db.db").string();
   extract.image_path = images.string();
@@ -404,8 +419,9 @@ CrossCheckResult CheckSharedSet(const fs::path& images, const std::string& model
 TEST(CrossCheck, SharedRenderedSetAgrees) {
   PORTCAL_REQUIRE_SHARED(shared);
   testing::TempDir dir;
-  const CrossCheckResult result = CheckSharedSet(shared / "datasets/rendered/chess_air_distorted/images",
-                                                 "RADIAL", 10, 7, 0.02, dir.path(), 3);
+  const CrossCheckResult result =
+      CheckSharedSet(shared / "datasets/rendered/chess_air_distorted/images", "RADIAL", 10, 7, 0.02,
+                     dir.path(), 3);
   EXPECT_LT(result.diff.mean_px, 0.05);
   EXPECT_TRUE(result.pass);
 }
@@ -431,7 +447,8 @@ TEST(CrossCheck, RealInAirSetBlamesTheBoardWarp) {
   ASSERT_TRUE(result.verdict.has_value());
   EXPECT_EQ(result.verdict->status, VerdictStatus::kCheck) << result.verdict->Summary();
   EXPECT_EQ(result.verdict->lines.front().rule, "mrcal");
-  EXPECT_NE(result.verdict->lines.front().text.find("agrees"), std::string::npos) << result.verdict->lines.front().text;
+  EXPECT_NE(result.verdict->lines.front().text.find("agrees"), std::string::npos)
+      << result.verdict->lines.front().text;
   EXPECT_EQ(testing::ReadFileToString(dir / "check/cross_check.txt").find("Verdict: CHECK"),
             testing::ReadFileToString(dir / "check/cross_check.txt").find("Verdict:"));
 }

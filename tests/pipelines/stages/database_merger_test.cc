@@ -50,17 +50,20 @@ std::string Text(const FeatureMatches& matches) {
 std::string ImageRows(Database* database, const std::string& name) {
   const DatabaseImage image = *database->ReadImageWithName(name);
   const Camera camera = *database->ReadCamera(image.camera_id);
-  std::string rows = camera.ModelName() + " " + std::to_string(camera.width) + "x" + std::to_string(camera.height);
+  std::string rows =
+      camera.ModelName() + " " + std::to_string(camera.width) + "x" + std::to_string(camera.height);
   for (double p : camera.params) rows += " " + std::to_string(p);
   const FeatureKeypoints keypoints = database->ReadKeypoints(image.image_id);
-  rows += "\n" + std::to_string(keypoints.size()) + " keypoints, first at " +
-          (keypoints.empty() ? "-" : std::to_string(keypoints[0].x) + "," + std::to_string(keypoints[0].y));
-  const FeatureDescriptors descriptors = database->ReadDescriptors(image.image_id);
   rows +=
-      "\ndescriptors " + std::to_string(descriptors.rows()) + " sum " + std::to_string(descriptors.cast<int>().sum());
+      "\n" + std::to_string(keypoints.size()) + " keypoints, first at " +
+      (keypoints.empty() ? "-"
+                         : std::to_string(keypoints[0].x) + "," + std::to_string(keypoints[0].y));
+  const FeatureDescriptors descriptors = database->ReadDescriptors(image.image_id);
+  rows += "\ndescriptors " + std::to_string(descriptors.rows()) + " sum " +
+          std::to_string(descriptors.cast<int>().sum());
   for (const TargetObservation& observation : database->ReadTargetObservations(image.image_id)) {
-    rows += "\n" + std::to_string(observation.point_id) + " " + std::to_string(observation.xy.x()) + " " +
-            std::to_string(observation.xy.y());
+    rows += "\n" + std::to_string(observation.point_id) + " " + std::to_string(observation.xy.x()) +
+            " " + std::to_string(observation.xy.y());
   }
   rows += "\nfound " + std::to_string(database->ReadTargetDetectionStatus(image.image_id)->found);
   return rows;
@@ -72,7 +75,8 @@ TEST(DatabaseMerger, SecondDatabaseFollowsTheFirstWithNewIds) {
   // The rig's first and second camera, 3.8 and 4.1 layouts.
   const fs::path images = dir / "set" / "images";
   std::vector<std::string> folders;
-  for (const auto& entry : fs::directory_iterator(images)) folders.push_back(entry.path().filename().string());
+  for (const auto& entry : fs::directory_iterator(images))
+    folders.push_back(entry.path().filename().string());
   std::sort(folders.begin(), folders.end());
   ASSERT_EQ(folders.size(), 2u);
   // Each camera's folder under a root of its own: names cam1/..., cam2/...
@@ -99,7 +103,8 @@ TEST(DatabaseMerger, SecondDatabaseFollowsTheFirstWithNewIds) {
   EXPECT_EQ(merged.NumCameras(), 2);
   EXPECT_EQ(summary.num_images, second.NumImages());
   EXPECT_EQ(merged.NumImages(), first.NumImages() + second.NumImages());
-  EXPECT_EQ(merged.NumVerifiedImagePairs(), first.NumVerifiedImagePairs() + second.NumVerifiedImagePairs());
+  EXPECT_EQ(merged.NumVerifiedImagePairs(),
+            first.NumVerifiedImagePairs() + second.NumVerifiedImagePairs());
   for (const DatabaseImage& image : first.ReadAllImages()) {
     EXPECT_EQ(merged.ReadImageWithName(image.name)->image_id, image.image_id) << image.name;
     EXPECT_EQ(ImageRows(&merged, image.name), ImageRows(&first, image.name)) << image.name;
@@ -136,7 +141,8 @@ TEST(DatabaseMerger, ANameInBothOrAnExistingOutputIsRefused) {
     RunDatabaseMerger(options, NoProgress());
     ADD_FAILURE() << "merged a database with its own copy";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(options.database_path1 + " and " + options.database_path2 + ": "),
+    EXPECT_NE(std::string(e.what()).find(options.database_path1 + " and " + options.database_path2 +
+                                         ": "),
               std::string::npos)
         << e.what();
     EXPECT_NE(std::string(e.what()).find("are in both (img_"), std::string::npos) << e.what();

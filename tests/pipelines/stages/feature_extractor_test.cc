@@ -2,6 +2,8 @@
 // cameras still meet the reader options (as target_extractor's do): other
 // options are an error naming the difference, the database untouched, and
 // --ImageReader.overwrite imports the cameras again with the features kept.
+#include "pipelines/stages/feature_extractor.h"
+
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -10,7 +12,6 @@
 
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
-#include "pipelines/stages/feature_extractor.h"
 #include "tests/test_utils.h"
 
 namespace fs = std::filesystem;
@@ -25,7 +26,8 @@ void WriteTexturedImages(const fs::path& dir) {
   for (const char* name : {"a.png", "b.png", "c.png"}) {
     cv::Mat small(12, 16, CV_8UC1);
     for (int y = 0; y < small.rows; ++y) {
-      for (int x = 0; x < small.cols; ++x) small.at<uint8_t>(y, x) = static_cast<uint8_t>(grey(rng));
+      for (int x = 0; x < small.cols; ++x)
+        small.at<uint8_t>(y, x) = static_cast<uint8_t>(grey(rng));
     }
     cv::Mat image;
     cv::resize(small, image, cv::Size(160, 120), 0, 0, cv::INTER_CUBIC);
@@ -47,7 +49,8 @@ TEST(FeatureExtractor, ARerunWithOtherReaderOptionsSaysSoOrImportsTheCamerasAgai
   {
     Database db(dir / "db.db", Database::OpenMode::kReadOnly);
     ASSERT_EQ(db.NumCameras(), 3);
-    for (const DatabaseImage& image : db.ReadAllImages()) num_keypoints += db.ReadKeypoints(image.image_id).size();
+    for (const DatabaseImage& image : db.ReadAllImages())
+      num_keypoints += db.ReadKeypoints(image.image_id).size();
   }
   ASSERT_GT(num_keypoints, 0);
   const std::string before = testing::ReadFileToString(dir / "db.db");

@@ -2,6 +2,8 @@
 // starts from the features as extracted (kept aside at the first masking);
 // where they were not kept, another mask is refused with the reason and the
 // way out, the database untouched.
+#include "pipelines/stages/feature_masker.h"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -11,7 +13,6 @@
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
 #include "pipelines/stages/feature_extractor.h"
-#include "pipelines/stages/feature_masker.h"
 #include "pipelines/stages/synthesize.h"
 #include "tests/test_utils.h"
 
@@ -25,7 +26,8 @@ namespace {
 FeatureExtractorOptions RenderAndExtract(const fs::path& dir, int num_images, int seed) {
   std::ofstream(dir / "set.yaml")
       << "name: mask\nnum_images: " << num_images << "\nseed: " << seed << "\n"
-      << "camera: {model: RADIAL, width: 480, height: 270, params: [330.0, 240.0, 135.0, 0.0, 0.0]}\n"
+      << "camera: {model: RADIAL, width: 480, height: 270, params: [330.0, 240.0, 135.0, 0.0, "
+         "0.0]}\n"
       << "housing: null\n"
       << testing::kTwoFaceTargetYaml
       << "poses: {distance: [0.4, 0.7], tilt_max_deg: 30, roll_max_deg: 30, visibility: markers}\n"
@@ -55,11 +57,13 @@ TEST(FeatureMasker, AnotherMaskStartsFromTheFeaturesAsExtracted) {
   ASSERT_LT(first.num_features_kept, first.num_features_before);
   const FeatureMaskerSummary again = RunFeatureMasker(mask, progress);
   EXPECT_EQ(again.num_features_kept, first.num_features_kept);
-  EXPECT_EQ(again.num_features_before, first.num_features_before);  // from the features as extracted
+  EXPECT_EQ(again.num_features_before,
+            first.num_features_before);  // from the features as extracted
   const auto matched_keypoints = [&] {
     Database db(dir / "db.db", Database::OpenMode::kReadOnly);
     std::vector<FeatureKeypoints> keypoints;
-    for (const DatabaseImage& image : db.ReadAllImages()) keypoints.push_back(db.ReadKeypoints(image.image_id));
+    for (const DatabaseImage& image : db.ReadAllImages())
+      keypoints.push_back(db.ReadKeypoints(image.image_id));
     return keypoints;
   };
   const std::vector<FeatureKeypoints> first_keypoints = matched_keypoints();
@@ -102,13 +106,15 @@ TEST(FeatureMasker, AnotherMaskStartsFromTheFeaturesAsExtracted) {
 TEST(FeatureMasker, KeepingAllFeaturesAfterAMaskBringsEveryImagesBack) {
   testing::TempDir dir;
   FeatureExtractorOptions extract = RenderAndExtract(dir.path(), 2, 5);
-  ASSERT_TRUE(cv::imwrite((dir / "set/images/no_markers.png").string(), testing::ClutteredScene(480, 270, 9)));
+  ASSERT_TRUE(cv::imwrite((dir / "set/images/no_markers.png").string(),
+                          testing::ClutteredScene(480, 270, 9)));
   NullProgress progress;
   RunFeatureExtractor(extract, progress);  // the new image only
   const auto counts = [&] {
     Database db(dir / "db.db", Database::OpenMode::kReadOnly);
     std::map<std::string, size_t> keypoints;
-    for (const DatabaseImage& image : db.ReadAllImages()) keypoints[image.name] = db.ReadKeypoints(image.image_id).size();
+    for (const DatabaseImage& image : db.ReadAllImages())
+      keypoints[image.name] = db.ReadKeypoints(image.image_id).size();
     return keypoints;
   };
   const std::map<std::string, size_t> extracted = counts();
@@ -149,7 +155,8 @@ TEST(FeatureMasker, AnotherMaskWithoutTheExtractedFeaturesIsRefused) {
     FAIL() << "a wider mask over masked features went through";
   } catch (const InputError& e) {
     const std::string what = e.what();
-    for (const char* named : {"masked before", "enlargement factor 3", "feature_extractor --overwrite 1"}) {
+    for (const char* named :
+         {"masked before", "enlargement factor 3", "feature_extractor --overwrite 1"}) {
       EXPECT_NE(what.find(named), std::string::npos) << named << ": " << what;
     }
   }

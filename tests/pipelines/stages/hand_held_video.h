@@ -18,11 +18,11 @@ namespace portcal::testing {
 
 struct HandHeldVideoOptions {
   double fps = 12.5;
-  double hold_s = 1.5;       // each view held this long
-  double move_s = 0.8;       // between views
-  double tremor_px = 0.15;   // the tremor's standard deviation
-  int blur_px = 31;          // length of the motion blur while moving
-  double exposure = 0.03;    // relative amplitude of the exposure's drift
+  double hold_s = 1.5;      // each view held this long
+  double move_s = 0.8;      // between views
+  double tremor_px = 0.15;  // the tremor's standard deviation
+  int blur_px = 31;         // length of the motion blur while moving
+  double exposure = 0.03;   // relative amplitude of the exposure's drift
   int jpeg_quality = 90;
   unsigned seed = 1;
 };
@@ -33,7 +33,8 @@ struct HandHeldVideo {
 };
 
 // Frames f00000.jpg ... in `folder`, a hold per still in order.
-inline HandHeldVideo WriteHandHeldVideo(const std::vector<cv::Mat>& stills, const std::filesystem::path& folder,
+inline HandHeldVideo WriteHandHeldVideo(const std::vector<cv::Mat>& stills,
+                                        const std::filesystem::path& folder,
                                         const HandHeldVideoOptions& options) {
   std::filesystem::create_directories(folder);
   std::mt19937 rng(options.seed);
@@ -46,7 +47,8 @@ inline HandHeldVideo WriteHandHeldVideo(const std::vector<cv::Mat>& stills, cons
     frame.convertTo(exposed, -1, 1 + options.exposure * std::sin(0.2 * step), 0);
     char name[32];
     std::snprintf(name, sizeof(name), "f%05d.jpg", index++);
-    cv::imwrite((folder / name).string(), exposed, {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality});
+    cv::imwrite((folder / name).string(), exposed,
+                {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality});
   };
   const int hold_frames = static_cast<int>(options.hold_s * options.fps);
   const int move_frames = static_cast<int>(options.move_s * options.fps);

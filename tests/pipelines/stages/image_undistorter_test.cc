@@ -33,7 +33,8 @@ Camera LensCamera() {
 
 Housing TiltedFlatPort() {
   const double tilt = 3.0 * M_PI / 180.0;
-  return Housing::FromName("FLATPORT", {std::sin(tilt), 0, std::cos(tilt), 0.02, 0.01, 1.0, 1.49, 1.334}, "test");
+  return Housing::FromName(
+      "FLATPORT", {std::sin(tilt), 0, std::cos(tilt), 0.02, 0.01, 1.0, 1.49, 1.334}, "test");
 }
 
 // Two images 0.3 m apart looking at points 1.5-2.5 m away, behind the port,
@@ -42,7 +43,8 @@ SparseModel WriteModelAndImages(const fs::path& dir, bool with_housing) {
   SparseModel model;
   model.cameras[1] = LensCamera();
   if (with_housing) model.housings[1] = TiltedFlatPort();
-  const HousedCamera camera{model.cameras[1], with_housing ? std::optional<Housing>(TiltedFlatPort()) : std::nullopt};
+  const HousedCamera camera{model.cameras[1],
+                            with_housing ? std::optional<Housing>(TiltedFlatPort()) : std::nullopt};
   fs::create_directories(dir / "images" / "left");
   for (image_t id : {1, 2}) {
     Image& image = model.images[id];
@@ -59,14 +61,16 @@ SparseModel WriteModelAndImages(const fs::path& dir, bool with_housing) {
     point.xyz = Eigen::Vector3d(x(rng), y(rng), z(rng));
     for (auto& [image_id, image] : model.images) {
       const std::optional<Eigen::Vector2d> pixel = camera.Project(image.cam_from_world * point.xyz);
-      if (!pixel || pixel->x() < 0 || pixel->y() < 0 || pixel->x() > 400 || pixel->y() > 300) continue;
+      if (!pixel || pixel->x() < 0 || pixel->y() < 0 || pixel->x() > 400 || pixel->y() > 300)
+        continue;
       point.track.push_back({image_id, static_cast<point2D_t>(image.points2D.size())});
       image.points2D.push_back({*pixel, id});
     }
     if (point.track.size() >= 2) {
       model.points3D[id] = point;
     } else {
-      for (const TrackElement& element : point.track) model.images[element.image_id].points2D.pop_back();
+      for (const TrackElement& element : point.track)
+        model.images[element.image_id].points2D.pop_back();
     }
   }
   WriteSparseModel(model, dir / "model", ModelFormat::kText);
@@ -100,21 +104,27 @@ TEST(ImageUndistorter, ModelBehindAPortBecomesADenseWorkspace) {
   ASSERT_EQ(output.images.size(), 2u);
   EXPECT_EQ(output.points3D.size(), input.points3D.size());
   for (const auto& [id, image] : output.images) {
-    EXPECT_LT((image.cam_from_world.translation - input.images.at(id).cam_from_world.translation).norm(), 1e-12);
-    const cv::Mat undistorted = cv::imread((dir / "out" / "images" / image.name).string(), cv::IMREAD_UNCHANGED);
+    EXPECT_LT(
+        (image.cam_from_world.translation - input.images.at(id).cam_from_world.translation).norm(),
+        1e-12);
+    const cv::Mat undistorted =
+        cv::imread((dir / "out" / "images" / image.name).string(), cv::IMREAD_UNCHANGED);
     EXPECT_EQ(undistorted.cols, static_cast<int>(output.cameras.at(1).width));
     EXPECT_EQ(undistorted.rows, static_cast<int>(output.cameras.at(1).height));
     // Each keypoint is where the pinhole projects its point, within the
     // approximation's worst error over the range.
     for (const Point2D& point2D : image.points2D) {
-      const Eigen::Vector3d point = image.cam_from_world * output.points3D.at(point2D.point3D_id).xyz;
+      const Eigen::Vector3d point =
+          image.cam_from_world * output.points3D.at(point2D.point3D_id).xyz;
       const Eigen::Vector2d projected = *camera.pinhole.PinholePixel(point);
       EXPECT_LT((projected - point2D.xy).norm(), camera.error.worst_px + 1e-6);
     }
   }
-  const std::string patch_match = testing::ReadFileToString(dir / "out" / "stereo" / "patch-match.cfg");
+  const std::string patch_match =
+      testing::ReadFileToString(dir / "out" / "stereo" / "patch-match.cfg");
   EXPECT_EQ(patch_match, "left/im1.png\n__auto__, 20\nleft/im2.png\n__auto__, 20\n");
-  EXPECT_EQ(testing::ReadFileToString(dir / "out" / "stereo" / "fusion.cfg"), "left/im1.png\nleft/im2.png\n");
+  EXPECT_EQ(testing::ReadFileToString(dir / "out" / "stereo" / "fusion.cfg"),
+            "left/im1.png\nleft/im2.png\n");
   EXPECT_TRUE(fs::is_directory(dir / "out" / "stereo" / "depth_maps" / "left"));
   EXPECT_TRUE(fs::exists(dir / "out" / "run-colmap-geometric.sh"));
   EXPECT_TRUE(fs::exists(dir / "out" / "report" / "report.html"));
@@ -139,18 +149,23 @@ TEST(ImageUndistorter, CalibrationFileGivesImagesMapsAndWarnings) {
   // A flat port over a decade of depths: pixels of error, said loudly.
   ASSERT_EQ(summary.warnings.size(), 1u);
   EXPECT_NE(summary.warnings[0].find("camera 1"), std::string::npos);
-  EXPECT_NE(testing::ReadFileToString(dir / "out" / "undistortion.txt").find("WARNING"), std::string::npos);
+  EXPECT_NE(testing::ReadFileToString(dir / "out" / "undistortion.txt").find("WARNING"),
+            std::string::npos);
   // The tables, read as a robot would, undistort as portcal did.
-  cv::FileStorage storage((dir / "out" / "maps" / "camera_1.yaml.gz").string(), cv::FileStorage::READ);
+  cv::FileStorage storage((dir / "out" / "maps" / "camera_1.yaml.gz").string(),
+                          cv::FileStorage::READ);
   ASSERT_TRUE(storage.isOpened());
   cv::Mat map_x, map_y;
   storage["map_x"] >> map_x;
   storage["map_y"] >> map_y;
   ASSERT_EQ(map_x.type(), CV_32FC1);
-  const cv::Mat source = cv::imread((dir / "images" / "left" / "im1.png").string(), cv::IMREAD_UNCHANGED);
+  const cv::Mat source =
+      cv::imread((dir / "images" / "left" / "im1.png").string(), cv::IMREAD_UNCHANGED);
   cv::Mat by_robot;
-  cv::remap(source, by_robot, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
-  const cv::Mat by_portcal = cv::imread((dir / "out" / "images" / "left" / "im1.png").string(), cv::IMREAD_UNCHANGED);
+  cv::remap(source, by_robot, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+            cv::Scalar::all(0));
+  const cv::Mat by_portcal =
+      cv::imread((dir / "out" / "images" / "left" / "im1.png").string(), cv::IMREAD_UNCHANGED);
   ASSERT_EQ(by_robot.size(), by_portcal.size());
   cv::Mat difference;
   cv::absdiff(by_robot, by_portcal, difference);
@@ -178,10 +193,14 @@ TEST(ImageUndistorter, InAirModelNeedsNoDepths) {
 // lenses behind flat ports, 10 cm apart.
 void WriteStereoCalibration(const fs::path& path) {
   std::ofstream out(path);
-  out << "cam2_from_cam1:\n  rotation_wxyz: [0.99996, 0.0, 0.00873, 0.0]\n  translation: [-0.1, 0.001, 0.0]\n";
+  out << "cam2_from_cam1:\n  rotation_wxyz: [0.99996, 0.0, 0.00873, 0.0]\n  translation: [-0.1, "
+         "0.001, 0.0]\n";
   for (const char* key : {"camera1", "camera2"}) {
-    out << key << ":\n  model: OPENCV\n  parameters: [330, 332, 203.5, 146.0, -0.2, 0.05, 0.001, -0.0005]\n"
-        << "  non_svp_model: FLATPORT\n  non_svp_parameters: [0, 0, 1, 0.02, 0.01, 1.0, 1.49, 1.334]\n"
+    out << key
+        << ":\n  model: OPENCV\n  parameters: [330, 332, 203.5, 146.0, -0.2, 0.05, 0.001, "
+           "-0.0005]\n"
+        << "  non_svp_model: FLATPORT\n  non_svp_parameters: [0, 0, 1, 0.02, 0.01, 1.0, 1.49, "
+           "1.334]\n"
         << "  width: 400\n  height: 300\n";
   }
 }
@@ -190,7 +209,8 @@ TEST(ImageUndistorter, StereoCalibrationGivesRectifiedPairs) {
   testing::TempDir dir;
   for (const char* folder : {"cam1", "cam2"}) {
     fs::create_directories(dir / "rig" / folder);
-    cv::imwrite((dir / "rig" / folder / "frame_01.png").string(), testing::ClutteredScene(400, 300, 4));
+    cv::imwrite((dir / "rig" / folder / "frame_01.png").string(),
+                testing::ClutteredScene(400, 300, 4));
   }
   WriteStereoCalibration(dir / "stereo.yaml");
   ImageUndistorterOptions options = Options(dir);
@@ -208,9 +228,9 @@ TEST(ImageUndistorter, StereoCalibrationGivesRectifiedPairs) {
   const cv::Mat left = cv::imread((dir / "out" / "images" / "cam1" / "frame_01.png").string());
   const cv::Mat right = cv::imread((dir / "out" / "images" / "cam2" / "frame_01.png").string());
   EXPECT_EQ(left.rows, right.rows);
-  EXPECT_NE(
-      testing::ReadFileToString(dir / "out" / "undistortion.txt").find("rectified with camera 2: baseline 0.1000 m"),
-      std::string::npos);
+  EXPECT_NE(testing::ReadFileToString(dir / "out" / "undistortion.txt")
+                .find("rectified with camera 2: baseline 0.1000 m"),
+            std::string::npos);
   // One folder of images cannot be a rig's.
   options.image_path = (dir / "rig" / "cam1").string();
   EXPECT_THROW(RunImageUndistorter(options, NoProgress()), InputError);
@@ -229,7 +249,8 @@ void ExpectFailureNaming(const ImageUndistorterOptions& options, const std::stri
     EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
   }
   std::vector<std::string> left;
-  for (const auto& entry : fs::directory_iterator(out)) left.push_back(entry.path().filename().string());
+  for (const auto& entry : fs::directory_iterator(out))
+    left.push_back(entry.path().filename().string());
   EXPECT_EQ(left, std::vector<std::string>{"previous.txt"});
 }
 
@@ -249,7 +270,8 @@ TEST(ImageUndistorter, BadInputNamesWhatIsWrongAndWritesNothing) {
   cv::imwrite((dir / "images" / "left" / "im2.png").string(), testing::ClutteredScene(320, 240, 2));
   ExpectFailureNaming(options, "left/im2.png: the image is 320 x 240 px, its camera 400 x 300");
   // housings.txt naming a camera the model does not have.
-  std::ofstream(dir / "model" / "housings.txt", std::ios::app) << "7 FLATPORT 0 0 1 0.02 0.01 1 1.49 1.334\n";
+  std::ofstream(dir / "model" / "housings.txt", std::ios::app)
+      << "7 FLATPORT 0 0 1 0.02 0.01 1 1.49 1.334\n";
   ExpectFailureNaming(options, "housings.txt");
   // A calibration file behind a port with no depths to go by.
   CalibrationReport report;

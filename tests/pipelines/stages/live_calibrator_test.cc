@@ -13,8 +13,8 @@
 #include "colmap_ext/util/error.h"
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
-#include "pipelines/stages/camera_calibrator.h"
 #include "pipelines/images/image_reader.h"
+#include "pipelines/stages/camera_calibrator.h"
 #include "tests/pipelines/stages/live_test_setup.h"
 
 namespace fs = std::filesystem;
@@ -32,16 +32,18 @@ LiveCalibratorOptions Options(const testing::TempDir& dir, const std::string& so
 // The final calibration is the last live estimate: every parameter within
 // 0.1 of its standard deviation (the same views, the same model, the board
 // fitted alike; only the start differs). Constants and held values equal.
-void ExpectFinalIsTheLiveEstimate(const LiveSummary& session, const std::vector<double>& final_values,
+void ExpectFinalIsTheLiveEstimate(const LiveSummary& session,
+                                  const std::vector<double>& final_values,
                                   const std::vector<double>& final_std_devs) {
   ASSERT_TRUE(session.estimate && session.estimate->solved);
   const std::vector<double>& live = session.estimate->values;
   ASSERT_EQ(live.size(), final_values.size());
   ASSERT_EQ(final_std_devs.size(), final_values.size());
   for (size_t k = 0; k < live.size(); ++k) {
-    EXPECT_LE(std::abs(live[k] - final_values[k]), 0.1 * std::max(0.0, final_std_devs[k]) + 1e-9 * (1 + std::abs(final_values[k])))
-        << session.estimate->names[k] << ": live " << live[k] << ", final " << final_values[k] << " +- "
-        << final_std_devs[k];
+    EXPECT_LE(std::abs(live[k] - final_values[k]),
+              0.1 * std::max(0.0, final_std_devs[k]) + 1e-9 * (1 + std::abs(final_values[k])))
+        << session.estimate->names[k] << ": live " << live[k] << ", final " << final_values[k]
+        << " +- " << final_std_devs[k];
   }
 }
 
@@ -55,7 +57,8 @@ CameraCalibrationResult Calibrate(const std::string& database, const fs::path& o
 TEST(LiveCalibrator, HandsFreeKeepsOneFramePerPauseAndMatchesTheBatchStages) {
   const testing::TempDir dir;
   testing::RenderSet(dir, kTrajectoryYaml);
-  const std::vector<std::pair<int, int>> pauses = testing::TrajectoryPauses(dir / "set/trajectory.yaml");
+  const std::vector<std::pair<int, int>> pauses =
+      testing::TrajectoryPauses(dir / "set/trajectory.yaml");
   ASSERT_EQ(pauses.size(), 5u);
   // In real time, as a camera would deliver it: frames the session is late
   // for are dropped.
@@ -75,7 +78,8 @@ TEST(LiveCalibrator, HandsFreeKeepsOneFramePerPauseAndMatchesTheBatchStages) {
   }
   for (size_t p = 0; p < pauses.size(); ++p) EXPECT_EQ(kept_per_pause[p], 1) << "pause " << p;
   ASSERT_TRUE(summary.camera);
-  ExpectFinalIsTheLiveEstimate(summary.session, summary.camera->camera.params, summary.camera->params_std_dev);
+  ExpectFinalIsTheLiveEstimate(summary.session, summary.camera->camera.params,
+                               summary.camera->params_std_dev);
 
   // The batch stages on the kept frames: the same corners, the same camera.
   testing::ExtractBoard(dir / "kept", dir / "batch.db", false);
@@ -83,7 +87,8 @@ TEST(LiveCalibrator, HandsFreeKeepsOneFramePerPauseAndMatchesTheBatchStages) {
   const CameraCalibrationResult batch = Calibrate((dir / "batch.db").string(), dir / "out_batch");
   ASSERT_EQ(live.camera.params.size(), batch.camera.params.size());
   for (size_t k = 0; k < live.camera.params.size(); ++k) {
-    EXPECT_NEAR(live.camera.params[k], batch.camera.params[k], 1e-9 * (1 + std::abs(batch.camera.params[k])));
+    EXPECT_NEAR(live.camera.params[k], batch.camera.params[k],
+                1e-9 * (1 + std::abs(batch.camera.params[k])));
   }
   EXPECT_EQ(live.num_points, batch.num_points);
   EXPECT_TRUE(fs::exists(dir / "out/calibration.yaml"));
@@ -97,7 +102,8 @@ TEST(LiveCalibrator, AHousingIsCalibratedFromTheKeptViews) {
   std::string yaml = testing::LiveTrajectoryYaml(6, 5, false);
   const std::string in_air = "housing: null";
   yaml.replace(yaml.find(in_air), in_air.size(),
-               "housing: {model: FLATPORT, params: [0.0174524, 0, 0.9998477, 0.012, 0.008, 1.0, 1.49, 1.334]}");
+               "housing: {model: FLATPORT, params: [0.0174524, 0, 0.9998477, 0.012, 0.008, 1.0, "
+               "1.49, 1.334]}");
   testing::RenderSet(dir, yaml);
   CalibrationReport air;
   air.camera = Camera::FromModelName("OPENCV", 505, 640, 480);
@@ -106,7 +112,8 @@ TEST(LiveCalibrator, AHousingIsCalibratedFromTheKeptViews) {
   LiveCalibratorOptions options = Options(dir, (dir / "set/images").string());
   options.live.source.realtime = false;
   options.input_calibration = (dir / "air/calibration.yaml").string();
-  options.housing = Housing::FromName("FLATPORT", {0, 0, 1, 0.005, 0.008, 1.0, 1.49, 1.334}, "test");
+  options.housing =
+      Housing::FromName("FLATPORT", {0, 0, 1, 0.005, 0.008, 1.0, 1.49, 1.334}, "test");
   const LiveCalibratorSummary summary = RunLiveCalibrator(options, NoProgress());
   EXPECT_EQ(summary.session.kept, 5);
   ASSERT_TRUE(summary.calibrated && summary.housing);
@@ -118,7 +125,8 @@ TEST(LiveCalibrator, AHousingIsCalibratedFromTheKeptViews) {
   const std::vector<double> truth = {0.0174524, 0, 0.9998477, 0.012};
   for (int k = 0; k < 4; ++k) {
     EXPECT_GT(sigma[k], 0) << k;
-    EXPECT_LT(std::abs(p[k] - truth[k]), 5 * sigma[k] + 1e-6) << "parameter " << k << ": " << p[k] << " ± " << sigma[k];
+    EXPECT_LT(std::abs(p[k] - truth[k]), 5 * sigma[k] + 1e-6)
+        << "parameter " << k << ": " << p[k] << " ± " << sigma[k];
   }
 }
 
@@ -165,14 +173,17 @@ TEST(LiveCalibrator, ASecondSessionOnTheSameDatabaseAtOnceIsRefused) {
         }
         session.Finish();
       });
-  EXPECT_NE(refusal.find("another live_calibrator session is using this database"), std::string::npos) << refusal;
+  EXPECT_NE(refusal.find("another live_calibrator session is using this database"),
+            std::string::npos)
+      << refusal;
   EXPECT_EQ(first.session.end_reason, "finish requested");
   EXPECT_FALSE(fs::exists(dir / "kept2"));
 }
 
 TEST(LiveCalibrator, AMissingDeviceOrFileIsAClearError) {
   const testing::TempDir dir;
-  for (const std::string& source : std::vector<std::string>{"/dev/video97", (dir / "no_such.avi").string()}) {
+  for (const std::string& source :
+       std::vector<std::string>{"/dev/video97", (dir / "no_such.avi").string()}) {
     try {
       RunLiveCalibrator(Options(dir, source), NoProgress());
       ADD_FAILURE() << source << " accepted";
@@ -204,7 +215,8 @@ TEST(LiveCalibrator, FramesOfAnotherSizeAreSkippedAndCtrlCKeepsTheViews) {
   std::thread watcher;
   const auto on_start = [&](LiveSession& session, const std::string&) {
     watcher = std::thread([&session] {
-      while (session.Snapshot().kept.size() < 3) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      while (session.Snapshot().kept.size() < 3)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
       CancelFlag::Request();
     });
   };
@@ -240,7 +252,8 @@ TEST(LiveCalibrator, FramesOfAnotherSizeAreSkippedAndCtrlCKeepsTheViews) {
     RunLiveCalibrator(options, NoProgress());
     ADD_FAILURE() << "frames of another size for good were accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("changed size to 320x240 instead of 640x480"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("changed size to 320x240 instead of 640x480"),
+              std::string::npos)
         << e.what();
   }
   Database changed(options.database_path, Database::OpenMode::kReadOnly);

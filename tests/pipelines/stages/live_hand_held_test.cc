@@ -8,7 +8,6 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "colmap_ext/io/ground_truth.h"
-
 #include "pipelines/stages/live_calibrator.h"
 #include "tests/pipelines/stages/hand_held_video.h"
 #include "tests/pipelines/stages/live_test_setup.h"
@@ -41,7 +40,8 @@ std::vector<cv::Mat> ReadStills(const fs::path& folder) {
 
 // Distinct poses: views whose true corners lie, on average, at least twice
 // the session's novelty distance from those of every view chosen before.
-std::vector<cv::Mat> DistinctStills(const fs::path& set, const GroundTruth& truth, double novelty_px) {
+std::vector<cv::Mat> DistinctStills(const fs::path& set, const GroundTruth& truth,
+                                    double novelty_px) {
   std::vector<const ImageTruth*> chosen;
   std::vector<cv::Mat> stills;
   for (const FrameTruth& frame : truth.images) {
@@ -64,7 +64,8 @@ std::vector<cv::Mat> DistinctStills(const fs::path& set, const GroundTruth& trut
   return stills;
 }
 
-LiveCalibratorOptions PlayAsFolder(LiveCalibratorOptions options, const testing::HandHeldVideo& video) {
+LiveCalibratorOptions PlayAsFolder(LiveCalibratorOptions options,
+                                   const testing::HandHeldVideo& video) {
   options.live.source.folder_fps = video.fps;
   options.live.source.realtime = false;  // every frame, as fast as the session takes them
   options.calibrate_at_end = false;
@@ -73,7 +74,8 @@ LiveCalibratorOptions PlayAsFolder(LiveCalibratorOptions options, const testing:
 
 // Each hold: a view kept within it, or a note said within it (or on the
 // frame that ended it); nothing kept while the target moved.
-void ExpectEveryHoldKeptOrExplained(const LiveSummary& session, const testing::HandHeldVideo& video) {
+void ExpectEveryHoldKeptOrExplained(const LiveSummary& session,
+                                    const testing::HandHeldVideo& video) {
   const double frame_s = 1 / video.fps;
   int kept_holds = 0;
   for (size_t h = 0; h < video.holds.size(); ++h) {
@@ -88,13 +90,16 @@ void ExpectEveryHoldKeptOrExplained(const LiveSummary& session, const testing::H
     for (const LiveNote& note : session.notes) {
       if (within(note.time_s)) said += note.text + "; ";
     }
-    EXPECT_FALSE(said.empty()) << "hold " << h << " (" << start << "-" << end << " s) neither kept nor explained";
+    EXPECT_FALSE(said.empty()) << "hold " << h << " (" << start << "-" << end
+                               << " s) neither kept nor explained";
     if (!said.empty()) std::cout << "hold " << h << " not kept: " << said << "\n";
   }
   for (const KeptView& view : session.kept_views) {
     bool in_a_hold = false;
-    for (const auto& [start, end] : video.holds) in_a_hold = in_a_hold || (view.time_s >= start && view.time_s < end);
-    EXPECT_TRUE(in_a_hold) << view.name << " at " << view.time_s << " s was taken while the target moved";
+    for (const auto& [start, end] : video.holds)
+      in_a_hold = in_a_hold || (view.time_s >= start && view.time_s < end);
+    EXPECT_TRUE(in_a_hold) << view.name << " at " << view.time_s
+                           << " s was taken while the target moved";
   }
   const int n = static_cast<int>(video.holds.size());
   EXPECT_GE(kept_holds, n - 1) << "of " << n << " holds";
@@ -105,13 +110,14 @@ TEST(LiveHandHeld, RenderedViewsWithTremorBlurAndJpegAreKeptOrExplained) {
   const testing::TempDir dir;
   const GroundTruth truth = testing::RenderSet(dir, kStillsYaml);
   const LiveCalibratorOptions options = testing::LiveOptions(dir, (dir / "video").string());
-  const std::vector<cv::Mat> stills =
-      DistinctStills(dir / "set", truth, options.live.hands_free.novelty_fraction * std::hypot(640.0, 480.0));
+  const std::vector<cv::Mat> stills = DistinctStills(
+      dir / "set", truth, options.live.hands_free.novelty_fraction * std::hypot(640.0, 480.0));
   ASSERT_GE(stills.size(), 8u);
   testing::HandHeldVideoOptions hand;
   hand.tremor_px = 1.0;  // the top of a hand's range (the real video's: 0.15 px)
   const testing::HandHeldVideo video = WriteHandHeldVideo(stills, dir / "video", hand);
-  const LiveCalibratorSummary summary = RunLiveCalibrator(PlayAsFolder(options, video), NoProgress());
+  const LiveCalibratorSummary summary =
+      RunLiveCalibrator(PlayAsFolder(options, video), NoProgress());
   EXPECT_EQ(summary.session.end_reason, "the source ended");
   ExpectEveryHoldKeptOrExplained(summary.session, video);
 }
@@ -122,12 +128,14 @@ TEST(LiveHandHeld, AHandsFreeSessionFinishesItselfAtTheGoal) {
   const testing::TempDir dir;
   const GroundTruth truth = testing::RenderSet(dir, kStillsYaml);
   LiveCalibratorOptions options = testing::LiveOptions(dir, (dir / "video").string());
-  const std::vector<cv::Mat> stills =
-      DistinctStills(dir / "set", truth, options.live.hands_free.novelty_fraction * std::hypot(640.0, 480.0));
-  const testing::HandHeldVideo video = WriteHandHeldVideo(stills, dir / "video", testing::HandHeldVideoOptions());
+  const std::vector<cv::Mat> stills = DistinctStills(
+      dir / "set", truth, options.live.hands_free.novelty_fraction * std::hypot(640.0, 480.0));
+  const testing::HandHeldVideo video =
+      WriteHandHeldVideo(stills, dir / "video", testing::HandHeldVideoOptions());
   options.live.goal.auto_finish = true;
   options.live.goal.target_uncertainty_px = 0.12;
-  const LiveCalibratorSummary summary = RunLiveCalibrator(PlayAsFolder(options, video), NoProgress());
+  const LiveCalibratorSummary summary =
+      RunLiveCalibrator(PlayAsFolder(options, video), NoProgress());
   EXPECT_EQ(summary.session.end_reason, "the goal was met (--Live.auto_finish)");
   ASSERT_TRUE(summary.session.estimate && summary.session.estimate->uncertainty.determined);
   EXPECT_LE(summary.session.estimate->uncertainty.mean_px, 0.12);
@@ -145,7 +153,8 @@ TEST(LiveHandHeld, RealViewsHeldByHandAreKeptOrExplained) {
   const testing::TempDir dir;
   const testing::HandHeldVideo video =
       WriteHandHeldVideo(ReadStills(air), dir / "video", testing::HandHeldVideoOptions());
-  LiveCalibratorOptions options = PlayAsFolder(testing::LiveOptions(dir, (dir / "video").string()), video);
+  LiveCalibratorOptions options =
+      PlayAsFolder(testing::LiveOptions(dir, (dir / "video").string()), video);
   options.live.detector.chessboard.cols = 8;
   options.live.estimator.guidance.distance_min_m = 0.3;
   options.live.estimator.guidance.distance_max_m = 1.5;

@@ -2,9 +2,8 @@
 // from a running live_calibrator, its stream moves on, its capture and undo
 // buttons work; a screenshot is kept as an artefact. Also the page's HTTP
 // endpoints, a port already in use, and Ctrl-C on the real process.
-#include <gtest/gtest.h>
-
 #include <arpa/inet.h>
+#include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -12,9 +11,9 @@
 #include <algorithm>
 #include <csignal>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
 #include <future>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <regex>
 #include <thread>
 
@@ -70,9 +69,11 @@ std::string RawRequestStatus(int port, const std::string& request) {
 // Headless chromium as the machine's probe runs it, with a fresh profile.
 std::string Chromium(const testing::TempDir& dir, const std::string& what, const std::string& url) {
   return "timeout 90 chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
-         "--disable-background-networking --disable-component-update --disable-sync --user-data-dir=" +
+         "--disable-background-networking --disable-component-update --disable-sync "
+         "--user-data-dir=" +
          (dir / ("profile_" + std::to_string(std::hash<std::string>()(what)))).string() +
-         " --window-size=1400,1000 --virtual-time-budget=15000 " + what + " '" + url + "' 2>/dev/null";
+         " --window-size=1400,1000 --virtual-time-budget=15000 " + what + " '" + url +
+         "' 2>/dev/null";
 }
 
 TEST(LivePage, ABrowserSeesTheStreamAndItsButtonsWork) {
@@ -84,10 +85,11 @@ TEST(LivePage, ABrowserSeesTheStreamAndItsButtonsWork) {
   std::promise<std::string> url_promise;
   LiveSession* session = nullptr;
   auto run = std::async(std::launch::async, [&] {
-    return RunLiveCalibrator(Options(dir), NoProgress(), [&](LiveSession& s, const std::string& url) {
-      session = &s;
-      url_promise.set_value(url);
-    });
+    return RunLiveCalibrator(Options(dir), NoProgress(),
+                             [&](LiveSession& s, const std::string& url) {
+                               session = &s;
+                               url_promise.set_value(url);
+                             });
   });
   const std::string url = url_promise.get_future().get();
   ASSERT_FALSE(url.empty());
@@ -99,10 +101,12 @@ TEST(LivePage, ABrowserSeesTheStreamAndItsButtonsWork) {
   httplib::Client client("127.0.0.1", std::stoi(port[1]));
 
   // The page presses its own buttons (?selftest=1) and writes what happened.
-  const testing::CommandResult dom = testing::RunCommand(Chromium(dir, "--dump-dom", url + "?selftest=1"));
+  const testing::CommandResult dom =
+      testing::RunCommand(Chromium(dir, "--dump-dom", url + "?selftest=1"));
   EXPECT_NE(dom.output.find("selftest: passed"), std::string::npos) << dom.output.substr(0, 4000);
   EXPECT_NE(dom.output.find("capture: "), std::string::npos);
-  EXPECT_NE(dom.output.find("layout: no text overflows its box"), std::string::npos) << dom.output.substr(0, 4000);
+  EXPECT_NE(dom.output.find("layout: no text overflows its box"), std::string::npos)
+      << dom.output.substr(0, 4000);
 
   // A screenshot, kept beside the test binary for a person to look at.
   const fs::path artefact = fs::current_path() / "artifacts/live_page.png";
@@ -141,17 +145,21 @@ TEST(LivePage, ABrowserSeesTheStreamAndItsButtonsWork) {
   // The guard. A command from another origin, a foreign Host (DNS
   // rebinding), a page another site serves: refused, the session goes on.
   const int live_port = std::stoi(port[1]);
-  EXPECT_EQ(RawRequestStatus(live_port, "POST /finish HTTP/1.1\r\nHost: 127.0.0.1:" + std::string(port[1]) +
-                                            "\r\nOrigin: http://evil.example\r\n\r\n"),
+  EXPECT_EQ(RawRequestStatus(live_port,
+                             "POST /finish HTTP/1.1\r\nHost: 127.0.0.1:" + std::string(port[1]) +
+                                 "\r\nOrigin: http://evil.example\r\n\r\n"),
             "HTTP/1.1 403 Forbidden");
-  EXPECT_EQ(RawRequestStatus(live_port, "GET /state.json HTTP/1.1\r\nHost: evil.example:" + std::string(port[1]) +
-                                            "\r\n\r\n"),
+  EXPECT_EQ(RawRequestStatus(live_port, "GET /state.json HTTP/1.1\r\nHost: evil.example:" +
+                                            std::string(port[1]) + "\r\n\r\n"),
             "HTTP/1.1 403 Forbidden");
   const fs::path evil = dir / "evil.html";
-  std::ofstream(evil) << "<!DOCTYPE html><html><body><p id=r>sent</p><script>fetch('http://127.0.0.1:" << port[1]
-                      << "/finish', {method: 'POST', mode: 'no-cors'}).catch(() => {});"
-                         "fetch('http://127.0.0.1:" << port[1] << "/remove?name=live_0001.png', {method: 'POST', "
-                         "mode: 'no-cors'}).catch(() => {});</script></body></html>";
+  std::ofstream(evil)
+      << "<!DOCTYPE html><html><body><p id=r>sent</p><script>fetch('http://127.0.0.1:" << port[1]
+      << "/finish', {method: 'POST', mode: 'no-cors'}).catch(() => {});"
+         "fetch('http://127.0.0.1:"
+      << port[1]
+      << "/remove?name=live_0001.png', {method: 'POST', "
+         "mode: 'no-cors'}).catch(() => {});</script></body></html>";
   testing::RunCommand(Chromium(dir, "--dump-dom", "file://" + evil.string()));
   const auto after = client.Get("/state.json");
   ASSERT_TRUE(after && after->status == 200);
@@ -160,12 +168,14 @@ TEST(LivePage, ABrowserSeesTheStreamAndItsButtonsWork) {
   // no name ever parsed as HTML.
   const auto page = client.Get("/");
   ASSERT_TRUE(page && page->status == 200);
-  EXPECT_NE(page->get_header_value("Content-Security-Policy").find("script-src 'self' 'nonce-"), std::string::npos);
+  EXPECT_NE(page->get_header_value("Content-Security-Policy").find("script-src 'self' 'nonce-"),
+            std::string::npos);
   EXPECT_EQ(page->body.find("innerHTML"), std::string::npos);
 
   // As `curl -X POST URL/finish` sends it: answered at once, and done.
-  EXPECT_EQ(RawRequestStatus(std::stoi(port[1]), "POST /finish HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n"),
-            "HTTP/1.1 200 OK");
+  EXPECT_EQ(
+      RawRequestStatus(std::stoi(port[1]), "POST /finish HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n"),
+      "HTTP/1.1 200 OK");
   const LiveCalibratorSummary summary = run.get();
   EXPECT_EQ(summary.session.end_reason, "finish requested");
   Database database(dir / "live.db", Database::OpenMode::kReadOnly);
@@ -182,7 +192,8 @@ TEST(LivePage, AHostileImageNameShowsAsText) {
   const testing::TempDir dir;
   testing::RenderSet(dir, kTrajectoryYaml);
   std::vector<fs::path> frames;
-  for (const fs::directory_entry& entry : fs::directory_iterator(dir / "set/images")) frames.push_back(entry.path());
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir / "set/images"))
+    frames.push_back(entry.path());
   std::sort(frames.begin(), frames.end());
   const int held = testing::TrajectoryPauses(dir / "set/trajectory.yaml").at(0).first;
   const std::string hostile = "<img src=x onerror=document.title=7>.png";
@@ -191,8 +202,9 @@ TEST(LivePage, AHostileImageNameShowsAsText) {
   testing::ExtractBoard(dir / "kept", dir / "live.db", false);
   std::promise<std::string> url_promise;
   auto run = std::async(std::launch::async, [&] {
-    return RunLiveCalibrator(Options(dir), NoProgress(),
-                             [&](LiveSession&, const std::string& url) { url_promise.set_value(url); });
+    return RunLiveCalibrator(Options(dir), NoProgress(), [&](LiveSession&, const std::string& url) {
+      url_promise.set_value(url);
+    });
   });
   const std::string url = url_promise.get_future().get();
   ASSERT_FALSE(url.empty());
@@ -225,8 +237,9 @@ TEST(LivePage, ARigShowsBothCamerasAndTheRelativePose) {
   options.calibrate_at_end = true;
   std::promise<std::string> url_promise;
   auto run = std::async(std::launch::async, [&] {
-    return RunLiveCalibrator(options, NoProgress(),
-                             [&](LiveSession&, const std::string& url) { url_promise.set_value(url); });
+    return RunLiveCalibrator(options, NoProgress(), [&](LiveSession&, const std::string& url) {
+      url_promise.set_value(url);
+    });
   });
   const std::string url = url_promise.get_future().get();
   std::smatch port;
@@ -237,7 +250,8 @@ TEST(LivePage, ARigShowsBothCamerasAndTheRelativePose) {
     const auto state = client.Get("/state.json");
     ASSERT_TRUE(state && state->status == 200);
     estimate = nlohmann::json::parse(state->body)["estimate"];
-    if (estimate.is_object() && estimate.contains("rig") && estimate["rig"]["solved"] == true) break;
+    if (estimate.is_object() && estimate.contains("rig") && estimate["rig"]["solved"] == true)
+      break;
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   ASSERT_TRUE(estimate.is_object() && estimate.contains("rig")) << estimate.dump();
@@ -252,7 +266,8 @@ TEST(LivePage, ARigShowsBothCamerasAndTheRelativePose) {
   });
   const size_t start = stream.find("\xff\xd8");
   ASSERT_NE(start, std::string::npos);
-  const cv::Mat frame = cv::imdecode(std::vector<uint8_t>(stream.begin() + start, stream.end()), cv::IMREAD_COLOR);
+  const cv::Mat frame =
+      cv::imdecode(std::vector<uint8_t>(stream.begin() + start, stream.end()), cv::IMREAD_COLOR);
   ASSERT_FALSE(frame.empty());
   EXPECT_NEAR(frame.cols, 2 * frame.rows * 640 / 480, 2) << "not two 640 x 480 frames side by side";
   if (testing::RunCommand("command -v chromium").exit_code == 0) {
@@ -270,7 +285,8 @@ TEST(LivePage, ARigShowsBothCamerasAndTheRelativePose) {
     final_status = nlohmann::json::parse(state->body)["final"].get<std::string>();
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
-  EXPECT_NE(final_status.find("reports in " + (dir / "out").string()), std::string::npos) << final_status;
+  EXPECT_NE(final_status.find("reports in " + (dir / "out").string()), std::string::npos)
+      << final_status;
   EXPECT_NE(final_status.find("baseline"), std::string::npos) << final_status;
   const LiveCalibratorSummary summary = run.get();
   EXPECT_TRUE(summary.calibrated && summary.stereo);
@@ -282,24 +298,28 @@ TEST(LivePage, CtrlCOnTheProcessKeepsEveryViewItReported) {
   const testing::TempDir dir;
   testing::RenderSet(dir, kTrajectoryYaml);
   const std::string log = (dir / "log.txt").string();
-  const std::string command = testing::PortcalBinary() + " live_calibrator --source " + (dir / "set/images").string() +
-                              " --Live.fps 4 --Live.headless 1 --database_path " + (dir / "live.db").string() +
-                              " --image_path " + (dir / "kept").string() + " --output_path " +
-                              (dir / "out").string() +
-                              " --Target.cols 9 --Target.rows 6 --Target.square_size 0.03 "
-                              "--ImageReader.camera_model OPENCV --Live.distance_range 0.35,0.8";
+  const std::string command =
+      testing::PortcalBinary() + " live_calibrator --source " + (dir / "set/images").string() +
+      " --Live.fps 4 --Live.headless 1 --database_path " + (dir / "live.db").string() +
+      " --image_path " + (dir / "kept").string() + " --output_path " + (dir / "out").string() +
+      " --Target.cols 9 --Target.rows 6 --Target.square_size 0.03 "
+      "--ImageReader.camera_model OPENCV --Live.distance_range 0.35,0.8";
   // In the background (its own output away from RunCommand's pipe, which
   // would wait for it); SIGINT once the second view is kept.
-  testing::RunCommand("(" + command + " > " + log + " 2>&1; echo exit=$? >> " + log + ") > /dev/null 2>&1 &");
+  testing::RunCommand("(" + command + " > " + log + " 2>&1; echo exit=$? >> " + log +
+                      ") > /dev/null 2>&1 &");
   int kept = 0;
   for (int wait = 0; wait < 300 && kept < 2; ++wait) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     const std::string text = testing::ReadFileToString(log);
     kept = 0;
-    for (size_t at = text.find("live: kept "); at != std::string::npos; at = text.find("live: kept ", at + 1)) ++kept;
+    for (size_t at = text.find("live: kept "); at != std::string::npos;
+         at = text.find("live: kept ", at + 1))
+      ++kept;
   }
   ASSERT_GE(kept, 2) << testing::ReadFileToString(log);
-  testing::RunCommand("pkill -INT -f 'live_calibrator --source " + (dir / "set/images").string() + "'");
+  testing::RunCommand("pkill -INT -f 'live_calibrator --source " + (dir / "set/images").string() +
+                      "'");
   std::string text;
   for (int wait = 0; wait < 200 && text.find("exit=") == std::string::npos; ++wait) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
@@ -307,10 +327,13 @@ TEST(LivePage, CtrlCOnTheProcessKeepsEveryViewItReported) {
   }
   EXPECT_NE(text.find("exit=130"), std::string::npos) << text;
   size_t reported = 0;
-  for (size_t at = text.find("live: kept "); at != std::string::npos; at = text.find("live: kept ", at + 1)) ++reported;
+  for (size_t at = text.find("live: kept "); at != std::string::npos;
+       at = text.find("live: kept ", at + 1))
+    ++reported;
   Database database(dir / "live.db", Database::OpenMode::kReadOnly);
   EXPECT_EQ(static_cast<size_t>(database.NumImages()), reported);
-  for (const DatabaseImage& image : database.ReadAllImages()) EXPECT_TRUE(fs::exists(dir / "kept" / image.name));
+  for (const DatabaseImage& image : database.ReadAllImages())
+    EXPECT_TRUE(fs::exists(dir / "kept" / image.name));
 }
 
 }  // namespace

@@ -32,7 +32,8 @@ StereoCalibrationResult BatchStereo(const testing::TempDir& dir) {
   for (const int camera : {1, 2}) {
     CameraCalibratorOptions calibrate;
     calibrate.database_path = batch_database;
-    calibrate.camera_id = database.ReadImageWithName("cam" + std::to_string(camera) + "/live_0001.png")->camera_id;
+    calibrate.camera_id =
+        database.ReadImageWithName("cam" + std::to_string(camera) + "/live_0001.png")->camera_id;
     calibrate.output_path = (dir / ("batch_cam" + std::to_string(camera))).string();
     RunCameraCalibrator(calibrate, NoProgress());
     (camera == 1 ? stereo.camera1_id : stereo.camera2_id) = static_cast<int>(calibrate.camera_id);
@@ -49,7 +50,8 @@ TEST(LiveStereo, TwoVideosInRealTimeKeepOnePairPerPauseAndCalibrateTheRig) {
   const testing::TempDir dir;
   const GroundTruth truth = testing::RenderSet(dir, testing::LiveStereoTrajectoryYaml(11, 4, true));
   ASSERT_TRUE(truth.stereo.has_value());
-  const std::vector<std::pair<int, int>> pauses = testing::TrajectoryPauses(dir / "set/trajectory.yaml");
+  const std::vector<std::pair<int, int>> pauses =
+      testing::TrajectoryPauses(dir / "set/trajectory.yaml");
   ASSERT_EQ(pauses.size(), 4u);
   LiveCalibratorOptions options = testing::LiveOptions(dir, (dir / "set/trajectory.avi").string());
   options.live.source2 = (dir / "set/trajectory_cam2.avi").string();
@@ -79,12 +81,14 @@ TEST(LiveStereo, TwoVideosInRealTimeKeepOnePairPerPauseAndCalibrateTheRig) {
   // Each camera's final calibration is its last live estimate, within 0.1σ.
   ASSERT_TRUE(summary.session.estimate && summary.session.estimate->camera2);
   const std::vector<std::pair<const LiveEstimate*, const CameraCalibrationResult*>> cameras = {
-      {summary.session.estimate.get(), &*summary.camera}, {summary.session.estimate->camera2.get(), &*summary.camera2}};
+      {summary.session.estimate.get(), &*summary.camera},
+      {summary.session.estimate->camera2.get(), &*summary.camera2}};
   for (const auto& [estimate, final_camera] : cameras) {
     ASSERT_TRUE(estimate->solved);
     ASSERT_EQ(estimate->values.size(), final_camera->camera.params.size());
     for (size_t k = 0; k < estimate->values.size(); ++k) {
-      EXPECT_LE(std::abs(estimate->values[k] - final_camera->camera.params[k]), 0.1 * final_camera->params_std_dev[k])
+      EXPECT_LE(std::abs(estimate->values[k] - final_camera->camera.params[k]),
+                0.1 * final_camera->params_std_dev[k])
           << estimate->names[k];
     }
   }
@@ -96,13 +100,16 @@ TEST(LiveStereo, TwoVideosInRealTimeKeepOnePairPerPauseAndCalibrateTheRig) {
   EXPECT_NEAR(live.cam2_from_cam1.rotation.angularDistance(batch.cam2_from_cam1.rotation), 0, 1e-9);
 
   // And the truth, within its standard deviations (4 pairs, 0.1 m baseline).
-  const Eigen::Vector3d error = live.cam2_from_cam1.translation - truth.stereo->cam2_from_cam1.translation;
-  std::printf("rig from %d pairs: translation error (%.4f, %.4f, %.4f) mm, sigma (%.4f, %.4f, %.4f) mm; "
-              "rotation error %.4f deg\n",
-              static_cast<int>(summary.session.kept), 1e3 * error.x(), 1e3 * error.y(), 1e3 * error.z(),
-              1e3 * live.translation_std_dev.x(), 1e3 * live.translation_std_dev.y(),
-              1e3 * live.translation_std_dev.z(),
-              live.cam2_from_cam1.rotation.angularDistance(truth.stereo->cam2_from_cam1.rotation) * 180 / M_PI);
+  const Eigen::Vector3d error =
+      live.cam2_from_cam1.translation - truth.stereo->cam2_from_cam1.translation;
+  std::printf(
+      "rig from %d pairs: translation error (%.4f, %.4f, %.4f) mm, sigma (%.4f, %.4f, %.4f) mm; "
+      "rotation error %.4f deg\n",
+      static_cast<int>(summary.session.kept), 1e3 * error.x(), 1e3 * error.y(), 1e3 * error.z(),
+      1e3 * live.translation_std_dev.x(), 1e3 * live.translation_std_dev.y(),
+      1e3 * live.translation_std_dev.z(),
+      live.cam2_from_cam1.rotation.angularDistance(truth.stereo->cam2_from_cam1.rotation) * 180 /
+          M_PI);
   for (int k = 0; k < 3; ++k) {
     EXPECT_GT(live.translation_std_dev[k], 0);
     EXPECT_LT(std::abs(error[k]), 5 * live.translation_std_dev[k] + 1e-5)
@@ -119,9 +126,12 @@ TEST(LiveStereo, ARigBehindTwoFlatPortsIsCalibrated) {
   std::string yaml = testing::LiveStereoTrajectoryYaml(11, 4, false);
   const std::string in_air = "housing: null";
   yaml.replace(yaml.find(in_air), in_air.size(),
-               "housing: {model: FLATPORT, params: [0.0174524, 0, 0.9998477, 0.012, 0.008, 1.0, 1.49, 1.334]}");
-  yaml += "  housing2: {model: FLATPORT, params: [-0.012198631, 0.008699023, 0.999887754, 0.015, 0.008, 1.0, 1.49, "
-          "1.334]}\n";
+               "housing: {model: FLATPORT, params: [0.0174524, 0, 0.9998477, 0.012, 0.008, 1.0, "
+               "1.49, 1.334]}");
+  yaml +=
+      "  housing2: {model: FLATPORT, params: [-0.012198631, 0.008699023, 0.999887754, 0.015, "
+      "0.008, 1.0, 1.49, "
+      "1.334]}\n";
   const GroundTruth truth = testing::RenderSet(dir, yaml);
   ASSERT_TRUE(truth.stereo && truth.stereo->housing2);
   for (const int camera : {1, 2}) {
@@ -134,7 +144,8 @@ TEST(LiveStereo, ARigBehindTwoFlatPortsIsCalibrated) {
   options.live.source.realtime = false;
   options.input_calibration = (dir / "air1/calibration.yaml").string();
   options.input_calibration2 = (dir / "air2/calibration.yaml").string();
-  options.housing = Housing::FromName("FLATPORT", {0, 0, 1, 0.005, 0.008, 1.0, 1.49, 1.334}, "test");
+  options.housing =
+      Housing::FromName("FLATPORT", {0, 0, 1, 0.005, 0.008, 1.0, 1.49, 1.334}, "test");
   // Two sessions: the second goes on from the first's two pairs (read back
   // by the name their images share), its frames joining the same cameras.
   options.live.max_views = 2;
@@ -153,9 +164,11 @@ TEST(LiveStereo, ARigBehindTwoFlatPortsIsCalibrated) {
   for (const auto& [result, port] : {std::pair{&*summary.housing, &*truth.housing},
                                      std::pair{&*summary.housing2, &*truth.stereo->housing2}}) {
     for (int k = 0; k < 4; ++k) {  // the normal and the distance
-      const double sigma = result->housing_std_dev[k], error = result->housing.params[k] - port->params[k];
+      const double sigma = result->housing_std_dev[k],
+                   error = result->housing.params[k] - port->params[k];
       EXPECT_GT(sigma, 0) << k;
-      EXPECT_LT(std::abs(error), 5 * sigma + 1e-6) << "parameter " << k << ": error " << error << ", sigma " << sigma;
+      EXPECT_LT(std::abs(error), 5 * sigma + 1e-6)
+          << "parameter " << k << ": error " << error << ", sigma " << sigma;
     }
   }
   // The relative pose through the two ports, held: its own deviations leave
@@ -173,8 +186,10 @@ TEST(FramePairSource, FramesPairByTimeNotByOrder) {
   const cv::Mat image(48, 64, CV_8UC1, cv::Scalar(128));
   fs::create_directories(dir / "fast");
   fs::create_directories(dir / "slow");
-  for (int k = 0; k < 10; ++k) cv::imwrite((dir / ("fast/f" + std::to_string(k) + ".png")).string(), image);
-  for (int k = 0; k < 5; ++k) cv::imwrite((dir / ("slow/s" + std::to_string(k) + ".png")).string(), image);
+  for (int k = 0; k < 10; ++k)
+    cv::imwrite((dir / ("fast/f" + std::to_string(k) + ".png")).string(), image);
+  for (int k = 0; k < 5; ++k)
+    cv::imwrite((dir / ("slow/s" + std::to_string(k) + ".png")).string(), image);
   FrameSourceOptions fast, slow;
   fast.source = (dir / "fast").string();
   fast.folder_fps = 10;
@@ -189,7 +204,8 @@ TEST(FramePairSource, FramesPairByTimeNotByOrder) {
     indices.emplace_back(pair.first.index, pair.second.index);
     EXPECT_LE(pair.offset_s, 0.01);
   }
-  const std::vector<std::pair<int64_t, int64_t>> expected = {{0, 0}, {2, 1}, {4, 2}, {6, 3}, {8, 4}};
+  const std::vector<std::pair<int64_t, int64_t>> expected = {
+      {0, 0}, {2, 1}, {4, 2}, {6, 3}, {8, 4}};
   EXPECT_EQ(indices, expected);
   EXPECT_EQ(pairs.dropped(), 4);  // 1, 3, 5, 7 of the fast one (9 is left when the slow one ends)
   // The default tolerance: half the slower source's frame interval.

@@ -34,13 +34,16 @@ trajectory: {fps: 10, pause_seconds: 1.2, move_seconds: 1.0, exposure: 0.03, pau
 inline std::string LiveStereoTrajectoryYaml(int seed, int pauses, bool video) {
   return LiveTrajectoryYaml(seed, pauses, video) +
          "stereo:\n"
-         "  cam2_from_cam1: {rotation_axis_angle_deg: [0, 1, 0, 4], translation: [-0.1, 0.002, 0.004]}\n"
-         "  camera2: {model: OPENCV, width: 640, height: 480, params: [511, 506, 317.5, 243.0, -0.19, 0.05, "
+         "  cam2_from_cam1: {rotation_axis_angle_deg: [0, 1, 0, 4], translation: [-0.1, 0.002, "
+         "0.004]}\n"
+         "  camera2: {model: OPENCV, width: 640, height: 480, params: [511, 506, 317.5, 243.0, "
+         "-0.19, 0.05, "
          "-0.0009, 0.0011]}\n";
 }
 
 // Each pause's first and last frame, from the set's trajectory.yaml.
-inline std::vector<std::pair<int, int>> TrajectoryPauses(const std::filesystem::path& trajectory_yaml) {
+inline std::vector<std::pair<int, int>> TrajectoryPauses(
+    const std::filesystem::path& trajectory_yaml) {
   std::vector<std::pair<int, int>> pauses;
   for (const YAML::Node& pause : YAML::LoadFile(trajectory_yaml.string())["pauses"]) {
     pauses.emplace_back(pause["first_frame"].as<int>(), pause["last_frame"].as<int>());
@@ -52,8 +55,8 @@ inline std::vector<std::pair<int, int>> TrajectoryPauses(const std::filesystem::
 // and a board of `cols` x 6 corners of `square_size_m`): one camera for all
 // images, or one per folder (a rig's cam1/ and cam2/).
 inline void ExtractBoard(const std::filesystem::path& images, const std::filesystem::path& database,
-                         bool camera_per_folder, const std::string& camera_model = "OPENCV", int cols = 9,
-                         double square_size_m = 0.03) {
+                         bool camera_per_folder, const std::string& camera_model = "OPENCV",
+                         int cols = 9, double square_size_m = 0.03) {
   TargetExtractorOptions extract;
   extract.database_path = database.string();
   extract.image_path = images.string();

@@ -24,13 +24,14 @@ namespace {
 
 // Seven views of the two-face ArUco target, extracted and matched.
 fs::path MatchedDatabase(const testing::TempDir& dir) {
-  testing::RenderSet(dir, std::string("name: mapper_list\nnum_images: 7\nseed: 5\n") +
-                              "camera: {model: SIMPLE_RADIAL, width: 640, height: 360, params: [500.0, 320.0, "
-                              "180.0, -0.02]}\nhousing: null\n" +
-                              testing::kTwoFaceTargetYaml +
-                              "poses: {distance: [0.45, 0.9], tilt_max_deg: 35, roll_max_deg: 60, visibility: "
-                              "markers, border_margin_px: 10, max_view_angle_deg: 60}\n"
-                              "render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}\n");
+  testing::RenderSet(
+      dir, std::string("name: mapper_list\nnum_images: 7\nseed: 5\n") +
+               "camera: {model: SIMPLE_RADIAL, width: 640, height: 360, params: [500.0, 320.0, "
+               "180.0, -0.02]}\nhousing: null\n" +
+               testing::kTwoFaceTargetYaml +
+               "poses: {distance: [0.45, 0.9], tilt_max_deg: 35, roll_max_deg: 60, visibility: "
+               "markers, border_margin_px: 10, max_view_angle_deg: 60}\n"
+               "render: {spp: 2, noise_sigma: 1.0, white: 220, black: 30, background: 110}\n");
   FeatureExtractorOptions extract;
   extract.database_path = (dir / "db.db").string();
   extract.image_path = (dir / "set" / "images").string();
@@ -60,12 +61,14 @@ TEST(RefractiveMapper, ImageListMapsOnlyTheListedImages) {
     list << "\n";  // blank lines and surrounding blanks are ignored
     for (const std::string& name : listed) list << "  " << name << " \n";
   }
-  const RefractiveMapperSummary summary = RunRefractiveMapper(MapperOptions(dir, database), NoProgress());
+  const RefractiveMapperSummary summary =
+      RunRefractiveMapper(MapperOptions(dir, database), NoProgress());
   EXPECT_EQ(summary.num_images, 4);
   ASSERT_EQ(summary.num_models, 1);
   const SparseModel model = ReadSparseModel(summary.model_paths[0]);
   EXPECT_EQ(model.images.size(), 4u);
-  for (const auto& [id, image] : model.images) EXPECT_EQ(listed.count(image.name), 1u) << image.name;
+  for (const auto& [id, image] : model.images)
+    EXPECT_EQ(listed.count(image.name), 1u) << image.name;
 }
 
 // The auto-calibrator's next start excludes the pair the previous start's
@@ -104,7 +107,8 @@ TEST(RefractiveMapper, ABadImageListIsNamed) {
     }
     EXPECT_FALSE(fs::exists(dir / "sparse"));
   };
-  expect_error("img_001.png\nnope.png\n", options.image_list_path + ":2: image 'nope.png' is not in");
+  expect_error("img_001.png\nnope.png\n",
+               options.image_list_path + ":2: image 'nope.png' is not in");
   expect_error("\n \n", options.image_list_path + ": no image names");
   expect_error("missing", options.image_list_path + ": cannot read the image list");
 }
@@ -116,12 +120,14 @@ TEST(RefractiveMapper, TheSubsetSelectorsListMapsAsOneModel) {
   select.database_path = database.string();
   select.output_path = (dir / "list.txt").string();
   select.subset.num_images = 4;
-  const CalibrationSubsetSelectorSummary selected = RunCalibrationSubsetSelector(select, NoProgress());
+  const CalibrationSubsetSelectorSummary selected =
+      RunCalibrationSubsetSelector(select, NoProgress());
   EXPECT_EQ(selected.num_images, 7);
   EXPECT_EQ(selected.num_breaks, 0);
   EXPECT_GE(selected.num_selected, 4);
   EXPECT_LT(selected.num_selected, 7);
-  const RefractiveMapperSummary mapped = RunRefractiveMapper(MapperOptions(dir, database), NoProgress());
+  const RefractiveMapperSummary mapped =
+      RunRefractiveMapper(MapperOptions(dir, database), NoProgress());
   EXPECT_EQ(mapped.num_models, 1);
   EXPECT_EQ(mapped.num_registered, selected.num_selected);
 }

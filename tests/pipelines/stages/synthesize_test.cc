@@ -2,6 +2,8 @@
 // found in the images sit at the ground-truth pixels; the ground truth's
 // pixels are the forward projections of its 3-D points), deterministic
 // output, every target kind, stereo, survey and the underwater effects.
+#include "pipelines/stages/synthesize.h"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -12,7 +14,6 @@
 
 #include "colmap_ext/io/ground_truth.h"
 #include "colmap_ext/util/error.h"
-#include "pipelines/stages/synthesize.h"
 #include "pipelines/target/corner_refinement.h"
 #include "tests/test_utils.h"
 
@@ -93,9 +94,13 @@ class SynthesizeHousings : public ::testing::TestWithParam<std::string> {};
 TEST_P(SynthesizeHousings, CornersFoundInTheImagesSitAtTheGroundTruthPixels) {
   testing::TempDir dir;
   const std::string housing = GetParam() == "air" ? "housing: null\n"
-      : GetParam() == "flat" ? "housing:\n  model: FLATPORT\n  params: [0.08715574, 0.0, 0.9961947, 0.02, 0.014, 1.0, 1.473, 1.334]\n"
-                             : "housing:\n  model: DOMEPORT\n  params: [0.01, 0.006, 0.002, 0.05, 0.006, 1.0, 1.473, 1.334]\n";
-  const fs::path config = WriteConfig(dir, GetParam(), std::string(kCamera) + housing + kChessboard, 6);
+                              : GetParam() == "flat"
+                                  ? "housing:\n  model: FLATPORT\n  params: [0.08715574, 0.0, "
+                                    "0.9961947, 0.02, 0.014, 1.0, 1.473, 1.334]\n"
+                                  : "housing:\n  model: DOMEPORT\n  params: [0.01, 0.006, 0.002, "
+                                    "0.05, 0.006, 1.0, 1.473, 1.334]\n";
+  const fs::path config =
+      WriteConfig(dir, GetParam(), std::string(kCamera) + housing + kChessboard, 6);
   const GroundTruth truth = Synthesize(config, dir / "set");
   ASSERT_EQ(truth.images.size(), 6u);
   const std::vector<double> errors = CornerErrors(dir / "set", truth);
@@ -129,7 +134,8 @@ housing: null
   Synthesize(config, dir / "b");
   Synthesize(config, dir / "c", 99);
   for (const char* file : {"ground_truth.yaml", "images/img_001.png", "images/img_003.png"}) {
-    EXPECT_EQ(testing::ReadFileToString(dir / "a" / file), testing::ReadFileToString(dir / "b" / file))
+    EXPECT_EQ(testing::ReadFileToString(dir / "a" / file),
+              testing::ReadFileToString(dir / "b" / file))
         << file;
   }
   EXPECT_NE(testing::ReadFileToString(dir / "a/images/img_001.png"),
@@ -166,7 +172,8 @@ stereo:
     rotation_axis_angle_deg: [0.0, 1.0, 0.0, 3.0]
     translation: [-0.1, 0.0, 0.005]
 )";
-  const fs::path config = WriteConfig(dir, "stereo", std::string(kCamera) + stereo + kChessboard, 3);
+  const fs::path config =
+      WriteConfig(dir, "stereo", std::string(kCamera) + stereo + kChessboard, 3);
   const GroundTruth truth = Synthesize(config, dir / "set");
   ASSERT_TRUE(truth.stereo.has_value());
   for (const FrameTruth& frame : truth.images) {
@@ -206,7 +213,8 @@ void ExpectMarkersDetected(const fs::path& dir, const GroundTruth& truth) {
       // marker, so the centre moves less (0.3-0.4 px seen); each corner is in
       // its place of the order (a wrong layout or orientation would be off by
       // whole modules, 5+ px).
-      Eigen::Vector2d found_centre = Eigen::Vector2d::Zero(), truth_centre = Eigen::Vector2d::Zero();
+      Eigen::Vector2d found_centre = Eigen::Vector2d::Zero(),
+                      truth_centre = Eigen::Vector2d::Zero();
       for (int k = 0; k < 4; ++k) {
         const Eigen::Vector2d xy(found[k].x + 0.5, found[k].y + 0.5);
         EXPECT_LT((xy - marker.corners_px[k]).norm(), 1.5)
@@ -214,7 +222,8 @@ void ExpectMarkersDetected(const fs::path& dir, const GroundTruth& truth) {
         found_centre += xy / 4;
         truth_centre += marker.corners_px[k] / 4;
       }
-      EXPECT_LT((found_centre - truth_centre).norm(), 0.6) << frame.cam1.file << " marker " << marker.id;
+      EXPECT_LT((found_centre - truth_centre).norm(), 0.6)
+          << frame.cam1.file << " marker " << marker.id;
       ++num_matched;
     }
   }
@@ -223,8 +232,7 @@ void ExpectMarkersDetected(const fs::path& dir, const GroundTruth& truth) {
 
 TEST(Synthesize, MarkerTargetsAreDetectedWhereTheGroundTruthSays) {
   testing::TempDir dir;
-  const std::map<std::string, std::string> targets = {
-      {"aruco_grid", R"(target:
+  const std::map<std::string, std::string> targets = {{"aruco_grid", R"(target:
   type: aruco_grid
   markers_x: 4
   markers_y: 3
@@ -235,7 +243,7 @@ poses:
   distance: [0.35, 0.7]
   tilt_max_deg: 35
 )"},
-      {"charuco", R"(target:
+                                                      {"charuco", R"(target:
   type: charuco
   squares_x: 6
   squares_y: 5
@@ -246,7 +254,7 @@ poses:
   distance: [0.4, 0.8]
   tilt_max_deg: 35
 )"},
-      {"target3d", R"(target:
+                                                      {"target3d", R"(target:
   type: target3d
   num_faces: 2
   fold_angle_deg: 120
@@ -263,7 +271,8 @@ poses:
   tilt_max_deg: 30
 )"}};
   for (const auto& [name, target] : targets) {
-    const fs::path config = WriteConfig(dir, name, std::string(kCamera) + "housing: null\n" + target, 3);
+    const fs::path config =
+        WriteConfig(dir, name, std::string(kCamera) + "housing: null\n" + target, 3);
     const GroundTruth truth = Synthesize(config, dir / name);
     EXPECT_EQ(truth.target.type, name);
     ExpectMarkersDetected(dir / name, truth);
@@ -280,8 +289,8 @@ poses:
 
 TEST(Synthesize, UnderwaterEffectsChangeTheImageAsPhysicsSays) {
   testing::TempDir dir;
-  const std::string base = std::string(kCamera) + "housing: null\n" + kChessboard +
-                           "render:\n  noise_sigma: 0.0\n";
+  const std::string base =
+      std::string(kCamera) + "housing: null\n" + kChessboard + "render:\n  noise_sigma: 0.0\n";
   const auto render = [&](const std::string& name, const std::string& extra) {
     Synthesize(WriteConfig(dir, name, base + extra, 1), dir / name);
     return cv::imread((dir / name / "images/img_001.png").string(), cv::IMREAD_GRAYSCALE);
@@ -289,7 +298,8 @@ TEST(Synthesize, UnderwaterEffectsChangeTheImageAsPhysicsSays) {
   const cv::Mat clean = render("clean", "");
   const cv::Mat murky = render("murky", "water:\n  attenuation: 0.8\n  backscatter: 140\n");
   const cv::Mat vignetted = render("vignetted", "vignetting: 0.8\n");
-  const cv::Mat blurred = render("motion", "motion_blur:\n  velocity: [0.5, 0.0, 0.0]\n  exposure: 0.01\n");
+  const cv::Mat blurred =
+      render("motion", "motion_blur:\n  velocity: [0.5, 0.0, 0.0]\n  exposure: 0.01\n");
   double clean_min, clean_max, murky_min, murky_max;
   cv::minMaxLoc(clean, &clean_min, &clean_max);
   cv::minMaxLoc(murky, &murky_min, &murky_max);
@@ -308,9 +318,10 @@ TEST(Synthesize, UnderwaterEffectsChangeTheImageAsPhysicsSays) {
 
 TEST(Synthesize, OccludersHideCornersAndTheGroundTruthSaysWhich) {
   testing::TempDir dir;
-  const fs::path config = WriteConfig(
-      dir, "occluded",
-      std::string(kCamera) + "housing: null\n" + kChessboard + "occlusion:\n  probability: 1.0\n  fraction: 0.3\n", 4);
+  const fs::path config = WriteConfig(dir, "occluded",
+                                      std::string(kCamera) + "housing: null\n" + kChessboard +
+                                          "occlusion:\n  probability: 1.0\n  fraction: 0.3\n",
+                                      4);
   const GroundTruth truth = Synthesize(config, dir / "set");
   int hidden = 0;
   for (const FrameTruth& frame : truth.images) {
@@ -351,7 +362,8 @@ render:
   EXPECT_GT(sixth.y() - fifth.y(), 0.1);
   EXPECT_NEAR(first.z(), 2.0, 1e-12);
   // A textured seabed, not an empty frame.
-  const cv::Mat image = cv::imread((dir / "set" / truth.images[0].cam1.file).string(), cv::IMREAD_GRAYSCALE);
+  const cv::Mat image =
+      cv::imread((dir / "set" / truth.images[0].cam1.file).string(), cv::IMREAD_GRAYSCALE);
   cv::Scalar mean, stddev;
   cv::meanStdDev(image, mean, stddev);
   EXPECT_GT(stddev[0], 20);
@@ -367,11 +379,16 @@ TEST(Synthesize, BadConfigsNameTheFileAndKey) {
     }
     return std::string("no error");
   };
-  EXPECT_NE(message(std::string(kCamera) + "target:\n  type: hexagon\n").find("target.type"), std::string::npos);
-  EXPECT_NE(message(std::string(kCamera) + "housing:\n  model: DOMEPORT\n  params: [0.1, 0, 0, 0.05, 0.006, 1, 1.5, 1.33]\n" +
-                    kChessboard).find("inside"),
+  EXPECT_NE(message(std::string(kCamera) + "target:\n  type: hexagon\n").find("target.type"),
             std::string::npos);
-  EXPECT_NE(message("camera:\n  model: RADIAL\n  width: 100\n  height: 100\n  params: [1, 2]\n").find("bad.yaml"),
+  EXPECT_NE(
+      message(std::string(kCamera) +
+              "housing:\n  model: DOMEPORT\n  params: [0.1, 0, 0, 0.05, 0.006, 1, 1.5, 1.33]\n" +
+              kChessboard)
+          .find("inside"),
+      std::string::npos);
+  EXPECT_NE(message("camera:\n  model: RADIAL\n  width: 100\n  height: 100\n  params: [1, 2]\n")
+                .find("bad.yaml"),
             std::string::npos);
   EXPECT_FALSE(fs::exists(dir / "out" / "ground_truth.yaml"));
 }

@@ -2,6 +2,8 @@
 // truth says they are (portcal's detector: median <= 0.005 px, max <= 0.05
 // px on the shared renders in air and behind both ports), per-image outcome,
 // reruns, and a failed run that leaves the database as it was.
+#include "pipelines/stages/target_extractor.h"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -15,7 +17,6 @@
 #include "pipelines/calibration/camera_calibration.h"
 #include "pipelines/calibration/target_views.h"
 #include "pipelines/stages/synthesize.h"
-#include "pipelines/stages/target_extractor.h"
 #include "tests/test_utils.h"
 
 namespace fs = std::filesystem;
@@ -41,7 +42,9 @@ cv::Mat BoardImage(int width, int height) {
   const int x0 = (width - 11 * square) / 2, y0 = (height - 8 * square) / 2;
   for (int r = 0; r < 8; ++r) {
     for (int c = 0; c < 11; ++c) {
-      if ((r + c) % 2 == 0) cv::rectangle(image, cv::Rect(x0 + c * square, y0 + r * square, square, square), 20, cv::FILLED);
+      if ((r + c) % 2 == 0)
+        cv::rectangle(image, cv::Rect(x0 + c * square, y0 + r * square, square, square), 20,
+                      cv::FILLED);
     }
   }
   return image;
@@ -76,17 +79,20 @@ TEST_P(SharedSets, CornersWithinHundredthsOfAPixel) {
   const GroundTruth truth = ReadGroundTruth(set / "ground_truth.yaml");
   testing::TempDir dir;
   NullProgress progress;
-  const TargetExtractorSummary summary = RunTargetExtractor(Options(dir / "db.db", set / "images"), progress);
+  const TargetExtractorSummary summary =
+      RunTargetExtractor(Options(dir / "db.db", set / "images"), progress);
   EXPECT_EQ(summary.num_found, 25);
   const std::vector<double> errors = ObservationErrors(dir / "db.db", truth);
   ASSERT_EQ(errors.size(), 25u * 70u);
-  std::cout << GetParam() << ": median " << errors[errors.size() / 2] << " px, max " << errors.back() << " px\n";
+  std::cout << GetParam() << ": median " << errors[errors.size() / 2] << " px, max "
+            << errors.back() << " px\n";
   EXPECT_LE(errors[errors.size() / 2], 0.005) << GetParam();
   EXPECT_LE(errors.back(), 0.05) << GetParam();
 }
 
 INSTANTIATE_TEST_SUITE_P(Rendered, SharedSets,
-                         ::testing::Values("chess_air_distorted", "chess_domeport", "chess_flatport"));
+                         ::testing::Values("chess_air_distorted", "chess_domeport",
+                                           "chess_flatport"));
 
 TEST(TargetExtractor, ReportsImagesWithoutTheBoardAndRerunsCleanly) {
   testing::TempDir dir;
@@ -103,7 +109,8 @@ poses: {distance: [0.4, 0.8], tilt_max_deg: 35}
   synthesize.output_path = (dir / "set").string();
   NullProgress progress;
   RunSynthesize(synthesize, progress);
-  cv::imwrite((dir / "set/images/zz_empty.png").string(), cv::Mat(600, 800, CV_8UC1, cv::Scalar(120)));
+  cv::imwrite((dir / "set/images/zz_empty.png").string(),
+              cv::Mat(600, 800, CV_8UC1, cv::Scalar(120)));
 
   TargetExtractorOptions options = Options(dir / "db.db", dir / "set/images");
   options.chessboard.cols = 8;
@@ -249,11 +256,15 @@ class MarkerBoards : public ::testing::TestWithParam<std::string> {};
 TEST_P(MarkerBoards, ObservationsAndCalibration) {
   testing::TempDir dir;
   const bool charuco = GetParam() == "charuco";
-  std::ofstream(dir / "set.yaml") << "name: boards\nseed: 12\nnum_images: 10\n"
-      << "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 401.0, 299.0, -0.08, 0.01]}\n"
+  std::ofstream(dir / "set.yaml")
+      << "name: boards\nseed: 12\nnum_images: 10\n"
+      << "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 401.0, 299.0, -0.08, "
+         "0.01]}\n"
       << "housing: null\n"
-      << (charuco ? "target: {type: charuco, squares_x: 7, squares_y: 5, square_size: 0.03, marker_size: 0.022}\n"
-                  : "target: {type: aruco_grid, markers_x: 5, markers_y: 4, marker_size: 0.03, marker_separation: 0.008}\n")
+      << (charuco ? "target: {type: charuco, squares_x: 7, squares_y: 5, square_size: 0.03, "
+                    "marker_size: 0.022}\n"
+                  : "target: {type: aruco_grid, markers_x: 5, markers_y: 4, marker_size: 0.03, "
+                    "marker_separation: 0.008}\n")
       << "poses: {distance: [0.35, 0.8], tilt_max_deg: 40, roll_max_deg: 40}\n";
   SynthesizeOptions synthesize;
   synthesize.config_path = (dir / "set.yaml").string();
@@ -284,7 +295,8 @@ TEST_P(MarkerBoards, ObservationsAndCalibration) {
         errors.push_back((o.xy - *frame.cam1.corners_px[o.point_id]).norm());
       } else {
         for (const auto& marker : frame.cam1.markers) {
-          if (marker.id == o.point_id / 4) errors.push_back((o.xy - marker.corners_px[o.point_id % 4]).norm());
+          if (marker.id == o.point_id / 4)
+            errors.push_back((o.xy - marker.corners_px[o.point_id % 4]).norm());
         }
       }
     }
@@ -296,15 +308,19 @@ TEST_P(MarkerBoards, ObservationsAndCalibration) {
   // chessboard, so ~2.5x the chessboard's worst case). ArUco grid: the
   // marker outline's edges fitted to the pixels (OpenCV's contour corners
   // alone: a median of ~0.6 px, their bias); issue 24's goal of 0.02 px.
-  std::cout << GetParam() << ": median " << errors[errors.size() / 2] << " px, max " << errors.back() << " px\n";
+  std::cout << GetParam() << ": median " << errors[errors.size() / 2] << " px, max "
+            << errors.back() << " px\n";
   EXPECT_LT(errors[errors.size() / 2], 0.02) << GetParam();
   EXPECT_LT(errors.back(), charuco ? 0.3 : 0.5) << GetParam();
-  const CameraCalibrationResult result = CalibrateCamera(ReadTargetViews(&db).by_camera.begin()->second,
-                                                         Camera::FromModelName("RADIAL", 700, 800, 600), {});
+  const CameraCalibrationResult result =
+      CalibrateCamera(ReadTargetViews(&db).by_camera.begin()->second,
+                      Camera::FromModelName("RADIAL", 700, 800, 600), {});
   std::cout << GetParam() << ": parameters off by";
   for (int i = 0; i < 5; ++i) {
-    std::cout << " " << (result.camera.params[i] - truth.camera.params[i]) / result.params_std_dev[i];
-    EXPECT_LT(std::abs(result.camera.params[i] - truth.camera.params[i]), 4 * result.params_std_dev[i] + 1e-9)
+    std::cout << " "
+              << (result.camera.params[i] - truth.camera.params[i]) / result.params_std_dev[i];
+    EXPECT_LT(std::abs(result.camera.params[i] - truth.camera.params[i]),
+              4 * result.params_std_dev[i] + 1e-9)
         << "parameter " << i;
   }
   std::cout << " sigma\n";
@@ -320,9 +336,11 @@ TEST(MarkerBoardsLeftOut, TheStatusCountsTheMarkerCornersLeftOut) {
   const GroundTruth truth = testing::RenderSet(
       dir,
       "name: close\nseed: 7\nnum_images: 8\n"
-      "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 402.0, 298.0, -0.08, 0.01]}\n"
+      "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 402.0, 298.0, -0.08, "
+      "0.01]}\n"
       "housing: null\n"
-      "target: {type: aruco_grid, markers_x: 5, markers_y: 4, marker_size: 0.03, marker_separation: 0.008}\n"
+      "target: {type: aruco_grid, markers_x: 5, markers_y: 4, marker_size: 0.03, "
+      "marker_separation: 0.008}\n"
       "poses: {distance: [0.25, 0.5], tilt_max_deg: 65, roll_max_deg: 40, visibility: any}\n"
       "render: {spp: 4, blur_sigma: 0.8, noise_sigma: 2.0}\n");
   TargetExtractorOptions options = Options(dir / "db.db", dir / "set/images");
@@ -348,8 +366,9 @@ TEST(MarkerBoardsLeftOut, TheStatusCountsTheMarkerCornersLeftOut) {
     }
     ++with_note;
     const int left_out = 4 * detected - kept, markers = left_out / 4;
-    const std::string expected = "found; " + std::to_string(left_out) + " of " + std::to_string(4 * detected) +
-                                 " marker corners left out (" + std::to_string(markers) +
+    const std::string expected = "found; " + std::to_string(left_out) + " of " +
+                                 std::to_string(4 * detected) + " marker corners left out (" +
+                                 std::to_string(markers) +
                                  (markers == 1 ? " marker too" : " markers too");
     EXPECT_EQ(status->reason.rfind(expected, 0), 0u) << status->reason << " / " << expected;
   }

@@ -29,8 +29,8 @@ TEST(RandomDraws, AViewsPixelIsDrawnRowFirst) {
   const Eigen::Vector3d center(0.1, 0.05, 0);
   for (uint64_t seed : {1u, 7u, 12u}) {
     std::mt19937_64 rng(seed);
-    const Rigid3d cam_from_target =
-        SampleTargetView(camera, nullptr, {center}, center, Eigen::Vector3d::UnitZ(), options, &rng);
+    const Rigid3d cam_from_target = SampleTargetView(camera, nullptr, {center}, center,
+                                                     Eigen::Vector3d::UnitZ(), options, &rng);
     std::mt19937_64 replay(seed);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     const double row = unit(replay);
@@ -42,7 +42,8 @@ TEST(RandomDraws, AViewsPixelIsDrawnRowFirst) {
     const double margin = options.border_margin_px;
     EXPECT_NEAR(pixel->x(), margin + column * (camera.width - 2 * margin), 1e-9) << "seed " << seed;
     EXPECT_NEAR(pixel->y(), margin + row * (camera.height - 2 * margin), 1e-9) << "seed " << seed;
-    EXPECT_NEAR(center_in_cam.norm(), options.distance_min_m + d * (options.distance_max_m - options.distance_min_m),
+    EXPECT_NEAR(center_in_cam.norm(),
+                options.distance_min_m + d * (options.distance_max_m - options.distance_min_m),
                 1e-12)
         << "seed " << seed;
   }
@@ -56,14 +57,16 @@ TEST(RandomDraws, AShapesCentreIsDrawnRowFirst) {
   int tried = 0;
   for (uint64_t seed = 1; seed < 50 && tried < 3; ++seed) {
     std::mt19937_64 replay(seed);
-    std::uniform_int_distribution<int> gray(15, 240), x(0, cols - 1), y(0, rows - 1), size(min_size, max_size),
-        kind(0, 2);
+    std::uniform_int_distribution<int> gray(15, 240), x(0, cols - 1), y(0, rows - 1),
+        size(min_size, max_size), kind(0, 2);
     const int center_y = y(replay);
     const int center_x = x(replay);
     const int radius = size(replay);
     const int value = gray(replay);
     if (kind(replay) != 0 || value == 110) continue;  // not a disc, or the background's gray
-    if (center_x < radius || center_y < radius || center_x + radius >= cols || center_y + radius >= rows) continue;
+    if (center_x < radius || center_y < radius || center_x + radius >= cols ||
+        center_y + radius >= rows)
+      continue;
     ++tried;
     const cv::Mat raster = RandomShapesRaster(cols, rows, 1, seed, min_size, max_size);
     double sum_x = 0, sum_y = 0;

@@ -59,7 +59,8 @@ TEST_P(RenderVsShared, SameImageUpToNoise) {
     render.noise_sigma = 0;  // compare with the noise-free image
     const BuiltTarget target = BuildTarget(target_options, render.levels);
     const RayMap rays(truth.camera, truth.housing ? &*truth.housing : nullptr, spp, 2);
-    const cv::Mat ours = RenderImage(rays, {{target.object.get(), view.cam_from_target}}, render, 0);
+    const cv::Mat ours =
+        RenderImage(rays, {{target.object.get(), view.cam_from_target}}, render, 0);
     cv::Mat diff;
     cv::subtract(theirs, ours, diff, cv::noArray(), CV_64F);
     cv::Scalar mean, stddev;
@@ -74,7 +75,8 @@ TEST_P(RenderVsShared, SameImageUpToNoise) {
 }
 
 INSTANTIATE_TEST_SUITE_P(RenderedSets, RenderVsShared,
-                         ::testing::Values("chess_air_distorted", "chess_domeport", "chess_flatport"));
+                         ::testing::Values("chess_air_distorted", "chess_domeport",
+                                           "chess_flatport"));
 
 }  // namespace
 }  // namespace portcal

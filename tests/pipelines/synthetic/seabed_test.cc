@@ -26,8 +26,8 @@ class UniformTexture : public FaceTexture {
 // for rays within 25 deg of nadir, under 2e-11 m; 1e-10 m leaves a margin.
 constexpr double kOnReliefTolerance = 1e-10;
 
-double OffRelief(const SeabedObject& seabed, const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
-                 const Hit& hit) {
+double OffRelief(const SeabedObject& seabed, const Eigen::Vector3d& origin,
+                 const Eigen::Vector3d& dir, const Hit& hit) {
   const Eigen::Vector3d p = origin + hit.t * dir;
   return p.z() - seabed.Height(p.x(), p.y());
 }
@@ -36,11 +36,13 @@ TEST(SeabedObject, ANeighboursStartFindsTheSameHitOnTheRelief) {
   // The surveys' relief: 0.15 m standard deviation over a 2 m wavelength.
   const SeabedObject seabed(std::make_shared<UniformTexture>(), 0.15, 2.0, 7);
   std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> position(-20, 20), azimuth(0, 2 * M_PI), tilt(0, 25 * M_PI / 180);
+  std::uniform_real_distribution<double> position(-20, 20), azimuth(0, 2 * M_PI),
+      tilt(0, 25 * M_PI / 180);
   for (int i = 0; i < 2000; ++i) {
     const double a = tilt(rng), b = azimuth(rng);
     const Eigen::Vector3d dir =
-        Eigen::Vector3d(std::sin(a) * std::cos(b), std::sin(a) * std::sin(b), -std::cos(a)).normalized();
+        Eigen::Vector3d(std::sin(a) * std::cos(b), std::sin(a) * std::sin(b), -std::cos(a))
+            .normalized();
     const Eigen::Vector3d origin(position(rng), position(rng), 2.0);
     Hit from_plane;
     ASSERT_TRUE(seabed.Intersect(origin, dir, 1e300, &from_plane)) << "ray " << i;
@@ -64,9 +66,12 @@ TEST(SeabedObject, ANeighboursStartFindsTheSameHitOnTheRelief) {
 TEST(SeabedObject, RaysThatDoNotLookDownOrEndBeforeTheSeabedMissIt) {
   const SeabedObject seabed(std::make_shared<UniformTexture>(), 0.15, 2.0, 7);
   Hit hit;
-  EXPECT_FALSE(seabed.IntersectNear(Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(0, 0, 1), 1e300, 2.0, &hit));
-  EXPECT_FALSE(seabed.IntersectNear(Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(0, 0, -1), 1.0, 2.0, &hit));
-  EXPECT_TRUE(seabed.IntersectNear(Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(0, 0, -1), 3.0, 2.0, &hit));
+  EXPECT_FALSE(
+      seabed.IntersectNear(Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(0, 0, 1), 1e300, 2.0, &hit));
+  EXPECT_FALSE(
+      seabed.IntersectNear(Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(0, 0, -1), 1.0, 2.0, &hit));
+  EXPECT_TRUE(
+      seabed.IntersectNear(Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(0, 0, -1), 3.0, 2.0, &hit));
 }
 
 }  // namespace

@@ -4,13 +4,14 @@
 // their place on the board can be told, and is refused otherwise; the
 // X-junction count sees a board square to the image and not a cluttered
 // scene; too few corners refuse the view.
+#include "pipelines/target/chessboard_detector.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <iostream>
 #include <opencv2/imgproc.hpp>
 
-#include "pipelines/target/chessboard_detector.h"
 #include "pipelines/target/x_corner_count.h"
 #include "tests/test_utils.h"
 
@@ -30,8 +31,8 @@ void DrawSquares(int squares_x, int squares_y, int left, int top, cv::Mat* image
   for (int r = 0; r < squares_y; ++r) {
     for (int c = 0; c < squares_x; ++c) {
       if ((r + c) % 2 != 0) continue;
-      cv::rectangle(*image, cv::Rect(left + c * kSquare, top + r * kSquare, kSquare, kSquare), cv::Scalar(40),
-                    cv::FILLED);
+      cv::rectangle(*image, cv::Rect(left + c * kSquare, top + r * kSquare, kSquare, kSquare),
+                    cv::Scalar(40), cv::FILLED);
     }
   }
   cv::GaussianBlur(*image, *image, cv::Size(), 1.0);
@@ -57,7 +58,8 @@ TEST(ChessboardDetector, KeepsTheCornersThatRefineAndSaysWhyTheOthersWereLeftOut
   const ChessboardDetection detection = DetectChessboard(DrawnBoard(width, 480), Options());
   ASSERT_TRUE(detection.found) << detection.reason;
   EXPECT_EQ(detection.num_refined, kCols * kRows - kRows);
-  EXPECT_NE(detection.note.find("6 of 48 corners left out (6 window beyond the image)"), std::string::npos)
+  EXPECT_NE(detection.note.find("6 of 48 corners left out (6 window beyond the image)"),
+            std::string::npos)
       << detection.note;
   for (int r = 0; r < kRows; ++r) {
     for (int c = 0; c < kCols; ++c) {
@@ -66,7 +68,8 @@ TEST(ChessboardDetector, KeepsTheCornersThatRefineAndSaysWhyTheOthersWereLeftOut
       const Eigen::Vector2d truth(kLeft + (c + 1) * kSquare, kTop + (r + 1) * kSquare);
       const Eigen::Vector2d turned(kLeft + (kCols - c) * kSquare, kTop + (kRows - r) * kSquare);
       if (!corner) continue;
-      EXPECT_LT(std::min((*corner - truth).norm(), (*corner - turned).norm()), 0.02) << r << "," << c;
+      EXPECT_LT(std::min((*corner - truth).norm(), (*corner - turned).norm()), 0.02)
+          << r << "," << c;
     }
   }
 }
@@ -77,7 +80,8 @@ TEST(ChessboardDetector, RefusesAViewWithTooFewCornersForAPose) {
   options.min_refined_corners = kCols * kRows - kRows + 1;
   const ChessboardDetection detection = DetectChessboard(DrawnBoard(width, 480), options);
   EXPECT_FALSE(detection.found);
-  EXPECT_NE(detection.reason.find("too few corners for a pose"), std::string::npos) << detection.reason;
+  EXPECT_NE(detection.reason.find("too few corners for a pose"), std::string::npos)
+      << detection.reason;
 }
 
 // A 9 x 6 board (10 x 7 squares: it does not look the same turned by 180
@@ -85,7 +89,8 @@ TEST(ChessboardDetector, RefusesAViewWithTooFewCornersForAPose) {
 // canonical corner (r, c) at (left + (c + 1) kSquare, top + (r + 1) kSquare).
 cv::Mat DrawnAsymmetricBoard(int width, int height, int left, int top) {
   cv::Mat image(height, width, CV_8UC1, cv::Scalar(120));
-  cv::rectangle(image, cv::Rect(left - 15, top - 15, 10 * kSquare + 30, 7 * kSquare + 30), cv::Scalar(200), cv::FILLED);
+  cv::rectangle(image, cv::Rect(left - 15, top - 15, 10 * kSquare + 30, 7 * kSquare + 30),
+                cv::Scalar(200), cv::FILLED);
   DrawSquares(10, 7, left, top, &image);
   return image;
 }
@@ -100,13 +105,16 @@ ChessboardDetectionOptions AsymmetricOptions() {
 // Of a 9 x 6 board drawn at (left, top) and cut after its 6th column:
 // exactly the corners of columns 0-5, each within `tolerance` px of where
 // it is drawn.
-void ExpectColumnsInView(const ChessboardDetection& detection, int left, int top, double tolerance) {
+void ExpectColumnsInView(const ChessboardDetection& detection, int left, int top,
+                         double tolerance) {
   for (int r = 0; r < 6; ++r) {
     for (int c = 0; c < 9; ++c) {
       const auto& corner = detection.corners[r * 9 + c];
       ASSERT_EQ(corner.has_value(), c < 6) << r << "," << c;
       if (corner) {
-        EXPECT_LT((*corner - Eigen::Vector2d(left + (c + 1) * kSquare, top + (r + 1) * kSquare)).norm(), tolerance);
+        EXPECT_LT(
+            (*corner - Eigen::Vector2d(left + (c + 1) * kSquare, top + (r + 1) * kSquare)).norm(),
+            tolerance);
       }
     }
   }
@@ -117,7 +125,8 @@ void ExpectColumnsInView(const ChessboardDetection& detection, int left, int top
 TEST(PartialChessboard, ABoardCutByTheImagesBorderKeepsTheCornersInView) {
   const int left = 30, top = 60;
   const int width = left + 6 * kSquare + 25;  // inner columns 0-5 in view, 6-8 beyond
-  const ChessboardDetection detection = DetectChessboard(DrawnAsymmetricBoard(width, 400, left, top), AsymmetricOptions());
+  const ChessboardDetection detection =
+      DetectChessboard(DrawnAsymmetricBoard(width, 400, left, top), AsymmetricOptions());
   ASSERT_TRUE(detection.found) << detection.reason;
   EXPECT_TRUE(detection.partial);
   EXPECT_FALSE(detection.symmetric);
@@ -164,7 +173,10 @@ TEST(PartialChessboard, ABoardEndingAtAnOccluderGetsNoWrongCorners) {
   for (size_t i = 0; i < detection.corners.size(); ++i) {
     const int r = static_cast<int>(i) / 9, c = static_cast<int>(i) % 9;
     if (detection.corners[i]) {
-      EXPECT_LT((*detection.corners[i] - Eigen::Vector2d(left + (c + 1) * kSquare, top + (r + 1) * kSquare)).norm(), 0.05);
+      EXPECT_LT((*detection.corners[i] -
+                 Eigen::Vector2d(left + (c + 1) * kSquare, top + (r + 1) * kSquare))
+                    .norm(),
+                0.05);
     }
   }
 }

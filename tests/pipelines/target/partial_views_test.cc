@@ -19,8 +19,10 @@ TEST(PartialViews, CornersInViewKeptAtTheirPlaceOnTheBoard) {
   const GroundTruth truth = testing::RenderSet(
       dir,
       "name: partial\nseed: 41\nnum_images: 16\n"
-      "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 402.0, 298.0, -0.08, 0.01]}\n"
-      "housing: null\ntarget: {type: chessboard, cols: 9, rows: 6, square_size: 0.025, margin: 0.015}\n"
+      "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 402.0, 298.0, -0.08, "
+      "0.01]}\n"
+      "housing: null\ntarget: {type: chessboard, cols: 9, rows: 6, square_size: 0.025, margin: "
+      "0.015}\n"
       "poses: {distance: [0.3, 0.6], tilt_max_deg: 40, roll_max_deg: 40, visibility: any}\n"
       "render: {spp: 4, blur_sigma: 0.8, noise_sigma: 2.0}\n");
   ChessboardDetectionOptions options;
@@ -32,13 +34,15 @@ TEST(PartialViews, CornersInViewKeptAtTheirPlaceOnTheBoard) {
     const cv::Mat gray = cv::imread((dir / "set" / frame.cam1.file).string(), cv::IMREAD_GRAYSCALE);
     int in_view = 0;
     for (const auto& corner : frame.cam1.corners_px) {
-      in_view += corner && corner->x() > 0 && corner->y() > 0 && corner->x() < 800 && corner->y() < 600;
+      in_view +=
+          corner && corner->x() > 0 && corner->y() > 0 && corner->x() < 800 && corner->y() < 600;
     }
     const ChessboardDetection detection = DetectChessboard(gray, options);
     (in_view == 54 ? whole : cut) += 1;
     if (!detection.found) {
       EXPECT_FALSE(detection.reason.empty()) << frame.cam1.file;
-      std::cout << frame.cam1.file << " (" << in_view << " corners in view): " << detection.reason << "\n";
+      std::cout << frame.cam1.file << " (" << in_view << " corners in view): " << detection.reason
+                << "\n";
       continue;
     }
     (in_view == 54 ? whole_found : cut_found) += 1;
@@ -46,11 +50,12 @@ TEST(PartialViews, CornersInViewKeptAtTheirPlaceOnTheBoard) {
     // A corner given another's place on the board would be a square
     // (tens of pixels) off; refined ones are hundredths off.
     for (size_t i = 0; i < detection.corners.size(); ++i) {
-      if (detection.corners[i]) worst = std::max(worst, (*detection.corners[i] - *frame.cam1.corners_px[i]).norm());
+      if (detection.corners[i])
+        worst = std::max(worst, (*detection.corners[i] - *frame.cam1.corners_px[i]).norm());
     }
   }
-  std::cout << "whole boards found " << whole_found << " / " << whole << ", cut ones " << cut_found << " / " << cut
-            << "; largest corner error " << worst << " px\n";
+  std::cout << "whole boards found " << whole_found << " / " << whole << ", cut ones " << cut_found
+            << " / " << cut << "; largest corner error " << worst << " px\n";
   EXPECT_EQ(whole_found, whole);
   EXPECT_LT(worst, 0.15);
   // Without the partial search none of the cut views is found; with it 6 of

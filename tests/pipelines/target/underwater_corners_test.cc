@@ -38,9 +38,12 @@ CornerErrors DetectRendered(const std::string& effects, double max_level_drift) 
   testing::TempDir dir;
   const GroundTruth truth = testing::RenderSet(
       dir, std::string("name: underwater\nseed: 31\nnum_images: 10\n") +
-               "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 402.0, 298.0, -0.08, 0.01]}\n"
-               "housing: null\ntarget: {type: chessboard, cols: 9, rows: 6, square_size: 0.025, margin: 0.015}\n"
-               "poses: {distance: [0.35, 0.9], tilt_max_deg: 45, roll_max_deg: 40}\n" + effects);
+               "camera: {model: RADIAL, width: 800, height: 600, params: [650.0, 402.0, 298.0, "
+               "-0.08, 0.01]}\n"
+               "housing: null\ntarget: {type: chessboard, cols: 9, rows: 6, square_size: 0.025, "
+               "margin: 0.015}\n"
+               "poses: {distance: [0.35, 0.9], tilt_max_deg: 45, roll_max_deg: 40}\n" +
+               effects);
   ChessboardDetectionOptions options;
   options.cols = 9;
   options.rows = 6;
@@ -58,7 +61,8 @@ CornerErrors DetectRendered(const std::string& effects, double max_level_drift) 
       if (!detection.corners[i]) continue;
       ++result.corners_kept;
       double error = (*detection.corners[i] - *corners[i]).norm();
-      if (detection.symmetric) error = std::min(error, (*detection.corners[i] - *corners[53 - i]).norm());
+      if (detection.symmetric)
+        error = std::min(error, (*detection.corners[i] - *corners[53 - i]).norm());
       result.errors.push_back(error);
     }
   }
@@ -73,8 +77,8 @@ TEST(UnderwaterCorners, EveryViewKeptWithinTwiceTheCleanError) {
   const CornerErrors clean_noisy = DetectRendered(kCleanNoisy, 0.002);
   const CornerErrors underwater_noisy = DetectRendered(kUnderwaterNoisy, 0.002);
   std::cout << "median error: clean " << clean.Median() << ", underwater " << underwater.Median()
-            << " (shading left in: " << unshaded.Median() << "); noise 3: clean " << clean_noisy.Median()
-            << ", underwater " << underwater_noisy.Median() << " px\n";
+            << " (shading left in: " << unshaded.Median() << "); noise 3: clean "
+            << clean_noisy.Median() << ", underwater " << underwater_noisy.Median() << " px\n";
   for (const CornerErrors* set : {&clean, &underwater, &clean_noisy, &underwater_noisy}) {
     EXPECT_EQ(set->views_found, set->num_views);
     EXPECT_GE(set->corners_kept, 0.97 * set->num_corners);
@@ -95,8 +99,12 @@ TEST(UnderwaterCorners, EveryViewKeptWithinTwiceTheCleanError) {
 TEST(BoardShading, RecoversSmoothFieldsAndFlattensADrift) {
   std::vector<Eigen::Vector2d> corners;
   std::vector<double> means, contrasts;
-  const auto mean = [](const Eigen::Vector2d& p) { return 120 + 0.05 * p.x() - 0.02 * p.y() + 1e-5 * p.x() * p.y(); };
-  const auto contrast = [](const Eigen::Vector2d& p) { return 90 * std::exp(-2e-4 * p.x() + 1e-7 * p.y() * p.y()); };
+  const auto mean = [](const Eigen::Vector2d& p) {
+    return 120 + 0.05 * p.x() - 0.02 * p.y() + 1e-5 * p.x() * p.y();
+  };
+  const auto contrast = [](const Eigen::Vector2d& p) {
+    return 90 * std::exp(-2e-4 * p.x() + 1e-7 * p.y() * p.y());
+  };
   for (int r = 0; r < 6; ++r) {
     for (int c = 0; c < 9; ++c) {
       corners.emplace_back(100 + 60 * c + 5 * r, 80 + 55 * r);
@@ -119,7 +127,8 @@ TEST(BoardShading, RecoversSmoothFieldsAndFlattensADrift) {
   const double light_there = mean(p) + local.mean_gradient.dot(offset) +
                              (1 + local.relative_contrast_gradient.dot(offset)) * 0.5 * contrast(p);
   EXPECT_NEAR(local.Flatten(light_there, offset), mean(p) + 0.5 * contrast(p), 1e-9);
-  EXPECT_FALSE(BoardShading::Fit({corners.begin(), corners.begin() + 5}, means, contrasts).has_value());
+  EXPECT_FALSE(
+      BoardShading::Fit({corners.begin(), corners.begin() + 5}, means, contrasts).has_value());
 }
 
 }  // namespace

@@ -36,12 +36,14 @@ double Bilinear(const cv::Mat& map, const Eigen::Vector2d& at) {
 
 // The output pixel (COLMAP's convention) whose table entry is
 // `source_pixel`: Newton's method on the interpolated tables.
-std::optional<Eigen::Vector2d> FindInTables(const RemapTables& tables, const Eigen::Vector2d& source_pixel,
+std::optional<Eigen::Vector2d> FindInTables(const RemapTables& tables,
+                                            const Eigen::Vector2d& source_pixel,
                                             Eigen::Vector2d start) {
   Eigen::Vector2d u = start;
   const auto entry = [&](const Eigen::Vector2d& p) {
     const Eigen::Vector2d cv_pixel = p - Eigen::Vector2d(0.5, 0.5);
-    return Eigen::Vector2d(Bilinear(tables.map_x, cv_pixel) + 0.5, Bilinear(tables.map_y, cv_pixel) + 0.5);
+    return Eigen::Vector2d(Bilinear(tables.map_x, cv_pixel) + 0.5,
+                           Bilinear(tables.map_y, cv_pixel) + 0.5);
   };
   for (int iteration = 0; iteration < 10; ++iteration) {
     const Eigen::Vector2d miss = entry(u) - source_pixel;
@@ -60,7 +62,8 @@ std::optional<Eigen::Vector2d> FindInTables(const RemapTables& tables, const Eig
 // |found - pinhole projection| against ErrorAtDepth for points of the
 // camera frame seen at known pixels; returns the largest difference.
 double LargestDisagreement(const VirtualPinhole& pinhole, const RemapTables& tables,
-                           const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector2d>>& points, int* num_checked) {
+                           const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector2d>>& points,
+                           int* num_checked) {
   double largest = 0;
   for (const auto& [point, source_pixel] : points) {
     const std::optional<Eigen::Vector2d> projected = pinhole.PinholePixel(point);
@@ -90,7 +93,9 @@ Camera BenchCamera() {
 
 TEST(RemapTables, EntriesAreTheExactSourcePixels) {
   const HousedCamera camera{
-      BenchCamera(), Housing::FromName("DOMEPORT", {0.002, -0.001, 0.004, 0.05, 0.006, 1.0, 1.473, 1.334}, "test")};
+      BenchCamera(),
+      Housing::FromName("DOMEPORT", {0.002, -0.001, 0.004, 0.05, 0.006, 1.0, 1.473, 1.334},
+                        "test")};
   const VirtualPinhole pinhole = FitVirtualPinhole(camera, 1.5, Eigen::Matrix3d::Identity(), {});
   const RemapTables tables = ComputeRemapTables(pinhole, 2, NoProgress());
   ASSERT_EQ(tables.map_x.cols, static_cast<int>(pinhole.pinhole.width));
@@ -108,7 +113,8 @@ TEST(RemapTables, PointsLandWhereThePinholeSaysWithinTheReportedError) {
   const double tilt = 5.0 * M_PI / 180.0;
   const HousedCamera camera{
       BenchCamera(),
-      Housing::FromName("FLATPORT", {std::sin(tilt), 0, std::cos(tilt), 0.02, 0.014, 1.0, 1.473, 1.334}, "test")};
+      Housing::FromName(
+          "FLATPORT", {std::sin(tilt), 0, std::cos(tilt), 0.02, 0.014, 1.0, 1.473, 1.334}, "test")};
   const VirtualPinhole pinhole = FitVirtualPinhole(camera, 1.2, Eigen::Matrix3d::Identity(), {});
   const RemapTables tables = ComputeRemapTables(pinhole, 2, NoProgress());
   std::mt19937 rng(28);
@@ -124,8 +130,9 @@ TEST(RemapTables, PointsLandWhereThePinholeSaysWithinTheReportedError) {
     }
     int num_checked = 0;
     const double disagreement = LargestDisagreement(pinhole, tables, points, &num_checked);
-    std::printf("%.1f m: %d points, largest disagreement %.2e px, worst reported error %.3f px\n", depth, num_checked,
-                disagreement, MeasureApproximationError(pinhole, {depth}, 16, 1).worst_px);
+    std::printf("%.1f m: %d points, largest disagreement %.2e px, worst reported error %.3f px\n",
+                depth, num_checked, disagreement,
+                MeasureApproximationError(pinhole, {depth}, 16, 1).worst_px);
     EXPECT_LT(disagreement, 0.01) << depth << " m";
     EXPECT_GT(num_checked, 250) << depth << " m";
     if (depth == 1.2) {
@@ -141,14 +148,16 @@ TEST(RemapTables, PointsLandWhereThePinholeSaysWithinTheReportedError) {
 TEST(RemapTables, RenderedCornersAgreeWithTheReportedError) {
   PORTCAL_REQUIRE_SHARED(shared);
   for (const char* set : {"chess_flatport", "chess_domeport"}) {
-    const GroundTruth truth = ReadGroundTruth(shared / "datasets" / "rendered" / set / "ground_truth.yaml");
+    const GroundTruth truth =
+        ReadGroundTruth(shared / "datasets" / "rendered" / set / "ground_truth.yaml");
     ASSERT_TRUE(truth.housing) << set;
     std::vector<std::pair<Eigen::Vector3d, Eigen::Vector2d>> points;
     std::vector<double> depths;
     for (const FrameTruth& frame : truth.images) {
       for (size_t i = 0; i < truth.target.corners_3d.size(); ++i) {
         if (!frame.cam1.corners_px[i]) continue;
-        points.emplace_back(frame.cam1.cam_from_target * truth.target.corners_3d[i], *frame.cam1.corners_px[i]);
+        points.emplace_back(frame.cam1.cam_from_target * truth.target.corners_3d[i],
+                            *frame.cam1.corners_px[i]);
         depths.push_back(points.back().first.z());
       }
     }

@@ -34,8 +34,9 @@ TEST(StereoRectification, InAirRowsAgreeAndDisparityIsFocalTimesBaselineOverDept
   const Rigid3d cam2_from_cam1 = ToedInRig();
   const RectifyingRotations rotations = RectifyingRotationsOf(cam2_from_cam1);
   EXPECT_NEAR(rotations.baseline, Eigen::Vector3d(0.12, 0.004, 0.002).norm(), 1e-12);
-  const auto [first, second] = FitRectifiedPinholes({Lens(402.5, -0.2), std::nullopt},
-                                                    {Lens(396.0, -0.18), std::nullopt}, rotations, 1.0, 1.0, {});
+  const auto [first, second] =
+      FitRectifiedPinholes({Lens(402.5, -0.2), std::nullopt}, {Lens(396.0, -0.18), std::nullopt},
+                           rotations, 1.0, 1.0, {});
   EXPECT_EQ(first.pinhole.params[0], second.pinhole.params[0]);
   EXPECT_EQ(first.pinhole.params[3], second.pinhole.params[3]);
   EXPECT_EQ(first.pinhole.height, second.pinhole.height);
@@ -47,10 +48,12 @@ TEST(StereoRectification, InAirRowsAgreeAndDisparityIsFocalTimesBaselineOverDept
     const std::optional<Eigen::Vector2d> pixel1 = first.source.Project(point1);
     const std::optional<Eigen::Vector2d> pixel2 = second.source.Project(cam2_from_cam1 * point1);
     if (!pixel1 || !pixel2) continue;
-    const Eigen::Vector2d rectified1 = *first.OutputPixel(*pixel1), rectified2 = *second.OutputPixel(*pixel2);
+    const Eigen::Vector2d rectified1 = *first.OutputPixel(*pixel1),
+                          rectified2 = *second.OutputPixel(*pixel2);
     EXPECT_NEAR(rectified1.y(), rectified2.y(), 1e-6);
     const double depth = (rotations.rect_from_cam1 * point1).z();
-    const double disparity = rectified1.x() - rectified2.x() - (first.pinhole.params[2] - second.pinhole.params[2]);
+    const double disparity =
+        rectified1.x() - rectified2.x() - (first.pinhole.params[2] - second.pinhole.params[2]);
     EXPECT_NEAR(disparity, first.pinhole.params[0] * rotations.baseline / depth, 1e-6);
     ++checked;
   }
@@ -58,12 +61,13 @@ TEST(StereoRectification, InAirRowsAgreeAndDisparityIsFocalTimesBaselineOverDept
 }
 
 TEST(StereoRectification, BehindFlatPortsRowsAgreeWithinTheReportedErrors) {
-  const Housing port = Housing::FromName("FLATPORT", {0, 0, 1, 0.02, 0.01, 1.0, 1.49, 1.334}, "test");
+  const Housing port =
+      Housing::FromName("FLATPORT", {0, 0, 1, 0.02, 0.01, 1.0, 1.49, 1.334}, "test");
   const Rigid3d cam2_from_cam1(Eigen::Quaterniond::Identity(), Eigen::Vector3d(-0.15, 0, 0));
   const RectifyingRotations rotations = RectifyingRotationsOf(cam2_from_cam1);
   const double design = 1.5;
-  const auto [first, second] =
-      FitRectifiedPinholes({Lens(402.5, -0.2), port}, {Lens(396.0, -0.18), port}, rotations, design, design, {});
+  const auto [first, second] = FitRectifiedPinholes(
+      {Lens(402.5, -0.2), port}, {Lens(396.0, -0.18), port}, rotations, design, design, {});
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(0.15, 0.85);
   for (const double depth : {design, 0.8, 4.0}) {
@@ -74,7 +78,8 @@ TEST(StereoRectification, BehindFlatPortsRowsAgreeWithinTheReportedErrors) {
       const Eigen::Vector3d point1 = *first.PointAtDepth(pixel1, depth);
       const std::optional<Eigen::Vector2d> pixel2 = second.source.Project(cam2_from_cam1 * point1);
       if (!pixel2 || pixel2->x() < 0 || pixel2->x() > 800) continue;
-      const Eigen::Vector2d rectified1 = *first.OutputPixel(pixel1), rectified2 = *second.OutputPixel(*pixel2);
+      const Eigen::Vector2d rectified1 = *first.OutputPixel(pixel1),
+                            rectified2 = *second.OutputPixel(*pixel2);
       const double row_gap = std::abs(rectified1.y() - rectified2.y());
       const std::optional<double> error1 = first.ErrorAtDepth(rectified1, depth);
       const std::optional<double> error2 = second.ErrorAtDepth(rectified2, depth);
@@ -100,8 +105,8 @@ TEST(StereoRectification, RenderedRigCornersShareRows) {
       ReadGroundTruth(shared / "datasets" / "rendered" / "chess_stereo_air" / "ground_truth.yaml");
   ASSERT_TRUE(truth.stereo);
   const RectifyingRotations rotations = RectifyingRotationsOf(truth.stereo->cam2_from_cam1);
-  const auto [first, second] = FitRectifiedPinholes({truth.camera, std::nullopt}, {truth.stereo->camera2, std::nullopt},
-                                                    rotations, 1.0, 1.0, {});
+  const auto [first, second] = FitRectifiedPinholes(
+      {truth.camera, std::nullopt}, {truth.stereo->camera2, std::nullopt}, rotations, 1.0, 1.0, {});
   double largest_row_gap = 0, largest_depth_error = 0;
   int checked = 0;
   for (const FrameTruth& frame : truth.images) {
@@ -111,16 +116,19 @@ TEST(StereoRectification, RenderedRigCornersShareRows) {
       const Eigen::Vector2d rectified1 = *first.OutputPixel(*frame.cam1.corners_px[i]);
       const Eigen::Vector2d rectified2 = *second.OutputPixel(*frame.cam2->corners_px[i]);
       largest_row_gap = std::max(largest_row_gap, std::abs(rectified1.y() - rectified2.y()));
-      const double disparity = rectified1.x() - rectified2.x() - (first.pinhole.params[2] - second.pinhole.params[2]);
+      const double disparity =
+          rectified1.x() - rectified2.x() - (first.pinhole.params[2] - second.pinhole.params[2]);
       const Eigen::Vector3d point = frame.cam1.cam_from_target * truth.target.corners_3d[i];
       const double depth = (rotations.rect_from_cam1 * point).z();
       largest_depth_error =
-          std::max(largest_depth_error, std::abs(first.pinhole.params[0] * rotations.baseline / disparity - depth));
+          std::max(largest_depth_error,
+                   std::abs(first.pinhole.params[0] * rotations.baseline / disparity - depth));
       ++checked;
     }
   }
-  std::printf("%d corners: rows apart by at most %.2e px, depth from disparity off by at most %.2e m\n", checked,
-              largest_row_gap, largest_depth_error);
+  std::printf(
+      "%d corners: rows apart by at most %.2e px, depth from disparity off by at most %.2e m\n",
+      checked, largest_row_gap, largest_depth_error);
   EXPECT_GT(checked, 500);
   EXPECT_LT(largest_row_gap, 1e-4);
   EXPECT_LT(largest_depth_error, 1e-6);

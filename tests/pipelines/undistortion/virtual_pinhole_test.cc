@@ -22,11 +22,13 @@ Camera DistortedCamera() {
 
 Housing FlatPort() {
   const double tilt = 4.0 * M_PI / 180.0;
-  return Housing::FromName("FLATPORT", {std::sin(tilt), 0, std::cos(tilt), 0.025, 0.012, 1.0, 1.49, 1.334}, "test");
+  return Housing::FromName(
+      "FLATPORT", {std::sin(tilt), 0, std::cos(tilt), 0.025, 0.012, 1.0, 1.49, 1.334}, "test");
 }
 
 Housing DomePort(const Eigen::Vector3d& centre) {
-  return Housing::FromName("DOMEPORT", {centre.x(), centre.y(), centre.z(), 0.06, 0.008, 1.0, 1.49, 1.334}, "test");
+  return Housing::FromName(
+      "DOMEPORT", {centre.x(), centre.y(), centre.z(), 0.06, 0.008, 1.0, 1.49, 1.334}, "test");
 }
 
 Camera InAirPinholeLens() {
@@ -56,7 +58,8 @@ TEST(VirtualPinhole, InAirIsExactAtEveryDepth) {
 // Output pixels near the border, mapped back into the camera's image.
 int CountOutside(const VirtualPinhole& pinhole) {
   int outside = 0;
-  const double w = static_cast<double>(pinhole.pinhole.width), h = static_cast<double>(pinhole.pinhole.height);
+  const double w = static_cast<double>(pinhole.pinhole.width),
+               h = static_cast<double>(pinhole.pinhole.height);
   for (double t = 0; t <= 1.0; t += 1.0 / 64) {
     for (const Eigen::Vector2d& pixel :
          {Eigen::Vector2d(0.5, 0.5 + t * (h - 1)), Eigen::Vector2d(w - 0.5, 0.5 + t * (h - 1)),
@@ -84,8 +87,9 @@ TEST(VirtualPinhole, BlankPixelsChoosesTheFieldOfView) {
   EXPECT_GT(CountOutside(wide), 0);
   // Every pixel of the camera's border lands inside the wide output.
   for (double t = 0; t <= 1.0; t += 1.0 / 64) {
-    for (const Eigen::Vector2d& pixel : {Eigen::Vector2d(0, t * 600), Eigen::Vector2d(960, t * 600),
-                                         Eigen::Vector2d(t * 960, 0), Eigen::Vector2d(t * 960, 600)}) {
+    for (const Eigen::Vector2d& pixel :
+         {Eigen::Vector2d(0, t * 600), Eigen::Vector2d(960, t * 600), Eigen::Vector2d(t * 960, 0),
+          Eigen::Vector2d(t * 960, 600)}) {
       const Eigen::Vector2d output = *wide.OutputPixel(pixel);
       EXPECT_GE(output.x(), -1.0);
       EXPECT_GE(output.y(), -1.0);
@@ -98,7 +102,8 @@ TEST(VirtualPinhole, BlankPixelsChoosesTheFieldOfView) {
   const VirtualPinhole shrunk = FitVirtualPinhole(camera, 1.0, Eigen::Matrix3d::Identity(), small);
   EXPECT_EQ(std::max(shrunk.pinhole.width, shrunk.pinhole.height), 400u);
   EXPECT_NEAR(shrunk.pinhole.params[0] / tight.pinhole.params[0],
-              400.0 / static_cast<double>(std::max(tight.pinhole.width, tight.pinhole.height)), 1e-3);
+              400.0 / static_cast<double>(std::max(tight.pinhole.width, tight.pinhole.height)),
+              1e-3);
 }
 
 TEST(VirtualPinhole, CentredDomeIsNearlyExactEverywhere) {
@@ -106,12 +111,14 @@ TEST(VirtualPinhole, CentredDomeIsNearlyExactEverywhere) {
   const VirtualPinhole pinhole = FitVirtualPinhole(centred, 2.0, Eigen::Matrix3d::Identity(), {});
   // The dome does not magnify: the pinhole keeps the lens's focal length.
   EXPECT_NEAR(pinhole.pinhole.params[0], 800.0, 1.0);
-  const ApproximationError error = MeasureApproximationError(pinhole, SampleDepths({0.3, 20.0}, 5, 2.0), 32, 2);
+  const ApproximationError error =
+      MeasureApproximationError(pinhole, SampleDepths({0.3, 20.0}, 5, 2.0), 32, 2);
   EXPECT_LT(error.worst_px, 1e-3);
   // 3 mm off-centre: the rays miss the camera centre, and the error shows.
   const HousedCamera decentred{InAirPinholeLens(), DomePort(Eigen::Vector3d(0.003, 0, 0))};
   const VirtualPinhole off = FitVirtualPinhole(decentred, 2.0, Eigen::Matrix3d::Identity(), {});
-  const ApproximationError off_error = MeasureApproximationError(off, SampleDepths({0.3, 20.0}, 5, 2.0), 32, 2);
+  const ApproximationError off_error =
+      MeasureApproximationError(off, SampleDepths({0.3, 20.0}, 5, 2.0), 32, 2);
   EXPECT_GT(off_error.worst_px, 0.3);
 }
 
@@ -121,7 +128,8 @@ TEST(VirtualPinhole, FlatPortErrorGrowsAwayFromTheDesignDepth) {
   // Behind water the camera sees narrower: the apparent focal length is
   // about n_water times the lens's.
   EXPECT_NEAR(pinhole.pinhole.params[0] / 800.0, 1.334, 0.02);
-  const ApproximationError error = MeasureApproximationError(pinhole, {0.3, 0.5, 1.0, 2.0, 8.0}, 32, 2);
+  const ApproximationError error =
+      MeasureApproximationError(pinhole, {0.3, 0.5, 1.0, 2.0, 8.0}, 32, 2);
   ASSERT_EQ(error.depths.size(), 5u);
   EXPECT_LT(error.depths[2].max_px, 1e-6);
   EXPECT_GT(error.depths[1].max_px, 0.5);
@@ -139,13 +147,16 @@ TEST(VirtualPinhole, ChosenDesignDepthBalancesTheRange) {
   ASSERT_GT(design, range.near);
   ASSERT_LT(design, range.far);
   const VirtualPinhole chosen = FitVirtualPinhole(camera, design, Eigen::Matrix3d::Identity(), {});
-  const ApproximationError error = MeasureApproximationError(chosen, SampleDepths(range, 7, design), 32, 2);
+  const ApproximationError error =
+      MeasureApproximationError(chosen, SampleDepths(range, 7, design), 32, 2);
   // The worst error sits at both ends alike (minimax), within 2 %.
   EXPECT_NEAR(error.depths.front().max_px, error.depths.back().max_px, 0.02 * error.worst_px);
   // Better than the ends' and the refractive fork's fixed 5 m.
   for (const double other : {0.5, 3.0, 5.0}) {
     const VirtualPinhole fixed = FitVirtualPinhole(camera, other, Eigen::Matrix3d::Identity(), {});
-    EXPECT_LT(error.worst_px, MeasureApproximationError(fixed, SampleDepths(range, 7, other), 32, 2).worst_px) << other;
+    EXPECT_LT(error.worst_px,
+              MeasureApproximationError(fixed, SampleDepths(range, 7, other), 32, 2).worst_px)
+        << other;
   }
 }
 
