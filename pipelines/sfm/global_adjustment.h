@@ -10,7 +10,7 @@
 #include "colmap_ext/camera/housed_camera.h"
 #include "pipelines/bundle_adjustment/bundle_adjustment.h"
 #include "pipelines/reconstruction/reconstruction.h"
-#include "pipelines/sfm/incremental_mapper.h"
+#include "pipelines/sfm/incremental_mapper_options.h"
 
 namespace portcal {
 

@@ -1,146 +1,90 @@
-// Incremental structure-from-motion on refracted rays (Schoenberger and
-// Frahm, "Structure-from-motion revisited", CVPR 2016, with every
-// observation a ray in water as in She et al., "Refractive COLMAP", IROS
-// 2024): an initial pair by relative pose, then one image at a time by
-// generalized absolute pose (gp3p in RANSAC), triangulation of the new
-// rays, local and periodic global refractive bundle adjustment, outlier
-// filtering; several models when the scene falls apart. With no housing it
-// is ordinary SfM through the same code.
+// The steps of incremental structure-from-motion on refracted rays
+// (Schoenberger and Frahm, "Structure-from-motion revisited", CVPR 2016,
+// with every observation a ray in water as in She et al., "Refractive
+// COLMAP", IROS 2024): the next images to try, registration by generalized
+// absolute pose (gp3p in RANSAC), triangulation of the new rays, local and
+// global refractive bundle adjustment, outlier filtering. With no housing it
+// is ordinary SfM through the same code. When to take which step (initial
+// pairs, restarts, when to refine the calibration) is the pipeline's
+// (incremental_pipeline.h), as COLMAP splits sfm/incremental_mapper from
+// controllers/incremental_pipeline.
 #pragma once
 
+#include <map>
 #include <set>
 #include <vector>
 
-#include "colmap_ext/util/progress.h"
 #include "pipelines/bundle_adjustment/bundle_adjustment.h"
 #include "pipelines/reconstruction/reconstruction.h"
+#include "pipelines/sfm/global_adjustment.h"
+#include "pipelines/sfm/incremental_mapper_options.h"
 
 namespace portcal {
 
-struct IncrementalMapperOptions {
-  int init_min_num_inliers = 50;
-  double init_min_tri_angle_deg = 4.0;  // median over the initial points
-  int init_max_num_trials = 20;         // candidate initial pairs tried per model
-  // A model whose intrinsics come out implausible at three refinements in a
-  // row, or at the last one, grew from a wrong start (e.g. a low-parallax
-  // pair on the wrong side of the bas-relief ambiguity;
-  // docs/dev/auto_calibration_notes.md): it is started again from the next candidate
-  // pair, at most this many times; with no pair left, the first start is
-  // built to the end, its intrinsics held.
-  int init_max_restarts = 2;
-  // A focal length more than this factor from the start counts as
-  // implausible too (COLMAP's bound, 2, against its prior). When the ArUco
-  // markers gave the start, refractive_mapper tightens it to 1.25: a model
-  // grown from a wrong pair can drift that far over many adjustments, none
-  // of them a factor 2 (docs/dev/auto_calibration_notes.md).
-  double max_focal_ratio_to_start = 2.0;
-  double init_max_error_px = 4.0;
-  // Pairs no model starts from: the auto-calibrator's next start excludes
-  // the pair the previous start's model grew from, so that it takes another
-  // path (with only another random seed, three starts grew three identical
-  // wrong models from one pair; docs/dev/auto_calibration_notes.md).
-  std::set<image_pair_t> init_excluded_pairs;
-  // Scale of a model when markers do not give it: the initial pair's median
-  // scene depth, metres.
-  double init_scene_depth_m = 1.0;
-  double abs_pose_max_error_px = 12.0;
-  int abs_pose_min_num_inliers = 30;
-  double filter_max_reproj_error_px = 4.0;
-  double filter_min_tri_angle_deg = 1.5;
-  double tri_min_angle_deg = 1.5;
-  bool ba_refine_focal_length = true;
-  bool ba_refine_principal_point = false;
-  bool ba_refine_extra_params = true;
-  // Self-calibrate the housing in the global adjustments that refine the
-  // intrinsics, so that structure and port co-evolve (a model built under an
-  // untilted guess absorbs the tilt into poses and points, and the final
-  // refinement may not climb out). Wants a metric scale (markers): without
-  // one the port distance wanders and models split.
-  bool ba_refine_housing = false;
-  // Below this many images, of the distortion only the first radial term
-  // is refined (the other terms held; the principal point as asked): a
-  // handful of views of a small target cannot tell eight intrinsics apart,
-  // and freed together they leave the basin (docs/dev/auto_calibration_notes.md).
-  // 0: all from the start.
-  int ba_full_intrinsics_min_images = 10;
-  int ba_local_num_images = 6;
-  double ba_global_images_ratio = 1.1;
-  int ba_max_num_iterations = 50;
-  // A global adjustment ends when an iteration lowers the cost by less than
-  // this fraction. The mapper's models are intermediate (the refinement
-  // stage converges fully, at 1e-8), and iterating them further changed
-  // nothing downstream but the time (docs/benchmarks.md).
-  double ba_global_function_tolerance = 1e-5;
-  // A global adjustment while the model grows, with the calibration held,
-  // also ends once a step changed the robust loss's weight of at most this
-  // fraction of the observations by more than 0.01 (weights_settled.h): its
-  // model is intermediate, and on a long survey the robust solve otherwise
-  // crawls along the strips for more iterations the longer they are
-  // (docs/scale.md). Adjustments that refine the calibration end by the
-  // cost change alone; the model's final ones: ba_final_hold_weights. 0:
-  // the cost change alone everywhere.
-  double ba_global_max_unsettled_weights = 0.01;
-  // The model's final adjustment on the refinement's schedule: a robust
-  // solve that ends once the weights have settled (as above), the outliers
-  // filtered, then one solve with the weights held (BundleAdjustmentOptions::
-  // hold_loss_weights), a weighted least-squares problem Gauss-Newton
-  // converges in a few steps. The robust solve alone crawls to its stop:
-  // with the Cauchy loss it converges only linearly (BundleAdjustmentOptions::
-  // hold_loss_weights; the 120-image survey: 18 iterations against 3 + 2,
-  // the same refined port; docs/scale.md). 0: both final solves robust, to
-  // the cost change.
-  bool ba_final_hold_weights = true;
-  // The intrinsics and housing are refined whenever the model has grown by
-  // a third, until two such refinements in a row, on models of 50 images or
-  // more, moved no point at the scene's median depth by this many pixels;
-  // then they are held until the model's final adjustment, which refines
-  // them on all images. Each refinement costs the exact refraction on every
-  // observation, and on a survey the mapper's estimate stops improving early
-  // (docs/benchmarks.md). Below the keypoints' noise, the held calibration
-  // bends no structure. 0: refine to the end.
-  double ba_calibration_settled_px = 0.25;
-  // Below this many images the calibration is refined whenever the model
-  // has grown by a third, however little it moves: such adjustments take
-  // seconds, and from a few dozen views the estimate still moves with each
-  // image (the 25-view target sets).
-  int ba_calibration_settled_min_images = 50;
-  bool multiple_models = true;
-  int max_num_models = 50;
-  int min_model_size = 3;
-  MarkerScale marker_scale;  // side_length_m > 0: markers fix the scale
-  // > 0: global adjustments align the model to the images' position priors
-  // and keep them as residuals of this sigma (metres): the scale of a
-  // survey, so that ba_refine_housing can estimate the port distance.
-  double position_prior_sigma_m = 0;
-  int random_seed = 0;  // RANSAC's samples (colmap_ext/util/random_seed.h)
-  int num_threads = 2;
-  void Check() const;  // throws OptionError naming --Mapper.*
+// What a global adjustment did, for the pipeline's bookkeeping.
+struct GlobalAdjustmentOutcome {
+  bool refined_intrinsics = false;  // asked and allowed at this model size
+  bool implausible = false;         // the intrinsics came out bogus and were held
+  BundleAdjustmentOptions ba;       // as last solved
+  ceres::Solver::Summary summary;   // of the main solve
+  std::map<camera_t, HousedCamera> cameras_before;
 };
 
-// A global adjustment that refined the intrinsics or housing.
-struct CalibrationRefinement {
-  int num_images = 0;  // in the model then
-  // How far it moved the image, pixels at the scene's median depth
-  // (MaxImageShiftPx); infinity where not measured: on fewer than
-  // ba_calibration_settled_min_images, or when the adjustment did not
-  // converge.
-  double image_shift_px = 0;
-  // The calibration counts as settled after this one: held from here on,
-  // except in the model's final adjustments (which are recorded too).
-  bool settled = false;
-};
+class IncrementalMapper {
+ public:
+  IncrementalMapper(const SfmInputs& inputs, const std::map<camera_t, HousedCamera>& cameras,
+                    const IncrementalMapperOptions& options)
+      : inputs_(inputs), cameras_(cameras), options_(options) {}
 
-struct MappedModel {
-  Reconstruction reconstruction;
-  image_pair_t initial_pair = 0;  // the pair it grew from
-  std::vector<CalibrationRefinement>
-      calibration_refinements;  // in order; the final adjustment's last
-};
+  // Forgets what it tracked about the model grown before.
+  void BeginModel();
+  // The model's images are taken: no later model registers them.
+  void EndModel(const Reconstruction& r);
+  // Images registered in earlier models.
+  const std::set<image_t>& used() const { return used_; }
+  // The marker corners the last global adjustment left, dropped (the model
+  // they belong to was undone).
+  void ForgetMarkerCorners() { marker_corners_.clear(); }
 
-// Grows models until no image can be added; returns them largest first.
-std::vector<MappedModel> RunIncrementalMapper(const SfmInputs& inputs,
-                                              const std::map<camera_t, HousedCamera>& cameras,
-                                              const IncrementalMapperOptions& options,
-                                              ProgressSink& progress);
+  // Unregistered images that see enough of the model's points, most first
+  // (none that failed since the model last grew).
+  std::vector<image_t> NextImages(const Reconstruction& r) const;
+  // Registers the image and links its keypoints to the points they see;
+  // remembers a failure until an image registers.
+  bool RegisterImage(Reconstruction* r, image_t image_id);
+  // Continues tracks and triangulates new points of the image; returns the
+  // points created.
+  int Triangulate(Reconstruction* r, image_t image_id);
+  // Drops observations beyond the reprojection bound and points whose rays
+  // meet at too small an angle (of `images`' points; all when null).
+  int Filter(Reconstruction* r, const std::set<image_t>* images);
+  // The image and the images sharing the most points with it, adjusted.
+  void LocalAdjust(Reconstruction* r, image_t image_id);
+  // Adjusts the whole model (intrinsics and housing when asked and the model
+  // is large enough), undoing intrinsics that come out implausible; does not
+  // filter.
+  GlobalAdjustmentOutcome AdjustGlobally(Reconstruction* r, bool refine_intrinsics,
+                                         AdjustmentEnd end);
+
+ private:
+  double FocalOf(image_t image_id) const {
+    return cameras_.at(inputs_.images.at(image_id).camera_id).camera.MeanFocalLength();
+  }
+  bool Register(Reconstruction* r, image_t image_id);
+  // The housing's adjustments before the joint one (see AdjustGlobally).
+  void AdjustHousingFirst(Reconstruction* r, const BundleAdjustmentOptions& ba,
+                          std::vector<MarkerCorner>* markers);
+
+  const SfmInputs& inputs_;
+  const std::map<camera_t, HousedCamera>& cameras_;
+  const IncrementalMapperOptions& options_;
+  std::set<image_t> used_;    // registered in an earlier model
+  std::set<image_t> failed_;  // failed to register since the model last grew
+  // A global adjustment refining the housing has converged (off its bounds)
+  // in the current model.
+  bool port_converged_ = false;
+  // The markers' corners as the last global adjustment left them.
+  std::vector<MarkerCorner> marker_corners_;
+};
 
 }  // namespace portcal

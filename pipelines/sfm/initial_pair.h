@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "pipelines/reconstruction/reconstruction.h"
-#include "pipelines/sfm/incremental_mapper.h"
+#include "pipelines/sfm/incremental_mapper_options.h"
 
 namespace portcal {
 

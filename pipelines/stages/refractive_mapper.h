@@ -12,7 +12,7 @@
 
 #include "colmap_ext/housing/housing.h"
 #include "colmap_ext/util/progress.h"
-#include "pipelines/sfm/incremental_mapper.h"
+#include "pipelines/sfm/incremental_pipeline.h"
 #include "pipelines/sfm/radial_start.h"
 
 namespace portcal {
