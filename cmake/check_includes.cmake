@@ -3,10 +3,11 @@
 # library's header-only or transitively linked use; this does).
 #   cmake -DUNIT=pipelines/sfm -DALLOWED="colmap_ext;database;..." \
 #         -DSOURCES="a.cc;b.h" -DSTAMP=out.stamp -P check_includes.cmake
-# A unit is a top-level folder (colmap_ext, database, tools) or a folder of
-# pipelines/ (pipelines/sfm). In pipelines/stages a stage includes no other
-# stage unless it is one of COMPOSERS (the stages that run others: their
-# file names without extension); the rest only run.
+# A unit is a top-level folder (colmap_ext, database, tools), a folder of
+# pipelines/ (pipelines/sfm) or a test folder (tests/pipelines/sfm, whose
+# ALLOWED are those of the libraries its test links). In pipelines/stages a
+# stage includes no other stage unless it is one of COMPOSERS (the stages
+# that run others: their file names without extension); the rest only run.
 cmake_minimum_required(VERSION 3.18)
 set(errors "")
 foreach(source IN LISTS SOURCES)

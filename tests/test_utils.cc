@@ -11,7 +11,6 @@
 #include <sstream>
 
 #include "colmap_ext/util/string_utils.h"
-#include "pipelines/stages/synthesize.h"
 
 namespace fs = std::filesystem;
 
@@ -101,10 +100,15 @@ const char* const kThreeFaceTargetYaml = R"(target:
 
 GroundTruth RenderSet(const TempDir& dir, const std::string& config_yaml) {
   std::ofstream(dir / "set.yaml") << config_yaml;
-  SynthesizeOptions options;
-  options.config_path = (dir / "set.yaml").string();
-  options.output_path = (dir / "set").string();
-  RunSynthesize(options, NoProgress());
+  // Through the command, so that the helpers need no layer above colmap_ext
+  // (each test links only what it tests).
+  const CommandResult render =
+      RunCommand(PortcalBinary() + " synthesize --log_level warn --config '" +
+                 (dir / "set.yaml").string() + "' --output_path '" + (dir / "set").string() + "'");
+  if (render.exit_code != 0) {
+    throw std::runtime_error("portcal synthesize failed (exit " + std::to_string(render.exit_code) +
+                             "): " + render.output);
+  }
   return ReadGroundTruth(dir / "set/ground_truth.yaml");
 }
 
