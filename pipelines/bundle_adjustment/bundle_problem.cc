@@ -1,7 +1,5 @@
-// AdjustBundle (bundle_adjustment.h) as a problem builder: the residuals
-// (observations, marker constraints, position priors), the gauge, what the
-// calibration blocks refine, the solver's choice, the standard deviations
-// and the write-back, each a method of BundleProblem.
+#include "pipelines/bundle_adjustment/bundle_problem.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -58,20 +56,7 @@ std::vector<int> ConstantIntrinsics(const Camera& camera, const BundleAdjustment
   return constant;
 }
 
-// A residual's robust weight w, held: rho(s) = w s (a ScaledLoss without
-// an inner loss), kept by the problem builder in bulk.
-class HeldWeight final : public ceres::LossFunction {
- public:
-  explicit HeldWeight(double weight) : weight_(weight) {}
-  void Evaluate(double s, double rho[3]) const override {
-    rho[0] = weight_ * s;
-    rho[1] = weight_;
-    rho[2] = 0;
-  }
-
- private:
-  double weight_;
-};
+}  // namespace
 
 // The problem owns the cost functions; the losses are the builder's (see
 // BundleProblem's members).
@@ -80,92 +65,6 @@ ceres::Problem::Options ProblemOptions() {
   options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   return options;
 }
-
-class BundleProblem {
- public:
-  BundleProblem(Reconstruction* reconstruction, const BundleAdjustmentOptions& options,
-                const BundleAdjustmentScope& scope, std::vector<MarkerCorner>* markers,
-                const MarkerScale& marker_scale)
-      : reconstruction_(reconstruction),
-        options_(options),
-        scope_(scope),
-        markers_(markers),
-        marker_scale_(marker_scale),
-        poses_(reconstruction->mutable_poses()),
-        cameras_(reconstruction->mutable_cameras()) {
-    PORTCAL_CHECK(poses_.size() >= 2);
-    for (const auto& [id, pose] : poses_) pose_blocks_[id] = ToPose(pose);
-    for (auto& [id, camera] : cameras_) {
-      intrinsics_[id] = camera.camera.params;
-      if (camera.housing) housings_[id] = camera.housing->params;
-    }
-    // One loss object shared by the residuals. With the weights held, each
-    // residual gets its own weight instead and the robust loss only
-    // computes them.
-    if (options.loss_scale > 0 && options.hold_loss_weights) {
-      weight_loss_ = std::make_unique<ceres::CauchyLoss>(options.loss_scale);
-    } else if (options.loss_scale > 0) {
-      loss_ = std::make_unique<ceres::CauchyLoss>(options.loss_scale);
-    }
-    local_ = !scope.variable_images.empty();
-    // Which blocks the residuals carry: constants are captured instead (see
-    // bundle_costs.h), which makes the autodiff Jets much narrower.
-    refine_intrinsics_ = !local_ && (options.refine_focal_length ||
-                                     options.refine_principal_point || options.refine_extra_params);
-    refine_housing_ = !local_ && options.refine_housing;
-  }
-
-  void AddPoints();
-  void AddMarkers();
-  void AddPositionPriors();
-  void SetGauge();
-  void SetCalibrationBlocks();
-  ceres::Solver::Summary Solve();
-  void ComputeStdDevs(const ceres::Solver::Summary& summary, CalibrationStdDevs* std_devs);
-  void WriteBack();
-
- private:
-  bool IsVariable(image_t id) const { return !local_ || scope_.variable_images.count(id) > 0; }
-  CostBlocks BlocksOf(const HousedCamera& camera) const;
-  void AddObservation(image_t image_id, const Eigen::Vector2d& pixel, double* xyz, double sigma);
-  void AddRobustResidual(ceres::CostFunction* cost, const std::vector<double*>& blocks);
-  double SigmaOf(const TrackElement& e) const;
-  bool FreePose(image_t id) const;
-  ceres::Solver::Options SolverOptions(int* num_free_poses) const;
-  std::string Describe(const double* block, int index) const;
-  std::string DescribeResidual(const std::vector<double*>& blocks) const;
-  void StoreStdDevs(const MarginalCovariance& marginal, CalibrationStdDevs* std_devs) const;
-
-  Reconstruction* reconstruction_;
-  const BundleAdjustmentOptions& options_;
-  const BundleAdjustmentScope& scope_;
-  std::vector<MarkerCorner>* markers_;
-  const MarkerScale& marker_scale_;
-  std::map<image_t, Rigid3d>& poses_;
-  std::map<camera_t, HousedCamera>& cameras_;
-  std::map<image_t, PoseBlock> pose_blocks_;
-  std::map<camera_t, std::vector<double>> intrinsics_, housings_;
-  std::map<point3D_t, Eigen::Vector3d> point_blocks_;
-  std::set<camera_t> used_cameras_;
-  // The losses outlive the problem, which does not own them. A held weight
-  // is 16 bytes here; as a ScaledLoss owned by the problem it was an
-  // allocation and an entry in Ceres' table of the losses it owns, several
-  // times that per observation (docs/scale.md).
-  std::unique_ptr<ceres::LossFunction> loss_;  // the robust loss, shared
-  std::unique_ptr<ceres::LossFunction>
-      weight_loss_;                      // with hold_loss_weights: the weights' robust loss
-  std::deque<HeldWeight> held_weights_;  // with hold_loss_weights: one per residual block
-  ceres::HuberLoss prior_loss_{3.0};     // position priors' (3 sigma)
-  ceres::Problem problem_{ProblemOptions()};
-  std::vector<ceres::ResidualBlockId>
-      robust_blocks_;  // under loss_, with max_unsettled_weight_fraction
-  bool local_ = false;
-  bool refine_intrinsics_ = false;
-  bool refine_housing_ = false;
-  bool use_markers_ = false;
-  bool use_priors_ = false;
-  int64_t num_residuals_ = 0;
-};
 
 CostBlocks BundleProblem::BlocksOf(const HousedCamera& camera) const {
   if (refine_housing_ && camera.housing) {
@@ -455,147 +354,6 @@ ceres::Solver::Summary BundleProblem::Solve() {
   return summary;
 }
 
-// What a parameter block is, for the covariance's error messages.
-std::string BundleProblem::Describe(const double* block, int index) const {
-  for (const auto& [id, b] : pose_blocks_) {
-    if (b.data() == block) {
-      return "the pose of image '" + reconstruction_->inputs().images.at(id).name + "' (tangent " +
-             std::to_string(index) + ")";
-    }
-  }
-  for (const auto& [id, b] : intrinsics_) {
-    if (b.data() == block)
-      return "an intrinsic parameter of camera " + std::to_string(id) +
-             " (refined ones: " + cameras_.at(id).camera.ParamsInfo() + ")";
-  }
-  for (const auto& [id, b] : housings_) {
-    if (b.data() == block) return "a housing parameter of camera " + std::to_string(id);
-  }
-  return "a marker corner";
-}
-
-// A residual by its parameter blocks (see AddPoints, AddMarkers and
-// AddPositionPriors for their order).
-std::string BundleProblem::DescribeResidual(const std::vector<double*>& blocks) const {
-  std::string image;
-  for (const auto& [id, block] : pose_blocks_) {
-    if (block.data() == blocks[0])
-      image = "image '" + reconstruction_->inputs().images.at(id).name + "'";
-  }
-  if (image.empty()) return "a marker's side";
-  if (blocks.size() == 1) return "the position prior of " + image;
-  for (const auto& [id, xyz] : point_blocks_) {
-    if (xyz.data() == blocks[1])
-      return "the observation of 3D point " + std::to_string(id) + " in " + image;
-  }
-  return "the observation of a marker corner in " + image;
-}
-
-void BundleProblem::ComputeStdDevs(const ceres::Solver::Summary& summary,
-                                   CalibrationStdDevs* std_devs) {
-  std_devs->num_residuals = num_residuals_;
-  const double dof = std::max<double>(
-      1.0, summary.num_residuals_reduced - summary.num_effective_parameters_reduced);
-  // sigma0^2 = sum of squared (sigma-normalised) residuals / dof, from the
-  // unrobustified residuals.
-  double sum_sq = 0;
-  ceres::Problem::EvaluateOptions evaluate;
-  evaluate.apply_loss_function = false;
-  std::vector<double> residuals;
-  problem_.Evaluate(evaluate, nullptr, &residuals, nullptr, nullptr);
-  for (double r : residuals) sum_sq += r * r;
-  std_devs->sigma0 = std::sqrt(sum_sq / dof) * options_.sigma_px;
-  const double scale = std::sqrt(sum_sq / dof);
-  const auto is_free = [&](const double* block) {
-    return problem_.HasParameterBlock(block) && !problem_.IsParameterBlockConstant(block);
-  };
-  std::vector<double*> points, others;
-  std::vector<const double*> wanted;
-  for (auto& [id, xyz] : point_blocks_) {
-    if (is_free(xyz.data())) points.push_back(xyz.data());
-  }
-  for (auto& [id, block] : pose_blocks_) {
-    if (is_free(block.data())) others.push_back(block.data());
-  }
-  if (use_markers_) {
-    for (MarkerCorner& corner : *markers_) {
-      if (is_free(corner.xyz.data())) others.push_back(corner.xyz.data());
-    }
-  }
-  for (camera_t id : used_cameras_) {
-    if (is_free(intrinsics_.at(id).data())) {
-      others.push_back(intrinsics_.at(id).data());
-      wanted.push_back(intrinsics_.at(id).data());
-    }
-    if (housings_.count(id) && is_free(housings_.at(id).data())) {
-      others.push_back(housings_.at(id).data());
-      wanted.push_back(housings_.at(id).data());
-    }
-  }
-  if (wanted.empty()) return;
-  ResidualClusters clusters;
-  int image_index = 0;
-  for (const auto& [id, block] : pose_blocks_)
-    clusters.image_of_block[block.data()] = image_index++;
-  // The marginalised points are tracks by themselves; a marker's corner,
-  // seen in several images, is one too.
-  if (use_markers_) {
-    int corner_index = 0;
-    for (MarkerCorner& corner : *markers_)
-      clusters.track_of_block[corner.xyz.data()] = corner_index++;
-  }
-  clusters.residuals_per_dof = summary.num_residuals_reduced / dof;
-  const auto start = std::chrono::steady_clock::now();
-  const auto describe = [this](const double* block, int index) { return Describe(block, index); };
-  const MarginalCovariance marginal =
-      ComputeMarginalCovariance(&problem_, points, others, wanted, scale, describe, &clusters,
-                                /*max_dense_size=*/1200, options_.num_threads);
-  LOG(INFO) << "bundle adjustment: covariance of " << others.size()
-            << " pose and calibration blocks, " << points.size()
-            << " points marginalised, clustered by " << marginal.num_clusters << " images and "
-            << marginal.num_tracks << " tracks: "
-            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
-            << " s";
-  StoreStdDevs(marginal, std_devs);
-}
-
-// Each camera's standard deviations, the larger of the noise's and the
-// clusters' estimates, and the correlations of its intrinsics with its
-// housing.
-void BundleProblem::StoreStdDevs(const MarginalCovariance& marginal,
-                                 CalibrationStdDevs* std_devs) const {
-  const auto larger = [](std::vector<double> by_noise, const std::vector<double>& by_clusters) {
-    for (size_t i = 0; i < by_clusters.size() && i < by_noise.size(); ++i) {
-      by_noise[i] = std::max(by_noise[i], by_clusters[i]);
-    }
-    return by_noise;
-  };
-  for (camera_t id : used_cameras_) {
-    const double* intrinsics_block = intrinsics_.at(id).data();
-    const bool free_intrinsics = marginal.offset.count(intrinsics_block) > 0;
-    if (free_intrinsics) {
-      std_devs->intrinsics_by_noise[id] = marginal.StdDevs(intrinsics_block);
-      std_devs->intrinsics_by_clusters[id] = marginal.ClusteredStdDevs(intrinsics_block);
-      std_devs->intrinsics[id] =
-          larger(std_devs->intrinsics_by_noise[id], std_devs->intrinsics_by_clusters[id]);
-    }
-    if (!housings_.count(id) || !marginal.offset.count(housings_.at(id).data())) continue;
-    const double* housing_block = housings_.at(id).data();
-    std_devs->housing_by_noise[id] = marginal.StdDevs(housing_block);
-    std_devs->housing_by_clusters[id] = marginal.ClusteredStdDevs(housing_block);
-    std_devs->housing[id] =
-        larger(std_devs->housing_by_noise[id], std_devs->housing_by_clusters[id]);
-    if (!free_intrinsics) continue;
-    Eigen::MatrixXd& correlation = std_devs->intrinsics_housing_correlation[id];
-    correlation.resize(marginal.size.at(intrinsics_block), marginal.size.at(housing_block));
-    for (int i = 0; i < correlation.rows(); ++i) {
-      for (int j = 0; j < correlation.cols(); ++j) {
-        correlation(i, j) = marginal.Correlation(intrinsics_block, i, housing_block, j);
-      }
-    }
-  }
-}
-
 void BundleProblem::WriteBack() {
   for (auto& [id, block] : pose_blocks_) poses_[id] = FromPose(block);
   for (const auto& [point_id, xyz] : point_blocks_) reconstruction_->point(point_id).xyz = xyz;
@@ -610,8 +368,6 @@ void BundleProblem::WriteBack() {
   }
   if (cameras_changed) reconstruction_->UpdateRays();
 }
-
-}  // namespace
 
 ceres::Solver::Summary AdjustBundle(Reconstruction* reconstruction,
                                     const BundleAdjustmentOptions& options,
