@@ -108,14 +108,15 @@ namespace {
 struct CalibrationStart {
   int index = 0;  // 0: written to output_path itself; k: output_path/start_k
   int num_registered = 0;
-  RefractiveBundleAdjusterSummary refined;
+  ModelRefinementSummary refined;
+  SparseModel model;  // refined
 };
 
 std::string StartDir(int k) { return "start_" + std::to_string(k); }
 
 // Warnings another start might cure: not those about what the views'
 // geometry cannot tell apart.
-size_t NumCurableWarnings(const RefractiveBundleAdjusterSummary& refined) {
+size_t NumCurableWarnings(const ModelRefinementSummary& refined) {
   return refined.report.warnings.size() - static_cast<size_t>(refined.num_geometry_warnings);
 }
 
@@ -137,15 +138,11 @@ void KeepStart(const fs::path& output_path, int kept, int num_starts) {
   for (int k = 1; k < num_starts; ++k) fs::remove_all(output_path / StartDir(k));
 }
 
-RefractiveMapperOptions MapperOptions(const AutoCalibratorOptions& options,
-                                      const std::string& database_path, const fs::path& dir,
-                                      int random_seed, bool refine_intrinsics,
-                                      const std::set<image_pair_t>& excluded_pairs) {
-  RefractiveMapperOptions map;
+ModelMappingOptions MapperOptions(const AutoCalibratorOptions& options, int random_seed,
+                                  bool refine_intrinsics,
+                                  const std::set<image_pair_t>& excluded_pairs) {
+  ModelMappingOptions map;
   map.mapper.init_excluded_pairs = excluded_pairs;
-  map.database_path = database_path;
-  map.image_path = options.image_path;
-  map.output_path = (dir / "sparse").string();
   map.housing = options.housing;
   map.mapper.num_threads = options.num_threads;
   map.mapper.random_seed = random_seed;
@@ -173,15 +170,10 @@ RefractiveMapperOptions MapperOptions(const AutoCalibratorOptions& options,
   return map;
 }
 
-RefractiveBundleAdjusterOptions RefinerOptions(const AutoCalibratorOptions& options,
-                                               const std::string& database_path,
-                                               const std::string& input_path, const fs::path& dir,
-                                               bool refine_intrinsics) {
+ModelRefinementOptions RefinerOptions(const AutoCalibratorOptions& options,
+                                      bool refine_intrinsics) {
   const bool refine_principal_point = refine_intrinsics && options.refine_principal_point != false;
-  RefractiveBundleAdjusterOptions refine;
-  refine.input_path = input_path;
-  refine.output_path = (dir / "refined").string();
-  refine.database_path = database_path;
+  ModelRefinementOptions refine;
   refine.marker_scale = options.marker_scale;
   refine.housing_guess = options.housing;
   refine.ba.refine_housing = options.housing.has_value();
@@ -197,28 +189,67 @@ RefractiveBundleAdjusterOptions RefinerOptions(const AutoCalibratorOptions& opti
   return refine;
 }
 
-// Start k: the mapper (random seed + k, none of `excluded_pairs` as its
-// initial pair) and the refinement, judged; throws NumericalError where
-// either fails or the result is ruled out. Adds the pair the model grew
-// from to `excluded_pairs`.
-CalibrationStart MapAndRefine(const AutoCalibratorOptions& options,
+// What the database adds to the mapper's model's images, from the inputs
+// the mapper read: marker detections, position priors and, where the
+// model's points are the database's keypoints, their scales.
+void AddExtrasFrom(const std::map<std::string, const SfmImage*>& by_name, SfmImage* image) {
+  const auto it = by_name.find(image->name);
+  if (it == by_name.end()) return;
+  const SfmImage& read = *it->second;
+  image->markers = read.markers;
+  image->position_prior = read.position_prior;
+  if (read.keypoints.size() != image->keypoints.size()) return;
+  for (size_t k = 0; k < read.keypoints.size(); ++k) {
+    if (!((read.keypoints[k] - image->keypoints[k]).cwiseAbs().maxCoeff() < 1e-3)) return;
+  }
+  image->scales = read.scales;
+}
+
+// The mapper's models written to dir/sparse/0, /1, ... for inspection.
+void WriteMappedModels(const std::vector<MappedModel>& models, const fs::path& dir) {
+  for (size_t m = 0; m < models.size(); ++m) {
+    WriteSparseModel(models[m].reconstruction.ToSparseModel(), dir / "sparse" / std::to_string(m),
+                     ModelFormat::kBinary);
+  }
+}
+
+// Start k: the mapper on `inputs` (random seed + k, none of
+// `excluded_pairs` as its initial pair), its largest model handed to the
+// refinement in memory, judged; throws NumericalError where either fails or
+// the result is ruled out. Adds the pair the model grew from to
+// `excluded_pairs`.
+CalibrationStart MapAndRefine(const AutoCalibratorOptions& options, const SfmInputs& inputs,
                               const std::string& database_path, int k,
                               const std::optional<double>& markers_focal, bool refine_intrinsics,
                               std::set<image_pair_t>* excluded_pairs, ProgressSink& progress) {
   const fs::path dir =
       k == 0 ? fs::path(options.output_path) : fs::path(options.output_path) / StartDir(k);
-  const RefractiveMapperSummary mapped =
-      RunRefractiveMapper(MapperOptions(options, database_path, dir, options.random_seed + k,
-                                        refine_intrinsics, *excluded_pairs),
-                          progress);
-  excluded_pairs->insert(mapped.initial_pairs.at(0));
+  const ModelMappingOptions map =
+      MapperOptions(options, options.random_seed + k, refine_intrinsics, *excluded_pairs);
+  map.Check();
+  SparseModel mapped;
+  {
+    const std::vector<MappedModel> models = MapModels(inputs, map, progress);
+    WriteMappedModels(models, dir);
+    excluded_pairs->insert(models.at(0).initial_pair);
+    mapped = models.at(0).reconstruction.ToSparseModel();
+  }
   CalibrationStart start;
   start.index = k;
-  start.num_registered = static_cast<int>(ReadSparseModel(mapped.model_paths.at(0)).images.size());
-  start.refined = RunRefractiveBundleAdjuster(
-      RefinerOptions(options, database_path, mapped.model_paths.at(0).string(), dir,
-                     refine_intrinsics),
-      progress);
+  start.num_registered = static_cast<int>(mapped.images.size());
+  std::map<std::string, const SfmImage*> by_name;
+  for (const auto& [id, image] : inputs.images) by_name[image.name] = &image;
+  const ModelRefinementOptions refine = RefinerOptions(options, refine_intrinsics);
+  refine.Check();
+  ModelSource source;
+  source.model_name = (dir / "sparse" / "0").string();
+  source.database_name = database_path;
+  source.load_model = [&] { return mapped; };
+  source.add_extras = [&](SfmImage* image) { AddExtrasFrom(by_name, image); };
+  RefinedModel refined = RefineModel(refine, source);
+  WriteSparseModel(refined.model, dir / "refined", ModelFormat::kBinary);
+  start.refined = std::move(refined.summary);
+  start.model = std::move(refined.model);
   if (refine_intrinsics) {
     const size_t num_warnings = start.refined.report.warnings.size();
     JudgeAutoCalibration(markers_focal, &start.refined.report);
@@ -238,7 +269,8 @@ CalibrationStart MapAndRefine(const AutoCalibratorOptions& options,
 // choices from another seed take another path; the start with the fewest
 // warnings, then the smallest residual, is kept (its files moved into the
 // output folder). Throws the first start's error when none succeeds.
-CalibrationStart BestStart(const AutoCalibratorOptions& options, const std::string& database_path,
+CalibrationStart BestStart(const AutoCalibratorOptions& options, const SfmInputs& inputs,
+                           const std::string& database_path,
                            const std::optional<double>& markers_focal, bool refine_intrinsics,
                            ProgressSink& progress) {
   const int num_starts = refine_intrinsics ? options.max_num_starts : 1;
@@ -247,7 +279,7 @@ CalibrationStart BestStart(const AutoCalibratorOptions& options, const std::stri
   std::set<image_pair_t> excluded_pairs;
   for (int k = 0; k < num_starts; ++k) {
     try {
-      CalibrationStart start = MapAndRefine(options, database_path, k, markers_focal,
+      CalibrationStart start = MapAndRefine(options, inputs, database_path, k, markers_focal,
                                             refine_intrinsics, &excluded_pairs, progress);
       if (!best || BetterStart(start, *best)) best = std::move(start);
     } catch (const NumericalError& e) {
@@ -333,14 +365,22 @@ AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options,
   RunFeatureMatcher(match, progress);
   lap(PairingModeName(options.matcher) + "_matcher");
 
-  const CalibrationStart best =
-      BestStart(options, database_path, markers_focal, refine_intrinsics, progress);
+  const CalibrationStart best = [&] {
+    // The matched database read once for every start (as refractive_mapper
+    // reads it), its models handed over in memory.
+    Database database(database_path, Database::OpenMode::kReadOnly);
+    const SfmInputs inputs = SfmInputs::Read(&database);
+    if (inputs.pair_inliers.empty()) {
+      throw InputError(database_path + ": no verified image pairs; run a matcher first");
+    }
+    return BestStart(options, inputs, database_path, markers_focal, refine_intrinsics, progress);
+  }();
   result.refined = best.refined;
   result.num_registered = best.num_registered;
   lap("refractive_mapper + refractive_bundle_adjuster");
   std::optional<Database> database;
   if (options.update_database) database.emplace(database_path, Database::OpenMode::kReadWrite);
-  const SparseModel refined = ReadSparseModel(fs::path(options.output_path) / "refined");
+  const SparseModel& refined = best.model;
   // Judged again: the report gained this stage's own warnings.
   result.refined.report.verdict = JudgeCalibration(
       result.refined.report, refined, refined.cameras.empty() ? 0 : refined.cameras.begin()->first);

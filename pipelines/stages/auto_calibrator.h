@@ -1,10 +1,12 @@
 // `portcal auto_calibrator`: calibration without a known target, all the
 // database stages in one command with defaults for a calibration object
 // carrying ArUco markers: feature_extractor -> feature_masker ->
-// exhaustive (or sequential) matcher -> refractive_mapper ->
-// refractive_bundle_adjuster. Writes, under output_path: database.db,
-// sparse/0 (the mapper's model), refined/ (the self-calibrated model) and
-// calibration.yaml / calibration.txt.
+// exhaustive (or sequential) matcher, then refractive_mapper's and
+// refractive_bundle_adjuster's cores (sfm/model_mapping.h,
+// refinement/model_refinement.h), the model handed from one to the other in
+// memory. Writes, under output_path: database.db, sparse/0 (the mapper's
+// model), refined/ (the self-calibrated model) and, once, calibration.yaml /
+// calibration.txt and report.html.
 #pragma once
 
 #include <optional>
@@ -12,11 +14,11 @@
 
 #include "colmap_ext/housing/housing.h"
 #include "colmap_ext/util/progress.h"
+#include "pipelines/refinement/model_refinement.h"
+#include "pipelines/sfm/model_mapping.h"
 #include "pipelines/stages/feature_extractor.h"
 #include "pipelines/stages/feature_masker.h"
 #include "pipelines/stages/feature_matcher.h"
-#include "pipelines/stages/refractive_bundle_adjuster.h"
-#include "pipelines/stages/refractive_mapper.h"
 
 namespace portcal {
 
@@ -37,14 +39,14 @@ struct AutoCalibratorOptions {
   std::optional<bool> refine_intrinsics;
   // With the intrinsics refined: nullopt refines the principal point but
   // holds it at the image centre again unless it moves beyond 3 sigma (see
-  // RefractiveBundleAdjusterOptions::principal_point_test_sigmas); false
+  // SelfCalibrationOptions::principal_point_test_sigmas); false
   // holds it; true refines it.
   std::optional<bool> refine_principal_point;
   // Seeds every random choice (RANSAC in verification and mapping): the
   // same images and options give the same calibration.
   int random_seed = 0;
   // The lens's first radial term from the matches before mapping
-  // (RefractiveMapperOptions::init_radial_from_matches: not for fisheye
+  // (ModelMappingOptions::init_radial_from_matches: not for fisheye
   // models): nullopt (where it applies) or false.
   std::optional<bool> init_radial_from_matches;
   // With the intrinsics refined: starts of the mapper and refinement (each
@@ -62,7 +64,7 @@ struct AutoCalibratorOptions {
 };
 
 struct AutoCalibratorSummary {
-  RefractiveBundleAdjusterSummary refined;
+  ModelRefinementSummary refined;
   int num_images = 0;
   int num_registered = 0;
   std::vector<std::pair<std::string, double>> stage_seconds;

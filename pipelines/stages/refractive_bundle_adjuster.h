@@ -12,45 +12,23 @@
 // Writes the adjusted model and calibration.yaml / .txt.
 #pragma once
 
-#include <optional>
+#pragma once
+
 #include <string>
 
-#include "colmap_ext/housing/housing.h"
 #include "colmap_ext/util/progress.h"
-#include "pipelines/bundle_adjustment/self_calibration.h"
-#include "pipelines/calibration/calibration_report.h"
+#include "pipelines/refinement/model_refinement.h"
 
 namespace portcal {
 
-// The schedule's options (ba, marker_scale, the IRLS tolerances, the
-// principal point test) are SelfCalibrationOptions'.
-struct RefractiveBundleAdjusterOptions : SelfCalibrationOptions {
-  std::string input_path;          // sparse model (+ housings.txt)
-  std::string output_path;         // adjusted model and reports
-  std::string database_path;       // for marker detections (optional)
-  std::optional<Housing> housing;  // replaces the model's housings
-  // The first guess of the housing, for one case only: the model's own
-  // housing lies at a bound of the adjustment (a flat port's distance at its
-  // 0.1 mm floor, a dome decentred to 90 % of its radius; the mapper can
-  // slide it there). With intrinsics and housing refined, the adjustment
-  // then starts its bound parameters (flat: distance; dome: centre) from
-  // this guess, the rest (a flat port's normal) from the model, and adjusts
-  // the intrinsics first. auto_calibrator passes its --Housing.*.
-  std::optional<Housing> housing_guess;
-  void Check() const;  // throws OptionError naming the option
+struct RefractiveBundleAdjusterOptions : ModelRefinementOptions {
+  std::string input_path;     // sparse model (+ housings.txt)
+  std::string output_path;    // adjusted model and reports
+  std::string database_path;  // for marker detections (optional)
+  void Check() const;         // throws OptionError naming the option
 };
 
-struct RefractiveBundleAdjusterSummary {
-  CalibrationReport report;  // of the first camera
-  int num_marker_corners = 0;
-  int num_position_priors = 0;  // images whose priors fixed the frame
-  int num_filtered = 0;
-  bool principal_point_held = false;  // by principal_point_test_sigmas
-  // Of report.warnings, those about what the views' geometry cannot tell
-  // apart (an intrinsic and a housing parameter traded): another start on
-  // the same views cannot cure them.
-  int num_geometry_warnings = 0;
-};
+using RefractiveBundleAdjusterSummary = ModelRefinementSummary;
 
 RefractiveBundleAdjusterSummary RunRefractiveBundleAdjuster(
     const RefractiveBundleAdjusterOptions& options, ProgressSink& progress);

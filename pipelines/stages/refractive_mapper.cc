@@ -9,7 +9,6 @@
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "colmap_ext/util/new_paths.h"
-#include "pipelines/sfm/calibration_start.h"
 
 namespace fs = std::filesystem;
 
@@ -19,9 +18,7 @@ void RefractiveMapperOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (output_path.empty()) throw OptionError("--output_path", "''", "a directory for the models");
   CheckOutputFolder("--output_path", output_path);
-  radial_start.Check();
-  if (housing) housing->ValidateInput("--Housing.params");
-  mapper.Check();
+  ModelMappingOptions::Check();
 }
 
 namespace {
@@ -71,22 +68,7 @@ RefractiveMapperSummary RunRefractiveMapper(const RefractiveMapperOptions& optio
                      ": no image has a position prior, so --PosePrior.position_sigma "
                      "has nothing to use (run pose_prior_importer, or set it to 0)");
   }
-  std::map<camera_t, HousedCamera> cameras = inputs.cameras;
-  if (options.housing) ReplaceHousings(*options.housing, &cameras);
-  IncrementalMapperOptions mapper = options.mapper;
-  if (StartFocalFromMarkers(inputs, options.init_focal_from_markers, &cameras)) {
-    mapper.max_focal_ratio_to_start =
-        std::min(mapper.max_focal_ratio_to_start, kMaxFocalRatioToMarkers);
-  }
-  StartRadialFromMatches(inputs, options.init_radial_from_matches,
-                         options.mapper.ba_refine_extra_params, options.radial_start, &cameras);
-  const std::vector<MappedModel> models = RunIncrementalMapper(inputs, cameras, mapper, progress);
-  if (models.empty()) {
-    throw NumericalError("refractive_mapper: no model could be initialised from " +
-                         std::to_string(inputs.pair_inliers.size()) +
-                         " verified pairs (too few inlier matches or too little parallax; see "
-                         "--Mapper.init_min_num_inliers and --Mapper.init_min_tri_angle)");
-  }
+  const std::vector<MappedModel> models = MapModels(inputs, options, progress);
   RefractiveMapperSummary summary;
   summary.num_images = static_cast<int>(inputs.images.size());
   for (size_t m = 0; m < models.size(); ++m) {

@@ -12,29 +12,17 @@
 
 #include "colmap_ext/housing/housing.h"
 #include "colmap_ext/util/progress.h"
-#include "pipelines/sfm/incremental_pipeline.h"
-#include "pipelines/sfm/radial_start.h"
+#include "pipelines/sfm/model_mapping.h"
 
 namespace portcal {
 
-struct RefractiveMapperOptions {
+struct RefractiveMapperOptions : ModelMappingOptions {
   std::string database_path;
   std::string image_path;  // accepted for COLMAP compatibility
   std::string output_path;
   // COLMAP's --image_list_path: a file of image names, one per line; only
   // these images (and the pairs between them) are mapped. "": all.
   std::string image_list_path;
-  IncrementalMapperOptions mapper;
-  std::optional<Housing> housing;  // for every camera; none: the database's
-  // The focal length from the markers before mapping: always, never, or
-  // (nullopt) when the camera has no prior focal length.
-  std::optional<bool> init_focal_from_markers;
-  // The lens's first radial term from the verified matches (radial_start.h)
-  // before mapping: always, never, or (nullopt) when the camera has no
-  // prior focal length, its distortion is all zero, the mapper refines it
-  // and the model is not a fisheye.
-  std::optional<bool> init_radial_from_matches;
-  RadialStartOptions radial_start;
   void Check() const;  // throws OptionError naming the option
 };
 
