@@ -14,6 +14,7 @@
 
 #include "colmap_ext/housing/housing.h"
 #include "colmap_ext/util/progress.h"
+#include "pipelines/refinement/calibration_starts.h"
 #include "pipelines/refinement/model_refinement.h"
 #include "pipelines/sfm/model_mapping.h"
 #include "pipelines/stages/feature_extractor.h"
@@ -69,13 +70,6 @@ struct AutoCalibratorSummary {
   int num_registered = 0;
   std::vector<std::pair<std::string, double>> stage_seconds;
 };
-
-// The last look before the report is written (intrinsics refined): throws
-// NumericalError when the focal length is far from the markers' estimate
-// (`markers_focal`, the in-air focal length the ArUco markers give; a wrong
-// solution however small its standard deviation), and adds warnings to the
-// report for a poorly determined focal length.
-void JudgeAutoCalibration(const std::optional<double>& markers_focal, CalibrationReport* report);
 
 AutoCalibratorSummary RunAutoCalibrator(const AutoCalibratorOptions& options,
                                         ProgressSink& progress);
