@@ -16,7 +16,7 @@ double g_busy_timeout_s = 60;
 
 void SetDatabaseBusyTimeout(double seconds) {
   if (!std::isfinite(seconds) || seconds < 0) {
-    throw OptionError("--Database.busy_timeout", std::to_string(seconds), "seconds >= 0");
+    throw OptionError("--Database.busy_timeout", seconds, "seconds >= 0");
   }
   g_busy_timeout_s = seconds;
 }

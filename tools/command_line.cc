@@ -194,7 +194,7 @@ void CommandLine::AddTriState(const std::string& name, std::optional<bool>* valu
   int& raw = ints_.emplace_back(value->has_value() ? static_cast<int>(**value) : -1);
   Add(name, &raw, help);
   conversions_.push_back([name, value, &raw] {
-    if (raw < -1 || raw > 1) throw OptionError("--" + name, std::to_string(raw), "-1, 0 or 1");
+    if (raw < -1 || raw > 1) throw OptionError("--" + name, raw, "-1, 0 or 1");
     *value = raw == -1 ? std::nullopt : std::optional<bool>(raw == 1);
   });
 }

@@ -20,6 +20,9 @@ class OptionError : public InputError {
  public:
   OptionError(const std::string& option, const std::string& value, const std::string& expected)
       : InputError("option " + option + " = " + value + ": expected " + expected) {}
+  // A number as the user would type it back: "1e+300", "0.04", "5" (not
+  // std::to_string's 300 digits or "0.000000").
+  OptionError(const std::string& option, double value, const std::string& expected);
 };
 
 // SQLite failure: carries sqlite3_errmsg, the database path and the SQL.

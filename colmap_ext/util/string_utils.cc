@@ -76,6 +76,12 @@ std::string FormatFixed(double value, int digits) {
   return out.str();
 }
 
+std::string FormatSignificant(double value, int digits) {
+  std::ostringstream out;
+  out << std::setprecision(digits) << value;
+  return out.str();
+}
+
 std::string FormatShortest(double value) {
   // 17 significant digits always read back exactly; the first precision
   // that does is the shortest. Exponents only for the very small or large:

@@ -18,6 +18,9 @@ long long ParseInteger(const std::string& token, const std::string& context, lon
 std::vector<double> ParseDoubleList(const std::string& s, const std::string& context);
 // `value` with `digits` digits after the point (std::fixed), for reports.
 std::string FormatFixed(double value, int digits);
+// `value` with `digits` significant digits (as `std::setprecision` alone
+// prints it: "1.234e+05" where needed), for messages and labels.
+std::string FormatSignificant(double value, int digits);
 // The shortest text that reads back as exactly `value` ("0.04", where
 // lexical_cast gives "0.040000000000000001"), for help texts and defaults.
 std::string FormatShortest(double value);

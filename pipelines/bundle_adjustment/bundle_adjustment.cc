@@ -15,29 +15,24 @@
 namespace portcal {
 
 void BundleAdjustmentOptions::Check() const {
-  if (!(sigma_px > 0))
-    throw OptionError("--BundleAdjustment.sigma_px", std::to_string(sigma_px), "> 0");
+  if (!(sigma_px > 0)) throw OptionError("--BundleAdjustment.sigma_px", sigma_px, "> 0");
   if (max_num_iterations < 1) {
-    throw OptionError("--BundleAdjustment.max_num_iterations", std::to_string(max_num_iterations),
-                      ">= 1");
+    throw OptionError("--BundleAdjustment.max_num_iterations", max_num_iterations, ">= 1");
   }
-  if (!(loss_scale >= 0))
-    throw OptionError("--BundleAdjustment.loss_scale", std::to_string(loss_scale), ">= 0");
+  if (!(loss_scale >= 0)) throw OptionError("--BundleAdjustment.loss_scale", loss_scale, ">= 0");
   if (!(position_prior_sigma_m >= 0)) {
-    throw OptionError("--PosePrior.position_sigma", std::to_string(position_prior_sigma_m),
-                      ">= 0 m");
+    throw OptionError("--PosePrior.position_sigma", position_prior_sigma_m, ">= 0 m");
   }
   if (!(function_tolerance > 0)) {
-    throw OptionError("--BundleAdjustment.function_tolerance", std::to_string(function_tolerance),
-                      "> 0");
+    throw OptionError("--BundleAdjustment.function_tolerance", function_tolerance, "> 0");
   }
   if (!(max_unsettled_weight_fraction >= 0 && max_unsettled_weight_fraction < 1)) {
     throw OptionError("--BundleAdjustment.robust_max_unsettled_weights",
-                      std::to_string(max_unsettled_weight_fraction), "in [0, 1)");
+                      max_unsettled_weight_fraction, "in [0, 1)");
   }
   if (!(initial_trust_region_radius > 0 && initial_trust_region_radius <= 1e16)) {
-    throw OptionError("--BundleAdjustment.held_trust_region_radius",
-                      std::to_string(initial_trust_region_radius), "in (0, 1e16]");
+    throw OptionError("--BundleAdjustment.held_trust_region_radius", initial_trust_region_radius,
+                      "in (0, 1e16]");
   }
 }
 
@@ -57,9 +52,8 @@ BundleAdjustmentOptions BundleAdjustmentOptions::WithWeightsHeld(
 }
 
 void MarkerScale::Check() const {
-  if (!(side_length_m >= 0))
-    throw OptionError("--Markers.side_length", std::to_string(side_length_m), ">= 0 m");
-  if (!(sigma_m > 0)) throw OptionError("--Markers.side_sigma", std::to_string(sigma_m), "> 0 m");
+  if (!(side_length_m >= 0)) throw OptionError("--Markers.side_length", side_length_m, ">= 0 m");
+  if (!(sigma_m > 0)) throw OptionError("--Markers.side_sigma", sigma_m, "> 0 m");
 }
 
 bool ImplausibleIntrinsics(const Camera& before, const Camera& after, std::string* why) {

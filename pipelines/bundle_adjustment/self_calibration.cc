@@ -14,16 +14,15 @@ namespace portcal {
 void SelfCalibrationOptions::Check() const {
   marker_scale.Check();
   if (!(max_reproj_error_px > 0)) {
-    throw OptionError("--BundleAdjustment.max_reproj_error", std::to_string(max_reproj_error_px),
-                      "> 0 px");
+    throw OptionError("--BundleAdjustment.max_reproj_error", max_reproj_error_px, "> 0 px");
   }
   if (!(robust_function_tolerance > 0 && robust_function_tolerance < 1)) {
-    throw OptionError("--BundleAdjustment.robust_function_tolerance",
-                      std::to_string(robust_function_tolerance), "in (0, 1)");
+    throw OptionError("--BundleAdjustment.robust_function_tolerance", robust_function_tolerance,
+                      "in (0, 1)");
   }
   if (!(principal_point_test_sigmas >= 0)) {
-    throw OptionError("--BundleAdjustment.principal_point_test_sigmas",
-                      std::to_string(principal_point_test_sigmas), ">= 0 (0: no test)");
+    throw OptionError("--BundleAdjustment.principal_point_test_sigmas", principal_point_test_sigmas,
+                      ">= 0 (0: no test)");
   }
   // ba as the robust and the held solves take it (their two options are
   // checked where BundleAdjustmentOptions checks its own).

@@ -40,7 +40,7 @@ void VerdictRules::Check() const {
     throw OptionError("verdict rms_check_px / rms_fail_px", FormatShortest(rms_check_px),
                       "0 < check <= fail");
   }
-  if (min_views < 1) throw OptionError("verdict min_views", std::to_string(min_views), ">= 1");
+  if (min_views < 1) throw OptionError("verdict min_views", min_views, ">= 1");
   if (!(min_covered_fraction >= 0 && min_covered_fraction <= 1)) {
     throw OptionError("verdict min_covered_fraction", FormatShortest(min_covered_fraction),
                       "in [0, 1]");

@@ -19,18 +19,15 @@ namespace portcal {
 
 void CameraCalibrationSettings::Check() const {
   if (!(outlier_view_factor > 1)) {
-    throw OptionError("--Calibration.outlier_view_factor", std::to_string(outlier_view_factor),
-                      "> 1");
+    throw OptionError("--Calibration.outlier_view_factor", outlier_view_factor, "> 1");
   }
   if (min_points_per_view < 4) {
-    throw OptionError("--Calibration.min_points_per_view", std::to_string(min_points_per_view),
-                      ">= 4");
+    throw OptionError("--Calibration.min_points_per_view", min_points_per_view, ">= 4");
   }
   if (max_num_iterations < 1) {
-    throw OptionError("--Calibration.max_num_iterations", std::to_string(max_num_iterations),
-                      ">= 1");
+    throw OptionError("--Calibration.max_num_iterations", max_num_iterations, ">= 1");
   }
-  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+  if (num_threads < 1) throw OptionError("--num_threads", num_threads, ">= 1");
 }
 
 Eigen::Vector4d BoardExtent(const std::vector<CalibrationView>& views) {

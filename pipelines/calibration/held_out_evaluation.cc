@@ -114,7 +114,7 @@ HeldOutEvaluation EvaluateHeldOut(const std::vector<CalibrationView>& views,
 std::vector<FoldEvaluation> CrossValidate(const std::vector<CalibrationView>& views, int folds,
                                           const CalibrationMethod& calibrate, int num_threads) {
   if (folds < 2 || folds > static_cast<int>(views.size())) {
-    throw OptionError("--Evaluation.folds", std::to_string(folds),
+    throw OptionError("--Evaluation.folds", folds,
                       "between 2 and the number of views (" + std::to_string(views.size()) + ")");
   }
   std::vector<FoldEvaluation> result;

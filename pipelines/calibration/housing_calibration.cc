@@ -24,10 +24,9 @@ namespace portcal {
 
 void HousingCalibrationSettings::Check() const {
   if (max_num_iterations < 1) {
-    throw OptionError("--Calibration.max_num_iterations", std::to_string(max_num_iterations),
-                      ">= 1");
+    throw OptionError("--Calibration.max_num_iterations", max_num_iterations, ">= 1");
   }
-  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+  if (num_threads < 1) throw OptionError("--num_threads", num_threads, ">= 1");
 }
 
 namespace {

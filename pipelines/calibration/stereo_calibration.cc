@@ -19,9 +19,9 @@ namespace portcal {
 
 void StereoCalibrationSettings::Check() const {
   if (max_num_iterations < 1) {
-    throw OptionError("--Stereo.max_num_iterations", std::to_string(max_num_iterations), ">= 1");
+    throw OptionError("--Stereo.max_num_iterations", max_num_iterations, ">= 1");
   }
-  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+  if (num_threads < 1) throw OptionError("--num_threads", num_threads, ">= 1");
 }
 
 Rigid3d MedianPose(const std::vector<Rigid3d>& poses) {

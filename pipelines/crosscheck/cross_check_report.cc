@@ -10,12 +10,6 @@
 namespace portcal {
 namespace {
 
-std::string Number(double value) {
-  std::ostringstream out;
-  out << std::setprecision(12) << value;
-  return out.str();
-}
-
 // A YAML single-quoted scalar.
 std::string Quoted(const std::string& text) {
   std::string out = "'";
@@ -50,9 +44,10 @@ std::string YamlParameters(const std::vector<ParameterComparison>& parameters,
   out << std::setprecision(12);
   for (const ParameterComparison& p : parameters) {
     out << indent << "- {name: " << p.name << ", portcal: " << p.portcal << ", portcal_std_dev: "
-        << (p.portcal_std_dev < 0 ? std::string("null") : Number(p.portcal_std_dev))
+        << (p.portcal_std_dev < 0 ? std::string("null") : FormatSignificant(p.portcal_std_dev, 12))
         << ", mrcal: " << p.mrcal << ", mrcal_std_dev: " << p.mrcal_std_dev
-        << ", z: " << (std::isfinite(p.z) ? Number(p.z) : std::string("null")) << "}\n";
+        << ", z: " << (std::isfinite(p.z) ? FormatSignificant(p.z, 12) : std::string("null"))
+        << "}\n";
   }
   return out.str();
 }

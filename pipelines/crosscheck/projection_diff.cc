@@ -289,7 +289,7 @@ void PredictDiff(const CalibratedLens& a, const CalibratedLens& b, const Grid& g
 }  // namespace
 
 void ProjectionDiffOptions::Check() const {
-  if (gridn_width < 3) throw OptionError("gridn_width", std::to_string(gridn_width), ">= 3");
+  if (gridn_width < 3) throw OptionError("gridn_width", gridn_width, ">= 3");
 }
 
 ProjectionDiff ComputeProjectionDiff(const CalibratedLens& a, const CalibratedLens& b,

@@ -44,8 +44,7 @@ void TargetDetectorOptions::Check() const {
   if (type != "chessboard" && type != "aruco_grid" && type != "charuco") {
     throw OptionError("--Target.type", type, "chessboard, aruco_grid or charuco");
   }
-  if (!(square_size_m > 0))
-    throw OptionError("--Target.square_size", std::to_string(square_size_m), "> 0 m");
+  if (!(square_size_m > 0)) throw OptionError("--Target.square_size", square_size_m, "> 0 m");
   // A board's squares and markers are millimetres to decimetres: a metre or
   // more is a size in millimetres given as metres.
   for (const auto& [option, size] : {std::pair("--Target.square_size", square_size_m),

@@ -12,23 +12,22 @@ namespace portcal {
 
 void DescriptorMatchingOptions::Check() const {
   if (!(max_ratio > 0 && max_ratio <= 1)) {
-    throw OptionError("--SiftMatching.max_ratio", std::to_string(max_ratio), "in (0, 1]");
+    throw OptionError("--SiftMatching.max_ratio", max_ratio, "in (0, 1]");
   }
   if (!(max_distance > 0 && max_distance <= M_PI)) {
-    throw OptionError("--SiftMatching.max_distance", std::to_string(max_distance), "in (0, pi]");
+    throw OptionError("--SiftMatching.max_distance", max_distance, "in (0, pi]");
   }
   if (max_num_matches < 1) {
-    throw OptionError("--SiftMatching.max_num_matches", std::to_string(max_num_matches), ">= 1");
+    throw OptionError("--SiftMatching.max_num_matches", max_num_matches, ">= 1");
   }
   if (method != "brute_force" && method != "kdtree") {
     throw OptionError("--SiftMatching.method", method, "brute_force or kdtree");
   }
   if (kdtree_num_trees < 1) {
-    throw OptionError("--SiftMatching.kdtree_num_trees", std::to_string(kdtree_num_trees), ">= 1");
+    throw OptionError("--SiftMatching.kdtree_num_trees", kdtree_num_trees, ">= 1");
   }
   if (kdtree_num_checks < 1) {
-    throw OptionError("--SiftMatching.kdtree_num_checks", std::to_string(kdtree_num_checks),
-                      ">= 1");
+    throw OptionError("--SiftMatching.kdtree_num_checks", kdtree_num_checks, ">= 1");
   }
 }
 

@@ -24,29 +24,25 @@ std::string PairingModeName(PairingMode mode) {
 }
 
 void SequentialPairingOptions::Check() const {
-  if (overlap < 1)
-    throw OptionError("--SequentialMatching.overlap", std::to_string(overlap), ">= 1");
+  if (overlap < 1) throw OptionError("--SequentialMatching.overlap", overlap, ">= 1");
   if (loop_detection_period < 1) {
-    throw OptionError("--SequentialMatching.loop_detection_period",
-                      std::to_string(loop_detection_period), ">= 1");
+    throw OptionError("--SequentialMatching.loop_detection_period", loop_detection_period, ">= 1");
   }
   if (loop_detection_num_images < 1) {
-    throw OptionError("--SequentialMatching.loop_detection_num_images",
-                      std::to_string(loop_detection_num_images), ">= 1");
+    throw OptionError("--SequentialMatching.loop_detection_num_images", loop_detection_num_images,
+                      ">= 1");
   }
   if (vocabulary_size < 2) {
-    throw OptionError("--SequentialMatching.vocabulary_size", std::to_string(vocabulary_size),
-                      ">= 2");
+    throw OptionError("--SequentialMatching.vocabulary_size", vocabulary_size, ">= 2");
   }
 }
 
 void SpatialPairingOptions::Check() const {
   if (max_num_neighbors < 1) {
-    throw OptionError("--SpatialMatching.max_num_neighbors", std::to_string(max_num_neighbors),
-                      ">= 1");
+    throw OptionError("--SpatialMatching.max_num_neighbors", max_num_neighbors, ">= 1");
   }
   if (!(max_distance_m > 0)) {
-    throw OptionError("--SpatialMatching.max_distance", std::to_string(max_distance_m), "> 0 m");
+    throw OptionError("--SpatialMatching.max_distance", max_distance_m, "> 0 m");
   }
 }
 

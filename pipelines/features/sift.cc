@@ -15,26 +15,24 @@ constexpr double kUpsamplingShift = 0.25;
 
 void SiftExtractionOptions::Check() const {
   if (max_num_features < 1) {
-    throw OptionError("--SiftExtraction.max_num_features", std::to_string(max_num_features),
-                      ">= 1");
+    throw OptionError("--SiftExtraction.max_num_features", max_num_features, ">= 1");
   }
   if (max_image_size < 16) {
-    throw OptionError("--SiftExtraction.max_image_size", std::to_string(max_image_size), ">= 16");
+    throw OptionError("--SiftExtraction.max_image_size", max_image_size, ">= 16");
   }
   if (first_octave < -1 || first_octave > 4) {
-    throw OptionError("--SiftExtraction.first_octave", std::to_string(first_octave), "-1 ... 4");
+    throw OptionError("--SiftExtraction.first_octave", first_octave, "-1 ... 4");
   }
   if (octave_resolution < 1 || octave_resolution > 10) {
-    throw OptionError("--SiftExtraction.octave_resolution", std::to_string(octave_resolution),
-                      "1 ... 10");
+    throw OptionError("--SiftExtraction.octave_resolution", octave_resolution, "1 ... 10");
   }
   if (!(peak_threshold > 0)) {
-    throw OptionError("--SiftExtraction.peak_threshold", std::to_string(peak_threshold), "> 0");
+    throw OptionError("--SiftExtraction.peak_threshold", peak_threshold, "> 0");
   }
   if (!(edge_threshold > 1)) {
-    throw OptionError("--SiftExtraction.edge_threshold", std::to_string(edge_threshold), "> 1");
+    throw OptionError("--SiftExtraction.edge_threshold", edge_threshold, "> 1");
   }
-  if (!(sigma > 0)) throw OptionError("--SiftExtraction.sigma", std::to_string(sigma), "> 0");
+  if (!(sigma > 0)) throw OptionError("--SiftExtraction.sigma", sigma, "> 0");
 }
 
 void QuantizeRootSift(const float* descriptor, uint8_t* out) {

@@ -11,21 +11,19 @@
 namespace portcal {
 
 void TwoViewVerificationOptions::Check() const {
-  if (!(max_error > 0))
-    throw OptionError("--TwoViewGeometry.max_error", std::to_string(max_error), "> 0 px");
+  if (!(max_error > 0)) throw OptionError("--TwoViewGeometry.max_error", max_error, "> 0 px");
   if (!(confidence > 0 && confidence < 1)) {
-    throw OptionError("--TwoViewGeometry.confidence", std::to_string(confidence), "in (0, 1)");
+    throw OptionError("--TwoViewGeometry.confidence", confidence, "in (0, 1)");
   }
   if (max_num_trials < 1) {
-    throw OptionError("--TwoViewGeometry.max_num_trials", std::to_string(max_num_trials), ">= 1");
+    throw OptionError("--TwoViewGeometry.max_num_trials", max_num_trials, ">= 1");
   }
-  if (random_seed < 0) throw OptionError("--random_seed", std::to_string(random_seed), ">= 0");
+  if (random_seed < 0) throw OptionError("--random_seed", random_seed, ">= 0");
   if (min_num_inliers < 8) {
-    throw OptionError("--TwoViewGeometry.min_num_inliers", std::to_string(min_num_inliers), ">= 8");
+    throw OptionError("--TwoViewGeometry.min_num_inliers", min_num_inliers, ">= 8");
   }
   if (!(min_inlier_ratio >= 0 && min_inlier_ratio <= 1)) {
-    throw OptionError("--TwoViewGeometry.min_inlier_ratio", std::to_string(min_inlier_ratio),
-                      "in [0, 1]");
+    throw OptionError("--TwoViewGeometry.min_inlier_ratio", min_inlier_ratio, "in [0, 1]");
   }
 }
 

@@ -16,9 +16,9 @@ void LiveEstimatorOptions::Check() const {
   if (housing) housing->ValidateInput("--Housing.params");
   guidance.Check();
   if (!(prior_pixel_sigma_px > 0)) {
-    throw OptionError("prior pixel sigma", std::to_string(prior_pixel_sigma_px), "> 0 px");
+    throw OptionError("prior pixel sigma", prior_pixel_sigma_px, "> 0 px");
   }
-  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+  if (num_threads < 1) throw OptionError("--num_threads", num_threads, ">= 1");
 }
 
 std::string LiveEstimate::Summary() const {

@@ -58,24 +58,21 @@ std::vector<Eigen::Quaterniond> OpeningRotations(const NextPoseOptions& options)
 }  // namespace
 
 void NextPoseOptions::Check() const {
-  if (!(distance_min_m > 0))
-    throw OptionError("--Live.distance_range", std::to_string(distance_min_m), "> 0 m");
+  if (!(distance_min_m > 0)) throw OptionError("--Live.distance_range", distance_min_m, "> 0 m");
   if (!(distance_max_m >= distance_min_m)) {
-    throw OptionError("--Live.distance_range", std::to_string(distance_max_m),
-                      ">= the minimum distance");
+    throw OptionError("--Live.distance_range", distance_max_m, ">= the minimum distance");
   }
   if (!(tilt_max_deg >= 0 && tilt_max_deg <= 80)) {
-    throw OptionError("--Live.max_tilt_deg", std::to_string(tilt_max_deg), "[0, 80]");
+    throw OptionError("--Live.max_tilt_deg", tilt_max_deg, "[0, 80]");
   }
   if (!(roll_max_deg >= 0 && roll_max_deg <= 180)) {
-    throw OptionError("--Live.max_roll_deg", std::to_string(roll_max_deg), "[0, 180]");
+    throw OptionError("--Live.max_roll_deg", roll_max_deg, "[0, 180]");
   }
-  if (!(border_margin_px >= 0))
-    throw OptionError("--Live.margin_px", std::to_string(border_margin_px), ">= 0");
+  if (!(border_margin_px >= 0)) throw OptionError("--Live.margin_px", border_margin_px, ">= 0");
   // Each candidate is a covariance evaluation (milliseconds): 10^5 already
   // takes minutes per suggestion.
   if (num_candidates < 1 || num_candidates > 100000) {
-    throw OptionError("--Live.num_candidates", std::to_string(num_candidates), "in [1, 100000]");
+    throw OptionError("--Live.num_candidates", num_candidates, "in [1, 100000]");
   }
   Uncertainty().Check();
 }

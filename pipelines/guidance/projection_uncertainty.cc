@@ -57,14 +57,13 @@ void Summarise(const Eigen::MatrixXd& map, double* mean, double* max) {
 
 void ProjectionUncertaintyOptions::Check() const {
   if (!(working_distance_m > 0)) {
-    throw OptionError("working_distance", std::to_string(working_distance_m), "> 0 m");
+    throw OptionError("working_distance", working_distance_m, "> 0 m");
   }
   if (grid_cols < 2 || grid_rows < 2) {
     throw OptionError("uncertainty grid",
                       std::to_string(grid_cols) + "x" + std::to_string(grid_rows), ">= 2x2");
   }
-  if (!(pixel_sigma_px > 0))
-    throw OptionError("pixel sigma", std::to_string(pixel_sigma_px), "> 0 px");
+  if (!(pixel_sigma_px > 0)) throw OptionError("pixel sigma", pixel_sigma_px, "> 0 px");
 }
 
 // Cell centres: the image's edge itself is where few cameras are used.

@@ -28,8 +28,8 @@ void ImageReaderOptions::Check() const {
     }
   }
   if (!(default_focal_length_factor > 0)) {
-    throw OptionError("--ImageReader.default_focal_length_factor",
-                      std::to_string(default_focal_length_factor), "> 0");
+    throw OptionError("--ImageReader.default_focal_length_factor", default_focal_length_factor,
+                      "> 0");
   }
 }
 

@@ -29,9 +29,8 @@ bool AllDigits(const std::string& text) {
 void FrameSourceOptions::Check() const {
   if (source.empty())
     throw OptionError("--source", "''", "a device, video file, folder, URL or GStreamer pipeline");
-  if (!(folder_fps > 0)) throw OptionError("--Live.fps", std::to_string(folder_fps), "> 0");
-  if (!(stall_seconds > 0))
-    throw OptionError("--Live.stall_seconds", std::to_string(stall_seconds), "> 0 s");
+  if (!(folder_fps > 0)) throw OptionError("--Live.fps", folder_fps, "> 0");
+  if (!(stall_seconds > 0)) throw OptionError("--Live.stall_seconds", stall_seconds, "> 0 s");
 }
 
 SourceKind ClassifySource(const std::string& source) {

@@ -9,13 +9,10 @@
 namespace portcal {
 
 void HandsFreeOptions::Check() const {
-  if (!(still_px > 0)) throw OptionError("--Live.still_px", std::to_string(still_px), "> 0 px");
-  if (!(still_seconds > 0))
-    throw OptionError("--Live.still_seconds", std::to_string(still_seconds), "> 0 s");
-  if (!(novelty_fraction >= 0))
-    throw OptionError("--Live.novelty", std::to_string(novelty_fraction), ">= 0");
-  if (!(min_gain >= 0 && min_gain < 1))
-    throw OptionError("--Live.min_gain", std::to_string(min_gain), "[0, 1)");
+  if (!(still_px > 0)) throw OptionError("--Live.still_px", still_px, "> 0 px");
+  if (!(still_seconds > 0)) throw OptionError("--Live.still_seconds", still_seconds, "> 0 s");
+  if (!(novelty_fraction >= 0)) throw OptionError("--Live.novelty", novelty_fraction, ">= 0");
+  if (!(min_gain >= 0 && min_gain < 1)) throw OptionError("--Live.min_gain", min_gain, "[0, 1)");
 }
 
 double MeanCornerShift(const CornerMap& a, const CornerMap& b) {

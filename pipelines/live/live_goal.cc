@@ -13,8 +13,7 @@ namespace portcal {
 
 void LiveGoalOptions::Check() const {
   if (!(target_uncertainty_px > 0)) {
-    throw OptionError("--Live.target_uncertainty_px", std::to_string(target_uncertainty_px),
-                      "> 0 px");
+    throw OptionError("--Live.target_uncertainty_px", target_uncertainty_px, "> 0 px");
   }
 }
 

@@ -90,13 +90,13 @@ void LivePageOptions::Check() const {
     throw OptionError("--Live.address", address, "a port in [0, 65535]");
   }
   if (max_width < 64 || max_width > 8192) {
-    throw OptionError("--Live.max_width", std::to_string(max_width), "in [64, 8192]");
+    throw OptionError("--Live.max_width", max_width, "in [64, 8192]");
   }
   if (!token.empty() && !IsValidLiveToken(token)) {
     throw OptionError("--Live.token", "(hidden)", "16-128 characters of A-Z, a-z, 0-9, _ and -");
   }
   if (jpeg_quality < 10 || jpeg_quality > 100) {
-    throw OptionError("--Live.jpeg_quality", std::to_string(jpeg_quality), "[10, 100]");
+    throw OptionError("--Live.jpeg_quality", jpeg_quality, "[10, 100]");
   }
 }
 

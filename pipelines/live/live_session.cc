@@ -69,9 +69,9 @@ void LiveSessionOptions::Check() const {
   hands_free.Check();
   estimator.guidance.Check();
   goal.Check();
-  if (max_views < 0) throw OptionError("--Live.max_views", std::to_string(max_views), ">= 0");
+  if (max_views < 0) throw OptionError("--Live.max_views", max_views, ">= 0");
   if (!(pair_tolerance_s >= 0)) {
-    throw OptionError("--Live.pair_tolerance", std::to_string(pair_tolerance_s),
+    throw OptionError("--Live.pair_tolerance", pair_tolerance_s,
                       ">= 0 s (0: the frames' own order)");
   }
   if (Stereo() && source2 == source.source)

@@ -19,20 +19,18 @@ void MarkerBoardOptions::Check() const {
   }
   CheckArucoDictionaryOption("--Target.dictionary", dictionary);
   if (type == "aruco_grid" && (markers_x < 1 || markers_y < 1)) {
-    throw OptionError("--Target.markers_x/markers_y", std::to_string(markers_x), ">= 1 each");
+    throw OptionError("--Target.markers_x/markers_y", markers_x, ">= 1 each");
   }
   if (type == "charuco" && (squares_x < 3 || squares_y < 3)) {
-    throw OptionError("--Target.squares_x/squares_y", std::to_string(squares_x), ">= 3 each");
+    throw OptionError("--Target.squares_x/squares_y", squares_x, ">= 3 each");
   }
-  if (!(marker_size_m > 0))
-    throw OptionError("--Target.marker_size", std::to_string(marker_size_m), "> 0 m");
+  if (!(marker_size_m > 0)) throw OptionError("--Target.marker_size", marker_size_m, "> 0 m");
   if (type == "charuco" && !(square_size_m > marker_size_m)) {
-    throw OptionError("--Target.square_size", std::to_string(square_size_m), "> marker_size");
+    throw OptionError("--Target.square_size", square_size_m, "> marker_size");
   }
-  if (min_points < 4) throw OptionError("--Target.min_points", std::to_string(min_points), ">= 4");
+  if (min_points < 4) throw OptionError("--Target.min_points", min_points, ">= 4");
   if (coarse_max_image_size < 0) {
-    throw OptionError("--Target.coarse_max_image_size", std::to_string(coarse_max_image_size),
-                      ">= 0");
+    throw OptionError("--Target.coarse_max_image_size", coarse_max_image_size, ">= 0");
   }
   refinement.Check();
 }

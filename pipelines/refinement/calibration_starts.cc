@@ -1,24 +1,17 @@
 #include "pipelines/refinement/calibration_starts.h"
 
-#include <iomanip>
 #include <map>
-#include <sstream>
 
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
+#include "colmap_ext/util/string_utils.h"
 #include "pipelines/sfm/calibration_start.h"
 
 namespace fs = std::filesystem;
 
 namespace portcal {
 namespace {
-
-std::string FormatNumber(double value) {
-  std::ostringstream out;
-  out << std::setprecision(4) << value;
-  return out.str();
-}
 
 // A focal length with a standard deviation above this fraction of itself
 // is not determined by the views (well-posed sets: 0.05-0.5 %).
@@ -134,8 +127,8 @@ void JudgeAutoCalibration(const std::optional<double>& markers_focal, Calibratio
   if (markers_focal && !(focal / *markers_focal < kMaxFocalRatioToMarkers &&
                          *markers_focal / focal < kMaxFocalRatioToMarkers)) {
     throw NumericalError(
-        "auto_calibrator: the refined focal length " + FormatNumber(focal) +
-        " px is far from the ArUco markers' estimate " + FormatNumber(*markers_focal) +
+        "auto_calibrator: the refined focal length " + FormatSignificant(focal, 4) +
+        " px is far from the ArUco markers' estimate " + FormatSignificant(*markers_focal, 4) +
         " px: the reconstruction settled in a wrong solution (lens distortion and housing "
         "traded against each other); " +
         remedy);
@@ -147,9 +140,9 @@ void JudgeAutoCalibration(const std::optional<double>& markers_focal, Calibratio
                                remedy);
     LOG(WARNING) << "auto_calibrator: " << report->warnings.back();
   } else if (focal_std_dev > kMaxRelativeFocalStdDev * focal) {
-    report->warnings.push_back("the focal length is poorly determined: std dev " +
-                               FormatNumber(focal_std_dev) + " px, " +
-                               FormatNumber(100 * focal_std_dev / focal) + " % of it; " + remedy);
+    report->warnings.push_back(
+        "the focal length is poorly determined: std dev " + FormatSignificant(focal_std_dev, 4) +
+        " px, " + FormatSignificant(100 * focal_std_dev / focal, 4) + " % of it; " + remedy);
     LOG(WARNING) << "auto_calibrator: " << report->warnings.back();
   }
 }

@@ -2,23 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iomanip>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <sstream>
 
 #include "colmap_ext/io/sparse_model.h"
 #include "colmap_ext/util/error.h"
+#include "colmap_ext/util/string_utils.h"
 
 namespace portcal {
 
 namespace {
-
-std::string Short(double value) {
-  std::ostringstream out;
-  out << std::setprecision(3) << value;
-  return out.str();
-}
 
 // OpenCV's viridis, looked up once.
 cv::Vec3b Viridis(double fraction) {
@@ -40,7 +33,7 @@ void DrawColourBar(cv::Mat* canvas, int x, int top, int h, double max_value,
   }
   for (int t = 0; t <= 4; ++t) {
     const int y = top + (h - 1) - (h - 1) * t / 4;
-    DrawLabel(canvas, Short(max_value * t / 4), cv::Point(x + 24, y + 5), 0.45);
+    DrawLabel(canvas, FormatSignificant(max_value * t / 4, 3), cv::Point(x + 24, y + 5), 0.45);
   }
   DrawLabel(canvas, unit, cv::Point(x + 2, top - 6), 0.45);
 }
@@ -126,7 +119,7 @@ cv::Mat BarChartPicture(const std::vector<double>& values, const std::vector<cv:
   cv::line(canvas, cv::Point(left, base), cv::Point(left, kTitleHeight), cv::Scalar(0, 0, 0), 1);
   for (int t = 0; t <= 4; ++t) {
     const double v = max_value * 0.95 * t / 4;
-    DrawLabel(&canvas, Short(v), cv::Point(4, y_of(v) + 5), 0.4);
+    DrawLabel(&canvas, FormatSignificant(v, 3), cv::Point(4, y_of(v) + 5), 0.4);
   }
   DrawLabel(&canvas, unit, cv::Point(4, kTitleHeight - 4), 0.4);
   const int label_every = std::max(1, 40 / bar_w);
@@ -178,7 +171,8 @@ void PlanCanvas::DrawScaleBar(const std::string& axes) {
   const double length = target >= 5 * step ? 5 * step : target >= 2 * step ? 2 * step : step;
   const int y = image_.rows - 14, x = 10, len = static_cast<int>(length * scale_);
   cv::line(image_, cv::Point(x, y), cv::Point(x + len, y), cv::Scalar(0, 0, 0), 2);
-  const std::string text = length >= 1 ? Short(length) + " m" : Short(length * 1000) + " mm";
+  const std::string text = length >= 1 ? FormatSignificant(length, 3) + " m"
+                                       : FormatSignificant(length * 1000, 3) + " mm";
   DrawLabel(&image_, text + "   (" + axes + ")", cv::Point(x + len + 8, y + 5), 0.45);
 }
 

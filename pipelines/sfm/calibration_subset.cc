@@ -8,9 +8,8 @@
 namespace portcal {
 
 void CalibrationSubsetOptions::Check() const {
-  if (num_images < 2) throw OptionError("--Subset.num_images", std::to_string(num_images), ">= 2");
-  if (min_num_inliers < 1)
-    throw OptionError("--Subset.min_num_inliers", std::to_string(min_num_inliers), ">= 1");
+  if (num_images < 2) throw OptionError("--Subset.num_images", num_images, ">= 2");
+  if (min_num_inliers < 1) throw OptionError("--Subset.min_num_inliers", min_num_inliers, ">= 1");
 }
 
 namespace {

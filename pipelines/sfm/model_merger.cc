@@ -10,8 +10,7 @@ namespace portcal {
 
 void ModelMergeOptions::Check() const {
   if (min_shared_points < 3) {
-    throw OptionError("--Hierarchical.min_shared_points", std::to_string(min_shared_points),
-                      ">= 3");
+    throw OptionError("--Hierarchical.min_shared_points", min_shared_points, ">= 3");
   }
 }
 

@@ -14,16 +14,13 @@
 namespace portcal {
 
 void RadialStartOptions::Check() const {
-  if (!(min_k < max_k))
-    throw OptionError("--Mapper.init_radial_min_k", std::to_string(min_k), "< max_k");
-  if (num_steps < 3)
-    throw OptionError("--Mapper.init_radial_num_steps", std::to_string(num_steps), ">= 3");
+  if (!(min_k < max_k)) throw OptionError("--Mapper.init_radial_min_k", min_k, "< max_k");
+  if (num_steps < 3) throw OptionError("--Mapper.init_radial_num_steps", num_steps, ">= 3");
   if (max_num_pairs < 2) {
-    throw OptionError("--Mapper.init_radial_max_num_pairs", std::to_string(max_num_pairs), ">= 2");
+    throw OptionError("--Mapper.init_radial_max_num_pairs", max_num_pairs, ">= 2");
   }
   if (max_matches_per_pair < 16) {
-    throw OptionError("--Mapper.init_radial_max_matches", std::to_string(max_matches_per_pair),
-                      ">= 16");
+    throw OptionError("--Mapper.init_radial_max_matches", max_matches_per_pair, ">= 16");
   }
 }
 

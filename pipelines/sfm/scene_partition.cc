@@ -12,11 +12,9 @@ namespace portcal {
 
 void ScenePartitionOptions::Check() const {
   if (leaf_max_num_images < 10) {
-    throw OptionError("--Hierarchical.leaf_max_num_images", std::to_string(leaf_max_num_images),
-                      ">= 10");
+    throw OptionError("--Hierarchical.leaf_max_num_images", leaf_max_num_images, ">= 10");
   }
-  if (image_overlap < 2)
-    throw OptionError("--Hierarchical.image_overlap", std::to_string(image_overlap), ">= 2");
+  if (image_overlap < 2) throw OptionError("--Hierarchical.image_overlap", image_overlap, ">= 2");
 }
 
 namespace {

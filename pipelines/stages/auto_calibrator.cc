@@ -25,9 +25,9 @@ void AutoCalibratorOptions::Check() const {
   if (matcher == PairingMode::kSpatial) {
     throw OptionError("--AutoCalibration.matcher", "spatial", "exhaustive or sequential");
   }
-  if (random_seed < 0) throw OptionError("--random_seed", std::to_string(random_seed), ">= 0");
+  if (random_seed < 0) throw OptionError("--random_seed", random_seed, ">= 0");
   if (max_num_starts < 1) {
-    throw OptionError("--AutoCalibration.max_num_starts", std::to_string(max_num_starts), ">= 1");
+    throw OptionError("--AutoCalibration.max_num_starts", max_num_starts, ">= 1");
   }
   marker_scale.Check();
 }

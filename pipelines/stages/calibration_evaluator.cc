@@ -28,9 +28,8 @@ void CalibrationEvaluatorOptions::Check() const {
   if (output_path.empty())
     throw OptionError("--output_path", "''", "a folder for evaluation.yaml/.txt");
   CheckOutputFolder("--output_path", output_path);
-  if (folds != 0 && folds < 2)
-    throw OptionError("--Evaluation.folds", std::to_string(folds), "0 (none) or >= 2");
-  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+  if (folds != 0 && folds < 2) throw OptionError("--Evaluation.folds", folds, "0 (none) or >= 2");
+  if (num_threads < 1) throw OptionError("--num_threads", num_threads, ">= 1");
 }
 
 namespace {
@@ -60,9 +59,7 @@ CalibrationMethod MethodLike(const CalibrationReport& report, int num_threads) {
 
 std::string Number(double value) {
   if (!std::isfinite(value)) return ".nan";
-  std::ostringstream out;
-  out << std::setprecision(6) << value;
-  return out.str();
+  return FormatSignificant(value, 6);
 }
 
 void WriteEvaluation(const CalibrationEvaluatorOptions& options, const CalibrationReport& report,

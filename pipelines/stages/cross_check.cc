@@ -3,10 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <limits>
 #include <numeric>
 #include <set>
-#include <sstream>
 
 #include "colmap_ext/io/mrcal_model.h"
 #include "colmap_ext/util/error.h"
@@ -16,6 +14,7 @@
 #include "database/database.h"
 #include "pipelines/calibration/calibration_report.h"
 #include "pipelines/calibration/target_views.h"
+#include "pipelines/crosscheck/disagreement.h"
 #include "pipelines/crosscheck/lens_comparison.h"
 #include "pipelines/crosscheck/mrcal_calibration.h"
 #include "pipelines/report/calibration_html.h"
@@ -53,102 +52,6 @@ std::vector<CalibrationView> ViewsOfInput(const CrossCheckOptions& options,
   return views;
 }
 
-// A cause when the input is not portcal's solution of these observations.
-void NoteResolveDifference(const Camera& input, const Camera& resolved,
-                           const ProjectionDiffOptions& diff_options, CrossCheckResult* result) {
-  ProjectionDiffOptions plain = diff_options;
-  plain.focus_radius = 1e9;  // the whole imager, unweighted
-  const ProjectionDiff resolve = ComputeProjectionDiff({input, {}}, {resolved, {}}, plain);
-  if (resolve.mean_px > 0.01) {
-    result->causes.push_back(
-        "the input calibration is not portcal's solution of these observations (re-solving "
-        "from it moves the projection by " +
-        FormatFixed(resolve.mean_px, 3) + " px on average): made from other views or settings?");
-  }
-}
-
-// mrcal's fit, outliers and board warp into the result.
-void NoteMrcalSolution(const std::vector<CalibrationView>& views,
-                       const MrcalCalibrationResult& mrcal, CrossCheckResult* result) {
-  result->num_points = mrcal.num_points;
-  result->mrcal_rms_px = mrcal.rms_px;
-  result->mrcal_outliers = mrcal.num_outliers;
-  for (size_t v = 0; v < views.size(); ++v) {
-    if (!mrcal.outliers[v].empty()) {
-      result->mrcal_outliers_per_view.emplace_back(views[v].image_name,
-                                                   static_cast<int>(mrcal.outliers[v].size()));
-    }
-  }
-  result->mrcal_warp = mrcal.board_warp;
-  result->mrcal_warp_std_dev = mrcal.board_warp_std_dev;
-}
-
-// Why portcal and mrcal disagree: the differences between the two solvers'
-// problems, strongest evidence first.
-void ExplainDisagreement(const CalibrationReport& input, const std::string& lensmodel,
-                         const MrcalCalibrationResult& mrcal, bool warp_cause, bool outlier_cause,
-                         bool mrcal_regularization, CrossCheckResult* result) {
-  if (warp_cause) {
-    result->causes.push_back(
-        "board warp: mrcal finds the board bent by x " +
-        FormatFixed(mrcal.board_warp.x() * 1e3, 2) + " +- " +
-        FormatFixed(mrcal.board_warp_std_dev.x() * 1e3, 2) + " mm, y " +
-        FormatFixed(mrcal.board_warp.y() * 1e3, 2) + " +- " +
-        FormatFixed(mrcal.board_warp_std_dev.y() * 1e3, 2) +
-        " mm, portcal holds it flat (camera_calibrator --Calibration.estimate_board_warp 1)");
-  }
-  if (outlier_cause) {
-    result->causes.push_back("outliers: mrcal rejected " + std::to_string(mrcal.num_outliers) +
-                             " corners in " +
-                             std::to_string(result->mrcal_outliers_per_view.size()) +
-                             " views; portcal fits every corner");
-  }
-  const std::string freedom = MrcalExtraFreedom(input.camera.ModelName());
-  if (!freedom.empty()) {
-    result->causes.push_back("parameterisation: mrcal's " + lensmodel + " frees " + freedom +
-                             ", which " + input.camera.ModelName() + " holds");
-  }
-  if (mrcal_regularization) {
-    result->causes.push_back(
-        "regularisation: mrcal pulls the distortions and the principal point "
-        "weakly towards zero and the centre (a small bias by design)");
-  }
-}
-
-// portcal re-run with what mrcal did differently (board warp, without its
-// outlier corners), compared again; returns the views it used.
-std::vector<CalibrationView> RerunAsMrcal(const std::vector<CalibrationView>& views,
-                                          const Camera& camera, const MrcalCalibrationResult& mrcal,
-                                          bool outlier_cause,
-                                          const ProjectionDiffOptions& diff_options,
-                                          const std::filesystem::path& dir,
-                                          CameraCalibrationSettings* rerun_settings,
-                                          CrossCheckResult* result) {
-  std::vector<CalibrationView> rerun_views = views;
-  rerun_settings->estimate_board_warp = true;
-  if (outlier_cause) {
-    for (size_t v = 0; v < views.size(); ++v) {
-      std::vector<int> drop = mrcal.outliers[v];
-      std::sort(drop.rbegin(), drop.rend());
-      for (const int i : drop) {
-        rerun_views[v].pixels.erase(rerun_views[v].pixels.begin() + i);
-        rerun_views[v].points_in_target.erase(rerun_views[v].points_in_target.begin() + i);
-      }
-    }
-  }
-  result->rerun_description = std::string("portcal with board warp") +
-                              (outlier_cause ? " and without mrcal's outlier corners" : "");
-  const CameraCalibrationResult rerun = CalibrateCamera(rerun_views, camera, *rerun_settings);
-  result->rerun_diff = ComputeProjectionDiff(LensOf(rerun), LensOf(mrcal), diff_options);
-  result->rerun_parameters = CompareParameters(rerun.camera, rerun.params_std_dev, mrcal);
-  WriteProjectionDiffHeatMap(*result->rerun_diff, static_cast<int>(camera.width),
-                             static_cast<int>(camera.height), "portcal (re-run) vs mrcal",
-                             dir / "projection_diff_rerun.png");
-  return rerun_views;
-}
-
-// What the report says before any comparison: the models, the threshold,
-// the views and portcal's own fit.
 // The projection-difference maps the stage wrote, for the page.
 std::vector<ReportPicture> DifferenceMaps(const CrossCheckResult& result,
                                           const CrossCheckOptions& options) {
@@ -177,6 +80,8 @@ std::vector<ReportPicture> DifferenceMaps(const CrossCheckResult& result,
   return maps;
 }
 
+// What the report says before any comparison: the models, the threshold,
+// the views and portcal's own fit.
 CrossCheckResult ResultHeader(const CrossCheckOptions& options, const CalibrationReport& input,
                               const std::string& lensmodel, int num_views,
                               const CameraCalibrationResult& portcal) {
@@ -209,13 +114,10 @@ void CrossCheckOptions::Check() const {
     throw OptionError("--input_calibration", "''", "a calibration.yaml");
   if (output_path.empty()) throw OptionError("--output_path", "''", "an output directory");
   CheckOutputFolder("--output_path", output_path);
-  if (folds == 1 || folds < 0)
-    throw OptionError("--CrossCheck.folds", std::to_string(folds), "0 or >= 2");
-  if (!(max_diff_px > 0))
-    throw OptionError("--CrossCheck.max_diff_px", std::to_string(max_diff_px), "> 0");
-  if (gridn_width < 3)
-    throw OptionError("--CrossCheck.gridn_width", std::to_string(gridn_width), ">= 3");
-  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+  if (folds == 1 || folds < 0) throw OptionError("--CrossCheck.folds", folds, "0 or >= 2");
+  if (!(max_diff_px > 0)) throw OptionError("--CrossCheck.max_diff_px", max_diff_px, "> 0");
+  if (gridn_width < 3) throw OptionError("--CrossCheck.gridn_width", gridn_width, ">= 3");
+  if (num_threads < 1) throw OptionError("--num_threads", num_threads, ">= 1");
 }
 
 CrossCheckSummary RunCrossCheck(const CrossCheckOptions& options, ProgressSink& progress) {

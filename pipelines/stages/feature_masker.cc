@@ -21,9 +21,9 @@ void FeatureMaskerOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (image_path.empty()) throw OptionError("--image_path", "''", "a directory of images");
   if (!(enlargement_factor >= 1.0)) {
-    throw OptionError("--Mask.enlargement_factor", std::to_string(enlargement_factor), ">= 1");
+    throw OptionError("--Mask.enlargement_factor", enlargement_factor, ">= 1");
   }
-  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+  if (num_threads < 1) throw OptionError("--num_threads", num_threads, ">= 1");
   CheckArucoDictionaryOption("--Markers.dictionary", dictionary);
 }
 

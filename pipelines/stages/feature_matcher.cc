@@ -19,7 +19,7 @@ namespace portcal {
 
 void FeatureMatcherOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
-  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+  if (num_threads < 1) throw OptionError("--num_threads", num_threads, ">= 1");
   sequential.Check();
   spatial.Check();
   matching.Check();

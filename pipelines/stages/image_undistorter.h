@@ -13,29 +13,22 @@
 #include <vector>
 
 #include "colmap_ext/util/progress.h"
+#include "pipelines/undistortion/undistortion_plan.h"
 #include "pipelines/undistortion/undistortion_report.h"
 
 namespace portcal {
 
-struct ImageUndistorterOptions {
+// The planning options (field of view, distance or depth range, error
+// depths, threads) come from UndistortionPlanOptions.
+struct ImageUndistorterOptions : UndistortionPlanOptions {
   // A sparse-model folder (cameras, images, points3D; housings.txt), or a
   // calibration file (any ReadCalibrationReport reads; with its housing)
   // for every image of image_path.
   std::string input_path;
   std::string image_path;
-  std::string output_path;  // the workspace folder (created)
-  FieldOfViewOptions field_of_view;
-  // Behind a port: the design depth (m, z in the camera frame), or the depth
-  // range whose worst error the chosen design depth minimises; 0: not given.
-  // With the distance alone the error is reported over [distance / 2,
-  // 2 distance]; with neither, a model's range is that of its points
-  // (5th-95th percentile of their depths in each camera).
-  double distance = 0;
-  DepthRange depth_range;
-  int num_error_depths = 5;   // depths the error is reported at (the range's ends included)
+  std::string output_path;    // the workspace folder (created)
   double max_error_px = 1.0;  // a worst error above this is a warning
   bool write_maps = false;    // maps/camera_<id>.yaml.gz (OpenCV FileStorage)
-  int num_threads = 2;
 
   void Check() const;  // throws OptionError naming --Undistort.* or the option
 };

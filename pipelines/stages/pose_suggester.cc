@@ -23,7 +23,7 @@ void PoseSuggesterOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (output_path.empty()) throw OptionError("--output_path", "''", "a folder for the suggestions");
   CheckOutputFolder("--output_path", output_path);
-  if (num_poses < 1) throw OptionError("--num_poses", std::to_string(num_poses), ">= 1");
+  if (num_poses < 1) throw OptionError("--num_poses", num_poses, ">= 1");
   if (housing.has_value() != !input_calibration.empty()) {
     throw OptionError(housing ? "--input_calibration" : "--Housing.model", "''",
                       "both --input_calibration and --Housing.model for a housing calibration, "

@@ -37,8 +37,8 @@ void ProjectPointsOptions::Check() const {
     if (!ExistsCameraModelWithName(camera_model)) {
       throw OptionError("--Camera.model", "'" + camera_model + "'", "one of " + CameraModelNames());
     }
-    if (width <= 0) throw OptionError("--Camera.width", std::to_string(width), "> 0");
-    if (height <= 0) throw OptionError("--Camera.height", std::to_string(height), "> 0");
+    if (width <= 0) throw OptionError("--Camera.width", width, "> 0");
+    if (height <= 0) throw OptionError("--Camera.height", height, "> 0");
   }
 }
 

@@ -22,8 +22,7 @@ void StereoCalibratorOptions::Check() const {
   if (pairing != "name" && pairing != "order")
     throw OptionError("--Stereo.pairing", pairing, "name or order");
   if (camera1_id >= 0 && camera1_id == camera2_id) {
-    throw OptionError("--Stereo.camera2_id", std::to_string(camera2_id),
-                      "another camera than --Stereo.camera1_id");
+    throw OptionError("--Stereo.camera2_id", camera2_id, "another camera than --Stereo.camera1_id");
   }
   if (input_calibration1.empty() != input_calibration2.empty()) {
     throw OptionError("--input_calibration1/2",

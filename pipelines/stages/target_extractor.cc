@@ -31,7 +31,7 @@ TargetDetectorOptions DetectorOptions(const TargetExtractorOptions& o) {
 void TargetExtractorOptions::Check() const {
   if (database_path.empty()) throw OptionError("--database_path", "''", "a database file");
   if (image_path.empty()) throw OptionError("--image_path", "''", "a directory of images");
-  if (num_threads < 1) throw OptionError("--num_threads", std::to_string(num_threads), ">= 1");
+  if (num_threads < 1) throw OptionError("--num_threads", num_threads, ">= 1");
   reader.Check();
   DetectorOptions(*this).Check();
 }

@@ -25,7 +25,7 @@ void CheckRenderArea(const Camera& camera, const std::string& key) {
 }  // namespace
 
 void DatasetConfig::Check() const {
-  if (num_images < 1) throw OptionError("num_images", std::to_string(num_images), ">= 1");
+  if (num_images < 1) throw OptionError("num_images", num_images, ">= 1");
   camera.Validate("camera");
   CheckRenderArea(camera, "camera");
   if (housing) housing->ValidateInput("housing");
@@ -45,13 +45,13 @@ void DatasetConfig::Check() const {
     trajectory->Check();
   }
   if (!(clutter_distance_m > 0)) {
-    throw OptionError("clutter.distance", std::to_string(clutter_distance_m), "> 0 m");
+    throw OptionError("clutter.distance", clutter_distance_m, "> 0 m");
   }
   if (!(occlusion_probability >= 0 && occlusion_probability <= 1)) {
-    throw OptionError("occlusion.probability", std::to_string(occlusion_probability), "[0, 1]");
+    throw OptionError("occlusion.probability", occlusion_probability, "[0, 1]");
   }
   if (!(occlusion_fraction > 0 && occlusion_fraction < 0.9)) {
-    throw OptionError("occlusion.fraction", std::to_string(occlusion_fraction), "(0, 0.9)");
+    throw OptionError("occlusion.fraction", occlusion_fraction, "(0, 0.9)");
   }
 }
 

@@ -11,30 +11,26 @@
 namespace portcal {
 
 void ImageFormationOptions::Check() const {
-  if (spp < 1 || spp > 16) throw OptionError("render.spp", std::to_string(spp), "[1, 16]");
-  if (!(blur_sigma_px >= 0))
-    throw OptionError("render.blur_sigma", std::to_string(blur_sigma_px), ">= 0");
-  if (!(noise_sigma >= 0))
-    throw OptionError("render.noise_sigma", std::to_string(noise_sigma), ">= 0");
+  if (spp < 1 || spp > 16) throw OptionError("render.spp", spp, "[1, 16]");
+  if (!(blur_sigma_px >= 0)) throw OptionError("render.blur_sigma", blur_sigma_px, ">= 0");
+  if (!(noise_sigma >= 0)) throw OptionError("render.noise_sigma", noise_sigma, ">= 0");
   if (!(attenuation_per_m >= 0)) {
-    throw OptionError("water.attenuation", std::to_string(attenuation_per_m), ">= 0 (1/m)");
+    throw OptionError("water.attenuation", attenuation_per_m, ">= 0 (1/m)");
   }
   if (!(forward_scatter_per_m >= 0)) {
-    throw OptionError("water.forward_scatter", std::to_string(forward_scatter_per_m), ">= 0 (1/m)");
+    throw OptionError("water.forward_scatter", forward_scatter_per_m, ">= 0 (1/m)");
   }
   if (!(forward_scatter_sigma_px > 0)) {
-    throw OptionError("water.forward_scatter_sigma_px", std::to_string(forward_scatter_sigma_px),
-                      "> 0");
+    throw OptionError("water.forward_scatter_sigma_px", forward_scatter_sigma_px, "> 0");
   }
   if (!(vignetting >= 0 && vignetting <= 1)) {
-    throw OptionError("vignetting", std::to_string(vignetting), "[0, 1]");
+    throw OptionError("vignetting", vignetting, "[0, 1]");
   }
-  if (!(exposure_s >= 0))
-    throw OptionError("motion_blur.exposure", std::to_string(exposure_s), ">= 0 (s)");
+  if (!(exposure_s >= 0)) throw OptionError("motion_blur.exposure", exposure_s, ">= 0 (s)");
   if (motion_samples < 1 || motion_samples > 64) {
-    throw OptionError("motion_blur.samples", std::to_string(motion_samples), "[1, 64]");
+    throw OptionError("motion_blur.samples", motion_samples, "[1, 64]");
   }
-  if (num_threads < 1) throw OptionError("num_threads", std::to_string(num_threads), ">= 1");
+  if (num_threads < 1) throw OptionError("num_threads", num_threads, ">= 1");
 }
 
 Eigen::Vector2d SampleOffset(int s, int spp) {

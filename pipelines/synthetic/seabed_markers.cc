@@ -9,17 +9,16 @@
 namespace portcal {
 
 void SeabedMarkerOptions::Check() const {
-  if (count < 0) throw OptionError("survey.markers.count", std::to_string(count), ">= 0");
-  if (!(side_m > 0)) throw OptionError("survey.markers.side", std::to_string(side_m), "> 0 m");
+  if (count < 0) throw OptionError("survey.markers.count", count, ">= 0");
+  if (!(side_m > 0)) throw OptionError("survey.markers.side", side_m, "> 0 m");
   if (!(spacing_m > 1.5 * side_m)) {
-    throw OptionError("survey.markers.spacing", std::to_string(spacing_m),
-                      "> 1.5 x the side (the plates)");
+    throw OptionError("survey.markers.spacing", spacing_m, "> 1.5 x the side (the plates)");
   }
   const cv::Ptr<cv::aruco::Dictionary> aruco =
       ArucoDictionaryByName(dictionary);  // throws for unknown names
   if (count > aruco->bytesList.rows) {
     throw OptionError(
-        "survey.markers.count", std::to_string(count),
+        "survey.markers.count", count,
         "<= " + std::to_string(aruco->bytesList.rows) + " (the ids of " + dictionary + ")");
   }
 }

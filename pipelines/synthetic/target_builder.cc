@@ -18,41 +18,37 @@ void TargetOptions::Check() const {
                       ">= 2 inner corners each");
   }
   if (type == "charuco" && (squares_x < 3 || squares_y < 3)) {
-    throw OptionError("target.squares_x/squares_y", std::to_string(squares_x), ">= 3 each");
+    throw OptionError("target.squares_x/squares_y", squares_x, ">= 3 each");
   }
-  if (!(square_size_m > 0))
-    throw OptionError("target.square_size", std::to_string(square_size_m), "> 0 m");
-  if (!(margin_m >= 0)) throw OptionError("target.margin", std::to_string(margin_m), ">= 0 m");
+  if (!(square_size_m > 0)) throw OptionError("target.square_size", square_size_m, "> 0 m");
+  if (!(margin_m >= 0)) throw OptionError("target.margin", margin_m, ">= 0 m");
   if (type == "aruco_grid" && (markers_x < 1 || markers_y < 1)) {
-    throw OptionError("target.markers_x/markers_y", std::to_string(markers_x), ">= 1 each");
+    throw OptionError("target.markers_x/markers_y", markers_x, ">= 1 each");
   }
-  if (!(marker_size_m > 0))
-    throw OptionError("target.marker_size", std::to_string(marker_size_m), "> 0 m");
+  if (!(marker_size_m > 0)) throw OptionError("target.marker_size", marker_size_m, "> 0 m");
   if (type == "charuco" && !(marker_size_m < square_size_m)) {
-    throw OptionError("target.marker_size", std::to_string(marker_size_m), "< square_size");
+    throw OptionError("target.marker_size", marker_size_m, "< square_size");
   }
   if (!(marker_separation_m >= 0)) {
-    throw OptionError("target.marker_separation", std::to_string(marker_separation_m), ">= 0 m");
+    throw OptionError("target.marker_separation", marker_separation_m, ">= 0 m");
   }
   if (type == "target3d") {
-    if (num_faces < 2 || num_faces > 3)
-      throw OptionError("target.num_faces", std::to_string(num_faces), "2 or 3");
+    if (num_faces < 2 || num_faces > 3) throw OptionError("target.num_faces", num_faces, "2 or 3");
     if (!(fold_angle_deg >= 60 && fold_angle_deg <= 180)) {
-      throw OptionError("target.fold_angle_deg", std::to_string(fold_angle_deg), "[60, 180]");
+      throw OptionError("target.fold_angle_deg", fold_angle_deg, "[60, 180]");
     }
     if (!(face_width_m > 0 && face_height_m > 0)) {
-      throw OptionError("target.face_width/face_height", std::to_string(face_width_m), "> 0 m");
+      throw OptionError("target.face_width/face_height", face_width_m, "> 0 m");
     }
     if (!marker_ids.empty() && static_cast<int>(marker_ids.size()) != num_faces) {
       throw OptionError("target.marker_ids", std::to_string(marker_ids.size()) + " ids",
                         "one per face");
     }
     if (!(dots.r_min_m > 0 && dots.r_max_m >= dots.r_min_m)) {
-      throw OptionError("target.dots.r_min/r_max", std::to_string(dots.r_min_m),
-                        "0 < r_min <= r_max");
+      throw OptionError("target.dots.r_min/r_max", dots.r_min_m, "0 < r_min <= r_max");
     }
     if (!(dots.coverage > 0 && dots.coverage <= 0.8)) {
-      throw OptionError("target.dots.coverage", std::to_string(dots.coverage), "(0, 0.8]");
+      throw OptionError("target.dots.coverage", dots.coverage, "(0, 0.8]");
     }
   }
   ArucoDictionaryByName(dictionary);  // throws for unknown names

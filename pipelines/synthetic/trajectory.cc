@@ -9,14 +9,11 @@
 namespace portcal {
 
 void TrajectoryOptions::Check() const {
-  if (!(fps > 0)) throw OptionError("trajectory.fps", std::to_string(fps), "> 0");
-  if (num_pauses < 1) throw OptionError("trajectory.pauses", std::to_string(num_pauses), ">= 1");
-  if (!(pause_seconds > 0))
-    throw OptionError("trajectory.pause_seconds", std::to_string(pause_seconds), "> 0 s");
-  if (!(move_seconds > 0))
-    throw OptionError("trajectory.move_seconds", std::to_string(move_seconds), "> 0 s");
-  if (!(exposure_s >= 0))
-    throw OptionError("trajectory.exposure", std::to_string(exposure_s), ">= 0 s");
+  if (!(fps > 0)) throw OptionError("trajectory.fps", fps, "> 0");
+  if (num_pauses < 1) throw OptionError("trajectory.pauses", num_pauses, ">= 1");
+  if (!(pause_seconds > 0)) throw OptionError("trajectory.pause_seconds", pause_seconds, "> 0 s");
+  if (!(move_seconds > 0)) throw OptionError("trajectory.move_seconds", move_seconds, "> 0 s");
+  if (!(exposure_s >= 0)) throw OptionError("trajectory.exposure", exposure_s, ">= 0 s");
 }
 
 namespace {

@@ -18,27 +18,26 @@ bool InsideImage(const Camera& camera, const Eigen::Vector2d& pixel, double marg
 }  // namespace
 
 void ViewSamplingOptions::Check() const {
-  if (!(distance_min_m > 0))
-    throw OptionError("poses.distance[0]", std::to_string(distance_min_m), "> 0 m");
+  if (!(distance_min_m > 0)) throw OptionError("poses.distance[0]", distance_min_m, "> 0 m");
   if (!(distance_max_m >= distance_min_m)) {
-    throw OptionError("poses.distance[1]", std::to_string(distance_max_m), ">= distance[0]");
+    throw OptionError("poses.distance[1]", distance_max_m, ">= distance[0]");
   }
   if (!(tilt_max_deg >= 0 && tilt_max_deg <= 89)) {
-    throw OptionError("poses.tilt_max_deg", std::to_string(tilt_max_deg), "[0, 89]");
+    throw OptionError("poses.tilt_max_deg", tilt_max_deg, "[0, 89]");
   }
   if (!(roll_max_deg >= 0 && roll_max_deg <= 180)) {
-    throw OptionError("poses.roll_max_deg", std::to_string(roll_max_deg), "[0, 180]");
+    throw OptionError("poses.roll_max_deg", roll_max_deg, "[0, 180]");
   }
   if (!(border_margin_px >= 0)) {
-    throw OptionError("poses.border_margin_px", std::to_string(border_margin_px), ">= 0");
+    throw OptionError("poses.border_margin_px", border_margin_px, ">= 0");
   }
   if (!(max_view_angle_deg > 0 && max_view_angle_deg <= 90)) {
-    throw OptionError("poses.max_view_angle_deg", std::to_string(max_view_angle_deg), "(0, 90]");
+    throw OptionError("poses.max_view_angle_deg", max_view_angle_deg, "(0, 90]");
   }
   if (visibility != "full" && visibility != "markers" && visibility != "any") {
     throw OptionError("poses.visibility", visibility, "full, markers or any");
   }
-  if (max_tries < 1) throw OptionError("poses.max_tries", std::to_string(max_tries), ">= 1");
+  if (max_tries < 1) throw OptionError("poses.max_tries", max_tries, ">= 1");
 }
 
 Rigid3d SampleTargetView(const Camera& camera, const Housing* housing,
@@ -112,24 +111,21 @@ Rigid3d SampleTargetView(const Camera& camera, const Housing* housing,
 }
 
 void SurveyOptions::Check() const {
-  if (!(height_m > 0)) throw OptionError("survey.height", std::to_string(height_m), "> 0 m");
-  if (!(speed_m_s > 0)) throw OptionError("survey.speed", std::to_string(speed_m_s), "> 0 m/s");
-  if (!(frame_rate_hz > 0))
-    throw OptionError("survey.frame_rate", std::to_string(frame_rate_hz), "> 0 Hz");
+  if (!(height_m > 0)) throw OptionError("survey.height", height_m, "> 0 m");
+  if (!(speed_m_s > 0)) throw OptionError("survey.speed", speed_m_s, "> 0 m/s");
+  if (!(frame_rate_hz > 0)) throw OptionError("survey.frame_rate", frame_rate_hz, "> 0 Hz");
   if (!(side_overlap >= 0 && side_overlap <= 0.95)) {
-    throw OptionError("survey.side_overlap", std::to_string(side_overlap), "[0, 0.95]");
+    throw OptionError("survey.side_overlap", side_overlap, "[0, 0.95]");
   }
-  if (!(line_length_m > 0))
-    throw OptionError("survey.line_length", std::to_string(line_length_m), "> 0 m");
-  if (num_images < 1) throw OptionError("survey.num_images", std::to_string(num_images), ">= 1");
-  if (!(roughness_m >= 0))
-    throw OptionError("survey.roughness", std::to_string(roughness_m), ">= 0 m");
+  if (!(line_length_m > 0)) throw OptionError("survey.line_length", line_length_m, "> 0 m");
+  if (num_images < 1) throw OptionError("survey.num_images", num_images, ">= 1");
+  if (!(roughness_m >= 0)) throw OptionError("survey.roughness", roughness_m, ">= 0 m");
   if (!(relief_wavelength_m > 0)) {
-    throw OptionError("survey.relief_wavelength", std::to_string(relief_wavelength_m), "> 0 m");
+    throw OptionError("survey.relief_wavelength", relief_wavelength_m, "> 0 m");
   }
-  if (!(texel_m > 0)) throw OptionError("survey.texel", std::to_string(texel_m), "> 0 m");
+  if (!(texel_m > 0)) throw OptionError("survey.texel", texel_m, "> 0 m");
   if (!(navigation_sigma_m >= 0)) {
-    throw OptionError("survey.navigation_sigma", std::to_string(navigation_sigma_m), ">= 0 m");
+    throw OptionError("survey.navigation_sigma", navigation_sigma_m, ">= 0 m");
   }
   markers.Check();
 }

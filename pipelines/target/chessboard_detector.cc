@@ -13,18 +13,16 @@
 namespace portcal {
 
 void ChessboardDetectionOptions::Check() const {
-  if (cols < 2) throw OptionError("--Target.cols", std::to_string(cols), ">= 2 inner corners");
-  if (rows < 2) throw OptionError("--Target.rows", std::to_string(rows), ">= 2 inner corners");
+  if (cols < 2) throw OptionError("--Target.cols", cols, ">= 2 inner corners");
+  if (rows < 2) throw OptionError("--Target.rows", rows, ">= 2 inner corners");
   if (coarse_max_image_size < 0) {
-    throw OptionError("--Target.coarse_max_image_size", std::to_string(coarse_max_image_size),
-                      ">= 0");
+    throw OptionError("--Target.coarse_max_image_size", coarse_max_image_size, ">= 0");
   }
   if (!(min_x_corner_fraction >= 0 && min_x_corner_fraction <= 1)) {
-    throw OptionError("--Target.min_x_corner_fraction", std::to_string(min_x_corner_fraction),
-                      "[0, 1]");
+    throw OptionError("--Target.min_x_corner_fraction", min_x_corner_fraction, "[0, 1]");
   }
   if (min_refined_corners < 4) {
-    throw OptionError("--Target.min_refined_corners", std::to_string(min_refined_corners), ">= 4");
+    throw OptionError("--Target.min_refined_corners", min_refined_corners, ">= 4");
   }
   refinement.Check();
 }

@@ -11,24 +11,23 @@ namespace portcal {
 
 void CornerRefinementOptions::Check() const {
   if (!(window_fraction > 0 && window_fraction <= 0.5)) {
-    throw OptionError("window_fraction", std::to_string(window_fraction), "(0, 0.5]");
+    throw OptionError("window_fraction", window_fraction, "(0, 0.5]");
   }
   if (!(min_window_px >= 2 && max_window_px >= min_window_px)) {
-    throw OptionError("min_window_px", std::to_string(min_window_px), ">= 2 and <= max_window_px");
+    throw OptionError("min_window_px", min_window_px, ">= 2 and <= max_window_px");
   }
-  if (!(max_shift_px > 0)) throw OptionError("max_shift_px", std::to_string(max_shift_px), "> 0");
+  if (!(max_shift_px > 0)) throw OptionError("max_shift_px", max_shift_px, "> 0");
   if (!(max_shift_fraction >= 0 && max_shift_fraction < 0.5)) {
-    throw OptionError("max_shift_fraction", std::to_string(max_shift_fraction), "[0, 0.5)");
+    throw OptionError("max_shift_fraction", max_shift_fraction, "[0, 0.5)");
   }
   if (max_num_iterations < 1) {
-    throw OptionError("max_num_iterations", std::to_string(max_num_iterations), ">= 1");
+    throw OptionError("max_num_iterations", max_num_iterations, ">= 1");
   }
   if (!std::isfinite(max_level_drift)) {
-    throw OptionError("--Target.max_level_drift", std::to_string(max_level_drift),
-                      "a fraction (< 0: never)");
+    throw OptionError("--Target.max_level_drift", max_level_drift, "a fraction (< 0: never)");
   }
   if (!(corner_tolerance_px > 0)) {
-    throw OptionError("corner_tolerance_px", std::to_string(corner_tolerance_px), "> 0");
+    throw OptionError("corner_tolerance_px", corner_tolerance_px, "> 0");
   }
 }
 

@@ -12,14 +12,13 @@
 namespace portcal {
 
 void XCornerCountOptions::Check() const {
-  if (ring_radius_px < 2)
-    throw OptionError("ring_radius_px", std::to_string(ring_radius_px), ">= 2");
+  if (ring_radius_px < 2) throw OptionError("ring_radius_px", ring_radius_px, ">= 2");
   if (!(min_normalised_response > 0 && min_normalised_response < 1)) {
-    throw OptionError("min_normalised_response", std::to_string(min_normalised_response), "(0, 1)");
+    throw OptionError("min_normalised_response", min_normalised_response, "(0, 1)");
   }
-  if (!(min_response >= 0)) throw OptionError("min_response", std::to_string(min_response), ">= 0");
+  if (!(min_response >= 0)) throw OptionError("min_response", min_response, ">= 0");
   if (!(spacing_tolerance > 0 && spacing_tolerance < 1)) {
-    throw OptionError("spacing_tolerance", std::to_string(spacing_tolerance), "(0, 1)");
+    throw OptionError("spacing_tolerance", spacing_tolerance, "(0, 1)");
   }
 }
 

@@ -129,16 +129,13 @@ std::optional<double> VirtualPinhole::ErrorAtDepth(const Eigen::Vector2d& output
 
 void FieldOfViewOptions::Check() const {
   if (!(blank_pixels >= 0 && blank_pixels <= 1)) {
-    throw OptionError("--Undistort.blank_pixels", std::to_string(blank_pixels),
-                      "a value in [0, 1]");
+    throw OptionError("--Undistort.blank_pixels", blank_pixels, "a value in [0, 1]");
   }
-  if (!(min_scale > 0))
-    throw OptionError("--Undistort.min_scale", std::to_string(min_scale), "> 0");
+  if (!(min_scale > 0)) throw OptionError("--Undistort.min_scale", min_scale, "> 0");
   // Beyond 10x the input's side the output is all interpolation, and its
   // remap tables grow with the square.
   if (!(max_scale >= min_scale && max_scale <= 10)) {
-    throw OptionError("--Undistort.max_scale", std::to_string(max_scale),
-                      "in [--Undistort.min_scale, 10]");
+    throw OptionError("--Undistort.max_scale", max_scale, "in [--Undistort.min_scale, 10]");
   }
 }
 
