@@ -43,22 +43,6 @@ void KeepStart(const fs::path& output_path, int kept, int num_starts) {
   for (int k = 1; k < num_starts; ++k) fs::remove_all(output_path / StartDir(k));
 }
 
-// What the database adds to the mapper's model's images, from the inputs
-// the mapper read: marker detections, position priors and, where the
-// model's points are the database's keypoints, their scales.
-void AddExtrasFrom(const std::map<std::string, const SfmImage*>& by_name, SfmImage* image) {
-  const auto it = by_name.find(image->name);
-  if (it == by_name.end()) return;
-  const SfmImage& read = *it->second;
-  image->markers = read.markers;
-  image->position_prior = read.position_prior;
-  if (read.keypoints.size() != image->keypoints.size()) return;
-  for (size_t k = 0; k < read.keypoints.size(); ++k) {
-    if (!((read.keypoints[k] - image->keypoints[k]).cwiseAbs().maxCoeff() < 1e-3)) return;
-  }
-  image->scales = read.scales;
-}
-
 // The mapper's models written to dir/sparse/0, /1, ... for inspection.
 void WriteMappedModels(const std::vector<MappedModel>& models, const fs::path& dir) {
   for (size_t m = 0; m < models.size(); ++m) {
@@ -98,7 +82,10 @@ CalibrationStart MapAndRefine(const CalibrationStartsOptions& options, const Sfm
   source.model_name = (dir / "sparse" / "0").string();
   source.database_name = options.database_path;
   source.load_model = [&] { return mapped; };
-  source.add_extras = [&](SfmImage* image) { AddExtrasFrom(by_name, image); };
+  source.add_extras = [&](SfmImage* image) {
+    const auto read = by_name.find(image->name);
+    if (read != by_name.end()) AddExtrasOf(*read->second, image);
+  };
   RefinedModel refined = RefineModel(options.refine, source);
   WriteSparseModel(refined.model, dir / "refined", ModelFormat::kBinary);
   start.refined = std::move(refined.summary);

@@ -279,6 +279,19 @@ Reconstruction LoadAlignedModel(const ModelRefinementOptions& options, const Mod
 
 }  // namespace
 
+void AddExtrasOf(const SfmImage& read, SfmImage* image) {
+  image->markers = read.markers;
+  image->position_prior = read.position_prior;
+  if (read.keypoints.size() != image->keypoints.size() ||
+      read.scales.size() != read.keypoints.size()) {
+    return;
+  }
+  for (size_t k = 0; k < read.keypoints.size(); ++k) {
+    if (!((read.keypoints[k] - image->keypoints[k]).cwiseAbs().maxCoeff() < 1e-3)) return;
+  }
+  image->scales = read.scales;
+}
+
 RefinedModel RefineModel(const ModelRefinementOptions& options, const ModelSource& source) {
   RefinedModel refined;
   ModelRefinementSummary& result = refined.summary;

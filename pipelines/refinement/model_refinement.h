@@ -45,6 +45,13 @@ struct ModelSource {
   std::function<void(SfmImage*)> add_extras;
 };
 
+// What the mapper's or the database's image of the same name (`read`:
+// keypoints with scales, markers, position prior) adds to `image`, an image
+// of a model that holds keypoints only: its markers and prior, and the
+// scales where the model's points are `read`'s keypoints (each within
+// 1e-3 px; a model from elsewhere keeps no scales). For add_extras.
+void AddExtrasOf(const SfmImage& read, SfmImage* image);
+
 struct ModelRefinementSummary {
   CalibrationReport report;  // of the first camera, with its verdict
   int num_marker_corners = 0;

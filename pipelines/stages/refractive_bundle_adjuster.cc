@@ -33,17 +33,14 @@ namespace {
 void AddDatabaseExtras(Database* database, SfmImage* image) {
   const auto row = database->ReadImageWithName(image->name);
   if (!row) return;
-  image->markers = database->ReadMarkerDetections(row->image_id);
-  image->position_prior = row->PriorPosition();
-  const FeatureKeypoints keypoints = database->ReadKeypoints(row->image_id);
-  if (keypoints.size() != image->keypoints.size()) return;
-  for (size_t k = 0; k < keypoints.size(); ++k) {
-    if (!(std::abs(keypoints[k].x - image->keypoints[k].x()) < 1e-3 &&
-          std::abs(keypoints[k].y - image->keypoints[k].y()) < 1e-3)) {
-      return;
-    }
+  SfmImage read;
+  read.markers = database->ReadMarkerDetections(row->image_id);
+  read.position_prior = row->PriorPosition();
+  for (const FeatureKeypoint& k : database->ReadKeypoints(row->image_id)) {
+    read.keypoints.emplace_back(k.x, k.y);
+    read.scales.push_back(k.ComputeScale());
   }
-  for (const FeatureKeypoint& k : keypoints) image->scales.push_back(k.ComputeScale());
+  AddExtrasOf(read, image);
 }
 
 }  // namespace
