@@ -135,6 +135,20 @@ void Register(CommandLine* cli, IncrementalMapperOptions* o) {
   cli->Add("num_threads", &o->num_threads, "threads");
 }
 
+void Register(CommandLine* cli, FocalStartOptions* focal) {
+  cli->Add("Mapper.init_focal_min_factor", &focal->min_focal_factor,
+           "search range of the focal length from the pairs, lower end, x the larger image side");
+  cli->Add("Mapper.init_focal_max_factor", &focal->max_focal_factor,
+           "search range of the focal length from the pairs, upper end, x the larger image side");
+  cli->Add("Mapper.init_focal_num_steps", &focal->num_steps,
+           "grid points over that range (log spaced)");
+  cli->Add("Mapper.init_focal_max_num_pairs", &focal->max_num_pairs, "best-matched pairs used");
+  cli->Add("Mapper.init_focal_max_matches", &focal->max_matches_per_pair, "matches used per pair");
+  cli->Add("Mapper.init_focal_min_contrast", &focal->min_contrast,
+           "the cost 30 % from its minimum must exceed it by this factor minus one, or the pairs "
+           "do not tell the focal length");
+}
+
 void Register(CommandLine* cli, RadialStartOptions* radial) {
   cli->Add("Mapper.init_radial_min_k", &radial->min_k,
            "search range of the first radial term, lower end");

@@ -38,6 +38,7 @@ void Register(CommandLine* cli, MarkerScale* marker_scale);
 // --random_seed and --num_threads of the mapper).
 void Register(CommandLine* cli, IncrementalMapperOptions* mapper);
 // --Mapper.init_radial_*: the search of the first radial term.
+void Register(CommandLine* cli, FocalStartOptions* focal);
 void Register(CommandLine* cli, RadialStartOptions* radial);
 // --Target.*: the calibration target and how it is detected.
 void Register(CommandLine* cli, TargetDetectorOptions* target);

@@ -53,6 +53,10 @@ int RefractiveMapperCommand(int argc, char** argv) {
   cli.AddTriState(
       "Mapper.init_focal_from_markers", &options.init_focal_from_markers,
       "focal length from ArUco markers: -1 when the camera has no prior, 0 never, 1 always");
+  cli.AddTriState("Mapper.init_focal_from_pairs", &options.init_focal_from_pairs,
+                  "focal length from the verified pairs' epipolar geometry where the markers give "
+                  "none: -1 when the camera has no prior, 0 never, 1 always");
+  Register(&cli, &options.focal_start);
   cli.AddTriState("Mapper.init_radial_from_matches", &options.init_radial_from_matches,
                   "first radial distortion term from the verified matches: -1 when the camera has "
                   "no prior focal length "
@@ -86,6 +90,7 @@ int HierarchicalMapperCommand(int argc, char** argv) {
           "images each cluster takes from its neighbours");
   cli.Add("Hierarchical.min_shared_points", &options.merge.min_shared_points,
           "points a cluster's model must share with the merged ones to be merged");
+  Register(&cli, &options.mapper.focal_start);
   Register(&cli, &options.mapper.radial_start);
   Register(&cli, &options.mapper.mapper);
   return ReportErrors([&] {
@@ -161,6 +166,9 @@ int AutoCalibratorCommand(int argc, char** argv) {
                   "-1: with the intrinsics, held at the image centre unless the data move it "
                   "beyond 3 sigma; 0; 1");
   Register(&cli, &options.sift);
+  cli.AddTriState("Mapper.init_focal_from_pairs", &options.init_focal_from_pairs,
+                  "focal length from the verified pairs' epipolar geometry where the markers give "
+                  "none: -1 when the intrinsics are refined, 0 never");
   cli.AddTriState("Mapper.init_radial_from_matches", &options.init_radial_from_matches,
                   "first radial distortion term from the verified matches before mapping: -1 when "
                   "the intrinsics are "

@@ -8,10 +8,10 @@
 
 namespace portcal {
 
-bool StartFocalFromMarkers(const SfmInputs& inputs, std::optional<bool> mode,
-                           std::map<camera_t, HousedCamera>* cameras) {
-  if (mode == false) return false;
-  bool any = false;
+std::set<camera_t> StartFocalFromMarkers(const SfmInputs& inputs, std::optional<bool> mode,
+                                         std::map<camera_t, HousedCamera>* cameras) {
+  std::set<camera_t> set;
+  if (mode == false) return set;
   for (auto& [camera_id, camera] : *cameras) {
     if (!mode && camera.camera.has_prior_focal_length) continue;
     std::vector<MarkerQuad> quads;
@@ -26,17 +26,45 @@ bool StartFocalFromMarkers(const SfmInputs& inputs, std::optional<bool> mode,
     // the rest.
     if (focal && camera.housing) *focal *= camera.housing->InAirFocalRatio();
     if (!focal) {
-      LOG(WARNING) << "camera " << camera_id << ": too few markers for a focal length; keeping "
-                   << camera.camera.MeanFocalLength() << " px";
+      // The pairs may still give one (StartFocalFromPairs says if not).
+      LOG(INFO) << "camera " << camera_id << ": " << quads.size()
+                << " markers, too few for a focal length";
       continue;
     }
     LOG(INFO) << "camera " << camera_id << ": focal length from " << quads.size()
               << " markers: " << *focal << " px (was " << camera.camera.MeanFocalLength() << ")";
     for (int idx : CameraModelFocalLengthIdxs(camera.camera.model_id))
       camera.camera.params[idx] = *focal;
-    any = true;
+    set.insert(camera_id);
   }
-  return any;
+  return set;
+}
+
+std::set<camera_t> StartFocalFromPairs(const SfmInputs& inputs, std::optional<bool> mode,
+                                       const FocalStartOptions& options,
+                                       const std::set<camera_t>& done,
+                                       std::map<camera_t, HousedCamera>* cameras) {
+  std::set<camera_t> set;
+  if (mode == false) return set;
+  for (auto& [camera_id, camera] : *cameras) {
+    if (done.count(camera_id) || (!mode && camera.camera.has_prior_focal_length)) continue;
+    std::string why_not;
+    const auto start = EstimateFocalFromPairs(inputs, camera_id, camera, options, &why_not);
+    if (!start) {
+      LOG(WARNING) << "camera " << camera_id << ": no focal length from the markers or the pairs ("
+                   << why_not << "); starting from " << camera.camera.MeanFocalLength()
+                   << " px, judged only against what a lens could be";
+      continue;
+    }
+    LOG(INFO) << "camera " << camera_id << ": focal length from " << start->num_pairs
+              << " pairs' epipolar geometry: " << start->focal << " px (was "
+              << camera.camera.MeanFocalLength() << "; 30 % away the cost is "
+              << 1 + start->contrast << " times its minimum)";
+    for (int idx : CameraModelFocalLengthIdxs(camera.camera.model_id))
+      camera.camera.params[idx] = start->focal;
+    set.insert(camera_id);
+  }
+  return set;
 }
 
 void StartRadialFromMatches(const SfmInputs& inputs, std::optional<bool> mode,

@@ -5,9 +5,11 @@
 
 #include <map>
 #include <optional>
+#include <set>
 
 #include "colmap_ext/camera/housed_camera.h"
 #include "pipelines/reconstruction/reconstruction.h"
+#include "pipelines/sfm/focal_start.h"
 #include "pipelines/sfm/radial_start.h"
 
 namespace portcal {
@@ -20,9 +22,18 @@ constexpr double kMaxFocalRatioToMarkers = 1.25;
 // Focal lengths from the markers of each camera's images (see
 // FocalLengthFromMarkers), in-air equivalent behind a housing. `mode`:
 // always (true), never (false), or for cameras without a prior focal length
-// (nullopt). True if any was set.
-bool StartFocalFromMarkers(const SfmInputs& inputs, std::optional<bool> mode,
-                           std::map<camera_t, HousedCamera>* cameras);
+// (nullopt). Returns the cameras it set.
+std::set<camera_t> StartFocalFromMarkers(const SfmInputs& inputs, std::optional<bool> mode,
+                                         std::map<camera_t, HousedCamera>* cameras);
+
+// Focal lengths from the verified pairs (EstimateFocalFromPairs) of the
+// cameras not in `done` (those the markers set); `mode` as above. Says
+// (once per camera) why a camera keeps its guess. Returns the cameras it
+// set.
+std::set<camera_t> StartFocalFromPairs(const SfmInputs& inputs, std::optional<bool> mode,
+                                       const FocalStartOptions& options,
+                                       const std::set<camera_t>& done,
+                                       std::map<camera_t, HousedCamera>* cameras);
 
 // The first radial term of each camera from the matches
 // (EstimateFirstRadialTerm). `mode`: always, never, or (nullopt) where the

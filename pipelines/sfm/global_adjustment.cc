@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <sstream>
 
+#include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/util/logging.h"
 
 namespace portcal {
@@ -40,9 +41,20 @@ bool EndedOnItsCriterion(const ceres::Solver::Summary& summary) {
 
 bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before,
                      const std::map<camera_t, HousedCamera>& after,
-                     const std::map<camera_t, HousedCamera>& start,
-                     double max_focal_ratio_to_start) {
+                     const std::map<camera_t, HousedCamera>& start, double max_focal_ratio_to_start,
+                     const std::set<camera_t>& guessed_focal) {
   for (const auto& [id, camera] : after) {
+    if (guessed_focal.count(id)) {
+      const double side = static_cast<double>(std::max(camera.camera.width, camera.camera.height));
+      const double factor = camera.camera.MeanFocalLength() / side;
+      if (!(factor > kMinPlausibleFocalFactor && factor < kMaxPlausibleFocalFactor)) return true;
+      // The distortion still against COLMAP's bound.
+      Camera reference = before.at(id).camera;
+      for (const int idx : CameraModelFocalLengthIdxs(reference.model_id))
+        reference.params[idx] = camera.camera.params[idx];
+      if (ImplausibleIntrinsics(reference, camera.camera)) return true;
+      continue;
+    }
     if (ImplausibleIntrinsics(before.at(id).camera, camera.camera)) return true;
     const double ratio = camera.camera.MeanFocalLength() / start.at(id).camera.MeanFocalLength();
     if (!(ratio < max_focal_ratio_to_start && 1 / ratio < max_focal_ratio_to_start)) return true;

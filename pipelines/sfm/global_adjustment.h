@@ -40,13 +40,22 @@ BundleAdjustmentOptions GlobalAdjustmentOptions(const IncrementalMapperOptions& 
 // (WeightsSettledCallback's USER_SUCCESS). What it moved is then a result.
 bool EndedOnItsCriterion(const ceres::Solver::Summary& summary);
 
+// The focal lengths any lens and port give, times the larger image side: a
+// fisheye of 180 deg across a 16:9 frame's height has 0.18, a long lens a few.
+constexpr double kMinPlausibleFocalFactor = 0.15;
+constexpr double kMaxPlausibleFocalFactor = 5.0;
+
 // COLMAP's bogus-camera test against the intrinsics before the adjustment,
 // and the focal length against the mapper's start, which a slow drift of
-// many adjustments would otherwise pass.
+// many adjustments would otherwise pass. A camera of `guessed_focal` (its
+// start a guess, not data) has its focal length judged against what a lens
+// could be (kMin/MaxPlausibleFocalFactor), not against the start or the
+// last adjustment: refusing an answer for being far from a guess keeps the
+// guess (a wide lens at 0.56 x the width against the 1.2 x default).
 bool BogusIntrinsics(const std::map<camera_t, HousedCamera>& before,
                      const std::map<camera_t, HousedCamera>& after,
-                     const std::map<camera_t, HousedCamera>& start,
-                     double max_focal_ratio_to_start);
+                     const std::map<camera_t, HousedCamera>& start, double max_focal_ratio_to_start,
+                     const std::set<camera_t>& guessed_focal);
 
 // The markers' corners for a global adjustment of `r` (markers of side
 // `side_length_m`): the model scaled to them first (ScaleToMarkers) when a

@@ -267,11 +267,16 @@ GlobalAdjustmentOutcome IncrementalMapper::AdjustGlobally(Reconstruction* r, boo
       AdjustBundle(r, ba, BundleAdjustmentScope(), &markers, options_.marker_scale);
   const bool implausible =
       refine_intrinsics &&
-      BogusIntrinsics(before.cameras, r->cameras(), cameras_, options_.max_focal_ratio_to_start);
+      BogusIntrinsics(before.cameras, r->cameras(), cameras_, options_.max_focal_ratio_to_start,
+                      options_.guessed_focal_cameras);
   if (implausible) {
-    LOG(WARNING) << "refractive_mapper: intrinsics refined on " << r->poses().size()
-                 << " images came out implausible (" << CalibrationText(*r, false)
-                 << " ); held for now";
+    // Said once with its numbers; the later ones only at --log_level debug.
+    const std::string text = "refractive_mapper: intrinsics refined on " +
+                             std::to_string(r->poses().size()) + " images came out implausible (" +
+                             CalibrationText(*r, false) + " ); held for now";
+    const bool first = num_implausible_said_++ == 0;
+    LOG_IF(WARNING, first) << text << " (the next ones at --log_level debug)";
+    VLOG_IF(1, !first) << text;
     before.Restore(r, &markers);
     ba = ba.WithIntrinsicsHeld();
     ba.refine_housing = false;

@@ -85,6 +85,7 @@ class IncrementalMapper {
   bool port_converged_ = false;
   // The markers' corners as the last global adjustment left them.
   std::vector<MarkerCorner> marker_corners_;
+  int num_implausible_said_ = 0;  // warnings of implausible intrinsics so far
 };
 
 }  // namespace portcal

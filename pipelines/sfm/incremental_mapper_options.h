@@ -27,6 +27,10 @@ struct IncrementalMapperOptions {
   // grown from a wrong pair can drift that far over many adjustments, none
   // of them a factor 2 (docs/dev/auto_calibration_notes.md).
   double max_focal_ratio_to_start = 2.0;
+  // Cameras whose starting focal length is a guess (no prior, none from the
+  // markers or the pairs): judged against what a lens could be instead
+  // (BogusIntrinsics).
+  std::set<camera_t> guessed_focal_cameras;
   double init_max_error_px = 4.0;
   // Pairs no model starts from: the auto-calibrator's next start excludes
   // the pair the previous start's model grew from, so that it takes another

@@ -10,6 +10,7 @@
 namespace portcal {
 
 void ModelMappingOptions::Check() const {
+  focal_start.Check();
   radial_start.Check();
   if (housing) housing->ValidateInput("--Housing.params");
   mapper.Check();
@@ -20,9 +21,17 @@ std::vector<MappedModel> MapModels(const SfmInputs& inputs, const ModelMappingOp
   std::map<camera_t, HousedCamera> cameras = inputs.cameras;
   if (options.housing) ReplaceHousings(*options.housing, &cameras);
   IncrementalMapperOptions mapper = options.mapper;
-  if (StartFocalFromMarkers(inputs, options.init_focal_from_markers, &cameras)) {
+  const std::set<camera_t> from_markers =
+      StartFocalFromMarkers(inputs, options.init_focal_from_markers, &cameras);
+  if (!from_markers.empty()) {
     mapper.max_focal_ratio_to_start =
         std::min(mapper.max_focal_ratio_to_start, kMaxFocalRatioToMarkers);
+  }
+  const std::set<camera_t> from_pairs = StartFocalFromPairs(
+      inputs, options.init_focal_from_pairs, options.focal_start, from_markers, &cameras);
+  for (const auto& [id, camera] : cameras) {
+    if (!camera.camera.has_prior_focal_length && !from_markers.count(id) && !from_pairs.count(id))
+      mapper.guessed_focal_cameras.insert(id);
   }
   StartRadialFromMatches(inputs, options.init_radial_from_matches,
                          options.mapper.ba_refine_extra_params, options.radial_start, &cameras);

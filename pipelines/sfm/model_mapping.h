@@ -9,6 +9,7 @@
 
 #include "colmap_ext/housing/housing.h"
 #include "colmap_ext/util/progress.h"
+#include "pipelines/sfm/focal_start.h"
 #include "pipelines/sfm/incremental_pipeline.h"
 #include "pipelines/sfm/radial_start.h"
 
@@ -20,6 +21,11 @@ struct ModelMappingOptions {
   // The focal length from the markers before mapping: always, never, or
   // (nullopt) when the camera has no prior focal length.
   std::optional<bool> init_focal_from_markers;
+  // The focal length from the verified pairs (focal_start.h) for a camera
+  // the markers gave none: always, never, or (nullopt) when the camera has
+  // no prior focal length.
+  std::optional<bool> init_focal_from_pairs;
+  FocalStartOptions focal_start;
   // The lens's first radial term from the verified matches (radial_start.h)
   // before mapping: always, never, or (nullopt) when the camera has no
   // prior focal length, its distortion is all zero, the mapper refines it

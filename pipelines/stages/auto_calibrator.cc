@@ -67,6 +67,7 @@ ModelMappingOptions MapperOptions(const AutoCalibratorOptions& options, int rand
   map.mapper.num_threads = options.num_threads;
   map.mapper.random_seed = random_seed;
   map.init_radial_from_matches = options.init_radial_from_matches;
+  map.init_focal_from_pairs = options.init_focal_from_pairs;
   map.mapper.marker_scale = options.marker_scale;
   map.mapper.ba_refine_focal_length = refine_intrinsics;
   map.mapper.ba_refine_extra_params = refine_intrinsics;

@@ -50,6 +50,10 @@ struct AutoCalibratorOptions {
   // (ModelMappingOptions::init_radial_from_matches: not for fisheye
   // models): nullopt (where it applies) or false.
   std::optional<bool> init_radial_from_matches;
+  // The focal length from the verified pairs where the markers give none
+  // (ModelMappingOptions::init_focal_from_pairs): nullopt (when the
+  // intrinsics are not given) or false.
+  std::optional<bool> init_focal_from_pairs;
   // With the intrinsics refined: starts of the mapper and refinement (each
   // from the next random seed) while a start fails or its report carries
   // a warning; the start with the fewest warnings, then the smallest

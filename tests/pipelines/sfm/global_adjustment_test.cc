@@ -109,5 +109,25 @@ TEST(GlobalAdjustment, SettledWeightsEndAnAdjustmentAsConvergenceDoes) {
   EXPECT_FALSE(EndedOnItsCriterion(summary));
 }
 
+// A focal length far from a guessed start is judged against what a lens
+// could be; far from a start taken from the data, against the start.
+TEST(GlobalAdjustment, AGuessedFocalLengthDoesNotJudgeTheAnswer) {
+  const auto cameras_with_focal = [](double focal, double k1) {
+    HousedCamera camera;
+    camera.camera = Camera::FromModelName("RADIAL", focal, 1920, 1080);
+    camera.camera.camera_id = 1;
+    camera.camera.params[3] = k1;
+    return std::map<camera_t, HousedCamera>{{1, camera}};
+  };
+  const auto start = cameras_with_focal(2304, 0);  // the image reader's 1.2 x width
+  const auto wide = cameras_with_focal(1074, -0.2);
+  EXPECT_TRUE(BogusIntrinsics(start, wide, start, 2.0, {}));  // 2.1 x from the start
+  EXPECT_FALSE(BogusIntrinsics(start, wide, start, 2.0, {1}));
+  // What no lens gives, or a distortion beyond COLMAP's bound, still is.
+  EXPECT_TRUE(BogusIntrinsics(start, cameras_with_focal(250, 0), start, 2.0, {1}));
+  EXPECT_TRUE(BogusIntrinsics(start, cameras_with_focal(12000, 0), start, 2.0, {1}));
+  EXPECT_TRUE(BogusIntrinsics(start, cameras_with_focal(1074, 1.5), start, 2.0, {1}));
+}
+
 }  // namespace
 }  // namespace portcal

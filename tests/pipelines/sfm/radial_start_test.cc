@@ -5,72 +5,10 @@
 
 #include <gtest/gtest.h>
 
-#include <random>
+#include "tests/pipelines/sfm/matched_views.h"
 
 namespace portcal {
 namespace {
-
-struct Scene {
-  SfmInputs inputs;
-  HousedCamera truth;
-};
-
-// `num_images` views on an arc around a cloud of points 0.6-1.0 m away,
-// every view matched with every other; keypoints with noise `sigma_px`.
-Scene MakeScene(const HousedCamera& truth, int num_images, double sigma_px, uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::normal_distribution<double> noise(0, sigma_px);
-  std::vector<Eigen::Vector3d> points;
-  for (int i = 0; i < 1500; ++i)
-    points.emplace_back(0.45 * u(rng), 0.3 * u(rng), 0.8 + 0.2 * u(rng));
-  Scene scene;
-  scene.truth = truth;
-  scene.inputs.cameras[1] = truth;
-  const Housing* housing = truth.housing ? &*truth.housing : nullptr;
-  // Per image, per point: its keypoint index (or -1).
-  std::vector<std::vector<int>> index(num_images, std::vector<int>(points.size(), -1));
-  for (int v = 0; v < num_images; ++v) {
-    const double angle = 0.35 * (v - 0.5 * (num_images - 1)) / num_images;
-    const Eigen::Matrix3d R =
-        Eigen::AngleAxisd(angle, Eigen::Vector3d(0.2 * u(rng), 1, 0.1 * u(rng)).normalized())
-            .toRotationMatrix();
-    // Orbiting the cloud's centre, looking at it.
-    const Eigen::Vector3d target(0, 0, 0.8);
-    const Eigen::Vector3d centre =
-        target - R.transpose() * target + Eigen::Vector3d(0, 0.03 * u(rng), 0);
-    SfmImage image;
-    image.image_id = static_cast<image_t>(v + 1);
-    image.name = "v" + std::to_string(v);
-    image.camera_id = 1;
-    for (size_t p = 0; p < points.size(); ++p) {
-      const auto pixel = ProjectPoint(truth.camera, housing, R * (points[p] - centre));
-      if (!pixel || pixel->x() < 0 || pixel->y() < 0 || pixel->x() > truth.camera.width ||
-          pixel->y() > truth.camera.height) {
-        continue;
-      }
-      index[v][p] = static_cast<int>(image.keypoints.size());
-      image.keypoints.push_back(*pixel + Eigen::Vector2d(noise(rng), noise(rng)));
-    }
-    image.correspondences.resize(image.keypoints.size());
-    scene.inputs.images[image.image_id] = std::move(image);
-  }
-  for (int a = 0; a < num_images; ++a) {
-    for (int b = a + 1; b < num_images; ++b) {
-      int count = 0;
-      for (size_t p = 0; p < points.size(); ++p) {
-        if (index[a][p] < 0 || index[b][p] < 0) continue;
-        scene.inputs.images[a + 1].correspondences[index[a][p]].push_back(
-            {static_cast<image_t>(b + 1), static_cast<point2D_t>(index[b][p])});
-        scene.inputs.images[b + 1].correspondences[index[b][p]].push_back(
-            {static_cast<image_t>(a + 1), static_cast<point2D_t>(index[a][p])});
-        ++count;
-      }
-      scene.inputs.pair_inliers[ImagePairToPairId(a + 1, b + 1)] = count;
-    }
-  }
-  return scene;
-}
 
 HousedCamera WithoutDistortion(HousedCamera camera) {
   for (size_t i = 4; i < camera.camera.params.size(); ++i) camera.camera.params[i] = 0;
@@ -83,7 +21,7 @@ TEST(RadialStart, FindsTheFirstRadialTermOfAWideLensBehindAFlatPort) {
   truth.camera.params = {905, 902, 981, 527, -0.3, 0, 0.0012, 0.0009};
   truth.housing = Housing::FromName(
       "FLATPORT", {0.0436194, 0, 0.9990482, 0.03, 0.008, 1, 1.473, 1.334}, "test");
-  const Scene scene = MakeScene(truth, 6, 0.3, 3);
+  const testing::MatchedViews scene = testing::MakeMatchedViews(truth, 6, 0.3, 3);
   // All but k1 known: the estimate is the lens's k1 to the grid's step
   // (0.025). The trimmed residual is not smooth in k at that scale (the
   // kept 80 % change with k), so the parabola through the best three nodes
@@ -115,7 +53,7 @@ TEST(RadialStart, KeepsAnUndistortedLensUndistorted) {
   HousedCamera truth;
   truth.camera = Camera::FromModelName("RADIAL", 1300, 1920, 1080);
   truth.camera.params = {1300, 960, 540, 0, 0};
-  const Scene scene = MakeScene(truth, 5, 0.3, 5);
+  const testing::MatchedViews scene = testing::MakeMatchedViews(truth, 5, 0.3, 5);
   const auto estimate = EstimateFirstRadialTerm(scene.inputs, 1, truth, RadialStartOptions());
   ASSERT_TRUE(estimate);
   // The grid step is 0.025; noise of 0.3 px over ~10 pairs moves k1 by
@@ -129,7 +67,7 @@ TEST(RadialStart, KeepsAnUndistortedLensUndistorted) {
 TEST(RadialStart, NoRadialTermNoEstimate) {
   HousedCamera pinhole;
   pinhole.camera = Camera::FromModelName("PINHOLE", 1000, 1280, 720);
-  const Scene scene = MakeScene(pinhole, 3, 0.3, 7);
+  const testing::MatchedViews scene = testing::MakeMatchedViews(pinhole, 3, 0.3, 7);
   EXPECT_EQ(FirstRadialParamIdx(pinhole.camera), -1);
   EXPECT_FALSE(EstimateFirstRadialTerm(scene.inputs, 1, pinhole, RadialStartOptions()));
   HousedCamera fisheye;
