@@ -13,6 +13,7 @@
 #include "colmap_ext/cost/distance_error.h"
 #include "colmap_ext/geometry/pose_block.h"
 #include "colmap_ext/housing/housing_manifold.h"
+#include "colmap_ext/util/cancel_callback.h"
 #include "colmap_ext/util/error.h"
 #include "colmap_ext/util/logging.h"
 #include "pipelines/bundle_adjustment/bundle_adjustment.h"
@@ -337,8 +338,11 @@ ceres::Solver::Summary BundleProblem::Solve() {
     solver.callbacks.push_back(weights_settled.get());
     solver.update_state_every_iteration = true;
   }
+  CancelCallback cancel;
+  solver.callbacks.push_back(&cancel);
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem_, &summary);
+  CancelFlag::ThrowIfRequested();  // an abort on SIGINT is no failed solve
   if (!summary.IsSolutionUsable()) {
     throw NumericalError(
         "bundle adjustment failed: " + summary.BriefReport() +

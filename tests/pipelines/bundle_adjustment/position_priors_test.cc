@@ -17,6 +17,7 @@
 #include "colmap_ext/camera/camera_models.h"
 #include "colmap_ext/housing/housing_models.h"
 #include "colmap_ext/util/error.h"
+#include "colmap_ext/util/progress.h"
 #include "database/database.h"
 #include "pipelines/bundle_adjustment/bundle_adjustment.h"
 #include "pipelines/stages/feature_matcher.h"
@@ -343,6 +344,23 @@ void ExpectSameSolution(const SyntheticSurvey& survey, const Reconstruction& rob
         std::max(worst_difference, (centre - other.poses().at(id).Inverse().translation).norm());
   }
   EXPECT_LT(worst_difference, 0.1 * worst_error);
+}
+
+// A stop asked for (SIGINT) ends a running adjustment at its next
+// iteration as Cancelled, not as a failed solve, and nothing is written back.
+TEST(PositionPriors, AStopEndsAnAdjustmentAsCancelled) {
+  std::mt19937 rng(11);
+  SyntheticSurvey survey(0.1, 0.02, &rng);
+  Reconstruction r = survey.InArbitraryFrame(ArbitraryFrame());
+  ASSERT_TRUE(AlignToPositionPriors(&r, 0.1).has_value());
+  BundleAdjustmentOptions ba;
+  ba.refine_housing = true;
+  ba.position_prior_sigma_m = 0.02;
+  const Rigid3d before = r.poses().begin()->second;
+  CancelFlag::Request();
+  EXPECT_THROW(AdjustBundle(&r, ba, BundleAdjustmentScope(), nullptr, MarkerScale()), Cancelled);
+  CancelFlag::Reset();
+  EXPECT_EQ(r.poses().begin()->second.translation, before.translation);
 }
 
 // The refinement's schedule (refractive_bundle_adjuster's hold_weights):
