@@ -106,7 +106,9 @@ std::optional<FocalStart> Sweep(const std::vector<PixelMatches>& pairs, const Ho
   if (!(start.contrast >= options.min_contrast)) {
     *why_not = "the views do not tell it (the cost 30 % away is only " +
                FormatSignificant(100 * start.contrast, 2) + " % above its minimum at " +
-               FormatSignificant(start.focal, 4) + " px: motion along or about the optical axis?)";
+               FormatSignificant(start.focal, 4) +
+               " px: moving straight ahead or turning about the optical axis, or a strong "
+               "distortion not yet known?)";
     return std::nullopt;
   }
   return start;

@@ -14,8 +14,9 @@
 // averaged over the best-matched pairs). Motions that do not tell f
 // (translation alone, rotation about the optical axis, optical axes that
 // meet at the same distance from both centres: Sturm's critical motions)
-// leave the cost flat; then no focal length is returned and the reason is
-// said.
+// leave the cost flat, and so does a strong distortion the camera does not
+// yet have (the rays stay bent at every f); then no focal length is
+// returned and the reason is said.
 #pragma once
 
 #include <optional>
