@@ -48,15 +48,7 @@ double CostAt(const std::vector<PixelMatches>& pairs, const HousedCamera& camera
   double sum = 0;
   for (const PixelMatches& matches : pairs) {
     std::vector<Eigen::Vector2d> x1, x2;
-    for (const auto& [pa, pb] : matches) {
-      const auto ra = UnprojectPixel(trial, housing, pa);
-      const auto rb = UnprojectPixel(trial, housing, pb);
-      if (!ra || !rb || ra->direction.z() < 1e-3 || rb->direction.z() < 1e-3) continue;
-      x1.push_back(ra->direction.hnormalized());
-      x2.push_back(rb->direction.hnormalized());
-    }
-    // A focal length that leaves keypoints without a ray is no candidate.
-    if (x1.size() < 16 || x1.size() < matches.size() * 95 / 100) {
+    if (!NormalisedRays(matches, trial, housing, &x1, &x2)) {
       return std::numeric_limits<double>::infinity();
     }
     const Eigen::Vector3d singular =

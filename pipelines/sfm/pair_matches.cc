@@ -67,6 +67,20 @@ Eigen::Matrix3d FitFundamentalRobustly(const std::vector<Eigen::Vector2d>& x1,
   return F;
 }
 
+bool NormalisedRays(const PixelMatches& matches, const Camera& camera, const Housing* housing,
+                    std::vector<Eigen::Vector2d>* x1, std::vector<Eigen::Vector2d>* x2) {
+  x1->clear();
+  x2->clear();
+  for (const auto& [pa, pb] : matches) {
+    const auto ra = UnprojectPixel(camera, housing, pa);
+    const auto rb = UnprojectPixel(camera, housing, pb);
+    if (!ra || !rb || ra->direction.z() < 1e-3 || rb->direction.z() < 1e-3) continue;
+    x1->push_back(ra->direction.hnormalized());
+    x2->push_back(rb->direction.hnormalized());
+  }
+  return x1->size() >= 16 && x1->size() >= matches.size() * 95 / 100;
+}
+
 std::vector<PixelMatches> BestMatchedPairs(const SfmInputs& inputs, camera_t camera_id,
                                            int max_num_pairs, int max_matches_per_pair) {
   std::vector<std::pair<int, image_pair_t>> ranked;

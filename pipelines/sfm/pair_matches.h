@@ -25,6 +25,15 @@ double SampsonSquared(const Eigen::Matrix3d& F, const Eigen::Vector2d& x1,
 Eigen::Matrix3d FitFundamentalRobustly(const std::vector<Eigen::Vector2d>& x1,
                                        const std::vector<Eigen::Vector2d>& x2);
 
+// The normalised coordinates (x/z, y/z) of the rays of a pair's matches
+// through `camera` (and `housing`: the rays' directions in water). False
+// when fewer than 16, or fewer than 95 %, of them have a ray ahead of the
+// camera: a candidate lens that cannot turn the keypoints into rays is no
+// candidate (the residuals of the rest would look better for having fewer
+// points).
+bool NormalisedRays(const PixelMatches& matches, const Camera& camera, const Housing* housing,
+                    std::vector<Eigen::Vector2d>* x1, std::vector<Eigen::Vector2d>* x2);
+
 // Up to `max_num_pairs` of the camera's pairs (both images its own, not
 // planar), most inliers first, each with at least 16 matches, evenly
 // subsampled to at most `max_matches_per_pair` (keeping their spread).

@@ -59,18 +59,10 @@ std::pair<double, int> ResidualAt(const std::vector<PixelMatches>& pairs,
   double sum = 0;
   int count = 0;
   for (const PixelMatches& matches : pairs) {
+    // A distortion that cannot be inverted that far out leaves keypoints
+    // without a ray: no candidate.
     std::vector<Eigen::Vector2d> x1, x2;
-    for (const auto& [pa, pb] : matches) {
-      const auto ra = UnprojectPixel(trial, housing, pa);
-      const auto rb = UnprojectPixel(trial, housing, pb);
-      if (!ra || !rb || ra->direction.z() < 1e-3 || rb->direction.z() < 1e-3) continue;
-      x1.push_back(ra->direction.hnormalized());
-      x2.push_back(rb->direction.hnormalized());
-    }
-    // A candidate that leaves keypoints without a ray (a distortion that
-    // cannot be inverted that far out) is no candidate: the residuals of the
-    // rest would look better for having fewer points.
-    if (x1.size() < 16 || x1.size() < matches.size() * 95 / 100) {
+    if (!NormalisedRays(matches, trial, housing, &x1, &x2)) {
       return {std::numeric_limits<double>::infinity(), 0};
     }
     const auto [pair_sum, pair_count] = PairResidual(x1, x2);
