@@ -25,6 +25,14 @@ HousedCamera Guessed(HousedCamera camera) {
   return camera;
 }
 
+// An undistorted 1280 x 720 lens of focal length `focal` in air.
+HousedCamera InAirLens(double focal) {
+  HousedCamera camera;
+  camera.camera = Camera::FromModelName("RADIAL", focal, 1280, 720);
+  camera.camera.params = {focal, 640, 360, 0, 0};
+  return camera;
+}
+
 TEST(FocalStart, FindsFocalLengthsFromWideToLongInAir) {
   // Noise of 0.5 px: within 1 % (0.5 % measured) up to 1.2 x the width; a
   // long lens sees little perspective, within 5 % (3.6 % measured).
@@ -85,9 +93,7 @@ TEST(FocalStart, FindsAFisheyesFocalLength) {
 
 TEST(FocalStart, ViewsStraightAheadSayTheyCannotTell) {
   // Translation alone: E = [t]x in every pair at every focal length.
-  HousedCamera truth;
-  truth.camera = Camera::FromModelName("RADIAL", 700, 1280, 720);
-  truth.camera.params = {700, 640, 360, 0, 0};
+  const HousedCamera truth = InAirLens(700);
   const MatchedViews views = MakeMatchedViews(truth, 8, 0.5, 3, ViewMotion::kForward);
   std::string why_not;
   EXPECT_FALSE(
@@ -104,9 +110,7 @@ TEST(FocalStart, OrbitsAroundATargetStillTellIt) {
   // Optical axes meeting at the cloud's centre from nearly the same
   // distance is the critical motion for two views; the views' small
   // differences in distance and axis still tell f (0.6 % measured).
-  HousedCamera truth;
-  truth.camera = Camera::FromModelName("RADIAL", 700, 1280, 720);
-  truth.camera.params = {700, 640, 360, 0, 0};
+  const HousedCamera truth = InAirLens(700);
   const MatchedViews views = MakeMatchedViews(truth, 8, 0.5, 3, ViewMotion::kOrbit);
   std::string why_not;
   const auto estimate =
